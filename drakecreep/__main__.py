@@ -1,0 +1,5 @@
+import sys
+
+from drakecreep.cli import main
+
+sys.exit(main())

@@ -1,0 +1,434 @@
+"""Typed, validated parameters of a ball-screw feed drive, loaded from and saved to YAML.
+
+Every quantity is SI (m, kg, s, N, rad). Each field carries its unit, its allowed range and a
+one-line meaning in ``metadata``; invalid values raise :class:`drakecreep.errors.InputError`
+naming the dotted field, the value and the allowed range.
+
+The reference preset (:func:`preset`, ``"paper"``) is ``presets/paper.yaml`` beside this module;
+the values the seed paper gives are marked there with their table, every other value is an
+assumption with its source.
+"""
+
+import dataclasses
+import math
+import re
+import typing
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import yaml
+
+from drakecreep.errors import InputError
+
+__all__ = [
+    "MotorParams",
+    "ScrewParams",
+    "NutParams",
+    "TableParams",
+    "LoadCase",
+    "LoadParams",
+    "FrictionParams",
+    "ControllerParams",
+    "SensorParams",
+    "SimulationParams",
+    "DriveParams",
+    "PRESETS",
+    "preset",
+    "preset_text",
+    "load_params",
+    "save_params",
+    "params_from_dict",
+    "params_to_dict",
+    "with_value",
+    "get_value",
+]
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that also reads ``9.38e6`` (no exponent sign) as a float, as users write it."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(
+        r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+        |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+        |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+        |[-+]?\.(?:inf|Inf|INF)
+        |\.(?:nan|NaN|NAN))$""",
+        re.X,
+    ),
+    list("-+0123456789."),
+)
+
+
+def _yaml_load(text):
+    return yaml.load(text, Loader=_Loader)
+
+
+INTEGRATORS = ("runge_kutta2", "runge_kutta3", "runge_kutta5", "bogacki_shampine3", "radau3", "implicit_euler")
+
+
+def _q(default, unit, lo=None, hi=None, *, lo_open=False, choices=None, doc=""):
+    """A field with its unit, allowed range (closed unless ``lo_open``) or choices, and meaning."""
+    return field(
+        default=default,
+        metadata=dict(unit=unit, lo=lo, hi=hi, lo_open=lo_open, choices=choices, doc=doc),
+    )
+
+
+def _allowed(meta):
+    if meta.get("choices"):
+        return "one of " + ", ".join(str(c) for c in meta["choices"])
+    lo, hi = meta.get("lo"), meta.get("hi")
+    unit = f" {meta['unit']}" if meta.get("unit") not in (None, "", "-") else ""
+    if lo is not None and hi is not None:
+        left = "(" if meta.get("lo_open") else "["
+        return f"a finite number in {left}{lo}, {hi}]{unit}"
+    if lo is not None:
+        return f"a finite number {'>' if meta.get('lo_open') else '>='} {lo}{unit}"
+    return f"a finite number{unit}"
+
+
+class _Params:
+    """Mixin: validates scalar fields against their metadata after construction."""
+
+    def __post_init__(self):
+        hints = typing.get_type_hints(type(self))
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            meta = f.metadata
+            kind = hints[f.name]
+            if dataclasses.is_dataclass(kind) or typing.get_origin(kind) is tuple:
+                continue
+            if kind is bool:
+                if not isinstance(value, bool):
+                    raise InputError(f.name, value, "true or false")
+                continue
+            if kind is str:
+                if not isinstance(value, str) or (meta.get("choices") and value not in meta["choices"]):
+                    raise InputError(f.name, value, _allowed(meta))
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise InputError(f.name, value, _allowed(meta) if kind is float else "an integer")
+            if kind is int and not isinstance(value, int):
+                if float(value).is_integer():
+                    value = int(value)
+                    object.__setattr__(self, f.name, value)
+                else:
+                    raise InputError(f.name, value, "an integer")
+            if kind is float:
+                value = float(value)
+                object.__setattr__(self, f.name, value)
+            if not math.isfinite(value):
+                raise InputError(f.name, value, _allowed(meta))
+            lo, hi = meta.get("lo"), meta.get("hi")
+            if lo is not None and (value < lo or (meta.get("lo_open") and value == lo)):
+                raise InputError(f.name, value, _allowed(meta))
+            if hi is not None and value > hi:
+                raise InputError(f.name, value, _allowed(meta))
+        self._check()
+
+    def _check(self):
+        """Cross-field checks; overridden where needed."""
+
+
+@dataclass(frozen=True)
+class MotorParams(_Params):
+    """Servo motor: rotor, torque limit and the closed current loop seen as a first-order lag."""
+
+    rotor_inertia: float = _q(1.3e-4, "kg m^2", 0.0, lo_open=True, doc="rotor inertia")
+    coupling_inertia: float = _q(2.0e-5, "kg m^2", 0.0, doc="coupling inertia (motor side)")
+    torque_constant: float = _q(0.9, "N m/A", 0.0, lo_open=True, doc="torque constant (reports current)")
+    peak_torque: float = _q(7.1, "N m", 0.0, lo_open=True, doc="torque limit of the drive")
+    current_loop_time_constant: float = _q(
+        2.0e-4, "s", 0.0, 0.1, doc="closed current loop as a first-order lag; 0 = ideal"
+    )
+    viscous_damping: float = _q(1.0e-4, "N m s/rad", 0.0, doc="motor and bearing viscous drag")
+
+
+@dataclass(frozen=True)
+class ScrewParams(_Params):
+    """Ball screw shaft and its thrust bearing: the axial stiffness chain up to the nut."""
+
+    lead: float = _q(5.0e-3, "m", 0.0, 0.1, lo_open=True, doc="lead Ph (Table 3)")
+    nominal_diameter: float = _q(25.0e-3, "m", 0.0, 0.5, lo_open=True, doc="nominal diameter d0 (Table 3)")
+    root_diameter: float = _q(21.8e-3, "m", 0.0, 0.5, lo_open=True, doc="root diameter (shaft section)")
+    length: float = _q(0.6, "m", 0.0, 20.0, lo_open=True, doc="shaft length (rotating inertia)")
+    youngs_modulus: float = _q(2.06e11, "Pa", 0.0, lo_open=True, doc="shaft steel")
+    density: float = _q(7850.0, "kg/m^3", 0.0, lo_open=True, doc="shaft steel")
+    mounting: str = _q("fixed-free", "-", choices=("fixed-free", "fixed-fixed"), doc="axial support")
+    nut_start_distance: float = _q(
+        0.1, "m", 0.0, lo_open=True, doc="thrust bearing to nut at table position 0"
+    )
+    bearing_stiffness: float = _q(9.38e6, "N/m", 0.0, lo_open=True, doc="bearing axial stiffness (Table 6)")
+    bearing_damping: float = _q(60.61, "N s/m", 0.0, doc="bearing axial damping (Table 6)")
+
+    def _check(self):
+        if self.root_diameter > self.nominal_diameter:
+            raise InputError("root_diameter", self.root_diameter, f"<= nominal_diameter ({self.nominal_diameter} m)")
+        if self.nut_start_distance >= self.length:
+            raise InputError("nut_start_distance", self.nut_start_distance, f"< length ({self.length} m)")
+
+
+@dataclass(frozen=True)
+class NutParams(_Params):
+    """Screw-nut pair: contact stiffness and damping, and its share of friction."""
+
+    axial_stiffness: float = _q(51.6e6, "N/m", 0.0, lo_open=True, doc="screw-nut axial stiffness (Table 4)")
+    axial_damping: float = _q(898.88, "N s/m", 0.0, doc="screw-nut axial damping (Table 4)")
+    mass: float = _q(0.335, "kg", 0.0, doc="nut mass (Table 3), lumped into the table")
+    preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
+    load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
+
+
+@dataclass(frozen=True)
+class TableParams(_Params):
+    """Table (workbench) on rolling guides."""
+
+    mass: float = _q(40.0, "kg", 0.0, lo_open=True, doc="table, nut seat and sliders")
+    guide_friction_coefficient: float = _q(0.003, "-", 0.0, 1.0, doc="rolling guides, per N of normal load")
+    seal_force: float = _q(4.0, "N", 0.0, doc="seal and wiper drag of the slider blocks")
+
+
+@dataclass(frozen=True)
+class LoadCase(_Params):
+    """External load on the table (air cylinders in the paper): X axial, Y lateral, Z vertical."""
+
+    fx: float = _q(0.0, "N", doc="axial force opposing the feed")
+    fy: float = _q(0.0, "N", doc="lateral force on the guides")
+    fz: float = _q(0.0, "N", doc="vertical force on the guides (downwards positive)")
+
+
+@dataclass(frozen=True)
+class LoadParams(_Params):
+    """The load cases (Table 7) and gravity."""
+
+    cases: typing.Tuple[LoadCase, ...] = field(default_factory=tuple, metadata=dict(unit="-"))
+    gravity: float = _q(9.81, "m/s^2", 0.0, 100.0, doc="gravity (table weight on the guides)")
+
+
+@dataclass(frozen=True)
+class FrictionParams(_Params):
+    """Friction law and the shape of its curve; the levels come from the load case."""
+
+    law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre"), doc="friction law")
+    static_ratio: float = _q(1.5, "-", 1.0, 10.0, doc="breakaway / Coulomb force Fs/Fc")
+    stribeck_velocity: float = _q(1.0e-4, "m/s", 0.0, 1.0, lo_open=True, doc="vs")
+    stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
+    viscous: float = _q(200.0, "N s/m", 0.0, doc="viscous coefficient Fv")
+    bristle_stiffness: float = _q(2.0e7, "N/m", 0.0, lo_open=True, doc="LuGre sigma0")
+    bristle_damping: float = _q(2.0e3, "N s/m", 0.0, doc="LuGre sigma1")
+    regularization_velocity: float = _q(
+        1.0e-6, "m/s", 0.0, 1.0, lo_open=True, doc="tanh width replacing sign() in coulomb/stribeck"
+    )
+
+
+@dataclass(frozen=True)
+class ControllerParams(_Params):
+    """PI cascade: position P with velocity feedforward, velocity PI with anti-windup.
+
+    Gains are on table-side linear quantities: the position loop maps m to m/s, the velocity loop
+    maps m/s to an axial force (N) which the drive turns into torque through the lead.
+    """
+
+    position_gain: float = _q(40.0, "1/s", 0.0, doc="kp")
+    velocity_feedforward: float = _q(1.0, "-", 0.0, 2.0, doc="share of the reference speed fed forward")
+    velocity_gain: float = _q(1.2e5, "N s/m", 0.0, lo_open=True, doc="kv (proportional)")
+    velocity_integral_gain: float = _q(7.5e6, "N/m", 0.0, doc="ki (integral)")
+    anti_windup: bool = field(default=True, metadata=dict(unit="-", doc="stop integrating in saturation"))
+    position_feedback: str = _q(
+        "motor", "-", choices=("motor", "table"), doc="semi-closed (encoder) or closed loop (scale)"
+    )
+    sampled: bool = field(default=True, metadata=dict(unit="-", doc="discrete controller; false = continuous"))
+    velocity_period: float = _q(2.5e-4, "s", 0.0, 0.1, lo_open=True, doc="velocity loop sample time")
+    position_period: float = _q(1.0e-3, "s", 0.0, 1.0, lo_open=True, doc="position loop sample time")
+
+    def _check(self):
+        ratio = self.position_period / self.velocity_period
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise InputError(
+                "position_period", self.position_period,
+                f"an integer multiple (>= 1) of velocity_period ({self.velocity_period} s)",
+            )
+
+    @property
+    def position_divider(self):
+        """Velocity-loop samples per position-loop sample."""
+        return int(round(self.position_period / self.velocity_period))
+
+
+@dataclass(frozen=True)
+class SensorParams(_Params):
+    """Motor encoder and linear scale (grating); 0 means an ideal, unquantized sensor."""
+
+    encoder_counts_per_rev: int = _q(2**23, "counts/rev", 0, doc="motor encoder resolution")
+    scale_resolution: float = _q(50e-9, "m", 0.0, 1e-3, doc="linear scale resolution")
+
+
+@dataclass(frozen=True)
+class SimulationParams(_Params):
+    """Integrator, logging and the window over which metrics are taken."""
+
+    integrator: str = _q("runge_kutta3", "-", choices=INTEGRATORS, doc="Drake integrator")
+    accuracy: float = _q(1e-4, "-", 0.0, 0.1, lo_open=True, doc="integrator target accuracy (scaled states)")
+    max_step: float = _q(1e-3, "s", 0.0, 1.0, lo_open=True, doc="largest integrator step")
+    log_period: float = _q(2.5e-4, "s", 0.0, 1.0, lo_open=True, doc="sample time of the recorded signals")
+    acceleration_time: float = _q(0.05, "s", 0.0, 100.0, doc="reference ramps up to the feed in this time")
+    steady_start: float = _q(1.0, "s", 0.0, doc="metrics are taken from this time to the end")
+    stick_threshold: float = _q(0.05, "-", 0.0, 1.0, lo_open=True, doc="stuck when |v| < this x feed")
+    backend: str = _q("compiled", "-", choices=("compiled", "leaf"), doc="symbolic fast path or leaf systems")
+
+
+@dataclass(frozen=True)
+class DriveParams(_Params):
+    """Everything that defines a feed drive and how it is simulated."""
+
+    motor: MotorParams = field(default_factory=MotorParams)
+    screw: ScrewParams = field(default_factory=ScrewParams)
+    nut: NutParams = field(default_factory=NutParams)
+    table: TableParams = field(default_factory=TableParams)
+    loads: LoadParams = field(default_factory=LoadParams)
+    friction: FrictionParams = field(default_factory=FrictionParams)
+    controller: ControllerParams = field(default_factory=ControllerParams)
+    sensors: SensorParams = field(default_factory=SensorParams)
+    simulation: SimulationParams = field(default_factory=SimulationParams)
+
+    def load_case(self, number):
+        """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load."""
+        if number == 0:
+            return LoadCase()
+        if not isinstance(number, int) or not 1 <= number <= len(self.loads.cases):
+            raise InputError("load_case", number, f"an integer in 0..{len(self.loads.cases)} (0 = unloaded)")
+        return self.loads.cases[number - 1]
+
+
+# --------------------------------------------------------------------------- YAML I/O
+
+def _from_dict(cls, data, path):
+    if not isinstance(data, dict):
+        raise InputError(path or "params", data, f"a mapping of {cls.__name__} fields")
+    hints = typing.get_type_hints(cls)
+    names = {f.name for f in dataclasses.fields(cls)}
+    kwargs = {}
+    for key, value in data.items():
+        dotted = f"{path}.{key}" if path else str(key)
+        if key not in names:
+            raise InputError(dotted, value, "no such field; known: " + ", ".join(sorted(names)))
+        kind = hints[key]
+        if dataclasses.is_dataclass(kind):
+            kwargs[key] = _from_dict(kind, value, dotted)
+        elif typing.get_origin(kind) is tuple:
+            (item,) = {a for a in typing.get_args(kind) if a is not Ellipsis}
+            if not isinstance(value, list):
+                raise InputError(dotted, value, f"a list of {item.__name__} mappings")
+            kwargs[key] = tuple(_from_dict(item, v, f"{dotted}[{i}]") for i, v in enumerate(value))
+        else:
+            kwargs[key] = value
+    try:
+        return cls(**kwargs)
+    except InputError as err:
+        raise InputError(f"{path}.{err.field}" if path else err.field, err.value, err.allowed) from None
+
+
+def params_from_dict(data):
+    """Build validated :class:`DriveParams` from a (YAML-loaded) mapping; missing fields take defaults."""
+    return _from_dict(DriveParams, data if data is not None else {}, "")
+
+
+def params_to_dict(params):
+    """Plain nested dict (YAML/JSON-ready) of a parameter dataclass."""
+    return dataclasses.asdict(params)
+
+
+def load_params(path):
+    """Load and validate :class:`DriveParams` from a YAML file.
+
+    Raises
+    ------
+    InputError
+        For a YAML syntax error, an unknown key, a wrong type or a value out of range.
+    FileNotFoundError
+        If ``path`` does not exist.
+    """
+    text = Path(path).read_text()
+    try:
+        data = _yaml_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise InputError(str(path), "invalid YAML" + where, "a YAML mapping of parameter groups") from None
+    return params_from_dict(data)
+
+
+def save_params(params, path):
+    """Write ``params`` to ``path`` as YAML (SI units); :func:`load_params` reads it back identically."""
+    Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
+
+
+PRESETS = ("paper",)
+
+
+def preset_text(name="paper"):
+    """The commented YAML text of a preset (assumptions and their sources are in the comments)."""
+    if name not in PRESETS:
+        raise InputError("preset", name, "one of " + ", ".join(PRESETS))
+    return resources.files("drakecreep").joinpath("presets", f"{name}.yaml").read_text()
+
+
+def preset(name="paper"):
+    """Validated :class:`DriveParams` of a named preset (``"paper"``: the seed paper's rig)."""
+    data = _yaml_load(preset_text(name))
+    try:
+        return params_from_dict(data)
+    except InputError as err:  # pragma: no cover - a broken preset is a bug, say where
+        raise RuntimeError(f"preset {name!r} is invalid: {err}") from None
+
+
+# --------------------------------------------------------------------------- dotted access
+
+def get_value(params, path):
+    """Value at a dotted path such as ``"screw.lead"`` or ``"loads.cases[2].fx"``."""
+    obj = params
+    for part in path.split("."):
+        name, index = _split_index(part)
+        if not dataclasses.is_dataclass(obj) or name not in {f.name for f in dataclasses.fields(obj)}:
+            raise InputError(path, part, "a dotted path of existing parameter fields")
+        obj = getattr(obj, name)
+        if index is not None:
+            obj = obj[index]
+    return obj
+
+
+def with_value(params, path, value):
+    """A copy of ``params`` with the field at dotted ``path`` set to ``value`` (validated).
+
+    ``path`` may index load cases: ``"loads.cases[2].fx"``. Errors name the full dotted field.
+    """
+    head, _, rest = path.partition(".")
+    name, index = _split_index(head)
+    if not dataclasses.is_dataclass(params) or name not in {f.name for f in dataclasses.fields(params)}:
+        raise InputError(path, value, "a dotted path of existing parameter fields")
+    try:
+        if not rest:
+            if index is not None:
+                raise InputError(name, value, "a path ending in a field, not a list item")
+            return dataclasses.replace(params, **{name: value})
+        child = getattr(params, name)
+        if index is not None:
+            items = list(child)
+            items[index] = with_value(items[index], rest, value)
+            return dataclasses.replace(params, **{name: tuple(items)})
+        return dataclasses.replace(params, **{name: with_value(child, rest, value)})
+    except InputError as err:
+        if not rest:
+            raise
+        # the error names a field relative to the child: prefix this level's name
+        raise InputError(f"{head}.{err.field}", err.value, err.allowed) from None
+
+
+def _split_index(part):
+    if part.endswith("]") and "[" in part:
+        name, idx = part[:-1].split("[", 1)
+        return name, int(idx)
+    return part, None

@@ -1,0 +1,85 @@
+"""Plots of simulation results (report layer: mm/s, um and N on the axes)."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+__all__ = ["plot_feed", "zoom_window"]
+
+
+def zoom_window(result, span=None):
+    """A short window at the end of the run showing a few stick-slip cycles (or 0.1 s)."""
+    t = result.time
+    m = result.metrics
+    if span is None:
+        span = 0.1
+        if m is not None and m.stick_slip_frequency > 0:
+            span = min(0.5, max(0.02, 8.0 / m.stick_slip_frequency))
+    return max(t[0], t[-1] - span), t[-1]
+
+
+def plot_feed(result, path):
+    """Speed (whole run and a zoom), forces and travel error of one feed, saved as a PNG.
+
+    Parameters
+    ----------
+    result : drakecreep.simulation.SimulationResult
+    path : str or Path
+    """
+    s, t = result.signals, result.time
+    m, sc, p = result.metrics, result.scenario, result.params
+    fx = p.load_case(sc.load_case).fx
+    t0, t1 = zoom_window(result)
+    z = (t >= t0) & (t <= t1)
+    fig, axes = plt.subplots(4, 1, figsize=(9, 10), constrained_layout=True)
+
+    def speeds(ax, mask):
+        ax.plot(t[mask], s["motor_velocity"][mask] * 1e3, color="0.6", lw=0.8, label="motor (at the table)")
+        ax.plot(t[mask], s["table_speed"][mask] * 1e3, color="C0", lw=1.0, label="table")
+        ax.plot(t[mask], s["v_ref"][mask] * 1e3, "k--", lw=0.8, label="reference")
+        ax.axhline(0.0, color="k", lw=0.5)
+        ax.set_ylabel("speed (mm/s)")
+
+    ax = axes[0]
+    speeds(ax, slice(None))
+    if m is not None:
+        ax.axvspan(m.window_start, m.window_end, color="C2", alpha=0.07, lw=0, label="metrics window")
+    ax.axvspan(t0, t1, color="C1", alpha=0.15, lw=0, label="zoom below")
+    ax.legend(loc="lower right", fontsize=8, ncol=5)
+    ax.set_title("whole run", fontsize=9)
+    ax = axes[1]
+    speeds(ax, z)
+    ax.set_title(f"zoom {t0:.3f}-{t1:.3f} s", fontsize=9)
+    ax = axes[2]
+    ax.plot(t[z], s["spring_force"][z] - fx, color="C1", lw=0.9, label="screw force - axial load Fx")
+    ax.plot(t[z], s["friction_force"][z], color="C3", lw=0.9, label="friction force")
+    ax.set_ylabel("force (N)")
+    ax.set_title(f"zoom: forces on the table (Fx = {fx:g} N)", fontsize=9)
+    ax.legend(loc="lower right", fontsize=8, ncol=2)
+    ax = axes[3]
+    travel_ref = s["x_ref"] - s["x_ref"][0]
+    ax.plot(t, (travel_ref - (s["table_position"] - s["table_position"][0])) * 1e6, color="C4", lw=0.9,
+            label="table")
+    ax.plot(t, (travel_ref - (s["motor_position"] - s["motor_position"][0])) * 1e6, color="0.6", lw=0.8,
+            label="motor")
+    ax.set_ylabel("travel error (um)")
+    ax.set_xlabel("time (s)")
+    ax.set_title("reference travel minus travel", fontsize=9)
+    ax.legend(loc="lower right", fontsize=8, ncol=2)
+    title = (
+        f"feed {sc.feed * 1e3:g} mm/s, load case {sc.load_case}, {p.friction.law} friction, "
+        f"{'sampled' if p.controller.sampled else 'continuous'} cascade"
+    )
+    if m is not None:
+        title += (
+            f"\nmax fluctuation {m.max_fluctuation * 1e3:.4f} mm/s ({m.fluctuation_rate * 100:.2f} %), "
+            f"stick {m.stick_fraction * 100:.1f} %, {m.stick_slip_cycles} stick-slip cycles"
+        )
+    if not result.ok:
+        title += f"\n{result.status}"
+    fig.suptitle(title, fontsize=10)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
