@@ -1,0 +1,89 @@
+"""``drakecreep hertz``: screw-nut stiffness by Hertz contact theory (paper eqs. 12-16, Table 3).
+
+Defaults are the paper's Table 3 inputs; lengths at this edge are in mm, angles in degrees.
+"""
+
+import json
+import math
+
+from drakecreep.hertz import BallScrewNut, Material, ballscrew_stiffness
+
+__all__ = ["add_parser", "run"]
+
+PAPER = {"ka_N_per_m": 48.6e6, "fa_Hz": 1917.0, "kr_N_per_m": 1.83e5, "fr_Hz": 117.63}
+
+
+def add_parser(subparsers):
+    """Register ``hertz``."""
+    p = subparsers.add_parser("hertz", help="screw-nut axial/radial stiffness by Hertz theory (Table 3)",
+                              description=__doc__.split("\n\n")[0])
+    p.add_argument("--balls", type=int, default=47, help="loaded balls z (default 47)")
+    p.add_argument("--ball-diameter", type=float, default=3.175, metavar="MM", help="db (3.175)")
+    p.add_argument("--diameter", type=float, default=25.0, metavar="MM", help="screw d0 (25)")
+    p.add_argument("--contact-angle", type=float, default=45.0, metavar="DEG", help="beta (45)")
+    p.add_argument("--lead", type=float, default=5.0, metavar="MM", help="Ph (5)")
+    p.add_argument("--conformity", type=float, default=1.04,
+                   help="groove/ball radius ratio r (1.04)")
+    p.add_argument("--preload", type=float, default=579.0, metavar="N", help="axial force Fa (579)")
+    p.add_argument("--mass", type=float, default=0.335, metavar="KG", help="M for frequencies (0.335)")
+    p.add_argument("--youngs-modulus", type=float, default=206.0, metavar="GPA",
+                   help="E of screw, ball and nut (206, assumed: the paper prints none)")
+    p.add_argument("--poisson", type=float, default=0.3, help="Poisson's ratio (0.3, assumed)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args):
+    """Compute and print the Hertz stiffness."""
+    from drakecreep.errors import InputError
+
+    if not (math.isfinite(args.youngs_modulus) and args.youngs_modulus > 0):
+        raise InputError("--youngs-modulus", args.youngs_modulus, "> 0 GPa")
+    if not (math.isfinite(args.poisson) and 0.0 <= args.poisson < 0.5):
+        raise InputError("--poisson", args.poisson, "in [0, 0.5)")
+    steel = Material(args.youngs_modulus * 1e9, args.poisson)
+    nut = BallScrewNut(balls=args.balls, ball_diameter=args.ball_diameter * 1e-3,
+                       nominal_diameter=args.diameter * 1e-3,
+                       contact_angle=math.radians(args.contact_angle), lead=args.lead * 1e-3,
+                       conformity=args.conformity, preload=args.preload, mass=args.mass,
+                       screw=steel, ball=steel, nut=steel)
+    r = ballscrew_stiffness(nut)
+    out = {
+        "ball_load_N": r.ball_load,
+        "helix_angle_deg": math.degrees(r.helix),
+        "screw_contact": {"a_mm": float(r.screw_contact.a) * 1e3, "b_mm": float(r.screw_contact.b) * 1e3,
+                          "kappa": r.screw_contact.coefficients.kappa,
+                          "deformation_um": float(r.screw_contact.approach) * 1e6,
+                          "max_pressure_MPa": float(r.screw_contact.max_pressure) * 1e-6},
+        "nut_contact": {"a_mm": float(r.nut_contact.a) * 1e3, "b_mm": float(r.nut_contact.b) * 1e3,
+                        "kappa": r.nut_contact.coefficients.kappa,
+                        "deformation_um": float(r.nut_contact.approach) * 1e6,
+                        "max_pressure_MPa": float(r.nut_contact.max_pressure) * 1e-6},
+        "axial_deflection_um": r.axial_deflection * 1e6,
+        "ka_N_per_m": r.ka_tangent,
+        "ka_secant_N_per_m": r.ka_secant,
+        "fa_Hz": r.fa,
+        "kr_N_per_m": r.kr_paper_tangent,
+        "fr_Hz": r.fr_paper,
+        "kr_physical_N_per_m": r.kr_physical,
+        "fr_physical_Hz": r.fr_physical,
+        "paper_table3": PAPER,
+        "notes": "ka: tangent dFa/d(delta_a) (eq. 15); kr: tangent with the paper's eq. 16 "
+                 "(cos(beta) sin(lambda)); kr_physical: z/2 k_ball cos^2(beta)",
+    }
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    print(f"ball load P = {r.ball_load:.4g} N, helix angle = {math.degrees(r.helix):.4g} deg")
+    for name in ("screw_contact", "nut_contact"):
+        c = out[name]
+        print(f"{name:14s}: a = {c['a_mm']:.4g} mm, b = {c['b_mm']:.4g} mm, a/b = {c['kappa']:.4g}, "
+              f"delta = {c['deformation_um']:.4g} um, p0 = {c['max_pressure_MPa']:.4g} MPa")
+    print(f"{'':16s}{'computed':>12s} {'paper T3':>12s}")
+    print(f"{'Ka (N/m)':16s}{r.ka_tangent:12.4g} {PAPER['ka_N_per_m']:12.4g}   (secant {r.ka_secant:.4g})")
+    print(f"{'fa (Hz)':16s}{r.fa:12.4g} {PAPER['fa_Hz']:12.4g}")
+    print(f"{'Kr eq.16 (N/m)':16s}{r.kr_paper_tangent:12.4g} {PAPER['kr_N_per_m']:12.4g}"
+          f"   (physical z/2 k cos^2 b: {r.kr_physical:.4g})")
+    print(f"{'fr eq.16 (Hz)':16s}{r.fr_paper:12.4g} {PAPER['fr_Hz']:12.4g}   (physical {r.fr_physical:.4g})")
+    return 0
