@@ -1,0 +1,132 @@
+"""``drakecreep modal FILE.csv``: identify one joint mode (fn, damping, k, c) from a hammer test.
+
+The CSV holds either an FRF (columns ``f_Hz,re,im``; choose its kind with ``--frf-type``) or time
+records (columns ``t,force,response``; the response kind with ``--response``). Lines starting with
+``#`` are ignored. Results by the half-power bandwidth method (the paper's) and by a least-squares
+SDOF fit of the complex FRF.
+"""
+
+import json
+import math
+
+import numpy as np
+
+from drakecreep.errors import InputError
+from drakecreep.modal import HammerTest, identify_frf, identify_hammer_test
+
+__all__ = ["add_parser", "run"]
+
+_FRF_COLUMNS = ("f_Hz", "re", "im")
+_TIME_COLUMNS = ("t", "force", "response")
+
+
+def add_parser(subparsers):
+    """Register ``modal``."""
+    p = subparsers.add_parser("modal", help="half-power / SDOF-fit identification of a hammer test",
+                              description=__doc__.split("\n\n")[0])
+    p.add_argument("file", metavar="FILE.csv", help="f_Hz,re,im  or  t,force,response")
+    p.add_argument("--mass", type=float, metavar="KG",
+                   help="modal mass for k = m wn^2, c = 2 zeta m wn (half-power)")
+    p.add_argument("--frf-type", choices=("receptance", "mobility", "accelerance"),
+                   default="receptance", help="kind of FRF in an f_Hz,re,im file")
+    p.add_argument("--response", choices=("displacement", "velocity", "acceleration"),
+                   default="acceleration", help="kind of response in a t,force,response file")
+    p.add_argument("--pulse-width", type=float, metavar="S",
+                   help="impulse duration for the force window (default: estimated from the force)")
+    p.add_argument("--exp-tau", type=float, metavar="S",
+                   help="apply an exponential window of this time constant (corrected for)")
+    p.add_argument("--fmin", type=float, metavar="HZ", help="lower end of the band holding the mode")
+    p.add_argument("--fmax", type=float, metavar="HZ", help="upper end of the band holding the mode")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=run)
+    return p
+
+
+def _read_csv(path):
+    with open(path, newline="") as fh:
+        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(str(path), "empty", "a CSV with header f_Hz,re,im or t,force,response")
+    header = tuple(h.strip() for h in lines[0].split(","))
+    if header not in (_FRF_COLUMNS, _TIME_COLUMNS):
+        raise InputError(f"{path}: header", ",".join(header), "f_Hz,re,im  or  t,force,response")
+    try:
+        data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]], dtype=float)
+    except ValueError as err:
+        raise InputError(f"{path}: data", str(err).split(": ")[-1], "numbers") from None
+    if data.ndim != 2 or data.shape[0] < 8 or data.shape[1] != 3:
+        raise InputError(f"{path}: rows", data.shape[0] if data.ndim else 0,
+                         "at least 8 rows of 3 numbers")
+    if not np.all(np.isfinite(data)):
+        raise InputError(f"{path}: data", "nan/inf", "finite numbers")
+    return header, data
+
+
+def _uniform_step(x, name):
+    d = np.diff(x)
+    if not (np.all(d > 0) and np.allclose(d, d[0], rtol=1e-6, atol=0.0)):
+        raise InputError(name, "non-uniform or non-increasing", "uniformly spaced increasing values")
+    return float(d[0])
+
+
+def _estimate_pulse_width(force, dt):
+    """Width of the impulse: time the force stays above 10 % of its peak (at least 2 samples)."""
+    above = np.abs(force) >= 0.1 * np.max(np.abs(force))
+    idx = np.flatnonzero(above)
+    return max((idx[-1] - idx[0] + 1) * dt, 2 * dt)
+
+
+def run(args):
+    """Read the file, identify, print."""
+    if args.mass is not None and not (math.isfinite(args.mass) and args.mass > 0):
+        raise InputError("--mass", args.mass, "> 0 kg")
+    if args.exp_tau is not None and not (math.isfinite(args.exp_tau) and args.exp_tau > 0):
+        raise InputError("--exp-tau", args.exp_tau, "> 0 s")
+    header, data = _read_csv(args.file)
+    band = None
+    if args.fmin is not None or args.fmax is not None:
+        band = (args.fmin, args.fmax)
+    if header == _FRF_COLUMNS:
+        f = data[:, 0]
+        _uniform_step(f, "f_Hz")
+        ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], args.frf_type, args.mass, band,
+                             args.exp_tau)
+        kind = args.frf_type
+    else:
+        dt = _uniform_step(data[:, 0], "t")
+        force = data[:, 1]
+        if not np.any(force != 0.0):
+            raise InputError("force", "all zero", "a recorded impulse")
+        width = args.pulse_width if args.pulse_width is not None else _estimate_pulse_width(force, dt)
+        test = HammerTest(data[:, 0], force[None, :], data[:, 2][None, :], 1.0 / dt, args.response)
+        ident = identify_hammer_test(test, width, args.mass, args.exp_tau, band=band)
+        kind = args.response
+    fit = ident.fit
+    out = {
+        "input": {"file": str(args.file), "kind": kind, "modal_mass_kg": args.mass},
+        "band_Hz": list(ident.band),
+        "half_power": {"fn_Hz": ident.fn_half_power, "zeta": ident.zeta_half_power,
+                       "f1_Hz": ident.half_power.f1, "f2_Hz": ident.half_power.f2,
+                       "k_N_per_m": None if math.isnan(ident.k_half_power) else ident.k_half_power,
+                       "c_Ns_per_m": None if math.isnan(ident.c_half_power) else ident.c_half_power},
+        "sdof_fit": None if fit is None else {"fn_Hz": fit.fn, "zeta": fit.zeta, "k_N_per_m": fit.k,
+                                              "m_kg": fit.m, "c_Ns_per_m": fit.c},
+    }
+    if args.json:
+        print(json.dumps(out, indent=2))
+        return 0
+    hp = out["half_power"]
+    print(f"{args.file}: {kind}, band {ident.band[0]:.4g}-{ident.band[1]:.4g} Hz")
+    line = f"half-power: fn = {hp['fn_Hz']:.5g} Hz, zeta = {hp['zeta']:.4g}"
+    if hp["k_N_per_m"] is not None:
+        line += (f", k = {hp['k_N_per_m']:.4g} N/m, c = {hp['c_Ns_per_m']:.4g} N s/m "
+                 f"(modal mass {args.mass:.4g} kg)")
+    else:
+        line += " (give --mass for k and c)"
+    print(line)
+    if fit is None:
+        print("SDOF fit: failed (no single mode in the band)")
+    else:
+        print(f"SDOF fit:   fn = {fit.fn:.5g} Hz, zeta = {fit.zeta:.4g}, k = {fit.k:.4g} N/m, "
+              f"m = {fit.m:.4g} kg, c = {fit.c:.4g} N s/m")
+    return 0
