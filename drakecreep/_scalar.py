@@ -8,7 +8,7 @@ import numpy as np
 import pydrake.math as dmath
 from pydrake.symbolic import Expression, Formula, Variable, if_then_else
 
-__all__ = ["is_symbolic", "where", "clip", "smin", "smax", "tanh", "vector"]
+__all__ = ["is_symbolic", "where", "clip", "smin", "smax", "tanh", "exp", "fabs", "floor", "vector"]
 
 
 def is_symbolic(*values):
@@ -46,9 +46,32 @@ def clip(x, lo, hi):
     return smin(smax(x, lo), hi)
 
 
+def _numeric(x):
+    return isinstance(x, (float, int, np.ndarray, np.floating))
+
+
 def tanh(x):
-    """Hyperbolic tangent for any Drake scalar type."""
-    return np.tanh(x)
+    """Hyperbolic tangent of a float, numpy array, AutoDiffXd or Expression.
+
+    Drake scalars go to ``pydrake.math`` directly rather than through a numpy object-dtype ufunc,
+    whose floating-point status check reports harmless intermediate NaNs inside Drake as warnings.
+    """
+    return np.tanh(x) if _numeric(x) else dmath.tanh(x)
+
+
+def exp(x):
+    """Exponential of a float, numpy array, AutoDiffXd or Expression (see :func:`tanh`)."""
+    return np.exp(x) if _numeric(x) else dmath.exp(x)
+
+
+def fabs(x):
+    """Absolute value of a float, numpy array, AutoDiffXd or Expression (see :func:`tanh`)."""
+    return np.abs(x) if _numeric(x) else dmath.abs(x)
+
+
+def floor(x):
+    """Floor of a float, numpy array, AutoDiffXd (value only) or Expression (see :func:`tanh`)."""
+    return np.floor(x) if _numeric(x) else dmath.floor(x)
 
 
 def vector(values):

@@ -26,7 +26,7 @@ from drakecreep.screw import ScrewDrive, axial_stiffness, screw_inertia
 from drakecreep.sensors import LinearScale, MotorEncoder, encoder_resolution, quantize
 from drakecreep.table import NutTable
 
-__all__ = ["FeedDrive", "build_diagram", "SIGNALS", "initial_conditions"]
+__all__ = ["FeedDrive", "build_diagram", "build_plant", "SIGNALS", "initial_conditions"]
 
 #: recorded signals: name, (system, output port, index), unit
 SIGNALS = (
@@ -166,3 +166,37 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
         (f"friction_state_{i}", ("table", "friction_state", i), "m") for i in range(s["table"].law.num_states)
     )
     return FeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals)
+
+
+def build_plant(params, load_case=0):
+    """The mechanics alone: motor, screw and table, with the motor torque command as the input.
+
+    Input port ``torque_command`` (N m); output ports ``motor_state``, ``table_state``,
+    ``axial_force``, ``friction_force``. State order: motor ``[theta, omega(, tau)]``, table
+    ``[x, v, z...]``, all zero by default (no preload of the screw).
+
+    Parameters
+    ----------
+    params : drakecreep.params.DriveParams
+    load_case : int
+        Load case number (0 = unloaded).
+    """
+    builder = DiagramBuilder()
+    motor = builder.AddSystem(Motor(params.motor, load_inertia=screw_inertia(params.screw)))
+    motor.set_name("motor")
+    screw = builder.AddSystem(ScrewDrive(params.screw, params.nut))
+    screw.set_name("screw")
+    table = builder.AddSystem(NutTable(params, params.load_case(load_case)))
+    table.set_name("table")
+    builder.Connect(screw.GetOutputPort("load_torque"), motor.GetInputPort("load_torque"))
+    builder.Connect(motor.GetOutputPort("motor_state"), screw.GetInputPort("motor_state"))
+    builder.Connect(table.GetOutputPort("table_state"), screw.GetInputPort("table_state"))
+    builder.Connect(screw.GetOutputPort("axial_force"), table.GetInputPort("axial_force"))
+    builder.ExportInput(motor.GetInputPort("torque_command"), "torque_command")
+    builder.ExportOutput(motor.GetOutputPort("motor_state"), "motor_state")
+    builder.ExportOutput(table.GetOutputPort("table_state"), "table_state")
+    builder.ExportOutput(screw.GetOutputPort("axial_force"), "axial_force")
+    builder.ExportOutput(table.GetOutputPort("friction_force"), "friction_force")
+    diagram = builder.Build()
+    diagram.set_name("feed_drive_plant")
+    return diagram

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drakecreep._scalar import exp, fabs, tanh
+
 __all__ = [
     "FrictionLaw",
     "CoulombFriction",
@@ -42,8 +44,8 @@ def stribeck_curve(v, Fc, Fs, vs, exponent=2.0):
     Works for numpy arrays and any Drake scalar type.
     """
     if exponent == 2.0:
-        return Fc + (Fs - Fc) * np.exp(-((v / vs) ** 2))
-    return Fc + (Fs - Fc) * np.exp(-(np.abs(v / vs) ** exponent))
+        return Fc + (Fs - Fc) * exp(-((v / vs) ** 2))
+    return Fc + (Fs - Fc) * exp(-(fabs(v / vs) ** exponent))
 
 
 @dataclass(frozen=True)
@@ -105,7 +107,7 @@ class CoulombFriction(FrictionLaw):
     name = "coulomb"
 
     def force(self, v, z, Fc, Fs):
-        return Fc * np.tanh(v / self.regularization_velocity) + self.viscous * v
+        return Fc * tanh(v / self.regularization_velocity) + self.viscous * v
 
 
 @dataclass(frozen=True)
@@ -116,7 +118,7 @@ class StribeckFriction(FrictionLaw):
 
     def force(self, v, z, Fc, Fs):
         g = stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
-        return g * np.tanh(v / self.regularization_velocity) + self.viscous * v
+        return g * tanh(v / self.regularization_velocity) + self.viscous * v
 
 
 @dataclass(frozen=True)
@@ -142,7 +144,7 @@ class LuGreFriction(FrictionLaw):
 
     def state_rates(self, v, z, Fc, Fs):
         g = self._g(v, Fc, Fs)
-        return [v - self.bristle_stiffness * np.abs(v) * z[0] / g]
+        return [v - self.bristle_stiffness * fabs(v) * z[0] / g]
 
     def force(self, v, z, Fc, Fs):
         (zdot,) = self.state_rates(v, z, Fc, Fs)

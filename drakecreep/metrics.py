@@ -45,8 +45,9 @@ def speed_fluctuation(speed):
 def stick_slip(speed, feed, threshold):
     """Stick fraction and number of stick-slip cycles of a speed record.
 
-    The table is stuck while ``|v| < threshold * |feed|``; it must exceed twice that to count as
-    slipping again (hysteresis, so that noise around the threshold is not counted as cycles).
+    Speeds are taken in the feed direction. The table is stuck while it moves slower than
+    ``threshold * |feed|`` (including a presliding rebound backwards); it must exceed twice that to
+    count as slipping again (hysteresis, so that noise at the threshold is not counted as cycles).
     A cycle is one entry into sticking from slipping.
 
     Returns
@@ -55,7 +56,7 @@ def stick_slip(speed, feed, threshold):
         Share of samples stuck (0-1).
     cycles : int
     """
-    v = np.abs(np.asarray(speed, dtype=float))
+    v = np.asarray(speed, dtype=float) * np.sign(feed)
     low = threshold * abs(feed)
     stuck_samples = v < low
     cycles = 0

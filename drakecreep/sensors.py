@@ -10,7 +10,7 @@ import numpy as np
 from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
-from drakecreep._scalar import vector
+from drakecreep._scalar import floor, vector
 
 __all__ = ["MotorEncoder", "MotorEncoder_", "LinearScale", "LinearScale_", "quantize", "encoder_resolution"]
 
@@ -19,7 +19,7 @@ def quantize(value, resolution):
     """``resolution * floor(value / resolution)``; identity for ``resolution == 0``."""
     if resolution == 0:
         return value
-    return resolution * np.floor(value / resolution)
+    return resolution * floor(value / resolution)
 
 
 def encoder_resolution(counts_per_rev):

@@ -1,0 +1,70 @@
+"""The ``drakecreep`` command line: parses arguments and calls the library, nothing more.
+
+Each subcommand lives in its own module of this package and exposes
+
+* ``add_parser(subparsers)`` -- registers the subcommand and its options;
+* ``run(args) -> int`` -- calls the library and prints; returns the exit code.
+
+User errors (:class:`drakecreep.errors.DrakecreepError`, bad files, bad options) print one line on stderr
+and exit with code 2, never a traceback.
+"""
+
+import argparse
+import importlib
+import sys
+
+from drakecreep.errors import DrakecreepError
+
+__all__ = ["main", "build_parser", "COMMANDS"]
+
+#: Subcommand modules, in the order ``--help`` lists them.
+COMMANDS = [
+    "simulate",
+    "params",
+    "diagram",
+    "critical",
+    "hertz",
+    "modal",
+]
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line and exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser():
+    """Build the top-level parser with every registered subcommand."""
+    parser = _Parser(
+        prog="drakecreep",
+        description="Ball-screw feed drive in Drake: simulate creep, analyse servo loops, diagnose sim-to-real gaps.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in COMMANDS:
+        module = importlib.import_module(f"drakecreep.cli.{name}")
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv=None):
+    """Entry point of the ``drakecreep`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except DrakecreepError as err:
+        print(f"drakecreep {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except (FileNotFoundError, IsADirectoryError, PermissionError) as err:
+        print(f"drakecreep {args.command}: error: {err.strerror}: {err.filename}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"drakecreep {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,74 @@
+"""Options and conversions shared by the subcommands (report units at the edge: mm/s, N/um)."""
+
+import argparse
+import dataclasses
+import json
+import math
+
+from drakecreep.errors import InputError
+from drakecreep.params import PRESETS, load_params, preset, with_value
+
+__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number"]
+
+
+def number(text):
+    """argparse type: a finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} must be finite")
+    return value
+
+
+def positive_float(text):
+    """argparse type: a finite number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value) or value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number > 0")
+    return value
+
+
+def add_params_options(parser, friction=True):
+    """``--params FILE`` / ``--preset NAME`` (and ``--friction LAW``)."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--params", metavar="FILE", help="parameter file (YAML, SI units)")
+    group.add_argument("--preset", default="paper", choices=PRESETS, help="built-in parameter set (default: paper)")
+    if friction:
+        parser.add_argument(
+            "--friction", choices=("coulomb", "stribeck", "lugre"), help="friction law (default: from the parameters)"
+        )
+
+
+def params_from_args(args):
+    """:class:`~drakecreep.params.DriveParams` from ``--params``/``--preset`` and overrides."""
+    params = load_params(args.params) if args.params else preset(args.preset)
+    if getattr(args, "friction", None):
+        params = with_value(params, "friction.law", args.friction)
+    return params
+
+
+def print_json(obj):
+    """One JSON object on stdout."""
+    print(json.dumps(obj, default=_jsonable))
+
+
+def _jsonable(value):
+    if dataclasses.is_dataclass(value):
+        return dataclasses.asdict(value)
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"not JSON serializable: {type(value).__name__}")
+
+
+def feed_from_mm_s(value, option="--feed"):
+    """m/s from a CLI value in mm/s, or an InputError naming the option."""
+    from drakecreep.scenario import MAX_FEED
+
+    if not math.isfinite(value) or value == 0 or abs(value) > MAX_FEED * 1e3:
+        raise InputError(option, value, f"a non-zero feed within +-{MAX_FEED * 1e3:g} mm/s")
+    return value * 1e-3

@@ -1,0 +1,34 @@
+"""``drakecreep diagram``: draw the feed-drive diagram (Graphviz, from Drake)."""
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers):
+    from drakecreep.cli._common import add_params_options
+
+    p = subparsers.add_parser(
+        "diagram",
+        help="draw the Drake system diagram to SVG/PNG/PDF/DOT",
+        description="Build the feed-drive diagram from the parameters and draw it with Graphviz "
+        "(SVG, PNG and PDF need Graphviz's 'dot'; the .dot source is always written).",
+    )
+    add_params_options(p)
+    p.add_argument("--out", default="out/feed_drive.svg", metavar="FILE",
+                   help="output file: .svg, .png, .pdf or .dot (default out/feed_drive.svg)")
+    p.add_argument("--controller", choices=("sampled", "continuous"), help="controller variant to draw")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args):
+    from drakecreep.cli._common import params_from_args
+    from drakecreep.diagram import build_diagram
+    from drakecreep.drawing import draw_diagram
+    from drakecreep.scenario import Scenario
+
+    params = params_from_args(args)
+    continuous = None if args.controller is None else args.controller == "continuous"
+    drive = build_diagram(params, Scenario(), continuous=continuous)
+    path = draw_diagram(drive.diagram, args.out)
+    print(f"wrote {path}")
+    return 0

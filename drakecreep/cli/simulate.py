@@ -1,0 +1,86 @@
+"""``drakecreep simulate``: one feed at a speed and load; prints the creep metrics, saves CSV/JSON/PNG."""
+
+import sys
+
+from drakecreep.cli._common import add_params_options, feed_from_mm_s, number, params_from_args, positive_float, print_json
+from drakecreep.errors import InputError
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "simulate",
+        help="simulate a feed and measure creep (speed fluctuation, stick-slip)",
+        description=(
+            "Simulate the feed drive at a constant feed under one load case and print the paper's creep "
+            "metrics (max speed fluctuation and fluctuation rate over the steady window), stick fraction, "
+            "stick-slip cycles and following error. Writes timeseries.csv, metrics.json, params.yaml and "
+            "speed.png to --out."
+        ),
+    )
+    add_params_options(p)
+    p.add_argument("--load-case", type=int, default=3, metavar="N",
+                   help="load case of the parameters (paper: 1, 2, 3; 0 = unloaded; default 3)")
+    p.add_argument("--feed", type=number, default=1.0, metavar="MM_PER_S", help="feed speed in mm/s (default 1)")
+    p.add_argument("--duration", type=positive_float, default=5.0, metavar="S", help="simulated time in s (default 5)")
+    p.add_argument("--controller", choices=("sampled", "continuous"), help="controller variant (default: parameters)")
+    p.add_argument("--backend", choices=("compiled", "leaf"), help="compiled symbolic fast path or Python leaf systems")
+    p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
+    p.add_argument("--no-plot", action="store_true", help="skip the PNG")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the text summary")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args):
+    from drakecreep.params import with_value
+    from drakecreep.scenario import Scenario
+    from drakecreep.simulation import simulate
+
+    params = params_from_args(args)
+    if args.controller:
+        params = with_value(params, "controller.sampled", args.controller == "sampled")
+    feed = feed_from_mm_s(args.feed)
+    if not 0 <= args.load_case <= len(params.loads.cases):
+        raise InputError("--load-case", args.load_case, f"an integer in 0..{len(params.loads.cases)} (0 = unloaded)")
+    if params.simulation.steady_start >= args.duration:
+        raise InputError(
+            "--duration", args.duration,
+            f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window",
+        )
+    scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
+    result = simulate(params, scenario, backend=args.backend)
+    paths = result.save(args.out, plot=not args.no_plot)
+    summary = result.summary()
+    summary["out"] = str(paths["metrics"].parent)
+    if args.json:
+        print_json(summary)
+    else:
+        _print_text(result, paths)
+    if not result.ok:
+        print(f"drakecreep simulate: error: {result.status} (results up to then saved in {args.out})", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_text(result, paths):
+    s = result.summary()
+    print(f"feed {s['feed_mm_s']:g} mm/s, load case {s['load_case']}, {s['friction_law']} friction, "
+          f"{s['controller']} cascade: {s['sim_time_s']:g} s simulated in {s['wall_time_s']:.2f} s")
+    if result.metrics is not None:
+        rows = [
+            ("metrics window", f"{s['window_start_s']:g}-{s['window_end_s']:g} s"),
+            ("mean table speed", f"{s['mean_speed_mm_s']:.5f} mm/s"),
+            ("max speed fluctuation", f"{s['max_fluctuation_mm_s']:.5f} mm/s"),
+            ("fluctuation rate", f"{s['fluctuation_rate_percent']:.3f} %"),
+            ("table speed min / max", f"{s['min_speed_mm_s']:.5f} / {s['max_speed_mm_s']:.5f} mm/s"),
+            ("stick fraction", f"{s['stick_fraction'] * 100:.2f} %"),
+            ("stick-slip cycles", f"{s['stick_slip_cycles']} ({s['stick_slip_frequency_Hz']:.1f} Hz)"),
+            ("creep (stick-slip)", "yes" if s["creep"] else "no"),
+            ("travel error max / rms", f"{s['following_error_max_um']:.3f} / {s['following_error_rms_um']:.3f} um"),
+        ]
+        width = max(len(r[0]) for r in rows)
+        for name, value in rows:
+            print(f"  {name:<{width}}  {value}")
+    print("wrote " + ", ".join(str(p) for p in paths.values()))

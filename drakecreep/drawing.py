@@ -1,0 +1,54 @@
+"""Draw a Drake diagram with Graphviz: ``.dot`` always, SVG/PNG when Graphviz's ``dot`` is installed."""
+
+import shutil
+import subprocess
+from pathlib import Path
+
+from drakecreep.errors import DrakecreepError, InputError
+
+__all__ = ["draw_diagram", "FORMATS"]
+
+FORMATS = (".svg", ".png", ".dot", ".pdf")
+
+
+def draw_diagram(diagram, path, max_depth=1):
+    """Write ``diagram``'s Graphviz drawing to ``path`` (format from the suffix).
+
+    Parameters
+    ----------
+    diagram : pydrake.systems.framework.Diagram
+    path : str or Path
+        ``.svg``, ``.png``, ``.pdf`` or ``.dot``.
+    max_depth : int
+        Levels of nested diagrams to expand.
+
+    Returns
+    -------
+    Path
+        The file written. The Graphviz source is also written beside it as ``.dot``.
+
+    Raises
+    ------
+    InputError
+        Unknown suffix.
+    DrakecreepError
+        Graphviz's ``dot`` is not installed (the ``.dot`` source is still written).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise InputError("--out", str(path), "a file ending in " + ", ".join(FORMATS))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    source = diagram.GetGraphvizString(max_depth=max_depth)
+    dot_path = path.with_suffix(".dot")
+    dot_path.write_text(source)
+    if suffix == ".dot":
+        return dot_path
+    exe = shutil.which("dot")
+    if exe is None:
+        raise DrakecreepError(
+            f"Graphviz 'dot' is not installed, so {path.name} was not drawn; the source is in {dot_path} "
+            "(install Graphviz, e.g. 'apt-get install graphviz', or ask for a .dot file)"
+        )
+    subprocess.run([exe, f"-T{suffix[1:]}", str(dot_path), "-o", str(path)], check=True, capture_output=True)
+    return path

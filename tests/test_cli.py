@@ -1,0 +1,77 @@
+import json
+
+import pytest
+import yaml
+
+from drakecreep.cli import main
+
+
+def test_simulate_json(tmp_path, capsys):
+    code = main(["simulate", "--feed", "0.1", "--duration", "1.5", "--load-case", "1", "--out", str(tmp_path), "--json",
+                 "--no-plot"])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("mean_speed_mm_s", "max_fluctuation_mm_s", "fluctuation_rate_percent", "stick_fraction",
+                "stick_slip_cycles", "sim_time_s", "wall_time_s"):
+        assert key in out
+    assert out["stick_slip_cycles"] > 0 and out["mean_speed_mm_s"] == pytest.approx(0.1, rel=0.01)
+    assert (tmp_path / "timeseries.csv").exists() and (tmp_path / "metrics.json").exists()
+
+
+def test_simulate_text(tmp_path, capsys):
+    assert main(["simulate", "--feed", "2", "--duration", "1.2", "--friction", "stribeck", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "max speed fluctuation" in out
+    creep_line = next(line for line in out.splitlines() if "creep (stick-slip)" in line)
+    assert creep_line.split()[-1] == "no"
+    assert (tmp_path / "speed.png").exists()
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["simulate", "--feed", "abc"], "--feed"),
+    (["simulate", "--feed", "0"], "--feed"),
+    (["simulate", "--load-case", "9"], "--load-case"),
+    (["simulate", "--duration", "0.5"], "--duration"),
+    (["simulate", "--friction", "gms"], "--friction"),
+    (["simulate", "--params", "/no/such/file.yaml"], "No such file"),
+    (["diagram", "--out", "x.jpg"], "--out"),
+    (["nonsense"], "invalid choice"),
+])
+def test_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
+    try:
+        code = main(argv + (["--out", str(tmp_path / "o")] if argv[0] == "simulate" else []))
+    except SystemExit as exit_:
+        code = exit_.code
+    err = capsys.readouterr().err
+    assert code == 2
+    assert fragment in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_parameter_file(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text("table: {mass: -3}\n")
+    assert main(["simulate", "--params", str(path), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "table.mass" in err and "-3" in err and "> 0.0 kg" in err
+
+
+def test_params_prints_loadable_yaml(tmp_path, capsys):
+    assert main(["params", "--preset", "paper"]) == 0
+    text = capsys.readouterr().out
+    assert "[assumed]" in text
+    path = tmp_path / "p.yaml"
+    path.write_text(text)
+    assert main(["params", "--check", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["screw"]["lead"] == 0.005
+    assert yaml.safe_load(text)["nut"]["axial_damping"] == 898.88
+
+
+def test_diagram_dot_and_svg(tmp_path):
+    assert main(["diagram", "--out", str(tmp_path / "d.dot")]) == 0
+    assert "CascadeController" in (tmp_path / "d.dot").read_text()
+    import shutil
+
+    if shutil.which("dot") is None:
+        pytest.skip("Graphviz 'dot' not installed")
+    assert main(["diagram", "--out", str(tmp_path / "d.svg")]) == 0
+    assert (tmp_path / "d.svg").read_text().lstrip().startswith("<?xml")

@@ -1,0 +1,83 @@
+import math
+
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.params import (
+    DriveParams, get_value, load_params, params_from_dict, params_to_dict, preset, preset_text, save_params,
+    with_value,
+)
+
+
+def test_paper_preset_carries_the_paper_values(paper):
+    assert paper.screw.lead == 5e-3 and paper.screw.nominal_diameter == 25e-3
+    assert paper.nut.axial_stiffness == 51.6e6 and paper.nut.axial_damping == 898.88
+    assert paper.screw.bearing_stiffness == 9.38e6
+    assert [(c.fx, c.fy, c.fz) for c in paper.loads.cases] == [(174, 151, 524), (252, 228, 787), (434, 407, 1001)]
+
+
+def test_every_assumed_value_in_the_preset_names_a_source():
+    for line in preset_text("paper").splitlines():
+        if "[assumed]" in line:
+            comment = line.split("[assumed]", 1)[1].strip()
+            assert len(comment) > 10, line
+
+
+def test_yaml_round_trip_is_identical(tmp_path, paper):
+    path = tmp_path / "p.yaml"
+    save_params(paper, path)
+    assert load_params(path) == paper
+
+
+def test_exponent_without_sign_is_a_float(tmp_path):
+    path = tmp_path / "p.yaml"
+    path.write_text("nut: {axial_stiffness: 4.2e7}\n")
+    assert load_params(path).nut.axial_stiffness == 4.2e7
+
+
+@pytest.mark.parametrize(
+    "data, field, fragment",
+    [
+        ({"table": {"mass": -1.0}}, "table.mass", "> 0.0 kg"),
+        ({"screw": {"lead": 0.0}}, "screw.lead", "(0.0, 0.1]"),
+        ({"friction": {"viscous": float("nan")}}, "friction.viscous", "finite"),
+        ({"motor": {"rotor_inertia": "big"}}, "motor.rotor_inertia", "finite number"),
+        ({"table": {"mas": 3}}, "table.mas", "no such field"),
+        ({"controller": {"sampled": "yes"}}, "controller.sampled", "true or false"),
+        ({"friction": {"law": "gms"}}, "friction.law", "one of coulomb, stribeck, lugre"),
+        ({"loads": {"cases": [{"fx": 1.0}, {"fz": "x"}]}}, "loads.cases[1].fz", "finite"),
+        ({"controller": {"position_period": 3e-4}}, "controller.position_period", "integer multiple"),
+        ({"screw": {"root_diameter": 0.03}}, "screw.root_diameter", "nominal_diameter"),
+    ],
+)
+def test_invalid_values_name_field_value_and_range(data, field, fragment):
+    with pytest.raises(InputError) as info:
+        params_from_dict(data)
+    assert info.value.field == field
+    assert fragment in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_invalid_yaml_is_one_clear_error(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text("table: [\n")
+    with pytest.raises(InputError, match="invalid YAML"):
+        load_params(path)
+
+
+def test_with_value_and_get_value(paper):
+    p = with_value(paper, "loads.cases[2].fx", 500.0)
+    assert get_value(p, "loads.cases[2].fx") == 500.0
+    assert get_value(paper, "loads.cases[2].fx") == 434.0
+    with pytest.raises(InputError) as info:
+        with_value(paper, "controller.velocity_period", 3e-4)
+    assert info.value.field == "controller.position_period"
+    with pytest.raises(InputError):
+        with_value(paper, "screw.nope", 1.0)
+
+
+def test_defaults_are_valid_and_integers_accepted_for_floats():
+    p = params_from_dict({"table": {"mass": 50}})
+    assert isinstance(p.table.mass, float) and p.table.mass == 50.0
+    assert DriveParams() == params_from_dict({})
+    assert math.isfinite(params_to_dict(preset())["motor"]["rotor_inertia"])
