@@ -72,8 +72,10 @@ class BaselineModel:
             return self.fc * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
         if f.law == "stribeck":
             return self.g(v) * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
-        zdot = v - f.bristle_stiffness * abs(v) * z / self.g(v)
-        return f.bristle_stiffness * z + f.bristle_damping * zdot + f.viscous * v, zdot
+        # z is the bristle load as a fraction of Fc, w = sigma0 z_deflection / Fc (see LuGreFriction)
+        deflection_rate = v - abs(v) * z * self.fc / self.g(v)
+        friction = self.fc * z + f.bristle_damping * deflection_rate + f.viscous * v
+        return friction, f.bristle_stiffness / self.fc * deflection_rate
 
     def reference(self, t):
         v, ta, x0 = self.scenario.feed, self.p.simulation.acceleration_time, self.ic["x_ref0"]

@@ -163,7 +163,7 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
     diagram = builder.Build()
     diagram.set_name("feed_drive")
     signals = SIGNALS + tuple(
-        (f"friction_state_{i}", ("table", "friction_state", i), "m") for i in range(s["table"].law.num_states)
+        (f"friction_state_{i}", ("table", "friction_state", i), "-") for i in range(s["table"].law.num_states)
     )
     return FeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals)
 

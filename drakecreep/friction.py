@@ -14,7 +14,7 @@ StribeckFriction
     ``g(v) tanh(v / v_reg) + Fv v`` with ``g`` the Stribeck curve, no states.
 LuGreFriction
     Canudas de Wit, Olsson, Astrom, Lischinsky, "A new model for control of systems with
-    friction", IEEE TAC 40(3), 1995: one bristle state ``z``,
+    friction", IEEE TAC 40(3), 1995: one bristle state (stored normalized, see the class),
     ``dz/dt = v - sigma0 |v| z / g(v)``, ``F = sigma0 z + sigma1 dz/dt + Fv v``,
     ``g(v) = Fc + (Fs - Fc) exp(-|v/vs|^delta)``. Its steady state is the Stribeck curve.
 """
@@ -125,6 +125,12 @@ class StribeckFriction(FrictionLaw):
 class LuGreFriction(FrictionLaw):
     """LuGre dynamic friction (Canudas de Wit et al. 1995) with one bristle state.
 
+    The state is the bristle load as a fraction of the Coulomb level, ``w = sigma0 z / Fc``
+    (dimensionless, of order 1), rather than the bristle deflection ``z`` itself (about 0.3 um
+    here): an integrator's error control then sees it at the same scale as the other states.
+    The equations are the original ones, ``dz/dt = v - sigma0 |v| z / g(v)``,
+    ``F = sigma0 z + sigma1 dz/dt + Fv v``, rewritten in ``w``.
+
     Parameters
     ----------
     bristle_stiffness : float
@@ -142,17 +148,23 @@ class LuGreFriction(FrictionLaw):
     def _g(self, v, Fc, Fs):
         return stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
 
-    def state_rates(self, v, z, Fc, Fs):
-        g = self._g(v, Fc, Fs)
-        return [v - self.bristle_stiffness * fabs(v) * z[0] / g]
+    def deflection_rate(self, v, w, Fc, Fs):
+        """``dz/dt`` (m/s) of the bristles for the normalized state ``w``."""
+        return v - fabs(v) * w[0] * Fc / self._g(v, Fc, Fs)
 
-    def force(self, v, z, Fc, Fs):
-        (zdot,) = self.state_rates(v, z, Fc, Fs)
-        return self.bristle_stiffness * z[0] + self.bristle_damping * zdot + self.viscous * v
+    def state_rates(self, v, w, Fc, Fs):
+        return [self.bristle_stiffness / Fc * self.deflection_rate(v, w, Fc, Fs)]
+
+    def force(self, v, w, Fc, Fs):
+        return Fc * w[0] + self.bristle_damping * self.deflection_rate(v, w, Fc, Fs) + self.viscous * v
 
     def steady_state_force(self, v, Fc, Fs):
         v = np.asarray(v, dtype=float)
         return self._g(v, Fc, Fs) * np.sign(v) + self.viscous * v
+
+    def deflection(self, w, Fc):
+        """Bristle deflection ``z`` (m) for the normalized state ``w``."""
+        return np.asarray(w) * Fc / self.bristle_stiffness
 
     def presliding_stiffness(self, Fc, Fs):
         return self.bristle_stiffness

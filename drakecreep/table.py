@@ -52,7 +52,7 @@ def NutTable_(T):
         ------------
         table_state : 2, ``[x (m), v (m/s)]``
         friction_force : 1, friction on the table (N, opposing +v)
-        friction_state : internal friction states (m for LuGre), size 0 for stateless laws
+        friction_state : internal friction states (LuGre: bristle load / Fc), size 0 for stateless laws
         """
 
         def _construct(self, params, load, initial_state=None, converter=None):

@@ -13,7 +13,7 @@ def test_symbolic_equations_evaluate_like_the_leaf_systems(paper):
     assert len(eq.xc) == 6 and len(eq.xd) == 5 and eq.period == paper.controller.velocity_period
     c = drive.diagram.CreateDefaultContext()
     c.SetTime(0.02)
-    xc = eq.xc0 + np.array([1e-3, 0.5, 0.01, 2e-6, 1e-4, 1e-7])
+    xc = eq.xc0 + np.array([1e-3, 0.5, 0.01, 2e-6, 1e-4, 0.3])
     c.SetContinuousState(xc)
     env = {eq.time: 0.02, **dict(zip(eq.xc, xc)), **dict(zip(eq.xd, eq.xd0))}
     expected = drive.diagram.EvalTimeDerivatives(c).CopyToVector()

@@ -30,15 +30,16 @@ def test_derivatives_by_hand(paper):
     table = NutTable(paper, load)
     c = table.CreateDefaultContext()
     table.get_input_port(0).FixValue(c, [500.0])
-    x, v, z = 1e-3, 2e-4, 1e-7
-    c.SetContinuousState([x, v, z])
     f = paper.friction
     fc, fs = friction_levels(paper, load)
+    x, v, z = 1e-3, 2e-4, 1e-7  # z: bristle deflection (m); the state is sigma0 z / Fc
+    c.SetContinuousState([x, v, f.bristle_stiffness * z / fc])
     g = fc + (fs - fc) * math.exp(-((v / f.stribeck_velocity) ** 2))
     zdot = v - f.bristle_stiffness * abs(v) * z / g
     friction = f.bristle_stiffness * z + f.bristle_damping * zdot + f.viscous * v
     xdot = table.EvalTimeDerivatives(c).CopyToVector()
-    np.testing.assert_allclose(xdot, [v, (500.0 - load.fx - friction) / moving_mass(paper), zdot])
+    np.testing.assert_allclose(xdot, [v, (500.0 - load.fx - friction) / moving_mass(paper),
+                                      f.bristle_stiffness * zdot / fc])
     assert table.GetOutputPort("friction_force").Eval(c)[0] == pytest.approx(friction)
     converted = table.ToAutoDiffXd()
     assert converted.load == load and converted.fc == table.fc
