@@ -25,6 +25,7 @@ COMMANDS = [
     "critical",
     "hertz",
     "modal",
+    "sweep",
 ]
 
 
