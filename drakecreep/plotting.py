@@ -35,12 +35,14 @@ def plot_feed(result, path):
     z = (t >= t0) & (t <= t1)
     fig, axes = plt.subplots(4, 1, figsize=(9, 10), constrained_layout=True)
 
-    def speeds(ax, mask):
+    def speeds(ax, mask, zero_line=True):
         ax.plot(t[mask], s["motor_velocity"][mask] * 1e3, color="0.6", lw=0.8, label="motor (at the table)")
         ax.plot(t[mask], s["table_speed"][mask] * 1e3, color="C0", lw=1.0, label="table")
         ax.plot(t[mask], s["v_ref"][mask] * 1e3, "k--", lw=0.8, label="reference")
-        ax.axhline(0.0, color="k", lw=0.5)
+        if zero_line:
+            ax.axhline(0.0, color="k", lw=0.5)
         ax.set_ylabel("speed (mm/s)")
+        ax.ticklabel_format(axis="y", useOffset=False)
 
     ax = axes[0]
     speeds(ax, slice(None))
@@ -50,12 +52,14 @@ def plot_feed(result, path):
     ax.legend(loc="lower right", fontsize=8, ncol=5)
     ax.set_title("whole run", fontsize=9)
     ax = axes[1]
-    speeds(ax, z)
+    # in the zoom, show zero only when the table gets near it, so a small fluctuation stays visible
+    speeds(ax, z, zero_line=bool(np.min(s["table_speed"][z] * np.sign(sc.feed)) < 0.2 * abs(sc.feed)))
     ax.set_title(f"zoom {t0:.3f}-{t1:.3f} s", fontsize=9)
     ax = axes[2]
     ax.plot(t[z], s["spring_force"][z] - fx, color="C1", lw=0.9, label="screw force - axial load Fx")
     ax.plot(t[z], s["friction_force"][z], color="C3", lw=0.9, label="friction force")
     ax.set_ylabel("force (N)")
+    ax.ticklabel_format(axis="y", useOffset=False)
     ax.set_title(f"zoom: forces on the table (Fx = {fx:g} N)", fontsize=9)
     ax.legend(loc="lower right", fontsize=8, ncol=2)
     ax = axes[3]
@@ -74,7 +78,7 @@ def plot_feed(result, path):
     )
     if m is not None:
         title += (
-            f"\nmax fluctuation {m.max_fluctuation * 1e3:.4f} mm/s ({m.fluctuation_rate * 100:.2f} %), "
+            f"\nmax fluctuation {m.max_fluctuation * 1e3:.3g} mm/s ({m.fluctuation_rate * 100:.3g} %), "
             f"stick {m.stick_fraction * 100:.1f} %, {m.stick_slip_cycles} stick-slip cycles"
         )
     if not result.ok:
