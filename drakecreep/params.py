@@ -32,6 +32,9 @@ __all__ = [
     "ControllerParams",
     "SensorParams",
     "SimulationParams",
+    "DisturbanceParams",
+    "CompensationParams",
+    "COMPENSATION_METHODS",
     "DriveParams",
     "PRESETS",
     "preset",
@@ -281,6 +284,54 @@ class SimulationParams(_Params):
 
 
 @dataclass(frozen=True)
+class DisturbanceParams(_Params):
+    """Periodic disturbances of a real rig that the base model leaves out; all amplitudes 0 = off.
+
+    ``lead_error``: a kinematic error of the screw-nut pair, the nut advancing
+    ``theta Ph / 2 pi + a sin(2 pi (theta Ph / 2 pi) / period)`` (lead-error harmonic, ball-passage
+    waviness); the motor encoder cannot see it. ``load_ripple``: the axial load of the load case
+    (the paper's air cylinders) pulsates as ``Fx (1 + r sin(2 pi f t))``. See
+    :mod:`drakecreep.disturbance`.
+    """
+
+    lead_error_amplitude: float = _q(0.0, "m", 0.0, 1e-3, doc="amplitude a of the kinematic lead error")
+    lead_error_period: float = _q(
+        5.0e-3 / 12.0, "m", 0.0, 0.1, lo_open=True, doc="travel per cycle of the lead error"
+    )
+    load_ripple: float = _q(0.0, "-", 0.0, 1.0, doc="relative amplitude r of the axial load pulsation")
+    load_ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of the load pulsation")
+
+
+#: friction compensation methods (:mod:`drakecreep.compensation`)
+COMPENSATION_METHODS = ("none", "static", "lugre", "dob", "dither")
+
+
+@dataclass(frozen=True)
+class CompensationParams(_Params):
+    """Friction compensation added to the controller's torque command (:mod:`drakecreep.compensation`).
+
+    The compensator's friction model is the plant's nominal one (levels of the load case, shape of
+    ``friction``) times the ``*_factor`` mismatch factors (1 = exact model).
+    """
+
+    method: str = _q("none", "-", choices=COMPENSATION_METHODS, doc="compensation method")
+    coulomb_factor: float = _q(1.0, "-", 0.0, 10.0, doc="model Fc / plant Fc")
+    static_factor: float = _q(1.0, "-", 0.0, 10.0, doc="model Fs / plant Fs")
+    stribeck_velocity_factor: float = _q(1.0, "-", 0.0, 10.0, lo_open=True, doc="model vs / plant vs")
+    viscous_factor: float = _q(1.0, "-", 0.0, 10.0, doc="model Fv / plant Fv")
+    bristle_stiffness_factor: float = _q(1.0, "-", 0.0, 10.0, lo_open=True, doc="model sigma0 / plant sigma0")
+    bristle_damping_factor: float = _q(1.0, "-", 0.0, 10.0, doc="model sigma1 / plant sigma1")
+    inertia_factor: float = _q(1.0, "-", 0.0, 10.0, lo_open=True, doc="DOB nominal inertia / plant inertia")
+    observer_gain: float = _q(0.0, "-", 0.0, 1e3, doc="LuGre observer correction k (dz/dt -= k (v - v_ref))")
+    dob_bandwidth: float = _q(300.0, "rad/s", 0.0, 1e5, lo_open=True, doc="DOB Q-filter bandwidth")
+    dither_amplitude: float = _q(0.5, "-", 0.0, 10.0, doc="dither force amplitude / model Fc")
+    dither_frequency: float = _q(200.0, "Hz", 0.0, 1e4, lo_open=True, doc="dither frequency")
+    velocity_blend: float = _q(
+        0.0, "-", 0.0, 1.0, doc="static: share of the measured speed (0 = reference speed, feedforward)"
+    )
+
+
+@dataclass(frozen=True)
 class DriveParams(_Params):
     """Everything that defines a feed drive and how it is simulated."""
 
@@ -293,6 +344,8 @@ class DriveParams(_Params):
     controller: ControllerParams = field(default_factory=ControllerParams)
     sensors: SensorParams = field(default_factory=SensorParams)
     simulation: SimulationParams = field(default_factory=SimulationParams)
+    disturbance: DisturbanceParams = field(default_factory=DisturbanceParams)
+    compensation: CompensationParams = field(default_factory=CompensationParams)
 
     def load_case(self, number):
         """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load."""
@@ -366,7 +419,7 @@ def save_params(params, path):
     Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
 
 
-PRESETS = ("paper",)
+PRESETS = ("paper", "paper_calibrated")
 
 
 def preset_text(name="paper"):
