@@ -97,7 +97,7 @@ def initial_conditions(params, scenario):
     return dict(theta0=theta0, force0=force0, x_ref0=x_ref0, theta_counted0=theta_counted)
 
 
-def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
+def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, drive=None):
     """Wire the feed drive for ``scenario`` from ``params``.
 
     Parameters
@@ -109,6 +109,11 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
         ``params.controller.sampled``.
     ideal_sensors : bool
         Unquantized encoder and scale (for linearization).
+    drive : {"cascade", "constant_speed"}, optional
+        ``"cascade"``: controller + motor (the machine). ``"constant_speed"``: no controller; the motor
+        side turns at exactly the feed speed (:class:`~drakecreep.drive_source.ConstantSpeedDrive`, the
+        paper's Fig. 2); the controller's signals are then not recorded. Default: ``scenario.drive`` if
+        the scenario has one (:class:`~drakecreep.drive_source.DriveScenario`), else ``"cascade"``.
 
     Returns
     -------
@@ -116,6 +121,13 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
     """
     import dataclasses
 
+    from drakecreep.drive_source import DRIVES, ConstantSpeedDrive, motor_speed_for
+
+    drive = drive or getattr(scenario, "drive", "cascade")
+    if drive not in DRIVES:
+        from drakecreep.errors import InputError
+
+        raise InputError("drive", drive, "one of " + ", ".join(DRIVES))
     gains = params.controller
     if continuous is not None:
         gains = dataclasses.replace(gains, sampled=not continuous)
@@ -132,6 +144,9 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
         gains, params.screw.lead, force_limit(params), initial_force=ic["force0"], initial_angle=ic["theta_counted0"]
     )
     s["motor"] = Motor(params.motor, load_inertia=screw_inertia(params.screw), initial_state=motor_x0)
+    if drive == "constant_speed":
+        del s["controller"]
+        s["motor"] = ConstantSpeedDrive(motor_speed_for(scenario.feed, params.screw.lead), ic["theta0"])
     s["screw"] = ScrewDrive(params.screw, params.nut)
     s["table"] = NutTable(params, load)
     counts = 0 if ideal_sensors else params.sensors.encoder_counts_per_rev
@@ -142,10 +157,11 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
         builder.AddSystem(system)
 
     c = builder.Connect
-    c(s["reference"].GetOutputPort("reference"), s["controller"].GetInputPort("reference"))
-    c(s["encoder"].GetOutputPort("motor_measured"), s["controller"].GetInputPort("motor_measured"))
-    c(s["scale"].GetOutputPort("table_position_measured"), s["controller"].GetInputPort("table_position_measured"))
-    c(s["controller"].GetOutputPort("torque_command"), s["motor"].GetInputPort("torque_command"))
+    if "controller" in s:
+        c(s["reference"].GetOutputPort("reference"), s["controller"].GetInputPort("reference"))
+        c(s["encoder"].GetOutputPort("motor_measured"), s["controller"].GetInputPort("motor_measured"))
+        c(s["scale"].GetOutputPort("table_position_measured"), s["controller"].GetInputPort("table_position_measured"))
+        c(s["controller"].GetOutputPort("torque_command"), s["motor"].GetInputPort("torque_command"))
     c(s["screw"].GetOutputPort("load_torque"), s["motor"].GetInputPort("load_torque"))
     c(s["motor"].GetOutputPort("motor_state"), s["screw"].GetInputPort("motor_state"))
     c(s["table"].GetOutputPort("table_state"), s["screw"].GetInputPort("table_state"))
@@ -154,7 +170,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
     c(s["table"].GetOutputPort("table_state"), s["scale"].GetInputPort("table_state"))
 
     exported = set()
-    for _, (system, port, _), _ in SIGNALS:
+    signals = tuple(sig for sig in SIGNALS if sig[1][0] in s)
+    for _, (system, port, _), _ in signals:
         if (system, port) not in exported:
             builder.ExportOutput(s[system].GetOutputPort(port), f"{system}.{port}")
             exported.add((system, port))
@@ -162,7 +179,7 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False):
         builder.ExportOutput(s["table"].GetOutputPort("friction_state"), "table.friction_state")
     diagram = builder.Build()
     diagram.set_name("feed_drive")
-    signals = SIGNALS + tuple(
+    signals = signals + tuple(
         (f"friction_state_{i}", ("table", "friction_state", i), "-") for i in range(s["table"].law.num_states)
     )
     return FeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals)

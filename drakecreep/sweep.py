@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drakecreep.drive_source import scenario_with_drive
 from drakecreep.errors import InputError
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.scenario import Scenario
@@ -63,8 +64,9 @@ __all__ = [
     "plot_stability_map",
 ]
 
-#: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter
-SCENARIO_FIELDS = ("feed", "load_case", "duration")
+#: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter (``drive``:
+#: ``"cascade"`` or ``"constant_speed"``, see :class:`drakecreep.drive_source.DriveScenario`)
+SCENARIO_FIELDS = ("feed", "load_case", "duration", "drive")
 EXECUTORS = ("serial", "processes", "dask")
 #: bump when the meaning of a cached row changes (simulation semantics, report keys)
 CACHE_VERSION = 1
@@ -184,7 +186,7 @@ def make_cases(base, points, scenario=None, metric=None):
     points : list of dict
         ``{path: value}``; scenario fields override ``scenario``.
     scenario : Scenario or mapping, optional
-        Defaults of the scenario fields (default ``Scenario()``).
+        Defaults of the scenario fields (default ``Scenario()``); ``drive`` picks the drive.
     metric : callable, optional
         The function of the result (part of the cache key); default :func:`feed_report`.
 
@@ -209,7 +211,7 @@ def make_cases(base, points, scenario=None, metric=None):
                 fields[path] = value
             else:
                 params = with_value(params, path, value)
-        scen = Scenario(**fields)
+        scen = scenario_with_drive(**fields)
         if params.simulation.steady_start >= scen.duration:
             raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
         params.load_case(scen.load_case)  # validates the load case number
@@ -430,7 +432,7 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     points : list of dict
         From :func:`grid`, :func:`random_sample` or by hand.
     scenario : Scenario or mapping, optional
-        Defaults of ``feed``, ``load_case``, ``duration``.
+        Defaults of ``feed``, ``load_case``, ``duration``, ``drive``.
     metric : callable, optional
         ``metric(SimulationResult) -> dict``; a module-level function (it is pickled to the workers).
         Default :func:`feed_report`.
@@ -523,7 +525,7 @@ def _table(cases, rows, columns):
         for path, value in case.point.items():
             rec[path] = value
         for name in SCENARIO_FIELDS:
-            rec.setdefault(name, getattr(case.scenario, name))
+            rec.setdefault(name, getattr(case.scenario, name, "cascade"))
         row = rows.get(case.key, {})
         keep = row if columns is None else {k: row.get(k) for k in ["status", *columns] if k in row or k in columns}
         for k, v in keep.items():
