@@ -19,7 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder
 
+from drakecreep.compensation import add_compensation
 from drakecreep.controller import CascadeController, force_limit
+from drakecreep.disturbance import add_disturbances
 from drakecreep.motor import Motor
 from drakecreep.reference import FeedReference
 from drakecreep.screw import ScrewDrive, axial_stiffness, screw_inertia
@@ -156,16 +158,27 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         system.set_name(name)
         builder.AddSystem(system)
 
+    # optional disturbances and friction compensation (drakecreep.disturbance, drakecreep.compensation);
+    # both off by default, and then these are the plain input ports and the diagram is unchanged
+    ports = dict(
+        torque=s["motor"].GetInputPort("torque_command") if "controller" in s else None,
+        load_torque=s["motor"].GetInputPort("load_torque"),
+        nut_motion=s["screw"].GetInputPort("motor_state"), axial_force=s["table"].GetInputPort("axial_force"),
+    )
+    ports = add_disturbances(builder, s, params, scenario, ports, angle0=ic["theta0"])
+    if "controller" in s:
+        ports = add_compensation(builder, s, params, scenario, ports)
+
     c = builder.Connect
     if "controller" in s:
         c(s["reference"].GetOutputPort("reference"), s["controller"].GetInputPort("reference"))
         c(s["encoder"].GetOutputPort("motor_measured"), s["controller"].GetInputPort("motor_measured"))
         c(s["scale"].GetOutputPort("table_position_measured"), s["controller"].GetInputPort("table_position_measured"))
-        c(s["controller"].GetOutputPort("torque_command"), s["motor"].GetInputPort("torque_command"))
-    c(s["screw"].GetOutputPort("load_torque"), s["motor"].GetInputPort("load_torque"))
-    c(s["motor"].GetOutputPort("motor_state"), s["screw"].GetInputPort("motor_state"))
+        c(s["controller"].GetOutputPort("torque_command"), ports["torque"])
+    c(s["screw"].GetOutputPort("load_torque"), ports["load_torque"])
+    c(s["motor"].GetOutputPort("motor_state"), ports["nut_motion"])
     c(s["table"].GetOutputPort("table_state"), s["screw"].GetInputPort("table_state"))
-    c(s["screw"].GetOutputPort("axial_force"), s["table"].GetInputPort("axial_force"))
+    c(s["screw"].GetOutputPort("axial_force"), ports["axial_force"])
     c(s["motor"].GetOutputPort("motor_state"), s["encoder"].GetInputPort("motor_state"))
     c(s["table"].GetOutputPort("table_state"), s["scale"].GetInputPort("table_state"))
 
@@ -177,11 +190,16 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
             exported.add((system, port))
     if s["table"].law.num_states:
         builder.ExportOutput(s["table"].GetOutputPort("friction_state"), "table.friction_state")
+    compensation_signals = ()
+    if "compensator" in s:
+        builder.ExportOutput(s["compensator"].GetOutputPort("torque"), "compensator.torque")
+        compensation_signals = (("compensation_torque", ("compensator", "torque", 0), "N m"),)
     diagram = builder.Build()
     diagram.set_name("feed_drive")
     signals = signals + tuple(
         (f"friction_state_{i}", ("table", "friction_state", i), "-") for i in range(s["table"].law.num_states)
     )
+    signals = signals + compensation_signals
     return FeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals)
 
 

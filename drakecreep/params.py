@@ -298,8 +298,9 @@ class DisturbanceParams(_Params):
     lead_error_period: float = _q(
         5.0e-3 / 12.0, "m", 0.0, 0.1, lo_open=True, doc="travel per cycle of the lead error"
     )
+    force_ripple: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude A of a fixed-frequency force ripple on the table")
     load_ripple: float = _q(0.0, "-", 0.0, 1.0, doc="relative amplitude r of the axial load pulsation")
-    load_ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of the load pulsation")
+    ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")
 
 
 #: friction compensation methods (:mod:`drakecreep.compensation`)
@@ -328,6 +329,10 @@ class CompensationParams(_Params):
     dither_frequency: float = _q(200.0, "Hz", 0.0, 1e4, lo_open=True, doc="dither frequency")
     velocity_blend: float = _q(
         0.0, "-", 0.0, 1.0, doc="static: share of the measured speed (0 = reference speed, feedforward)"
+    )
+    velocity_source: str = _q(
+        "motor", "-", choices=("motor", "table"),
+        doc="measured speed of static/lugre: motor encoder (semi-closed) or table speed (ideal linear scale)",
     )
 
 

@@ -26,6 +26,7 @@ COMMANDS = [
     "hertz",
     "modal",
     "sweep",
+    "emps",
 ]
 
 
