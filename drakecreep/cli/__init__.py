@@ -27,6 +27,7 @@ COMMANDS = [
     "modal",
     "sweep",
     "emps",
+    "reproduce_paper", "compensate",
 ]
 
 

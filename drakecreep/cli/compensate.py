@@ -1,0 +1,70 @@
+"""``drakecreep compensate``: friction compensation methods against none over feeds and loads."""
+
+from drakecreep.cli._common import add_params_options, params_from_args, positive_float, print_json
+from drakecreep.errors import InputError
+from drakecreep.params import COMPENSATION_METHODS
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "compensate",
+        help="compare friction compensation methods (static, LuGre observer, DOB, dither) against none",
+        description=(
+            "Simulate each compensation method and no compensation at each feed and load case; report the speed "
+            "fluctuation, stick fraction and following error over the steady window, optionally the lowest feed "
+            "without creep (--critical) and the effect of a +-30 %% model error (--robustness). Writes "
+            "compensation.csv, summary.md, rows.json and comparison.png to --out."
+        ),
+    )
+    add_params_options(p)
+    p.add_argument("--method", action="append", choices=[m for m in COMPENSATION_METHODS if m != "none"],
+                   help="method to compare (repeatable; default all)")
+    p.add_argument("--feeds", default="0.05,0.1,0.2,0.5,1,2,5", metavar="MM_PER_S",
+                   help="comma-separated feeds in mm/s (default 0.05,0.1,0.2,0.5,1,2,5)")
+    p.add_argument("--load-cases", default="1,2,3", metavar="N", help="comma-separated load cases (default 1,2,3)")
+    p.add_argument("--duration", type=positive_float, default=2.0, metavar="S", help="simulated time per run (default 2)")
+    p.add_argument("--critical", action="store_true", help="also the lowest feed without creep (bisection)")
+    p.add_argument("--robustness", action="store_true", help="also the model off by +-30 %% in each parameter")
+    p.add_argument("--workers", type=int, default=2, metavar="N", help="processes (default 2)")
+    p.add_argument("--out", default="out/compensate", metavar="DIR", help="output folder")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=run)
+    return p
+
+
+def _list(text, option, kind, check, allowed):
+    try:
+        values = [kind(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise InputError(option, text, allowed) from None
+    if not values or not all(check(v) for v in values):
+        raise InputError(option, text, allowed)
+    return values
+
+
+def run(args):
+    from drakecreep.compensation import critical_speeds, evaluate, robustness, write_report
+    from drakecreep.scenario import MAX_FEED
+
+    params = params_from_args(args)
+    feeds = _list(args.feeds, "--feeds", float, lambda v: 0 < v <= MAX_FEED * 1e3,
+                  f"comma-separated feeds in (0, {MAX_FEED * 1e3:g}] mm/s")
+    n = len(params.loads.cases)
+    loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
+    if args.workers < 1:
+        raise InputError("--workers", args.workers, "an integer >= 1")
+    methods = ["none"] + list(dict.fromkeys(args.method or [m for m in COMPENSATION_METHODS if m != "none"]))
+    rows = evaluate(params, methods, feeds, loads, duration=args.duration, workers=args.workers)
+    crit = critical_speeds(params, methods, loads) if args.critical else None
+    robust = robustness(params, [m for m in methods if m != "none"], load_case=max(loads), duration=args.duration,
+                        workers=args.workers) if args.robustness else None
+    name = args.params or args.preset
+    paths = write_report(args.out, rows, crit, robust, name)
+    if args.json:
+        print_json(dict(rows=rows, critical=crit, robustness=robust, out={k: str(v) for k, v in paths.items()}))
+    else:
+        print(paths["markdown"].read_text(), end="")
+        print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0

@@ -1,0 +1,33 @@
+import json
+
+from drakecreep.cli import main
+
+
+def test_reproduce_paper_json_gives_the_six_rows(tmp_path, capsys):
+    assert main(["reproduce-paper", "--out", str(tmp_path), "--json", "--no-critical", "--no-plots"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["rows"]) == 6
+    for row in out["rows"]:
+        assert {"load_case", "feed_mm_s", "experiment_mm_s", "paper_sim_mm_s", "ours_mm_s", "calibrated"} <= set(row)
+    assert [r["row"] for r in out["rows"] if r["calibrated"]] == [4, 6]
+    assert (tmp_path / "table8_9.md").exists() and (tmp_path / "table8_9.csv").exists()
+
+
+def test_reproduce_paper_bad_calibration_rows_exit_2(tmp_path, capsys):
+    assert main(["reproduce-paper", "--out", str(tmp_path), "--calibrate", "3,5"]) == 2
+    assert "calibration_rows" in capsys.readouterr().err
+
+
+def test_compensate_json(tmp_path, capsys):
+    argv = ["compensate", "--method", "lugre", "--feeds", "1", "--load-cases", "3", "--duration", "0.8",
+            "--workers", "1", "--out", str(tmp_path), "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [r["method"] for r in out["rows"]] == ["none", "lugre"]
+    assert (tmp_path / "summary.md").exists() and (tmp_path / "comparison.png").exists()
+
+
+def test_compensate_bad_arguments_exit_2(tmp_path, capsys):
+    assert main(["compensate", "--feeds", "abc", "--out", str(tmp_path)]) == 2
+    assert main(["compensate", "--load-cases", "9", "--out", str(tmp_path)]) == 2
+    assert "--load-cases" in capsys.readouterr().err
