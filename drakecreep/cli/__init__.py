@@ -25,6 +25,7 @@ COMMANDS = [
     "critical",
     "hertz",
     "modal",
+    "margins", "tune", "report",
     "sweep",
     "emps",
     "reproduce_paper", "compensate",

@@ -1,0 +1,40 @@
+"""``drakecreep report``: a self-contained HTML servo-loop report (margins, Bode, Nyquist, loci, pole map, runs)."""
+
+from drakecreep.cli._common import add_params_options, number, params_from_args
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers):
+    """Register ``report``."""
+    p = subparsers.add_parser(
+        "report", help="HTML report: margins, Bode, Nyquist, root loci, pole map with the creep conditions",
+        description="Write DIR/index.html (plots embedded), DIR/margins.json and the PNGs.",
+    )
+    add_params_options(p)
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    p.add_argument("--feed", type=number, default=1.0, metavar="MM_PER_S", help="operating feed of the loop analysis (default 1)")
+    p.add_argument("--low-feed", type=number, default=0.1, metavar="MM_PER_S",
+                   help="low-speed feed of the simulation and the pole map (default 0.1)")
+    p.add_argument("--load-case", type=int, default=3, metavar="N", help="load case (default 3)")
+    p.add_argument("--no-sim-grid", action="store_true", help="skip the simulated creep markers on the pole map")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args):
+    """Build the report and print where it is."""
+    from drakecreep.cli._common import feed_from_mm_s
+    from drakecreep.cli.margins import scenario_from_args
+    from drakecreep.report import build_report
+
+    params = params_from_args(args)
+    scenario = scenario_from_args(args, params)
+    low = feed_from_mm_s(args.low_feed, "--low-feed")
+    source = args.params if args.params else f"preset {args.preset}"
+    if getattr(args, "friction", None):
+        source += f", friction law {args.friction}"
+    result = build_report(params, args.out, feed=scenario.feed, load_case=scenario.load_case, low_feed=low,
+                          source=source, sim_grid=None if args.no_sim_grid else (6, 6))
+    print(f"wrote {result['html']} ({result['timings']['total']:.1f} s)")
+    return 0
