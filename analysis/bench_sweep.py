@@ -12,7 +12,12 @@ Two measurements, both in this run, printed as ratios:
    sample like Drake's zero-order hold. Target: drakecreep within 10x. The numba port is checked
    against drakecreep on two cases (one steady, one creeping) so the ratio compares like with like.
 
+The throughput compares like with like on the same cases: numba case by case, drakecreep's batched
+path (:mod:`drakecreep.batch`, all cases in one Drake system: what ``run_sweep(batch_size=...)`` uses),
+and ``simulate()`` one case at a time.
+
 Run: ``python analysis/bench_sweep.py [--cases N] [--grid N] [--duration S] [--skip-map]``
+(needs the ``bench`` extra: ``pip install -e ".[bench]"`` for numba)
 """
 
 import argparse
@@ -198,34 +203,48 @@ def check_port(params):
               f"mean {r.metrics.mean_speed * 1e3:.4f} mm/s | numba {rate * 100:8.3f} %  mean {w.mean() * 1e3:.4f} mm/s")
 
 
-def throughput(params, n, duration):
+def throughput(params, n, duration, n_single=20):
+    """Case-seconds per wall second on one core: numba RK3, the batched Drake path, single simulate()."""
     feeds = np.geomspace(0.2e-3, 2e-3, n)
     scens = [Scenario(feed=float(f), load_case=3, duration=duration) for f in feeds]
     run_numba(params, scens[0])  # JIT compile (cached on disk) outside the timing
     start = time.perf_counter()
     steps_numba = sum(run_numba(params, s)[1] for s in scens)
     t_numba = time.perf_counter() - start
+    points = [dict(feed=float(f)) for f in feeds]
+    batch_size = max(2, n // 2)
     start = time.perf_counter()
-    steps_drake = sum(simulate(params, s).stats["steps"] for s in scens)
-    t_drake = time.perf_counter() - start
+    swept = run_sweep(params, points, scenario=dict(load_case=3, duration=duration), executor="serial",
+                      progress=False, batch_size=batch_size)
+    t_batch = time.perf_counter() - start
+    assert (swept.table["status"] == "ok").all()
+    single = scens[:: max(1, n // n_single)]
+    start = time.perf_counter()
+    steps_drake = sum(simulate(params, s).stats["steps"] for s in single)
+    t_single = (time.perf_counter() - start) * len(scens) / len(single)
     case_s = n * duration
-    print(f"throughput, {n} cases x {duration:g} s, one core each:")
-    print(f"  drakecreep simulate(): {t_drake:7.3f} s wall = {case_s / t_drake:8.1f} case-s/s  ({steps_drake} steps)")
-    print(f"  numba RK3:             {t_numba:7.3f} s wall = {case_s / t_numba:8.1f} case-s/s  ({steps_numba} steps)")
-    ratio = t_drake / t_numba
-    print(f"  RATIO drakecreep/numba time per case-second: {ratio:.1f}x  (target <= 10x: {'met' if ratio <= 10 else 'NOT met'})")
+    print(f"throughput, {n} cases x {duration:g} s (feeds 0.2-2 mm/s), one core:")
+    print(f"  numba RK3, case by case:         {t_numba:7.3f} s = {case_s / t_numba:8.1f} case-s/s  ({steps_numba} steps)")
+    print(f"  drakecreep run_sweep, batches of {batch_size}: {t_batch:7.3f} s = {case_s / t_batch:8.1f} case-s/s  "
+          f"(whole sweep call: cases, batches, metrics)")
+    print(f"  drakecreep simulate(), one by one: {t_single:5.3f} s = {case_s / t_single:8.1f} case-s/s  "
+          f"(timed on {len(single)} of the cases, {steps_drake} steps)")
+    ratio = t_batch / t_numba
+    print(f"  RATIO drakecreep (batched) / numba time per case-second: {ratio:.1f}x  "
+          f"(target <= 10x: {'met' if ratio <= 10 else 'NOT met'}); one by one: {t_single / t_numba:.1f}x")
     return ratio
 
 
-def map_400(params, n_grid, duration):
+def map_400(params, n_grid, duration, batch_size=None):
     points = grid({"nut.axial_stiffness": list(np.geomspace(5e6, 2e8, n_grid)),
                    "feed": list(np.geomspace(0.1e-3, 3e-3, n_grid))})
     start = time.perf_counter()
     result = run_sweep(params, points, scenario=dict(load_case=3, duration=duration), executor="processes",
-                       progress=True)
+                       progress=True, batch_size=batch_size)
     wall = time.perf_counter() - start
     ok = int((result.table["status"] == "ok").sum())
-    print(f"map: {len(points)} cases x {duration:g} s on {os.cpu_count()} processes: {wall:.1f} s wall "
+    how = f"in batches of {batch_size}" if batch_size else "case by case"
+    print(f"map: {len(points)} cases x {duration:g} s on {os.cpu_count()} processes, {how}: {wall:.1f} s wall "
           f"({ok} ok, {int(result.table['creep'].sum())} creeping)")
     print(f"  RATIO map wall / 60 s target: {wall / 60.0:.2f}  (target <= 1: {'met' if wall <= 60 else 'NOT met'})")
     return wall
@@ -233,7 +252,7 @@ def map_400(params, n_grid, duration):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cases", type=int, default=20, help="cases for the throughput comparison (default 20)")
+    ap.add_argument("--cases", type=int, default=400, help="cases for the throughput comparison (default 400)")
     ap.add_argument("--grid", type=int, default=20, help="map is grid x grid cases (default 20: 400)")
     ap.add_argument("--duration", type=float, default=2.0, help="simulated seconds per case (default 2)")
     ap.add_argument("--skip-map", action="store_true")
@@ -243,6 +262,7 @@ def main():
     throughput(params, args.cases, args.duration)
     if not args.skip_map:
         map_400(params, args.grid, args.duration)
+        map_400(params, args.grid, args.duration, batch_size=(args.grid * args.grid + 1) // 2)
 
 
 if __name__ == "__main__":

@@ -37,6 +37,9 @@ def add_parser(subparsers):
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default out/sweep)")
     p.add_argument("--retries", type=int, default=2, metavar="N", help="extra attempts of a failed case (default 2)")
+    p.add_argument("--batch", type=int, default=200, metavar="N",
+                   help="simulate up to N compatible cases together in one Drake system (default 200; "
+                        "1 = one case at a time)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=run)
     return p
@@ -49,6 +52,8 @@ def run(args):
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")
     if args.retries < 0:
         raise InputError("--retries", args.retries, "an integer >= 0")
+    if args.batch is not None and args.batch < 1:
+        raise InputError("--batch", args.batch, "an integer >= 1")
     spec = load_spec(args.spec)
     if args.scheduler:
         executor = "dask"
@@ -59,7 +64,7 @@ def run(args):
     result = run_sweep(
         spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
         scheduler=args.scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
-        columns=spec.metrics,
+        columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
     )
     paths = {k: str(v) for k, v in result.paths.items()}
     if spec.plot:
