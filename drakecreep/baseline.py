@@ -21,7 +21,24 @@ from scipy.integrate import solve_ivp
 
 from drakecreep.diagram import initial_conditions
 
-__all__ = ["BaselineModel", "simulate_baseline"]
+__all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
+
+
+def unsupported(params):
+    """Why these plain-Python equations cannot run ``params``: ``(field, value, allowed)``, or None.
+
+    They cover the base drive: no disturbances, no friction compensation, nut friction on the table.
+    """
+    p = params
+    if p.friction.nut_friction_on != "table":
+        return ("friction.nut_friction_on", p.friction.nut_friction_on,
+                "table (the plain-Python equations lump the nut's friction on the table)")
+    d = p.disturbance
+    if d.lead_error_amplitude > 0 or d.force_ripple > 0 or d.load_ripple > 0:
+        return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
+    if p.compensation.method != "none":
+        return ("compensation.method", p.compensation.method, "none (the plain-Python equations have no compensator)")
+    return None
 
 
 class BaselineModel:
@@ -29,6 +46,11 @@ class BaselineModel:
 
     def __init__(self, params, scenario, continuous=None):
         p = params
+        reason = unsupported(p)
+        if reason:
+            from drakecreep.errors import InputError
+
+            raise InputError(reason[0], reason[1], reason[2])
         self.p = p
         self.scenario = scenario
         self.sampled = p.controller.sampled if continuous is None else not continuous

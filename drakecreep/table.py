@@ -1,14 +1,21 @@
 """Nut and table on rolling guides, with friction whose level follows the load case.
 
-Friction level (Coulomb force) of the table, guides and nut lumped at the table::
+Friction levels (Coulomb force) of the guides and of the nut::
 
-    Fc = seal_force + mu_guide (m g + |Fz| + |Fy|) + 2 pi T_preload / Ph + mu_nut |Fx|
+    Fc = seal_force + mu_guide (m g + |Fz| + |Fy|)        guides and seals
+       + 2 pi T_preload / Ph + mu_nut |Fx|                 ball nut: preload drag + axial load
     Fs = static_ratio * Fc
 
-The nut friction acts between screw thread and nut; lumping it at the table is exact for the slip
-speed as long as the nut contact is stiff compared with the rest of the chain (here 51.6 N/um
-against ~8 N/um for the whole chain). The axial load ``Fx`` of the load case opposes the feed
-(+x) as a constant force, as the paper's air cylinders do.
+Where the nut's share acts is ``friction.nut_friction_on``:
+
+* ``"table"`` (default): lumped with the guides on the table, one friction law at the table speed.
+  Simple, and the slip speed is nearly the same (the nut contact is stiff: 51.6 N/um against ~8 N/um
+  for the whole chain), but the drag then loads the table rather than the screw.
+* ``"screw"``: as the drag torque it physically is, against the screw's rotation (on the motor side
+  of the screw's elasticity), in :mod:`drakecreep.nut_friction`; the table carries only the guides.
+
+The axial load ``Fx`` of the load case opposes the feed (+x) as a constant force, as the paper's air
+cylinders do.
 """
 
 import math
@@ -19,7 +26,7 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 from drakecreep._scalar import vector
 from drakecreep.friction import make_friction_law
 
-__all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels"]
+__all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels", "friction_split", "table_friction_levels"]
 
 
 def moving_mass(params):
@@ -37,6 +44,30 @@ def friction_levels(params, load):
         + params.nut.load_friction_coefficient * abs(load.fx)
     )
     return fc, params.friction.static_ratio * fc
+
+
+def friction_split(params, load):
+    """Coulomb levels (N) of the guides (seals + rolling guides) and of the nut (preload + axial load).
+
+    Returns
+    -------
+    guides, nut : float
+        Their sum is :func:`friction_levels`' ``Fc``.
+    """
+    normal = moving_mass(params) * params.loads.gravity + abs(load.fz) + abs(load.fy)
+    guides = params.table.seal_force + params.table.guide_friction_coefficient * normal
+    nut = 2.0 * math.pi * params.nut.preload_torque / params.screw.lead + params.nut.load_friction_coefficient * abs(load.fx)
+    return guides, nut
+
+
+def table_friction_levels(params, load):
+    """``(Fc, Fs)`` acting on the table: everything, or only the guides' share when
+    ``friction.nut_friction_on == "screw"`` (the nut's share then acts on the screw, see
+    :mod:`drakecreep.nut_friction`)."""
+    if params.friction.nut_friction_on == "screw":
+        fc = friction_split(params, load)[0]
+        return fc, params.friction.static_ratio * fc
+    return friction_levels(params, load)
 
 
 @TemplateSystem.define("NutTable_")
@@ -61,7 +92,7 @@ def NutTable_(T):
             self.load = load
             self.law = make_friction_law(params.friction)
             self.mass = moving_mass(params)
-            self.fc, self.fs = friction_levels(params, load)
+            self.fc, self.fs = table_friction_levels(params, load)
             n = 2 + self.law.num_states
             self.initial_state = [0.0] * n if initial_state is None else list(initial_state)
             if len(self.initial_state) != n:
