@@ -23,6 +23,7 @@ from drakecreep.compensation import add_compensation
 from drakecreep.controller import CascadeController, force_limit
 from drakecreep.disturbance import add_disturbances
 from drakecreep.motor import Motor
+from drakecreep.nut_friction import add_nut_friction
 from drakecreep.reference import FeedReference
 from drakecreep.screw import ScrewDrive, axial_stiffness, screw_inertia
 from drakecreep.sensors import LinearScale, MotorEncoder, encoder_resolution, quantize
@@ -166,6 +167,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         nut_motion=s["screw"].GetInputPort("motor_state"), axial_force=s["table"].GetInputPort("axial_force"),
     )
     ports = add_disturbances(builder, s, params, scenario, ports, angle0=ic["theta0"])
+    if drive != "constant_speed":
+        ports = add_nut_friction(builder, s, params, scenario, ports)
     if "controller" in s:
         ports = add_compensation(builder, s, params, scenario, ports)
 
@@ -190,6 +193,10 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
             exported.add((system, port))
     if s["table"].law.num_states:
         builder.ExportOutput(s["table"].GetOutputPort("friction_state"), "table.friction_state")
+    nut_signals = ()
+    if "nut_friction" in s:
+        builder.ExportOutput(s["nut_friction"].GetOutputPort("friction_force"), "nut_friction.friction_force")
+        nut_signals = (("nut_friction_force", ("nut_friction", "friction_force", 0), "N"),)
     compensation_signals = ()
     if "compensator" in s:
         builder.ExportOutput(s["compensator"].GetOutputPort("torque"), "compensator.torque")
@@ -199,7 +206,7 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     signals = signals + tuple(
         (f"friction_state_{i}", ("table", "friction_state", i), "-") for i in range(s["table"].law.num_states)
     )
-    signals = signals + compensation_signals
+    signals = signals + nut_signals + compensation_signals
     return FeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals)
 
 

@@ -225,6 +225,10 @@ class FrictionParams(_Params):
     regularization_velocity: float = _q(
         1.0e-6, "m/s", 0.0, 1.0, lo_open=True, doc="tanh width replacing sign() in coulomb/stribeck"
     )
+    nut_friction_on: str = _q(
+        "table", "-", choices=("table", "screw"),
+        doc="nut friction lumped on the table, or as a drag torque on the screw's rotation",
+    )
 
 
 @dataclass(frozen=True)

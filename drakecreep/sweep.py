@@ -279,13 +279,15 @@ def _work(unit, metric):
 
 def _batches(todo, batch_size, metric):
     """Group compatible cases into batches of at most ``batch_size``; the rest stay single cases."""
+    from drakecreep.baseline import unsupported
     from drakecreep.batch import batch_key
 
     if not batch_size or batch_size < 2 or metric is not feed_report:
         return list(todo)
     groups, units = {}, []
     for case in todo:
-        if getattr(case.scenario, "drive", "cascade") != "cascade" or not case.params.controller.sampled:
+        if (getattr(case.scenario, "drive", "cascade") != "cascade" or not case.params.controller.sampled
+                or unsupported(case.params) is not None):
             units.append(case)
         else:
             groups.setdefault(batch_key(case.params, case.scenario), []).append(case)
@@ -505,7 +507,8 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         Simulate up to this many compatible cases together in one Drake system
         (:mod:`drakecreep.batch`; several times the throughput for large sweeps). Only with the
         default metric; cases the batch path cannot run (constant-speed drive, continuous
-        controller) run one by one. The batches are the executors' units of work.
+        controller, disturbances, compensation, nut friction on the screw: see
+        :func:`drakecreep.baseline.unsupported`) run one by one. The batches are the executors' units of work.
 
     Returns
     -------
