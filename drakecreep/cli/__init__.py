@@ -29,6 +29,7 @@ COMMANDS = [
     "sweep",
     "emps",
     "reproduce_paper", "compensate",
+    "diagnose", "gap_benchmark",
 ]
 
 
