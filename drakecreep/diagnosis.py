@@ -359,7 +359,7 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
             out["orders"][name][axis] = {
                 "peak_order": float(orders[k]),
                 "peak_share": float(np.sum(psd[lo: k + 2]) / total) if total > 0 else 0.0,
-                "peak_ratio": float(psd[k] / np.median(psd[band])) if np.median(psd[band]) > 0 else 0.0,
+                "peak_ratio": _prominence(psd, k, idx[0]),
                 "at_band_edge": bool(k == idx[0])}
             out["spectra"][name][axis] = (orders, psd)
         ts = time_spectrum(cat[key], dt)
@@ -370,6 +370,13 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
         out["whiteness"] = whiteness(idim_residual, idim_input)
     out["sentences"] = _sentences(out)
     return out
+
+
+def _prominence(psd, k, lo, half=8):
+    """Peak over the median of its neighbourhood (``+-half`` bins, the peak's own 3 bins left out)."""
+    around = np.r_[psd[max(k - half, lo): max(k - 1, lo)], psd[k + 2: k + half + 1]]
+    med = float(np.median(around)) if around.size else 0.0
+    return float(psd[k] / med) if med > 0 else 0.0
 
 
 def _sentences(w):

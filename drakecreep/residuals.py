@@ -125,7 +125,8 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
     -------
     dict
         ``orders``, ``psd`` (arrays), ``peak_order``, ``peak_share`` (energy within +-1 bin of the peak /
-        total), ``peak_ratio`` (peak / median PSD), ``n_segments``.
+        total), ``peak_ratio`` (peak / median PSD of the 8 bins on either side, the peak's 3 bins left
+        out: a local prominence, insensitive to the low-pass filter's roll-off), ``n_segments``.
     """
     x, v, r = (np.asarray(a, dtype=float) for a in (x, v, residual))
     if period <= 0:
@@ -153,12 +154,13 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
         return {"orders": [], "psd": [], "peak_order": None, "peak_share": 0.0, "peak_ratio": 0.0, "n_segments": 0}
     psd = np.average(np.array(psds), axis=0, weights=weights)
     orders = f * period
-    band = orders >= 0.5
+    band = orders >= 0.75
     idx = np.flatnonzero(band)
     k = idx[np.argmax(psd[band])]
     total = float(np.sum(psd[band]))
-    share = float(np.sum(psd[max(k - 1, 0): k + 2]) / total) if total > 0 else 0.0
-    med = float(np.median(psd[band]))
+    share = float(np.sum(psd[max(k - 1, idx[0]): k + 2]) / total) if total > 0 else 0.0
+    around = np.r_[psd[max(k - 8, idx[0]): max(k - 1, idx[0])], psd[k + 2: k + 9]]
+    med = float(np.median(around)) if around.size else 0.0
     return {"orders": orders, "psd": psd, "peak_order": float(orders[k]), "peak_share": share,
             "peak_ratio": float(psd[k] / med) if med > 0 else 0.0, "n_segments": len(psds)}
 
