@@ -74,6 +74,8 @@ class DiagnosisConfig:
         Travel per screw / motor revolution [m]; ``motor_period`` defaults to the lead (direct drive).
     claim_score : float
         An effect is claimed when its penalized held-out score is below ``-claim_score``.
+    pair_claim_score : float
+        The same for the second effect of a pair (its score relative to the first one).
     min_gain : float
         ... and it removes at least this share of the held-out inverse-dynamics residual energy.
     max_effects : int
@@ -90,6 +92,7 @@ class DiagnosisConfig:
     screw_lead: float = 2.5e-3
     motor_period: float | None = None
     claim_score: float = 10.0
+    pair_claim_score: float = 10.0
     min_gain: float = 0.05
     max_effects: int = 2
     effects: tuple | None = None
@@ -453,8 +456,8 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
         ranking.append(fit)
     ranking.sort(key=lambda f: (not f.physical, f.score))
 
-    def claimable(f):
-        return f.physical and f.score < -cfg.claim_score and f.gain >= cfg.min_gain
+    def claimable(f, threshold=cfg.claim_score):
+        return f.physical and f.score < -threshold and f.gain >= cfg.min_gain
 
     claimed = []
     if ranking and claimable(ranking[0]):
@@ -470,7 +473,7 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
             pairs.sort(key=lambda f: (not f.physical, f.score))
             if pairs:
                 _log(cfg, f"best pair {pairs[0].label}: incremental score {pairs[0].score:+.1f}")
-            if pairs and claimable(pairs[0]):
+            if pairs and claimable(pairs[0], cfg.pair_claim_score):
                 claimed.append(pairs[0])
     final = claimed[-1] if claimed else base
     idim_test_nom = math.sqrt(base.sse_test / test.n)
