@@ -172,8 +172,7 @@ def simulate(params, scenario, *, backend=None):
     simulator = make_simulator(root, context, sim)
     status = "ok"
     try:
-        # one extra half log period so the last log sample at `duration` is taken
-        simulator.AdvanceTo(scenario.duration)
+        simulator.AdvanceTo(scenario.duration)  # the log's periodic publish lands on `duration` too
     except RuntimeError as err:
         status = f"integration stopped at t = {context.get_time():.6g} s: {str(err).splitlines()[0]}"
     wall = time.perf_counter() - start
