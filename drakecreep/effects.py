@@ -30,7 +30,7 @@ from scipy import signal
 
 from drakecreep.errors import InputError
 from drakecreep.idim import filtered_derivatives
-from drakecreep.replay import RigidModel, rigid_step
+from drakecreep.replay import RigidModel, SampledPPController, rigid_step
 
 __all__ = [
     "EffectContext",
@@ -272,8 +272,6 @@ def replay_with_effects(run, model, terms=(), initial_velocity=None):
     x_ref = run.x_ref
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(n)
     gain = run.u_gain
-    kp, kv, sat = ctrl.kp, ctrl.kv, ctrl.saturation
-    taps = ctrl.position_filter
     x = float(run.x_motor[0])
     for m in measures:  # start from the true position whose measurement is the first sample
         x = x - (m(x) - x)
@@ -285,24 +283,15 @@ def replay_with_effects(run, model, terms=(), initial_velocity=None):
             y = m(y) if m is not None else y
         return y
 
-    q0 = meas(x)
-    past = [q0 - (i + 1) * v * h for i in range(len(taps))]
-    qf_prev = sum(c * p for c, p in zip(taps, past))
+    controller = SampledPPController(ctrl, h, meas(x), v, run.u[:delay])
     xs, vs, us = np.empty(n), np.empty(n), np.empty(n)
     ua = np.empty(n)
-    queue = [float(a) for a in run.u[:delay]]
     models = {}
     last_sign, last_x = 0.0, x
     a_prev = 0.0
     for k in range(n):
         q = meas(x)
-        hist = [q] + past[: len(taps) - 1]
-        qf = sum(c * p for c, p in zip(taps, hist))
-        dq = (qf - qf_prev) / h
-        u = kp * kv * (x_ref[k] - q) - kv * dq
-        u = min(max(u, -sat), sat)
-        queue.append(u)
-        applied = queue.pop(0)
+        u, applied = controller.step(x_ref[k], q)
         force = gain * applied + f_ext[k]
         dm = 0.0
         if masses:
@@ -319,8 +308,6 @@ def replay_with_effects(run, model, terms=(), initial_velocity=None):
             mdl = RigidModel(M=max(model.M + dm, 1e-3 * model.M), Fv=model.Fv, Fc=model.Fc, offset=model.offset)
             models[key] = mdl
         xs[k], vs[k], us[k], ua[k] = q, v, u, applied
-        past = [q] + past[:-1]
-        qf_prev = qf
         v_old = v
         x, v = rigid_step(mdl, x, v, force - extra, h)
         a_prev = (v - v_old) / h

@@ -38,6 +38,7 @@ __all__ = [
     "RigidModel",
     "ReplayResult",
     "rigid_step",
+    "SampledPPController",
     "replay",
     "replay_errors",
 ]
@@ -178,6 +179,48 @@ class ReplayResult:
         return float(np.mean(np.abs(self.u_sim) >= sat)) if math.isfinite(sat) else 0.0
 
 
+class SampledPPController:
+    """The documented EMPS cascade, one sample at a time.
+
+    ``u = kp kv (x_ref - q) - kv dq``, with ``dq`` the first difference of the position filtered by
+    ``position_filter`` taps, saturated, and applied after ``delay`` samples (the queue starts with
+    the recorded outputs). Shared by :func:`replay` and :func:`drakecreep.effects.replay_with_effects`.
+
+    Parameters
+    ----------
+    ctrl : controller metadata (``kp``, ``kv``, ``saturation``, ``position_filter``)
+    h : float
+        Sample time (s).
+    q0, v0 : float
+        Measured position (m) and speed (m/s) at the first sample; the filter's memory starts on the
+        line through them.
+    history : sequence of float
+        Recorded outputs that fill the delay queue (its length is the delay in samples).
+    """
+
+    def __init__(self, ctrl, h, q0, v0, history=()):
+        self.kp, self.kv, self.saturation = ctrl.kp, ctrl.kv, ctrl.saturation
+        self.taps = ctrl.position_filter
+        self.h = h
+        # past measured positions (newest first) and the previous filtered position
+        self.past = [q0 - (i + 1) * v0 * h for i in range(len(self.taps))]
+        self.qf_prev = sum(c * p for c, p in zip(self.taps, self.past))
+        self.queue = [float(u) for u in history]
+
+    def step(self, x_ref, q):
+        """Controller output for reference ``x_ref`` and measured position ``q``: ``(u, u_applied)``."""
+        hist = [q] + self.past[: len(self.taps) - 1]
+        qf = sum(c * p for c, p in zip(self.taps, hist))
+        dq = (qf - self.qf_prev) / self.h
+        u = self.kp * self.kv * (x_ref - q) - self.kv * dq
+        u = min(max(u, -self.saturation), self.saturation)
+        self.queue.append(u)
+        applied = self.queue.pop(0)
+        self.past = [q] + self.past[:-1]
+        self.qf_prev = qf
+        return u, applied
+
+
 def replay(run, model, controller=None, quantize=False, initial_velocity=None, delay=0):
     """Replay a measured run in closed loop with a rigid model.
 
@@ -221,29 +264,16 @@ def replay(run, model, controller=None, quantize=False, initial_velocity=None, d
     x_ref = run.x_ref
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(n)
     gain = run.u_gain
-    kp, kv, sat = ctrl.kp, ctrl.kv, ctrl.saturation
-    taps = ctrl.position_filter
     x = float(run.x_motor[0])
     v = float(run.x_motor[1] - run.x_motor[0]) / h if initial_velocity is None else float(initial_velocity)
-    # controller memory: past measured positions (newest first) and the previous filtered position
-    past = [x - (i + 1) * v * h for i in range(len(taps))]
-    qf_prev = sum(c * p for c, p in zip(taps, past[: len(taps)]))
+    controller = SampledPPController(ctrl, h, x, v, run.u[:delay])
     xs, vs, acc, us, ua = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    queue = [float(x) for x in run.u[:delay]]
     for k in range(n):
         q = round(x / res) * res if res > 0 else x
-        hist = [q] + past[: len(taps) - 1]
-        qf = sum(c * p for c, p in zip(taps, hist))
-        dq = (qf - qf_prev) / h
-        u = kp * kv * (x_ref[k] - q) - kv * dq
-        u = min(max(u, -sat), sat)
-        queue.append(u)
-        applied = queue.pop(0)
+        u, applied = controller.step(x_ref[k], q)
         force = gain * applied + f_ext[k]
         xs[k], vs[k], us[k], ua[k] = x, v, u, applied
         acc[k] = model.acceleration(v, force)
-        past = [q] + past[:-1]
-        qf_prev = qf
         x, v = rigid_step(model, x, v, force, h)
     return ReplayResult(run=run, model=model, x_sim=xs, v_sim=vs, a_sim=acc, u_sim=us,
                         force_sim=gain * ua + f_ext, delay=delay)
