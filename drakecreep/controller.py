@@ -59,8 +59,8 @@ def CascadeController_(T):
             self.initial_angle = float(initial_angle)
             self.ratio = self.lead / (2.0 * math.pi)
             g = gains
-            self.tracking = 1.0 / (g.velocity_gain / g.velocity_integral_gain) if (
-                g.anti_windup and g.velocity_integral_gain > 0.0) else 0.0
+            # back-calculation with tracking time Tt = kv / ki: the rate 1 / Tt
+            self.tracking = g.velocity_integral_gain / g.velocity_gain if g.anti_windup else 0.0
             self.DeclareVectorInputPort("reference", 2)
             self.DeclareVectorInputPort("motor_measured", 2)
             self.DeclareVectorInputPort("table_position_measured", 1)

@@ -36,13 +36,7 @@ def moving_mass(params):
 
 def friction_levels(params, load):
     """Coulomb and breakaway friction forces ``(Fc, Fs)`` in N for a :class:`~drakecreep.params.LoadCase`."""
-    normal = moving_mass(params) * params.loads.gravity + abs(load.fz) + abs(load.fy)
-    fc = (
-        params.table.seal_force
-        + params.table.guide_friction_coefficient * normal
-        + 2.0 * math.pi * params.nut.preload_torque / params.screw.lead
-        + params.nut.load_friction_coefficient * abs(load.fx)
-    )
+    fc = sum(friction_split(params, load))
     return fc, params.friction.static_ratio * fc
 
 
