@@ -149,10 +149,18 @@ class LuGreFriction(FrictionLaw):
         return stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
 
     def deflection_rate(self, v, w, Fc, Fs):
-        """``dz/dt`` (m/s) of the bristles for the normalized state ``w``."""
+        """``dz/dt`` (m/s) of the bristles for the normalized state ``w``.
+
+        With no dry friction (``Fc = Fs = 0``, e.g. frictionless guides) the bristles relax
+        infinitely fast, ``z = 0``: the rate is 0 and the state stays put.
+        """
+        if Fc <= 0.0 and Fs <= 0.0:
+            return 0.0 * v
         return v - fabs(v) * w[0] * Fc / self._g(v, Fc, Fs)
 
     def state_rates(self, v, w, Fc, Fs):
+        if Fc <= 0.0:
+            return [0.0 * v]
         return [self.bristle_stiffness / Fc * self.deflection_rate(v, w, Fc, Fs)]
 
     def force(self, v, w, Fc, Fs):

@@ -59,3 +59,11 @@ def test_one_source_for_float_autodiff_and_symbolic(law):
 def test_make_friction_law_from_params(paper):
     law = make_friction_law(paper.friction)
     assert isinstance(law, LuGreFriction) and law.bristle_stiffness == paper.friction.bristle_stiffness
+
+
+def test_lugre_without_dry_friction_is_viscous_only():
+    # frictionless guides with the nut's share on the screw leave Fc = Fs = 0 on the table: the
+    # zero-friction limit (bristles relax at once), not a division by zero
+    law = LuGreFriction(bristle_stiffness=1e8, bristle_damping=2e3, **COMMON)
+    assert law.force(2e-4, [0.0], 0.0, 0.0) == pytest.approx(150.0 * 2e-4)
+    assert law.state_rates(2e-4, [0.0], 0.0, 0.0) == [0.0]
