@@ -46,8 +46,9 @@ def stick_slip(speed, feed, threshold):
     """Stick fraction and number of stick-slip cycles of a speed record.
 
     Speeds are taken in the feed direction. The table is stuck while it moves slower than
-    ``threshold * |feed|`` (including a presliding rebound backwards); it must exceed twice that to
-    count as slipping again (hysteresis, so that noise at the threshold is not counted as cycles).
+    ``threshold * |feed|`` (including a presliding rebound backwards); it must exceed the feed itself
+    to count as slipping again. A slip that makes up for a stick overshoots the feed, while noise at the
+    threshold and the ringing after a slip do not, so they are not counted as cycles.
     A cycle is one entry into sticking from slipping.
 
     Returns
@@ -62,7 +63,7 @@ def stick_slip(speed, feed, threshold):
     cycles = 0
     stuck = bool(stuck_samples[0])
     for value in v[1:]:
-        if stuck and value > 2.0 * low:
+        if stuck and value > abs(feed):
             stuck = False
         elif not stuck and value < low:
             stuck = True

@@ -26,6 +26,16 @@ def test_stick_slip_counts_cycles_with_hysteresis():
     assert stick_slip(-v, -feed, 0.05)[1] == 10  # a negative feed is the same creep
 
 
+def test_ringing_after_a_slip_is_not_a_new_cycle():
+    # integral-action stick-slip: each slip overshoots the feed, then rings about zero below it
+    t = np.linspace(0, 1, 20001)
+    feed = 1e-4
+    phase = (t * 4) % 1.0  # 4 slips per second
+    slip = 3 * feed * np.sin(np.pi * phase / 0.3) * (phase < 0.3)
+    ring = 0.6 * feed * np.sin(2 * np.pi * 40 * t) * np.exp(-(phase - 0.3) / 0.05) * (phase >= 0.3)
+    assert stick_slip(slip + ring, feed, 0.05)[1] == 4
+
+
 def test_following_error_and_window():
     assert following_error([1.0, 2.0], [0.5, 2.0]) == pytest.approx((0.5, np.sqrt(0.125)))
     t = np.linspace(0, 2, 201)
