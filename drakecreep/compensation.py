@@ -44,7 +44,7 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 from drakecreep._scalar import exp, fabs, tanh
 from drakecreep.disturbance import sin
 from drakecreep.errors import InputError
-from drakecreep.params import COMPENSATION_METHODS, with_value
+from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS, with_value
 from drakecreep.screw import screw_inertia
 from drakecreep.table import friction_levels, moving_mass
 
@@ -63,6 +63,8 @@ __all__ = [
     "add_compensation",
     "MISMATCH_FIELDS",
     "with_method",
+    "VARIANTS",
+    "method_names",
     "rigid_inertia",
     "DEFAULT_FEEDS_MM_S",
     "DEFAULT_METHODS",
@@ -336,10 +338,24 @@ MISMATCH_FIELDS = {
 }
 
 
+#: named evaluation variants of a method: label -> (method, compensation settings)
+VARIANTS = COMPENSATION_VARIANTS
+
+
+def method_names():
+    """Every name :func:`with_method` takes: the methods of ``compensation.method`` and :data:`VARIANTS`."""
+    return tuple(COMPENSATION_METHODS) + tuple(VARIANTS)
+
+
 def with_method(params, method, **settings):
-    """``params`` with ``compensation.method = method`` and other compensation fields set."""
-    if method not in COMPENSATION_METHODS:
-        raise InputError("method", method, "one of " + ", ".join(COMPENSATION_METHODS))
+    """``params`` with ``compensation.method = method`` and other compensation fields set.
+
+    ``method`` may also name a :data:`VARIANTS` entry, whose settings come first (``settings`` override).
+    """
+    _check_method(method)
+    if method in VARIANTS:
+        method, preset_settings = VARIANTS[method]
+        settings = {**preset_settings, **settings}
     out = with_value(params, "compensation.method", method)
     for key, value in settings.items():
         out = with_value(out, f"compensation.{key}", value)
@@ -349,7 +365,7 @@ def with_method(params, method, **settings):
 #: feed grid of the comparison (mm/s)
 DEFAULT_FEEDS_MM_S = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0)
 #: methods compared, the baseline first
-DEFAULT_METHODS = ("none", "static", "lugre", "dob", "dither")
+DEFAULT_METHODS = COMPENSATION_STUDY_METHODS
 #: metric keys of one evaluation row (report units)
 EVAL_KEYS = ("max_fluctuation_mm_s", "fluctuation_rate_percent", "stick_fraction", "creep",
              "following_error_max_um", "following_error_rms_um")
@@ -362,7 +378,7 @@ def _run_one(job):
 
     params, label, feed_mm_s, load_case, duration = job
     res = simulate(params, Scenario(feed=feed_mm_s * 1e-3, load_case=load_case, duration=duration))
-    row = dict(label=label, method=params.compensation.method, load_case=load_case, feed_mm_s=feed_mm_s,
+    row = dict(label=label, method=label.split(" ")[0], load_case=load_case, feed_mm_s=feed_mm_s,
                status=res.status)
     report = res.metrics.report() if res.metrics is not None else {}
     row.update({k: report.get(k, float("nan")) for k in EVAL_KEYS})
@@ -380,8 +396,8 @@ def _map(jobs, workers):
 
 
 def _check_method(method):
-    if method not in COMPENSATION_METHODS:
-        raise InputError("method", method, "one of " + ", ".join(COMPENSATION_METHODS))
+    if method not in COMPENSATION_METHODS and method not in VARIANTS:
+        raise InputError("method", method, "one of " + ", ".join(method_names()))
 
 
 def evaluate(params, methods=DEFAULT_METHODS, feeds_mm_s=DEFAULT_FEEDS_MM_S, load_cases=(1, 2, 3), duration=2.0,
@@ -426,7 +442,7 @@ def critical_speed(params, method, load_case, **kwargs):
     return _critical(with_method(params, method), load_case, **kwargs)
 
 
-def robustness(params, methods=("static", "lugre", "dob", "dither"), feeds_mm_s=(0.1, 0.2), load_case=3,
+def robustness(params, methods=DEFAULT_METHODS[1:], feeds_mm_s=(0.1, 0.2), load_case=3,
                factors=(0.7, 1.3), duration=2.0, workers=1):
     """The compensator's model off by each factor in each of its parameters (:data:`MISMATCH_FIELDS`).
 
@@ -442,7 +458,7 @@ def robustness(params, methods=("static", "lugre", "dob", "dither"), feeds_mm_s=
     configs = [("none", with_method(base, "none"))]
     for m in methods:
         configs.append((f"{m} nominal", with_method(base, m)))
-        for name in MISMATCH_FIELDS[m]:
+        for name in MISMATCH_FIELDS[VARIANTS[m][0] if m in VARIANTS else m]:
             for factor in factors:
                 configs.append((f"{m} {name} x{factor:g}", with_method(base, m, **{name: factor})))
     jobs = [(p, label, float(f), load_case, duration) for label, p in configs for f in feeds_mm_s]
@@ -451,13 +467,29 @@ def robustness(params, methods=("static", "lugre", "dob", "dither"), feeds_mm_s=
     return rows
 
 
-def critical_speeds(params, methods=DEFAULT_METHODS, load_cases=(1, 2, 3), **kwargs):
-    """Lowest feed without creep (mm/s) per method and load case: rows ``method, load_case, critical_mm_s``."""
-    return [dict(method=m, load_case=lc, critical_mm_s=critical_speed(params, m, lc, **kwargs) * 1e3)
+def critical_speeds(params, methods=DEFAULT_METHODS, load_cases=(1, 2, 3), lo=0.01e-3, **kwargs):
+    """Lowest feed without creep (mm/s) per method and load case.
+
+    Returns
+    -------
+    list of dict
+        Rows ``method, load_case, critical_mm_s, lowest_tested_mm_s``; ``critical_mm_s`` is 0 when no
+        feed down to ``lo`` creeps (see :func:`drakecreep.paper_reproduction.critical_speed`).
+    """
+    return [dict(method=m, load_case=lc, critical_mm_s=critical_speed(params, m, lc, lo=lo, **kwargs) * 1e3,
+                 lowest_tested_mm_s=lo * 1e3)
             for m in methods for lc in load_cases]
 
 
-def plot_comparison(rows, path):
+def _critical_cell(row):
+    if row["critical_mm_s"] > 0:
+        return f"{row['critical_mm_s']:.4f}"
+    if row["critical_mm_s"] == 0:
+        return f"no creep down to {row.get('lowest_tested_mm_s', 0.01):g}"
+    return "creeps at every feed tested"
+
+
+def plot_comparison(rows, path, title=None):
     """Fluctuation and stick fraction against feed, one column per load case, one line per method."""
     import matplotlib
 
@@ -465,11 +497,11 @@ def plot_comparison(rows, path):
     import matplotlib.pyplot as plt
 
     loads = sorted({r["load_case"] for r in rows})
-    methods = list(dict.fromkeys(r["method"] for r in rows))
+    methods = list(dict.fromkeys(r["label"] for r in rows))
     fig, axes = plt.subplots(2, len(loads), figsize=(4.2 * len(loads), 7), squeeze=False, constrained_layout=True)
     for j, lc in enumerate(loads):
         for m in methods:
-            sel = sorted((r for r in rows if r["load_case"] == lc and r["method"] == m), key=lambda r: r["feed_mm_s"])
+            sel = sorted((r for r in rows if r["load_case"] == lc and r["label"] == m), key=lambda r: r["feed_mm_s"])
             f = [r["feed_mm_s"] for r in sel]
             axes[0, j].loglog(f, [r["fluctuation_rate_percent"] for r in sel], "o-", ms=3, label=m)
             axes[1, j].semilogx(f, [r["stick_fraction"] * 100 for r in sel], "o-", ms=3, label=m)
@@ -478,6 +510,8 @@ def plot_comparison(rows, path):
         axes[1, j].set_ylabel("stick fraction (%)")
         axes[1, j].set_xlabel("feed (mm/s)")
     axes[0, 0].legend(fontsize=7)
+    if title:
+        fig.suptitle(title, fontsize=10)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
@@ -499,8 +533,8 @@ def summary_markdown(rows, critical=None, robust=None, params_name="paper"):
                   "| method | " + " | ".join(f"load case {lc}" for lc in loads) + " |",
                   "| --- |" + " --- |" * len(loads)]
         for m in dict.fromkeys(c["method"] for c in critical):
-            vals = {c["load_case"]: c["critical_mm_s"] for c in critical if c["method"] == m}
-            lines.append(f"| {m} | " + " | ".join(f"{vals[lc]:.4f}" for lc in loads) + " |")
+            cells = {c["load_case"]: _critical_cell(c) for c in critical if c["method"] == m}
+            lines.append(f"| {m} | " + " | ".join(cells[lc] for lc in loads) + " |")
     if robust:
         lines += ["", "## Robustness: the compensator's model off by a factor (load case "
                   f"{robust[0]['load_case']})", "",
@@ -530,5 +564,5 @@ def write_report(out_dir, rows, critical=None, robust=None, params_name="paper")
                 writer.writerow(dict(r, study=study))
     paths["markdown"].write_text(summary_markdown(rows, critical, robust, params_name))
     paths["json"].write_text(json.dumps(dict(rows=rows, critical=critical, robustness=robust), indent=2) + "\n")
-    plot_comparison(rows, paths["plot"])
+    plot_comparison(rows, paths["plot"], f"Friction compensation against none ({params_name})")
     return paths

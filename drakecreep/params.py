@@ -309,6 +309,14 @@ class DisturbanceParams(_Params):
 
 #: friction compensation methods (:mod:`drakecreep.compensation`)
 COMPENSATION_METHODS = ("none", "static", "lugre", "dob", "dither")
+#: named variants of a method for evaluations: label -> (method, compensation settings)
+COMPENSATION_VARIANTS = {
+    # the static model at the measured speed instead of the reference: model-based feedback rather
+    # than feedforward (Armstrong-Helouvry, Dupont, Canudas de Wit, Automatica 30(7), 1994, sec. 6)
+    "static-measured": ("static", {"velocity_blend": 1.0}),
+}
+#: the methods a compensation study compares by default, the baseline first
+COMPENSATION_STUDY_METHODS = ("none", "static", "static-measured", "lugre", "dob", "dither")
 
 
 @dataclass(frozen=True)
@@ -428,7 +436,7 @@ def save_params(params, path):
     Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
 
 
-PRESETS = ("paper", "paper_calibrated")
+PRESETS = ("paper", "paper_calibrated", "rigid_axis")
 
 
 def preset_text(name="paper"):

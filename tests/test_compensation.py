@@ -2,11 +2,14 @@ import math
 
 import pytest
 
-from drakecreep.compensation import compensator_model, critical_speed, evaluate, rigid_inertia, robustness, with_method
+from drakecreep.compensation import (
+    DEFAULT_METHODS, compensator_model, critical_speed, evaluate, rigid_inertia, robustness, summary_markdown,
+    with_method,
+)
 from drakecreep.compiled import compile_diagram
 from drakecreep.diagram import build_diagram
 from drakecreep.errors import InputError
-from drakecreep.params import with_value
+from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.simulation import simulate
 
@@ -64,6 +67,61 @@ def test_no_motor_side_compensator_removes_the_table_mode_creep(short_paper):
     rows = evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,), duration=1.0)
     assert all(r["creep"] for r in rows)
     assert all(r["stick_fraction_vs_none"] > 0.9 for r in rows)
+
+
+@pytest.fixture(scope="module")
+def within_reach():
+    """The ``rigid_axis`` preset: friction within the loop's reach (rigid transmission, kv below the slope)."""
+    rows = evaluate(preset("rigid_axis"), DEFAULT_METHODS, feeds_mm_s=(0.02, 0.05, 0.1), load_cases=(3,),
+                    duration=2.0)
+    return {(r["label"], r["feed_mm_s"]): r for r in rows}
+
+
+def test_rigid_axis_creeps_without_compensation(within_reach):
+    assert all(within_reach[("none", f)]["creep"] for f in (0.02, 0.05, 0.1))
+
+
+@pytest.mark.parametrize("method", ["static-measured", "lugre", "dob"])
+@pytest.mark.parametrize("feed", [0.05, 0.1])
+def test_model_based_compensators_remove_creep_within_reach(within_reach, method, feed):
+    # the issue's test, on the drive where the friction is within the loop's reach: nominal model
+    r = within_reach[(method, feed)]
+    assert not r["creep"]
+    assert r["fluctuation_vs_none"] < 0.05
+    assert r["following_error_max_um"] < 0.3 * within_reach[("none", feed)]["following_error_max_um"]
+
+
+def test_feedforward_and_dither_do_not_remove_creep_within_reach(within_reach):
+    # static feedforward at the reference speed is a constant at a constant feed: it cannot change
+    # the negative slope that drives the stick-slip; dither helps only at the lowest feed
+    for feed in (0.05, 0.1):
+        assert within_reach[("static", feed)]["creep"] and within_reach[("static", feed)]["fluctuation_vs_none"] > 0.9
+        assert within_reach[("dither", feed)]["creep"] and within_reach[("dither", feed)]["fluctuation_vs_none"] > 0.9
+    assert within_reach[("dither", 0.02)]["fluctuation_vs_none"] < 0.5
+    # the measured-speed model chatters about zero speed at the lowest feed
+    assert within_reach[("static-measured", 0.02)]["fluctuation_vs_none"] > 1.0
+
+
+def test_lugre_lowers_the_critical_speed_within_reach():
+    rigid = preset("rigid_axis")
+    none, lugre = critical_speed(rigid, "none", 3), critical_speed(rigid, "lugre", 3)
+    assert 0.1e-3 < none < 0.3e-3
+    assert lugre < 0.25 * none
+
+
+def test_variant_rows_are_labelled_and_summarised(within_reach):
+    rows = list(within_reach.values())
+    assert {r["label"] for r in rows} == set(DEFAULT_METHODS)
+    assert within_reach[("static-measured", 0.05)]["method"] == "static-measured"
+    text = summary_markdown(rows, critical=[dict(method="dob", load_case=3, critical_mm_s=0.0, lowest_tested_mm_s=0.01)])
+    assert "| static-measured | 3 | 0.05 |" in text
+    assert "no creep down to 0.01" in text
+
+
+def test_with_method_applies_a_variant(short_paper):
+    p = with_method(short_paper, "static-measured")
+    assert p.compensation.method == "static" and p.compensation.velocity_blend == 1.0
+    assert with_method(short_paper, "static-measured", velocity_blend=0.5).compensation.velocity_blend == 0.5
 
 
 def test_robustness_labels_every_mismatch(short_paper):

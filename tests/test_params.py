@@ -23,6 +23,21 @@ def test_every_assumed_value_in_the_preset_names_a_source():
             assert len(comment) > 10, line
 
 
+def test_rigid_axis_differs_from_paper_only_where_marked(paper):
+    # the compensation study variant: every changed value carries a [variant] comment
+    text = preset_text("rigid_axis")
+    marked = {line.split(":")[0].strip() for line in text.splitlines() if "[variant]" in line and not line.startswith("#")}
+    assert marked == {"bearing_stiffness", "axial_stiffness", "velocity_gain", "velocity_integral_gain"}
+    rigid = preset("rigid_axis")
+    changed = {"screw.bearing_stiffness", "nut.axial_stiffness", "controller.velocity_gain",
+               "controller.velocity_integral_gain"}
+    for path in changed:
+        assert get_value(rigid, path) != get_value(paper, path)
+    for path in changed:
+        rigid = with_value(rigid, path, get_value(paper, path))
+    assert rigid == paper
+
+
 def test_yaml_round_trip_is_identical(tmp_path, paper):
     path = tmp_path / "p.yaml"
     save_params(paper, path)

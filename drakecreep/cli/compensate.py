@@ -2,7 +2,7 @@
 
 from drakecreep.cli._common import add_params_options, params_from_args, positive_float, print_json
 from drakecreep.errors import InputError
-from drakecreep.params import COMPENSATION_METHODS
+from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS
 
 __all__ = ["add_parser", "run"]
 
@@ -14,13 +14,16 @@ def add_parser(subparsers):
         description=(
             "Simulate each compensation method and no compensation at each feed and load case; report the speed "
             "fluctuation, stick fraction and following error over the steady window, optionally the lowest feed "
-            "without creep (--critical) and the effect of a +-30 %% model error (--robustness). Writes "
+            "without creep (--critical) and the effect of a +-30 % model error (--robustness). Writes "
             "compensation.csv, summary.md, rows.json and comparison.png to --out."
         ),
     )
     add_params_options(p)
-    p.add_argument("--method", action="append", choices=[m for m in COMPENSATION_METHODS if m != "none"],
-                   help="method to compare (repeatable; default all)")
+    p.add_argument("--method", action="append",
+                   choices=[m for m in COMPENSATION_METHODS + tuple(COMPENSATION_VARIANTS) if m != "none"],
+                   help="method to compare (repeatable; default: " + ", ".join(COMPENSATION_STUDY_METHODS[1:]) + "). "
+                   "static = Stribeck feedforward at the reference speed; static-measured = the same model at the "
+                   "measured motor speed")
     p.add_argument("--feeds", default="0.05,0.1,0.2,0.5,1,2,5", metavar="MM_PER_S",
                    help="comma-separated feeds in mm/s (default 0.05,0.1,0.2,0.5,1,2,5)")
     p.add_argument("--load-cases", default="1,2,3", metavar="N", help="comma-separated load cases (default 1,2,3)")
@@ -55,7 +58,7 @@ def run(args):
     loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
     if args.workers < 1:
         raise InputError("--workers", args.workers, "an integer >= 1")
-    methods = ["none"] + list(dict.fromkeys(args.method or [m for m in COMPENSATION_METHODS if m != "none"]))
+    methods = ["none"] + list(dict.fromkeys(args.method or COMPENSATION_STUDY_METHODS[1:]))
     rows = evaluate(params, methods, feeds, loads, duration=args.duration, workers=args.workers)
     crit = critical_speeds(params, methods, loads) if args.critical else None
     robust = robustness(params, [m for m in methods if m != "none"], load_case=max(loads), duration=args.duration,
