@@ -9,7 +9,7 @@ and the compensator's model off by +-30 % in each parameter -- on two drives:
 The sweep API (drakecreep/sweep.py) runs a parameter grid; this study needs per-method parameter sets
 plus paired baselines, so it uses drakecreep.compensation.evaluate/robustness on a 2-process pool.
 Writes to OUT_DIR/<preset>/: compensation.csv, summary.md, rows.json, comparison.png.
-Run: python analysis/compensation_study.py [OUT_DIR] [PRESET ...]   (about 8 minutes on 2 cores)
+Run: python analysis/compensation_study.py [OUT_DIR] [PRESET ...]   (about 2 minutes on 2 cores)
 """
 
 import sys

@@ -16,7 +16,8 @@ Methods
 -------
 static
     Stribeck + viscous feedforward ``g(v_c) tanh(v_c / v_reg) + Fv v_c`` at the reference speed
-    (``velocity_blend`` mixes in the measured motor speed).
+    (``velocity_blend`` mixes in the measured motor speed; the :data:`VARIANTS` entry
+    ``"static-measured"`` is the model on the measured speed alone, i.e. model-based feedback).
 lugre
     LuGre model with a friction-state observer (Canudas de Wit, Olsson, Astrom, Lischinsky, IEEE TAC
     40(3), 1995): ``dz/dt = v - sigma0 |v| z / g(v) - k (v - v_ref)`` driven by the measured speed,
