@@ -18,11 +18,15 @@ from drakecreep.compensation import critical_speeds, evaluate, robustness, write
 from drakecreep.params import preset
 
 
+#: feeds (mm/s) of the mismatch study per preset: inside each drive's creeping range
+ROBUSTNESS_FEEDS = {"paper": (0.1, 0.2), "rigid_axis": (0.05, 0.1)}
+
+
 def study(out, name):
     params = preset(name)
     rows = evaluate(params, workers=2)
     crit = critical_speeds(params)
-    robust = robustness(params, feeds_mm_s=(0.05, 0.1) if name == "rigid_axis" else (0.1, 0.2), workers=2)
+    robust = robustness(params, feeds_mm_s=ROBUSTNESS_FEEDS.get(name, (0.1, 0.2)), workers=2)
     paths = write_report(f"{out}/{name}", rows, crit, robust, name)
     print(paths["markdown"].read_text())
 

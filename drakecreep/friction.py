@@ -154,7 +154,7 @@ class LuGreFriction(FrictionLaw):
         With no dry friction (``Fc = Fs = 0``, e.g. frictionless guides) the bristles relax
         infinitely fast, ``z = 0``: the rate is 0 and the state stays put.
         """
-        if Fc <= 0.0 and Fs <= 0.0:
+        if Fc <= 0.0:  # Fs = static_ratio * Fc is then 0 too
             return 0.0 * v
         return v - fabs(v) * w[0] * Fc / self._g(v, Fc, Fs)
 
