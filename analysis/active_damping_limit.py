@@ -1,13 +1,13 @@
 """How far could active damping from the linear scale lower the paper rig's critical speed?
 
-The friction compensators (drakecreep/compensation.py) cannot remove the paper rig's creep: it is the
+The friction compensators (drakecreep/studies/compensation.py) cannot remove the paper rig's creep: it is the
 table sticking and slipping on the screw's spring, and a torque added at the motor reaches that mode
 about 11x weaker (motor-side inertia 463 kg against the table's 40 kg). Active damping is the
 controls answer to a lightly damped mode, so this script bounds what it could achieve with an ideal
 (unquantized, undelayed) table speed: the motor torque gets an extra ``u = c (Ph / 2 pi) s`` with the
 signal ``s`` either the table speed or the spring's stretch rate (table speed minus motor speed at the
 table's scale), for gains ``c`` of either sign. The loop is the continuous cascade of the ``paper``
-preset, linearized with python-control at steady sliding (drakecreep.linearize); a feed is stable
+preset, linearized with python-control at steady sliding (drakecreep.servo.linearize); a feed is stable
 when every closed-loop pole has a negative real part. The lowest feed above which every feed on a
 log grid is stable is the linear critical feed.
 
@@ -20,7 +20,7 @@ import sys
 import control
 import numpy as np
 
-from drakecreep.linearize import linearize_controller, linearize_plant
+from drakecreep.servo.linearize import linearize_controller, linearize_plant
 from drakecreep.params import preset
 from drakecreep.scenario import Scenario
 

@@ -3,7 +3,7 @@
 Times the whole ``drakecreep diagnose estimation --out DIR`` path (load, split into cycles, IDIM fits of
 every effect with its grid, pairs, closed-loop replays on the held-out cycles, where-decomposition,
 HTML + JSON report) and, in the same process, a baseline: one closed-loop ``replay()`` of the whole
-estimation file with the IDIM rigid model (:mod:`drakecreep.replay`). The ratio is robust to a busy
+estimation file with the IDIM rigid model (:mod:`drakecreep.gap.replay`). The ratio is robust to a busy
 machine; the absolute time is the one the issue asks for.
 
 Run: ``python analysis/bench_diagnose.py [--repeats N]``
@@ -14,11 +14,11 @@ import tempfile
 import time
 
 from drakecreep.cli.diagnose import load_runs, pick
-from drakecreep.diagnosis import DiagnosisConfig, diagnose
-from drakecreep.diagnosis_report import write_report
-from drakecreep.idim import fit_idim
-from drakecreep.measured import load_emps
-from drakecreep.replay import replay
+from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose
+from drakecreep.report.gap_report import write_report
+from drakecreep.gap.idim import fit_idim
+from drakecreep.gap.measured import load_emps
+from drakecreep.gap.replay import replay
 
 
 def main():

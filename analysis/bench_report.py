@@ -13,9 +13,9 @@ import tempfile
 import time
 
 from drakecreep.params import preset
-from drakecreep.report import build_report
+from drakecreep.report.loop_report import build_report
 from drakecreep.scenario import Scenario
-from drakecreep.simulation import simulate
+from drakecreep.sim.simulation import simulate
 
 
 def main():

@@ -6,7 +6,7 @@ controller. Both sides are timed in this process, so the printed ratio is robust
 * drakecreep: the whole ``simulate()`` call (build the diagram, compile it to SymbolicVectorSystems,
   simulate with Drake's RK3 at the preset's accuracy, compute metrics).
 * SciPy: ``solve_ivp(method="LSODA")`` on the same equations written in plain Python
-  (:mod:`drakecreep.baseline`), integrated between controller samples as the zero-order hold requires.
+  (:mod:`drakecreep.sim.baseline`), integrated between controller samples as the zero-order hold requires.
 * "Same accuracy": both are scored against a tight reference (drakecreep at accuracy 1e-9, checked
   against SciPy at rtol 1e-9); SciPy gets the loosest rtol (atol = rtol x state scale) whose
   table-speed error is no larger than drakecreep's.
@@ -22,10 +22,10 @@ import time
 
 import numpy as np
 
-from drakecreep.baseline import simulate_baseline
+from drakecreep.sim.baseline import simulate_baseline
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
-from drakecreep.simulation import simulate
+from drakecreep.sim.simulation import simulate
 
 #: typical magnitude of each state (sampled controller): theta, omega, tau, x, v, w
 SCALES_SAMPLED = np.array([1.0, 1.0, 1.0, 1e-3, 1e-3, 1.0])

@@ -3,17 +3,17 @@
 Two measurements, both in this run, printed as ratios:
 
 1. **Map wall time**: a 20 x 20 grid (feed x screw-nut stiffness) of 2 s runs of the paper preset
-   (load case 3, LuGre, sampled cascade) through :func:`drakecreep.sweep.run_sweep` on local processes
+   (load case 3, LuGre, sampled cascade) through :func:`drakecreep.sim.sweep.run_sweep` on local processes
    (all cores), no cache. Target: <= 60 s on 2 cores; printed as ``wall / 60 s``.
 2. **Throughput per simulated case-second**, single core each: drakecreep (``simulate()`` per case,
    i.e. build + symbolic compile + Drake RK3 + metrics, as the sweep runs it) against the same
-   equations (:mod:`drakecreep.baseline`, ported here to numba) integrated by a compiled adaptive
+   equations (:mod:`drakecreep.sim.baseline`, ported here to numba) integrated by a compiled adaptive
    Bogacki-Shampine RK3(2) with the preset's accuracy and max step, stepping to every controller
    sample like Drake's zero-order hold. Target: drakecreep within 10x. The numba port is checked
    against drakecreep on two cases (one steady, one creeping) so the ratio compares like with like.
 
 The throughput compares like with like on the same cases: numba case by case, drakecreep's batched
-path (:mod:`drakecreep.batch`, all cases in one Drake system: what ``run_sweep(batch_size=...)`` uses),
+path (:mod:`drakecreep.sim.batch`, all cases in one Drake system: what ``run_sweep(batch_size=...)`` uses),
 and ``simulate()`` one case at a time.
 
 Run: ``python analysis/bench_sweep.py [--cases N] [--grid N] [--duration S] [--skip-map]``
@@ -28,11 +28,11 @@ import time
 import numpy as np
 from numba import njit
 
-from drakecreep.baseline import BaselineModel
+from drakecreep.sim.baseline import BaselineModel
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
-from drakecreep.simulation import simulate
-from drakecreep.sweep import grid, run_sweep
+from drakecreep.sim.simulation import simulate
+from drakecreep.sim.sweep import grid, run_sweep
 
 LAWS = {"coulomb": 0, "stribeck": 1, "lugre": 2}
 

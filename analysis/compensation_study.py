@@ -6,15 +6,15 @@ and the compensator's model off by +-30 % in each parameter -- on two drives:
 * ``rigid_axis``: the same rig with a rigid transmission and a softer velocity loop, where the
   friction is within the loop's reach (the textbook setting of friction compensation).
 
-The sweep API (drakecreep/sweep.py) runs a parameter grid; this study needs per-method parameter sets
-plus paired baselines, so it uses drakecreep.compensation.evaluate/robustness on a 2-process pool.
+The sweep API (drakecreep/sim/sweep.py) runs a parameter grid; this study needs per-method parameter sets
+plus paired baselines, so it uses drakecreep.studies.compensation.evaluate/robustness on a 2-process pool.
 Writes to OUT_DIR/<preset>/: compensation.csv, summary.md, rows.json, comparison.png.
 Run: python analysis/compensation_study.py [OUT_DIR] [PRESET ...]   (about 2 minutes on 2 cores)
 """
 
 import sys
 
-from drakecreep.compensation import critical_speeds, evaluate, robustness, write_report
+from drakecreep.studies.compensation import creep_boundaries, evaluate, robustness, write_report
 from drakecreep.params import preset
 
 
@@ -25,7 +25,7 @@ ROBUSTNESS_FEEDS = {"paper": (0.1, 0.2), "rigid_axis": (0.05, 0.1)}
 def study(out, name):
     params = preset(name)
     rows = evaluate(params, workers=2)
-    crit = critical_speeds(params)
+    crit = creep_boundaries(params)
     robust = robustness(params, feeds_mm_s=ROBUSTNESS_FEEDS.get(name, (0.1, 0.2)), workers=2)
     paths = write_report(f"{out}/{name}", rows, crit, robust, name)
     print(paths["markdown"].read_text())

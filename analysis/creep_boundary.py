@@ -1,17 +1,17 @@
 """Issue 3: the paper's analytic creep boundary (eq. 11) against the Drake model, with and without controller.
 
 For each of stiffness, damping, load mass and friction drop (one at a time around a base drive) and a
-ladder of feeds, the Drake model is simulated twice through :func:`drakecreep.sweep.run_sweep`:
+ladder of feeds, the Drake model is simulated twice through :func:`drakecreep.sim.sweep.run_sweep`:
 
 * ``constant_speed``: no controller, the motor side turns at exactly the feed speed and drives the
-  table through the screw's spring, the paper's Fig. 2 (:mod:`drakecreep.drive_source`);
+  table through the screw's spring, the paper's Fig. 2 (:mod:`drakecreep.model.drive_source`);
 * ``cascade``: the machine with its sampled PI cascade.
 
 Creep in simulation = the table sticks (speed < 5 % of the feed) in the steady window (1-2 s). The
 simulated boundary of a setting is bracketed by the fastest feed that creeps and the next one that
-does not; the analytic one is ``v0`` of :func:`drakecreep.creep.critical_speed` with ``C1`` the slope
+does not; the analytic one is ``v0`` of :func:`drakecreep.paper.creep.critical_speed` with ``C1`` the slope
 of the friction law's steady-state curve taken at ``v0`` itself
-(:func:`drakecreep.sweep.critical_speed_of`). Also reported: the low-speed window where ``C + C1 <= 0``
+(:func:`drakecreep.paper.creep.critical_speed_of`). Also reported: the low-speed window where ``C + C1 <= 0``
 (the falling Stribeck branch outweighs the damping), where eq. 11 has no meaning.
 
 The base is the paper preset with a soft screw-nut contact (``--nut-stiffness``, default 2 N/um) so
@@ -27,19 +27,22 @@ Run: ``python analysis/creep_boundary.py [--out DIR] [--workers N] [--quick]``
 
 import argparse
 import math
-import os
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-from drakecreep import creep
-from drakecreep.friction import make_friction_law
+from drakecreep.paper import creep
+from drakecreep.model.friction import make_friction_law
 from drakecreep.params import preset, with_value
-from drakecreep.screw import axial_damping, axial_stiffness
-from drakecreep.sweep import critical_speed_of, grid, plot_stability_map, run_sweep, write_atomic
-from drakecreep.table import friction_levels, moving_mass
+from drakecreep.model.screw import axial_damping, axial_stiffness
+from drakecreep.model.lumped import lumped
+from drakecreep.paper.creep import critical_speed_of
+from drakecreep.report.plots import plot_stability_map
+from drakecreep.files import write_atomic
+from drakecreep.sim.sweep import grid, run_sweep
+from drakecreep.model.nut_table import friction_levels, moving_mass
 
 DRIVES = ("constant_speed", "cascade")
 AXES = {
@@ -62,7 +65,7 @@ def drive_numbers(params, load_case):
     c1 = creep.friction_slope(lambda s: law.steady_state_force(s, fc, fs), v)
     negative = v[C + c1 <= 0.0]
     return dict(K_N_per_um=K * 1e-6, C_Ns_per_m=C, M_kg=float(moving_mass(params)), Fc_N=fc, Fs_N=fs,
-                v0_mm_s=critical_speed_of(params, load_case) * 1e3,
+                v0_mm_s=critical_speed_of(lumped(params, load_case)) * 1e3,
                 negative_damping_below_mm_s=float(negative.max()) * 1e3 if len(negative) else 0.0)
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from drakecreep.emps import reference_results, to_markdown
+from drakecreep.gap.emps import reference_results, to_markdown
 
 __all__ = ["main"]
 
@@ -20,7 +20,7 @@ def main(argv=None):
     """Compute, print and write the tables."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data", help="folder of DATA_EMPS.mat and DATA_EMPS_PULSES.mat "
-                                       "(default: $DRAKECREEP_EMPS_DATA or ../shared/data/emps)")
+                                       "(default: the files shipped in drakecreep/data/emps)")
     parser.add_argument("--out", default="out/emps_reference", help="output folder")
     args = parser.parse_args(argv)
     text = to_markdown(reference_results(args.data))

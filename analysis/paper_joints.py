@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from drakecreep.hertz import TABLE3_NUT, ballscrew_stiffness
-from drakecreep.joints import table1_ratios, table2_ratios
-from drakecreep.modal import identify_hammer_test, synthetic_hammer_test
-from drakecreep.paper_tables import read_paper_table
+from drakecreep.paper.hertz import TABLE3_NUT, ballscrew_stiffness
+from drakecreep.paper.joints import table1_ratios, table2_ratios
+from drakecreep.paper.modal import identify_hammer_test, synthetic_hammer_test
+from drakecreep.paper.tables import read_paper_table
 
 __all__ = ["hertz_rows", "moving_joint_rows", "fixed_joint_rows", "build_report", "main"]
 
@@ -152,7 +152,7 @@ visible role, and the damping is stiffness-proportional (c = βR k, βR = 1.74e-
 at 1 kHz). Kt/Kn = 1.7e-4 is implausibly low for a bolted joint (usually 0.1-1), which supports the
 data note that Table 1's columns may be shuffled or mis-scaled. Table 2 has C/K = 2.5e-5 s (axial) and
 1.0e-3 s (radial) in both rows but a different Kr/Ka per row. Without the unit-area curves, areas and
-bolt preloads (not printed), the integrated values themselves cannot be recomputed; drakecreep.joints
+bolt preloads (not printed), the integrated values themselves cannot be recomputed; drakecreep.paper.joints
 implements the integral, bolt-cone and Lamé models so that a user with those data can.
 """
 

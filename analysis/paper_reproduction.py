@@ -8,7 +8,7 @@ Run: python analysis/paper_reproduction.py [OUT_DIR]   (about 3-4 minutes on one
 import sys
 from pathlib import Path
 
-from drakecreep.paper_reproduction import calibrate, reproduce, write_report
+from drakecreep.studies.paper_reproduction import calibrate, reproduce, write_report
 from drakecreep.params import preset, with_value
 
 

@@ -10,7 +10,7 @@ from tempfile import TemporaryDirectory
 
 from drakecreep.params import preset
 from drakecreep.scenario import Scenario
-from drakecreep.simulation import simulate
+from drakecreep.sim.simulation import simulate
 
 CASES = {"creep_0.1mm_s.png": 1e-4, "smooth_1mm_s.png": 1e-3}
 

@@ -10,9 +10,9 @@ Run: ``python diagrams/draw_feed_drive.py [--params FILE] [--out DIR]``
 import argparse
 from pathlib import Path
 
-from drakecreep.compiled import compile_diagram
-from drakecreep.diagram import build_diagram, build_plant
-from drakecreep.drawing import draw_diagram
+from drakecreep.sim.compiled import compile_diagram
+from drakecreep.model.diagram import build_diagram, build_plant
+from drakecreep.report.drawing import draw_diagram
 from drakecreep.params import load_params, preset
 from drakecreep.scenario import Scenario
 

@@ -295,7 +295,7 @@ class DisturbanceParams(_Params):
     ``theta Ph / 2 pi + a sin(2 pi (theta Ph / 2 pi) / period)`` (lead-error harmonic, ball-passage
     waviness); the motor encoder cannot see it. ``load_ripple``: the axial load of the load case
     (the paper's air cylinders) pulsates as ``Fx (1 + r sin(2 pi f t))``. See
-    :mod:`drakecreep.disturbance`.
+    :mod:`drakecreep.model.disturbances`.
     """
 
     lead_error_amplitude: float = _q(0.0, "m", 0.0, 1e-3, doc="amplitude a of the kinematic lead error")
@@ -307,7 +307,7 @@ class DisturbanceParams(_Params):
     ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")
 
 
-#: friction compensation methods (:mod:`drakecreep.compensation`)
+#: friction compensation methods (:mod:`drakecreep.studies.compensation`)
 COMPENSATION_METHODS = ("none", "static", "lugre", "dob", "dither")
 #: named variants of a method for evaluations: label -> (method, compensation settings)
 COMPENSATION_VARIANTS = {
@@ -321,7 +321,7 @@ COMPENSATION_STUDY_METHODS = ("none", "static", "static-measured", "lugre", "dob
 
 @dataclass(frozen=True)
 class CompensationParams(_Params):
-    """Friction compensation added to the controller's torque command (:mod:`drakecreep.compensation`).
+    """Friction compensation added to the controller's torque command (:mod:`drakecreep.studies.compensation`).
 
     The compensator's friction model is the plant's nominal one (levels of the load case, shape of
     ``friction``) times the ``*_factor`` mismatch factors (1 = exact model).

@@ -11,6 +11,7 @@ and exit with code 2, never a traceback.
 
 import argparse
 import importlib
+import os
 import sys
 
 from drakecreep.errors import DrakecreepError
@@ -56,6 +57,7 @@ def build_parser():
 
 def main(argv=None):
     """Entry point of the ``drakecreep`` console script."""
+    os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

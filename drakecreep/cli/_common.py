@@ -1,14 +1,14 @@
 """Options and conversions shared by the subcommands (report units at the edge: mm/s, N/um)."""
 
 import argparse
-import dataclasses
 import json
 import math
 
 from drakecreep.errors import InputError
+from drakecreep.files import to_jsonable
 from drakecreep.params import PRESETS, load_params, preset, with_value
 
-__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number"]
+__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers"]
 
 
 def number(text):
@@ -51,15 +51,18 @@ def params_from_args(args):
 
 def print_json(obj):
     """One JSON object on stdout."""
-    print(json.dumps(obj, default=_jsonable))
+    print(json.dumps(to_jsonable(obj)))
 
 
-def _jsonable(value):
-    if dataclasses.is_dataclass(value):
-        return dataclasses.asdict(value)
-    if hasattr(value, "tolist"):
-        return value.tolist()
-    raise TypeError(f"not JSON serializable: {type(value).__name__}")
+def workers(text):
+    """argparse type: a number of worker processes, an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
+    return value
 
 
 def feed_from_mm_s(value, option="--feed"):

@@ -48,7 +48,7 @@ def _list(text, option, kind, check, allowed):
 
 
 def run(args):
-    from drakecreep.compensation import critical_speeds, evaluate, robustness, write_report
+    from drakecreep.studies.compensation import creep_boundaries, evaluate, robustness, write_report
     from drakecreep.scenario import MAX_FEED
 
     params = params_from_args(args)
@@ -60,7 +60,7 @@ def run(args):
         raise InputError("--workers", args.workers, "an integer >= 1")
     methods = ["none"] + list(dict.fromkeys(args.method or COMPENSATION_STUDY_METHODS[1:]))
     rows = evaluate(params, methods, feeds, loads, duration=args.duration, workers=args.workers)
-    crit = critical_speeds(params, methods, loads) if args.critical else None
+    crit = creep_boundaries(params, methods, loads) if args.critical else None
     robust = robustness(params, [m for m in methods if m != "none"], load_case=max(loads), duration=args.duration,
                         workers=args.workers) if args.robustness else None
     name = args.params or args.preset

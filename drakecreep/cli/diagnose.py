@@ -37,8 +37,8 @@ def add_parser(subparsers):
 
 def load_runs(data, meta=None):
     """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles."""
-    from drakecreep.diagnosis import split_cycles
-    from drakecreep.measured import EMPS_FILES, load_emps, load_measured
+    from drakecreep.gap.diagnosis import split_cycles
+    from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
     if data in EMPS_FILES or str(data).endswith(".mat"):
         md = load_emps(data)
@@ -71,8 +71,8 @@ def pick(runs, spec, default_parity):
 
 def run(args):
     """Diagnose, print the answer, write the report."""
-    from drakecreep.diagnosis import DiagnosisConfig, diagnose, score_fixed
-    from drakecreep.diagnosis_report import to_json_dict, write_report
+    from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
+    from drakecreep.report.gap_report import to_json_dict, write_report
 
     runs = load_runs(args.data, args.meta)
     train, test = pick(runs, args.train, 0), pick(runs, args.test, 1)

@@ -22,8 +22,8 @@ def add_parser(subparsers):
 
 def run(args):
     from drakecreep.cli._common import params_from_args
-    from drakecreep.diagram import build_diagram
-    from drakecreep.drawing import draw_diagram
+    from drakecreep.model.diagram import build_diagram
+    from drakecreep.report.drawing import draw_diagram
     from drakecreep.scenario import Scenario
 
     params = params_from_args(args)

@@ -1,7 +1,7 @@
 """``drakecreep emps``: the EMPS benchmark reference results (IDIM-LS table, replay errors) beside the published values.
 
 Fits on DATA_EMPS.mat only; DATA_EMPS_PULSES.mat (the held-out validation set) is only scored with the
-fixed parameters. The data folder is ``--data``, else ``$DRAKECREEP_EMPS_DATA``, else ``../shared/data/emps``
+fixed parameters. The data folder is ``--data``, else the files shipped in ``drakecreep/data/emps``
 beside the repository.
 """
 
@@ -25,8 +25,8 @@ def add_parser(subparsers):
 
 def run(args):
     """Compute and print the tables."""
-    from drakecreep.emps import reference_results, to_markdown
-    from drakecreep.measured import EMPS_FILES, emps_data_dir
+    from drakecreep.gap.emps import reference_results, to_markdown
+    from drakecreep.gap.measured import EMPS_FILES, emps_data_dir
 
     folder = Path(args.data) if args.data else emps_data_dir()
     missing = [name for name in EMPS_FILES.values() if not (folder / name).exists()]

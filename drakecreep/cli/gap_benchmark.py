@@ -2,8 +2,7 @@
 
 import sys
 
-from drakecreep.cli._common import print_json
-from drakecreep.cli.sweep import _workers as _count  # an integer >= 1
+from drakecreep.cli._common import print_json, workers
 
 __all__ = ["add_parser", "run"]
 
@@ -12,7 +11,7 @@ def add_parser(subparsers):
     """Register ``gap-benchmark``."""
     p = subparsers.add_parser("gap-benchmark", help="withheld-effect benchmark of the gap diagnosis",
                               description=__doc__)
-    p.add_argument("--n", type=_count, default=20, help="datasets (default 20)")
+    p.add_argument("--n", type=workers, default=20, help="datasets (default 20)")
     p.add_argument("--seed", type=int, default=0, help="first seed (datasets use seed .. seed+n-1)")
     p.add_argument("--no-replay", action="store_true", help="skip the closed-loop replay (inverse dynamics only)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
@@ -22,7 +21,7 @@ def add_parser(subparsers):
 
 def run(args):
     """Run and print the scores."""
-    from drakecreep.gap_benchmark import run_benchmark
+    from drakecreep.gap.benchmark import run_benchmark
 
     res = run_benchmark(n=args.n, seed=args.seed, replay=not args.no_replay, progress=True)
     if args.json:

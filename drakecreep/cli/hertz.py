@@ -6,7 +6,7 @@ Defaults are the paper's Table 3 inputs; lengths at this edge are in mm, angles 
 import json
 import math
 
-from drakecreep.hertz import BallScrewNut, Material, ballscrew_stiffness
+from drakecreep.paper.hertz import BallScrewNut, Material, ballscrew_stiffness
 
 __all__ = ["add_parser", "run"]
 

@@ -4,6 +4,7 @@ import math
 
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, number, params_from_args, print_json
 from drakecreep.errors import InputError
+from drakecreep.files import to_jsonable
 
 __all__ = ["add_parser", "run", "scenario_from_args"]
 
@@ -44,18 +45,6 @@ def scenario_from_args(args, params):
     return Scenario(feed=feed, load_case=args.load_case)
 
 
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None if math.isnan(obj) else ("inf" if obj > 0 else "-inf")
-    if hasattr(obj, "item"):
-        return _clean(obj.item())
-    return obj
-
-
 def print_margins(summary):
     """Text table of both loops (the configured controller, and continuous when sampled)."""
     variants = [summary["controller"]] + (["continuous"] if "continuous" in summary else [])
@@ -76,13 +65,13 @@ def print_margins(summary):
 
 def run(args):
     """Compute and print the margins."""
-    from drakecreep.loops import analyze_loops
+    from drakecreep.servo.loops import analyze_loops
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     summary = analyze_loops(params, scenario).summary()
     if args.json:
-        print_json(_clean(summary))
+        print_json(to_jsonable(summary))
         return 0
     op = summary["operating_point"]
     print(f"operating point: feed {op['feed_mm_s']:g} mm/s, load case {scenario.load_case}, "

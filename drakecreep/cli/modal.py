@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from drakecreep.errors import InputError
-from drakecreep.modal import HammerTest, identify_frf, identify_hammer_test
+from drakecreep.paper.modal import HammerTest, identify_frf, identify_hammer_test
 
 __all__ = ["add_parser", "run"]
 

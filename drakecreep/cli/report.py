@@ -26,7 +26,7 @@ def run(args):
     """Build the report and print where it is."""
     from drakecreep.cli._common import feed_from_mm_s
     from drakecreep.cli.margins import scenario_from_args
-    from drakecreep.report import build_report
+    from drakecreep.report.loop_report import build_report
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)

@@ -41,7 +41,7 @@ def _rows_option(text):
 
 
 def run(args):
-    from drakecreep.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
+    from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
     from drakecreep.params import load_params, preset
 
     params = load_params(args.params) if args.params else preset(args.preset)

@@ -36,7 +36,7 @@ def add_parser(subparsers):
 def run(args):
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
-    from drakecreep.simulation import simulate
+    from drakecreep.sim.simulation import simulate
 
     params = params_from_args(args)
     if args.controller:
@@ -51,7 +51,12 @@ def run(args):
         )
     scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
     result = simulate(params, scenario, backend=args.backend)
-    paths = result.save(args.out, plot=not args.no_plot)
+    paths = result.save(args.out)
+    if not args.no_plot:
+        from drakecreep.report.plots import plot_feed
+
+        paths["plot"] = paths["metrics"].parent / "speed.png"
+        plot_feed(result, paths["plot"])
     summary = result.summary()
     summary["out"] = str(paths["metrics"].parent)
     if args.json:

@@ -2,22 +2,10 @@
 
 import os
 
-from drakecreep.cli._common import print_json
+from drakecreep.cli._common import print_json, workers
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run"]
-
-
-def _workers(text):
-    import argparse
-
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
-    return value
 
 
 def add_parser(subparsers):
@@ -26,13 +14,13 @@ def add_parser(subparsers):
         help="parameter sweep over a grid or random sample; a tidy table of metrics per case",
         description=(
             "Run the sweep described by SPEC.yaml (base parameters, axes, scenario defaults, metrics; see "
-            "drakecreep.sweep.load_spec). Finished cases are cached in OUT/cache, so a rerun resumes; the table "
+            "drakecreep.sim.sweep.load_spec). Finished cases are cached in OUT/cache, so a rerun resumes; the table "
             "is written to OUT/results.parquet and OUT/results.csv, and a stability map to OUT/map.png when "
             "the spec has a plot section. Local processes by default, a Dask cluster with --scheduler."
         ),
     )
     p.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (YAML)")
-    p.add_argument("--workers", type=_workers, metavar="N",
+    p.add_argument("--workers", type=workers, metavar="N",
                    help=f"local worker processes (default: all cores, {os.cpu_count()}); 1 runs in this process")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default out/sweep)")
@@ -46,7 +34,8 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from drakecreep.sweep import load_spec, plot_stability_map, run_sweep
+    from drakecreep.report.plots import plot_stability_map
+    from drakecreep.sim.sweep import load_spec, run_sweep
 
     if args.scheduler and args.workers:
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")

@@ -2,6 +2,7 @@
 
 from drakecreep.cli._common import add_params_options, number, params_from_args, print_json
 from drakecreep.errors import InputError
+from drakecreep.files import to_jsonable
 
 __all__ = ["add_parser", "run"]
 
@@ -28,8 +29,8 @@ def add_parser(subparsers):
 
 def run(args):
     """Tune and print."""
-    from drakecreep.cli.margins import _clean, print_margins, scenario_from_args
-    from drakecreep.tuning import tune
+    from drakecreep.cli.margins import print_margins, scenario_from_args
+    from drakecreep.servo.tuning import tune
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
@@ -41,7 +42,7 @@ def run(args):
         raise
     summary = result.summary()
     if args.json:
-        print_json(_clean(summary))
+        print_json(to_jsonable(summary))
         return 0
     print(f"rule: {result.rule}")
     print(f"kv = {result.velocity_gain:.5g} N s/m, ki = {result.velocity_integral_gain:.5g} N/m "

@@ -1,0 +1,684 @@
+"""Measured runs of a real feed drive: validated arrays in SI units plus the metadata needed to replay them.
+
+A run is a CSV with a header of SI signal names (a unit may follow a name in brackets, ``x_motor[m]``,
+and must then be the SI one; ``u`` must carry the unit of the metadata, ``u[V]``):
+
+========== ======== ===================================================================
+column     unit     meaning
+========== ======== ===================================================================
+``t``      s        time, strictly increasing, uniform within ``dt_rtol``
+``x_ref``  m        reference position
+``x_motor`` m       motor encoder position at the table (angle x lead / 2 pi)
+``x_table`` m       optional: linear scale
+``u``      N, A, V  controller output, unit stated in the metadata
+``f_ext``  N        optional: external force on the axis
+``run``    text     optional: run label when a file holds several runs
+========== ======== ===================================================================
+
+Beside it, a metadata YAML (``<csv stem>.yaml`` by default) gives the units of ``u`` and the gain from
+``u`` to axial force, the drive parameters (``drakecreep.params``, inline or as a file path), the
+controller actually used (:class:`ControllerMeta`) and the sensor resolutions::
+
+    u_units: V                  # N, A or V
+    u_gain: 35.15               # N per unit of u (1 for N; for A derivable from params)
+    params: rig.yaml            # optional: a drakecreep parameter file (relative to this YAML) or a mapping
+    controller: {kind: p_p_cascade, kp: 160.18, kv: 243.45, saturation: 10.0, sample_time: 0.001,
+                 position_filter: [0.5, 0.5]}
+    sensors: {encoder_resolution: 1.0e-7, scale_resolution: 0.0}   # m per count; 0 = unknown/ideal
+    source: free text
+
+The EMPS benchmark files (``.mat``) map to the same form through :func:`load_emps`. Every error is a
+:class:`drakecreep.errors.InputError` naming the column or key, the value and what is allowed.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from drakecreep.data import emps_data_dir
+from drakecreep.errors import InputError
+
+__all__ = [
+    "U_UNITS",
+    "COLUMNS",
+    "CONTROLLER_KINDS",
+    "ControllerMeta",
+    "SensorMeta",
+    "MeasuredMeta",
+    "MeasuredRun",
+    "MeasuredData",
+    "load_measured",
+    "save_measured",
+    "load_emps",
+    "emps_data_dir",
+    "emps_path",
+    "EMPS_FILES",
+    "EMPS_CONTROLLER",
+    "EMPS_ENCODER_RESOLUTION",
+]
+
+#: Units allowed for the controller output ``u``.
+U_UNITS = ("N", "A", "V")
+#: Column name -> (SI unit, required). ``u``'s unit comes from the metadata.
+COLUMNS = {
+    "t": ("s", True),
+    "x_ref": ("m", True),
+    "x_motor": ("m", True),
+    "x_table": ("m", False),
+    "u": (None, True),
+    "f_ext": ("N", False),
+    "run": (None, False),
+}
+_ARRAYS = ("t", "x_ref", "x_motor", "x_table", "u", "f_ext")
+#: Controller kinds of the metadata schema.
+CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
+
+
+def _finite(name, value, lo=None, lo_open=False):
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(name, value, "a finite number") from None
+    if isinstance(value, bool) or not math.isfinite(x):
+        raise InputError(name, value, "a finite number")
+    if lo is not None and (x < lo or (lo_open and x == lo)):
+        raise InputError(name, value, f"a finite number {'>' if lo_open else '>='} {lo}")
+    return x
+
+
+@dataclass(frozen=True)
+class ControllerMeta:
+    """The controller that produced ``u`` during the run.
+
+    ``kind="p_p_cascade"`` is the EMPS law, sampled every ``sample_time``::
+
+        xf[k] = sum_i position_filter[i] * x[k-i]        (EMPS: 0.5 x[k] + 0.5 x[k-1])
+        dx[k] = (xf[k] - xf[k-1]) / sample_time
+        u[k]  = clip(kp * kv * (x_ref[k] - x[k]) - kv * dx[k], -saturation, saturation)
+
+    with ``x`` the motor encoder (``feedback="motor"``) or the scale (``"table"``); ``u`` is held over
+    the sample. ``kind="drakecreep"`` means the project's own cascade with the gains of
+    ``params.controller`` (the other fields are then unused).
+
+    Parameters
+    ----------
+    kind : str
+        ``"p_p_cascade"`` or ``"drakecreep"``.
+    kp : float
+        Position gain [1/s].
+    kv : float
+        Velocity gain [unit of u per m/s].
+    saturation : float
+        Output limit [unit of u], > 0 (``inf`` for none).
+    sample_time : float
+        Controller period [s].
+    position_filter : tuple of float
+        FIR taps on the position before the velocity difference; they must sum to 1.
+    feedback : str
+        ``"motor"`` or ``"table"``.
+    """
+
+    kind: str = "p_p_cascade"
+    kp: float = 0.0
+    kv: float = 0.0
+    saturation: float = math.inf
+    sample_time: float = 1e-3
+    position_filter: tuple = (1.0,)
+    feedback: str = "motor"
+
+    def __post_init__(self):
+        if self.kind not in CONTROLLER_KINDS:
+            raise InputError("controller.kind", self.kind, "one of " + ", ".join(CONTROLLER_KINDS))
+        if self.feedback not in ("motor", "table"):
+            raise InputError("controller.feedback", self.feedback, "one of motor, table")
+        for name in ("kp", "kv"):
+            object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), 0.0))
+        sat = self.saturation
+        if not (isinstance(sat, (int, float)) and not isinstance(sat, bool) and sat > 0 and not math.isnan(sat)):
+            raise InputError("controller.saturation", sat, "a number > 0 (inf for none)")
+        object.__setattr__(self, "saturation", float(sat))
+        object.__setattr__(self, "sample_time", _finite("controller.sample_time", self.sample_time, 0.0, True))
+        taps = self.position_filter
+        if isinstance(taps, (int, float)):
+            taps = (taps,)
+        try:
+            taps = tuple(float(x) for x in taps)
+        except (TypeError, ValueError):
+            raise InputError("controller.position_filter", self.position_filter, "a list of numbers") from None
+        if not taps or not all(math.isfinite(x) for x in taps) or abs(sum(taps) - 1.0) > 1e-9:
+            raise InputError("controller.position_filter", self.position_filter, "a non-empty list summing to 1")
+        object.__setattr__(self, "position_filter", taps)
+
+    @property
+    def law(self):
+        """The control law as one line of text."""
+        if self.kind == "drakecreep":
+            return "drakecreep cascade with params.controller"
+        taps = " + ".join(f"{c:g} x[k-{i}]" if i else f"{c:g} x[k]" for i, c in enumerate(self.position_filter))
+        return (f"u = clip(kp*kv*(x_ref - x) - kv*dx, +-{self.saturation:g}), dx = first difference of "
+                f"({taps}) over {self.sample_time:g} s")
+
+    def to_dict(self):
+        """YAML-ready mapping."""
+        d = dataclasses.asdict(self)
+        d["position_filter"] = list(self.position_filter)
+        if math.isinf(self.saturation):
+            d["saturation"] = ".inf"
+        return d
+
+    @classmethod
+    def from_dict(cls, data):
+        """Validated instance from a YAML mapping (unknown keys are errors)."""
+        if not isinstance(data, dict):
+            raise InputError("controller", data, "a mapping of " + ", ".join(f.name for f in dataclasses.fields(cls)))
+        names = {f.name for f in dataclasses.fields(cls)}
+        for key in data:
+            if key not in names:
+                raise InputError(f"controller.{key}", data[key], "no such field; known: " + ", ".join(sorted(names)))
+        data = dict(data)
+        if data.get("saturation") in (".inf", "inf", "none", None) and "saturation" in data:
+            data["saturation"] = math.inf
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class SensorMeta:
+    """Sensor resolutions of the run [m per count at the table]; 0 means unknown or ideal."""
+
+    encoder_resolution: float = 0.0
+    scale_resolution: float = 0.0
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            object.__setattr__(self, f.name, _finite(f"sensors.{f.name}", getattr(self, f.name), 0.0))
+
+
+@dataclass(frozen=True)
+class MeasuredMeta:
+    """Metadata of a measured file (shared by its runs).
+
+    Parameters
+    ----------
+    u_units : str
+        Unit of ``u``: ``"N"``, ``"A"`` or ``"V"``.
+    u_gain : float
+        Axial force per unit of ``u`` [N/unit]; 1 for ``N``.
+    params : drakecreep.params.DriveParams or None
+        The drive parameters of the rig, if known.
+    controller : ControllerMeta or None
+        The controller actually used.
+    sensors : SensorMeta
+        Resolutions.
+    source : str
+        Where the data come from.
+    notes : str
+        Anything a reader must know (conventions, deviations from the documentation).
+    """
+
+    u_units: str
+    u_gain: float
+    params: object = None
+    controller: ControllerMeta | None = None
+    sensors: SensorMeta = field(default_factory=SensorMeta)
+    source: str = ""
+    notes: str = ""
+
+    def __post_init__(self):
+        if self.u_units not in U_UNITS:
+            raise InputError("u_units", self.u_units, "one of " + ", ".join(U_UNITS))
+        gain = _finite("u_gain", self.u_gain, 0.0, True)
+        if self.u_units == "N" and gain != 1.0:
+            raise InputError("u_gain", self.u_gain, "1 when u_units is N (u is already a force)")
+        object.__setattr__(self, "u_gain", gain)
+
+
+def _as_array(name, value, n=None):
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.ravel()
+    if a.ndim != 1:
+        raise InputError(name, f"shape {a.shape}", "a 1-D array")
+    if n is not None and a.size != n:
+        raise InputError(name, f"length {a.size}", f"length {n}, the length of t")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise InputError(name, f"{a[bad[0]]} at sample {bad[0]} ({bad.size} non-finite)", "finite numbers")
+    return a
+
+
+def _check_time(t, rtol, where="t"):
+    if t.size < 3:
+        raise InputError(where, f"{t.size} samples", "at least 3 samples")
+    dt = np.diff(t)
+    bad = np.flatnonzero(dt <= 0)
+    if bad.size:
+        k = bad[0]
+        raise InputError(where, f"t[{k + 1}] = {t[k + 1]!r} after t[{k}] = {t[k]!r}", "strictly increasing time")
+    step = float(np.median(dt))
+    dev = np.abs(dt - step) / step
+    k = int(np.argmax(dev))
+    if dev[k] > rtol:
+        raise InputError(where, f"step {dt[k]!r} s at sample {k} (median step {step!r} s)",
+                         f"uniform sampling within a relative tolerance of {rtol:g}")
+    return step
+
+
+@dataclass(frozen=True)
+class MeasuredRun:
+    """One measured run: SI arrays of equal length, validated on construction.
+
+    Parameters
+    ----------
+    t, x_ref, x_motor, u : numpy.ndarray
+        Time [s], reference [m], motor encoder at the table [m], controller output [u_units].
+    meta : MeasuredMeta
+        Units and gain of ``u``, drive parameters, controller, sensors.
+    x_table, f_ext : numpy.ndarray or None
+        Linear scale [m] and external force [N], if measured.
+    label : str
+        Run label.
+    dt_rtol : float
+        Allowed relative deviation of a time step from the median step.
+    """
+
+    t: np.ndarray
+    x_ref: np.ndarray
+    x_motor: np.ndarray
+    u: np.ndarray
+    meta: MeasuredMeta
+    x_table: np.ndarray | None = None
+    f_ext: np.ndarray | None = None
+    label: str = "run"
+    dt_rtol: float = 1e-3
+
+    def __post_init__(self):
+        t = _as_array("t", self.t)
+        object.__setattr__(self, "t", t)
+        for name in ("x_ref", "x_motor", "u", "x_table", "f_ext"):
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, _as_array(name, value, t.size))
+        if not isinstance(self.meta, MeasuredMeta):
+            raise InputError("meta", type(self.meta).__name__, "a MeasuredMeta")
+        _check_time(t, self.dt_rtol, f"t (run {self.label})")
+        for name in _ARRAYS:
+            a = getattr(self, name)
+            if a is not None:
+                a.setflags(write=False)
+
+    @property
+    def n(self):
+        """Number of samples."""
+        return self.t.size
+
+    @property
+    def dt(self):
+        """Mean sample time [s]."""
+        return float((self.t[-1] - self.t[0]) / (self.t.size - 1))
+
+    @property
+    def u_gain(self):
+        """Axial force per unit of ``u`` [N/unit]."""
+        return self.meta.u_gain
+
+    @property
+    def force(self):
+        """Total axial drive force [N]: ``u_gain * u`` plus ``f_ext`` when present."""
+        f = self.u_gain * self.u
+        return f + self.f_ext if self.f_ext is not None else f
+
+    def slice(self, start=None, stop=None):
+        """A run restricted to samples ``start:stop`` (same metadata)."""
+        sl = slice(start, stop)
+        kw = {name: (None if getattr(self, name) is None else getattr(self, name)[sl]) for name in _ARRAYS}
+        return MeasuredRun(meta=self.meta, label=self.label, dt_rtol=self.dt_rtol, **kw)
+
+
+@dataclass(frozen=True)
+class MeasuredData:
+    """The runs of one file with their shared metadata."""
+
+    runs: tuple
+    meta: MeasuredMeta
+
+    def __post_init__(self):
+        runs = tuple(self.runs)
+        if not runs:
+            raise InputError("runs", 0, "at least one run")
+        labels = [r.label for r in runs]
+        if len(set(labels)) != len(labels):
+            raise InputError("run", labels, "distinct run labels")
+        object.__setattr__(self, "runs", runs)
+
+    def __len__(self):
+        return len(self.runs)
+
+    def __iter__(self):
+        return iter(self.runs)
+
+    @property
+    def labels(self):
+        """Run labels in file order."""
+        return tuple(r.label for r in self.runs)
+
+    def run(self, label=None):
+        """The run named ``label``; without a label, the only run."""
+        if label is None:
+            if len(self.runs) != 1:
+                raise InputError("run", None, "a label, one of " + ", ".join(self.labels))
+            return self.runs[0]
+        for r in self.runs:
+            if r.label == label:
+                return r
+        raise InputError("run", label, "one of " + ", ".join(self.labels))
+
+
+# --------------------------------------------------------------------------- metadata YAML
+
+def _meta_from_dict(data, meta_path):
+    from drakecreep.params import load_params, params_from_dict
+
+    where = str(meta_path)
+    if not isinstance(data, dict):
+        raise InputError(where, data, "a YAML mapping with at least u_units and u_gain")
+    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes"}
+    for key in data:
+        if key not in known:
+            raise InputError(f"{where}: {key}", data[key], "no such key; known: " + ", ".join(sorted(known)))
+    if "u_units" not in data:
+        raise InputError(f"{where}: u_units", None, "one of " + ", ".join(U_UNITS) + " (required)")
+    params = data.get("params")
+    if isinstance(params, str):
+        ppath = Path(params)
+        if not ppath.is_absolute():
+            ppath = Path(meta_path).parent / ppath
+        params = load_params(ppath)
+    elif isinstance(params, dict):
+        params = params_from_dict(params)
+    elif params is not None:
+        raise InputError(f"{where}: params", params, "a parameter file path or a mapping")
+    units = data["u_units"]
+    gain = data.get("u_gain")
+    if gain is None:
+        if units == "N":
+            gain = 1.0
+        elif units == "A" and params is not None:
+            gain = params.motor.torque_constant * 2.0 * math.pi / params.screw.lead
+        else:
+            allowed = "a number > 0 [N per A] (or params to derive it)" if units == "A" else "a number > 0 [N per V]"
+            raise InputError(f"{where}: u_gain", None, allowed)
+    ctrl = data.get("controller")
+    ctrl = ControllerMeta.from_dict(ctrl) if ctrl is not None else None
+    sensors = data.get("sensors") or {}
+    if not isinstance(sensors, dict):
+        raise InputError(f"{where}: sensors", sensors, "a mapping encoder_resolution, scale_resolution")
+    try:
+        sensors = SensorMeta(**sensors)
+    except TypeError:
+        raise InputError(f"{where}: sensors", sensors, "keys encoder_resolution, scale_resolution") from None
+    return MeasuredMeta(u_units=units, u_gain=gain, params=params, controller=ctrl, sensors=sensors,
+                        source=str(data.get("source", "")), notes=str(data.get("notes", "")))
+
+
+def _meta_to_dict(meta):
+    from drakecreep.params import params_to_dict
+
+    d = {"u_units": meta.u_units, "u_gain": meta.u_gain}
+    if meta.params is not None:
+        d["params"] = params_to_dict(meta.params)
+    if meta.controller is not None:
+        d["controller"] = meta.controller.to_dict()
+    d["sensors"] = dataclasses.asdict(meta.sensors)
+    if meta.source:
+        d["source"] = meta.source
+    if meta.notes:
+        d["notes"] = meta.notes
+    return d
+
+
+# --------------------------------------------------------------------------- CSV
+
+_HEADER = re.compile(r"^\s*([A-Za-z_]\w*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
+
+
+def _parse_header(cells, path, u_units):
+    names, seen = [], set()
+    for cell in cells:
+        m = _HEADER.match(cell)
+        if not m:
+            raise InputError(f"{path}: header", cell, "a column name, optionally with [unit]")
+        name, unit = m.group(1), m.group(2)
+        if name not in COLUMNS:
+            raise InputError(f"{path}: header", name, "columns among " + ", ".join(COLUMNS))
+        if name in seen:
+            raise InputError(f"{path}: header", name, "each column once")
+        seen.add(name)
+        want = u_units if name == "u" else COLUMNS[name][0]
+        if unit is not None and unit != "" and unit != want:
+            what = f"{want} (the u_units of the metadata)" if name == "u" else f"{want} (SI)"
+            raise InputError(f"{path}: column {name} unit", unit, what)
+        names.append(name)
+    missing = [c for c, (_, req) in COLUMNS.items() if req and c not in seen]
+    if missing:
+        raise InputError(f"{path}: header", ",".join(names), "the columns " + ", ".join(missing) + " as well")
+    return names
+
+
+def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
+    """Load measured runs from a CSV and its metadata YAML.
+
+    Parameters
+    ----------
+    csv_path : str or pathlib.Path
+        The CSV (header of column names, ``#`` comment lines ignored).
+    meta_path : str or pathlib.Path, optional
+        The metadata YAML; default: the CSV path with suffix ``.yaml`` (or ``.yml``).
+    dt_rtol : float
+        Allowed relative deviation of a time step from the median step of its run.
+
+    Returns
+    -------
+    MeasuredData
+        One run per label of the ``run`` column (file order), or a single run named after the file.
+
+    Raises
+    ------
+    InputError
+        Missing or unknown column, wrong unit in the header, unknown ``u_units``, a row with the wrong
+        number of fields, a non-number, NaN, non-monotonic or non-uniform time, missing metadata.
+    FileNotFoundError
+        If the CSV does not exist.
+    """
+    csv_path = Path(csv_path)
+    if meta_path is None:
+        candidates = [csv_path.with_suffix(".yaml"), csv_path.with_suffix(".yml")]
+        meta_path = next((p for p in candidates if p.exists()), None)
+        if meta_path is None:
+            raise InputError("meta_path", str(candidates[0]), "a metadata YAML beside the CSV (or pass meta_path)")
+    meta_path = Path(meta_path)
+    try:
+        meta_data = yaml.safe_load(meta_path.read_text())
+    except yaml.YAMLError:
+        raise InputError(str(meta_path), "invalid YAML", "a YAML mapping") from None
+    meta = _meta_from_dict(meta_data, meta_path)
+
+    with open(csv_path, newline="") as fh:
+        rows = [(i + 1, r) for i, r in enumerate(csv.reader(fh))
+                if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
+    if not rows:
+        raise InputError(str(csv_path), "empty", "a header line and data rows")
+    names = _parse_header(rows[0][1], csv_path, meta.u_units)
+    width = len(names)
+    cols = {name: [] for name in names}
+    for line, row in rows[1:]:
+        if len(row) != width:
+            raise InputError(f"{csv_path}: line {line}", f"{len(row)} fields", f"{width} fields like the header")
+        for name, cell in zip(names, row):
+            cols[name].append(cell.strip())
+    if not rows[1:]:
+        raise InputError(str(csv_path), "no data rows", "at least 3 rows")
+    arrays = {}
+    for name in names:
+        if name == "run":
+            continue
+        try:
+            arrays[name] = np.array([float(c) for c in cols[name]], dtype=float)
+        except ValueError as err:
+            raise InputError(f"{csv_path}: column {name}", str(err).split(": ")[-1], "numbers") from None
+        bad = np.flatnonzero(np.isnan(arrays[name]))
+        if bad.size:
+            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN)",
+                             "finite numbers")
+    if "run" in cols:
+        labels = np.array(cols["run"], dtype=object)
+        order = list(dict.fromkeys(labels.tolist()))
+        groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
+    else:
+        groups = [(csv_path.stem, np.arange(len(rows) - 1))]
+    runs = []
+    for label, idx in groups:
+        kw = {name: (arrays[name][idx] if name in arrays else None) for name in _ARRAYS}
+        try:
+            runs.append(MeasuredRun(meta=meta, label=str(label), dt_rtol=dt_rtol, **kw))
+        except InputError as err:
+            raise InputError(f"{csv_path}: {err.field}", err.value, err.allowed) from None
+    return MeasuredData(runs=tuple(runs), meta=meta)
+
+
+def save_measured(data, csv_path, meta_path=None):
+    """Write runs as CSV + metadata YAML; :func:`load_measured` reads them back identically.
+
+    Parameters
+    ----------
+    data : MeasuredData or MeasuredRun
+        What to write. Optional columns are written when every run has them.
+    csv_path : str or pathlib.Path
+        The CSV to write (floats with 17 significant digits: exact round trip).
+    meta_path : str or pathlib.Path, optional
+        Default: the CSV path with suffix ``.yaml``.
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        ``(csv_path, meta_path)``.
+    """
+    if isinstance(data, MeasuredRun):
+        data = MeasuredData(runs=(data,), meta=data.meta)
+    csv_path = Path(csv_path)
+    meta_path = Path(meta_path) if meta_path is not None else csv_path.with_suffix(".yaml")
+    names = ["t", "x_ref", "x_motor"]
+    if all(r.x_table is not None for r in data.runs):
+        names.append("x_table")
+    names.append("u")
+    if all(r.f_ext is not None for r in data.runs):
+        names.append("f_ext")
+    multi = len(data.runs) > 1 or data.runs[0].label != csv_path.stem
+    header = [f"{n}[{data.meta.u_units if n == 'u' else COLUMNS[n][0]}]" for n in names]
+    if multi:
+        header.append("run")
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(header)
+        for r in data.runs:
+            block = np.column_stack([getattr(r, n) for n in names])
+            for row in block:
+                cells = [repr(float(x)) for x in row]
+                w.writerow(cells + [r.label] if multi else cells)
+    meta_path.write_text(yaml.safe_dump(_meta_to_dict(data.meta), sort_keys=False))
+    return csv_path, meta_path
+
+
+# --------------------------------------------------------------------------- EMPS benchmark
+
+#: The benchmark's files: role -> file name.
+EMPS_FILES = {"estimation": "DATA_EMPS.mat", "validation": "DATA_EMPS_PULSES.mat"}
+
+#: The EMPS controller as documented (data folder README): position P / velocity P cascade, 1 ms,
+#: 2-tap mean on the position before the first difference, output saturated at 10 V.
+EMPS_CONTROLLER = ControllerMeta(kind="p_p_cascade", kp=160.18, kv=243.45, saturation=10.0, sample_time=1e-3,
+                                 position_filter=(0.5, 0.5), feedback="motor")
+
+_EMPS_NOTES = (
+    "x_ref = qg, x_motor = qm, u = controller output in V, force = gtau*u + f_ext. "
+    "In DATA_EMPS_PULSES.mat the recorded vir jumps by +5/-5 at every edge of pulses_N and the documented "
+    "law reproduces vir - pulses_N, not vir: the pulses were added to the drive command in volts "
+    "(5 V = 5*gtau N), not applied as 5 N. So u = vir - pulses_N and f_ext = gtau*pulses_N [N], "
+    "which keeps the total drive force gtau*vir. "
+    "Encoder: 50000 counts/rev (documented); qm of DATA_EMPS.mat lies on a 50 nm grid, so one count is "
+    "5e-8 m at the load (a 2.5 mm lead); qm of DATA_EMPS_PULSES.mat is not on that grid (stored processed)."
+)
+
+#: One encoder count at the load [m], read from DATA_EMPS.mat (every qm is a multiple of it).
+EMPS_ENCODER_RESOLUTION = 5e-8
+
+
+def emps_path(which="estimation"):
+    """Path of an EMPS file: ``"estimation"`` (DATA_EMPS.mat) or ``"validation"`` (held-out test set)."""
+    if which not in EMPS_FILES:
+        raise InputError("which", which, "one of " + ", ".join(EMPS_FILES))
+    return emps_data_dir() / EMPS_FILES[which]
+
+
+def load_emps(path=None):
+    """Load an EMPS benchmark ``.mat`` file as :class:`MeasuredData` (one run, labelled by the file stem).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, optional
+        A ``.mat`` file, or ``"estimation"`` / ``"validation"`` for the files of :func:`emps_data_dir`.
+        Default: the estimation set.
+
+    Returns
+    -------
+    MeasuredData
+        ``x_ref = qg``, ``x_motor = qm`` [m]; ``u`` the controller output [V] with ``u_gain = gtau``
+        [N/V]; ``f_ext = gtau * pulses_N`` [N] when the file has pulses (see ``meta.notes``: the pulses
+        are volts added to the drive command, so ``u = vir - pulses_N``); the controller is
+        :data:`EMPS_CONTROLLER` with the file's ``kp`` and ``kv``.
+    """
+    import scipy.io
+
+    if path is None:
+        path = "estimation"
+    if isinstance(path, str) and path in EMPS_FILES:
+        path = emps_path(path)
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(2, "No such file or directory", str(path))
+    mat = scipy.io.loadmat(str(path))
+    missing = [k for k in ("t", "qm", "qg", "vir", "gtau", "kp", "kv") if k not in mat]
+    if missing:
+        raise InputError(f"{path}: variables", ",".join(sorted(k for k in mat if not k.startswith("__"))),
+                         "the EMPS variables t, qm, qg, vir, gtau, kp, kv")
+
+    def scalar(name):
+        a = np.asarray(mat[name], dtype=float)
+        if a.size != 1:
+            raise InputError(f"{path}: {name}", f"shape {a.shape}", "a scalar")
+        return float(a.item())
+
+    gtau = scalar("gtau")
+    controller = dataclasses.replace(EMPS_CONTROLLER, kp=scalar("kp"), kv=scalar("kv"))
+    vir = np.asarray(mat["vir"], dtype=float).ravel()
+    u, f_ext = vir, None
+    if "pulses_N" in mat:
+        pulses = np.asarray(mat["pulses_N"], dtype=float).ravel()
+        if pulses.size != vir.size:
+            raise InputError(f"{path}: pulses_N", f"length {pulses.size}", f"length {vir.size} like vir")
+        u = vir - pulses
+        f_ext = gtau * pulses
+    meta = MeasuredMeta(u_units="V", u_gain=gtau, controller=controller,
+                        sensors=SensorMeta(encoder_resolution=EMPS_ENCODER_RESOLUTION, scale_resolution=0.0),
+                        source=f"EMPS benchmark (Janot, Gautier, Brunot 2019): {path.name}",
+                        notes=_EMPS_NOTES)
+    run = MeasuredRun(t=mat["t"], x_ref=mat["qg"], x_motor=mat["qm"], u=u, f_ext=f_ext, meta=meta,
+                      label=path.stem)
+    return MeasuredData(runs=(run,), meta=meta)

@@ -1,0 +1,244 @@
+"""Where the sim-to-real gap lies: residuals decomposed by time regime, order, operating map; whiteness.
+
+Inputs are plain arrays on a uniform time grid: the measured run and the closed-loop replay of a model
+(:func:`drakecreep.gap.effects.replay_with_effects`), or an inverse-dynamics residual. Functions:
+
+* :func:`classify_regimes`: every sample is ``dwell``, ``stick``, ``reversal``, ``acceleration`` or
+  ``constant_speed`` (from the reference motion and the measured speed);
+* :func:`regime_shares`: share of the residual energy and of the time in each regime;
+* :func:`order_spectrum`: residual resampled against position and its spectrum in orders (cycles per
+  period: screw revolution, motor revolution, millimetre of table travel), so a periodic effect shows
+  as a sharp order; :func:`time_spectrum` the same against time;
+* :func:`operating_map`: residual RMS binned by speed, position and load;
+* :func:`whiteness`: Ljung-Box test (SciPy chi-square) and the largest cross-correlation with the input.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import signal, stats
+
+from drakecreep.errors import InputError
+
+__all__ = [
+    "REGIMES",
+    "classify_regimes",
+    "regime_shares",
+    "order_spectrum",
+    "time_spectrum",
+    "operating_map",
+    "whiteness",
+]
+
+#: Time regimes, in order of precedence.
+REGIMES = ("dwell", "stick", "reversal", "acceleration", "constant_speed")
+
+
+def classify_regimes(t, x_ref, v_meas, v_frac=0.01, a_frac=0.02, reversal_window=0.03):
+    """Label every sample with a time regime.
+
+    Parameters
+    ----------
+    t : array_like
+        Time [s], uniform.
+    x_ref : array_like
+        Reference position [m].
+    v_meas : array_like
+        Measured (filtered) speed [m/s].
+    v_frac, a_frac : float
+        Speed and acceleration thresholds as fractions of the largest reference speed / acceleration.
+    reversal_window : float
+        Half-width [s] around a change of direction of the measured motion labelled ``reversal``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Array of regime names (dtype object).
+    """
+    t = np.asarray(t, dtype=float)
+    dt = float(t[1] - t[0])
+    v_ref = np.gradient(np.asarray(x_ref, dtype=float), dt)
+    a_ref = np.gradient(v_ref, dt)
+    v_meas = np.asarray(v_meas, dtype=float)
+    v_eps = v_frac * max(np.max(np.abs(v_ref)), 1e-12)
+    a_eps = a_frac * max(np.max(np.abs(a_ref)), 1e-12)
+    labels = np.full(t.size, "constant_speed", dtype=object)
+    labels[np.abs(a_ref) >= a_eps] = "acceleration"
+    moving = np.abs(v_meas) > v_eps
+    s = np.sign(v_meas) * moving
+    nz = np.flatnonzero(s)
+    rev = np.zeros(t.size, bool)
+    if nz.size > 1:
+        flips = nz[1:][np.diff(s[nz]) != 0]
+        prev = nz[:-1][np.diff(s[nz]) != 0]
+        w = int(round(reversal_window / dt))
+        for a, b in zip(prev, flips):
+            rev[max(a - w, 0): b + w + 1] = True
+    labels[rev] = "reversal"
+    labels[(np.abs(v_ref) >= v_eps) & ~moving & ~rev] = "stick"
+    labels[(np.abs(v_ref) < v_eps) & (np.abs(a_ref) < a_eps)] = "dwell"
+    return labels
+
+
+def regime_shares(residual, labels):
+    """Share of residual energy and of time per regime.
+
+    Returns
+    -------
+    dict
+        ``{regime: {"energy_share": ..., "time_share": ..., "rms": ...}}`` (shares in 0..1).
+    """
+    r = np.asarray(residual, dtype=float)
+    total = float(np.sum(r * r))
+    out = {}
+    for name in REGIMES:
+        m = labels == name
+        e = float(np.sum(r[m] ** 2))
+        out[name] = {"energy_share": e / total if total > 0 else 0.0, "time_share": float(np.mean(m)),
+                     "rms": float(np.sqrt(np.mean(r[m] ** 2))) if m.any() else 0.0}
+    return out
+
+
+def _stretches(mask):
+    d = np.diff(np.concatenate([[0], mask.astype(int), [0]]))
+    return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
+
+
+def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_segment=8, min_speed=None):
+    """Spectrum of a residual resampled against position, in orders (cycles per ``period`` of travel).
+
+    Monotone stretches of motion (``|v| > min_speed``) are resampled on a uniform position grid of
+    ``period / points_per_period`` and passed through Welch's method; the spectra are averaged.
+
+    Parameters
+    ----------
+    x, v, residual : array_like
+        Measured position [m], speed [m/s] and the residual, same length.
+    period : float
+        Travel of one cycle [m] (screw lead, motor revolution at the table, or 1e-3 for per-mm).
+    points_per_period, periods_per_segment : int
+        Resampling density and Welch segment length.
+    min_speed : float, optional
+        Default: 20 % of the largest speed.
+
+    Returns
+    -------
+    dict
+        ``orders``, ``psd`` (arrays), ``peak_order``, ``peak_share`` (energy within +-1 bin of the peak /
+        total), ``peak_ratio`` (peak / median PSD of the 8 bins on either side, the peak's 3 bins left
+        out: a local prominence, insensitive to the low-pass filter's roll-off), ``n_segments``.
+    """
+    x, v, r = (np.asarray(a, dtype=float) for a in (x, v, residual))
+    if period <= 0:
+        raise InputError("period", period, "a travel > 0 m")
+    if min_speed is None:
+        min_speed = 0.2 * np.max(np.abs(v))
+    step = period / points_per_period
+    nper = points_per_period * periods_per_segment
+    psds, weights = [], []
+    for sign in (1.0, -1.0):
+        for a, b in _stretches(sign * v > min_speed):
+            xs, rs = x[a:b], r[a:b]
+            if sign < 0:
+                xs, rs = xs[::-1], rs[::-1]
+            if xs.size < 4 or xs[-1] - xs[0] < nper * step:
+                continue
+            keep = np.concatenate([[True], np.diff(xs) > 0])
+            xs, rs = xs[keep], rs[keep]
+            grid = np.arange(xs[0], xs[-1], step)
+            rr = np.interp(grid, xs, rs)
+            f, p = signal.welch(rr, fs=1.0 / step, nperseg=nper, detrend="linear")
+            psds.append(p)
+            weights.append(grid.size)
+    if not psds:
+        return {"orders": [], "psd": [], "peak_order": None, "peak_share": 0.0, "peak_ratio": 0.0, "n_segments": 0}
+    psd = np.average(np.array(psds), axis=0, weights=weights)
+    orders = f * period
+    band = orders >= 0.75
+    idx = np.flatnonzero(band)
+    k = idx[np.argmax(psd[band])]
+    total = float(np.sum(psd[band]))
+    share = float(np.sum(psd[max(k - 1, idx[0]): k + 2]) / total) if total > 0 else 0.0
+    around = np.r_[psd[max(k - 8, idx[0]): max(k - 1, idx[0])], psd[k + 2: k + 9]]
+    med = float(np.median(around)) if around.size else 0.0
+    return {"orders": orders, "psd": psd, "peak_order": float(orders[k]), "peak_share": share,
+            "peak_ratio": float(psd[k] / med) if med > 0 else 0.0, "n_segments": len(psds)}
+
+
+def time_spectrum(residual, dt, nperseg=1024):
+    """Welch spectrum of a residual against time: ``freq`` [Hz], ``psd``, ``peak_hz``."""
+    r = np.asarray(residual, dtype=float)
+    f, p = signal.welch(r, fs=1.0 / dt, nperseg=min(nperseg, r.size), detrend="linear")
+    k = 1 + int(np.argmax(p[1:]))
+    return {"freq": f, "psd": p, "peak_hz": float(f[k])}
+
+
+def operating_map(residual, speed, position, load, bins=5):
+    """Residual RMS binned by |speed|, position and |load| (quantile bins for speed and load).
+
+    Returns
+    -------
+    dict
+        ``{"speed": [{"lo", "hi", "rms", "energy_share"}, ...], "position": [...], "load": [...]}``.
+    """
+    r = np.asarray(residual, dtype=float)
+    total = float(np.sum(r * r)) or 1.0
+    out = {}
+    for name, val, quantile in (("speed", np.abs(speed), True), ("position", np.asarray(position), False),
+                                ("load", np.abs(load), True)):
+        val = np.asarray(val, dtype=float)
+        if quantile:
+            edges = np.unique(np.quantile(val, np.linspace(0, 1, bins + 1)))
+        else:
+            edges = np.linspace(val.min(), val.max(), bins + 1)
+        if edges.size < 2:
+            edges = np.array([val.min(), val.max() + 1e-12])
+        which = np.clip(np.searchsorted(edges, val, side="right") - 1, 0, edges.size - 2)
+        rows = []
+        for i in range(edges.size - 1):
+            m = which == i
+            rows.append({"lo": float(edges[i]), "hi": float(edges[i + 1]),
+                         "rms": float(np.sqrt(np.mean(r[m] ** 2))) if m.any() else 0.0,
+                         "energy_share": float(np.sum(r[m] ** 2) / total)})
+        out[name] = rows
+    return out
+
+
+def whiteness(residual, inputs=None, lags=10):
+    """Is the residual white noise, uncorrelated with the input?
+
+    Parameters
+    ----------
+    residual : array_like
+        Residual samples (decimated, so that noise is not coloured by the pre-processing).
+    inputs : array_like, optional
+        The input (controller output) on the same samples.
+    lags : int
+        Lags of the Ljung-Box test and of the cross-correlation.
+
+    Returns
+    -------
+    dict
+        ``ljung_box_q``, ``ljung_box_p``, ``acf`` (lags 1..``lags``), ``max_abs_xcorr``, ``xcorr_bound``
+        (95 % family-wise band for the largest of the ``2 lags + 1`` values, ``z/sqrt(n)`` with Bonferroni), ``white`` (p >= 0.05 and the cross-correlation inside the band).
+    """
+    r = np.asarray(residual, dtype=float)
+    r = r - r.mean()
+    n = r.size
+    denom = float(r @ r)
+    acf = np.array([float(r[:-k] @ r[k:]) / denom for k in range(1, lags + 1)]) if denom > 0 else np.zeros(lags)
+    q = float(n * (n + 2) * np.sum(acf ** 2 / (n - np.arange(1, lags + 1))))
+    p = float(stats.chi2.sf(q, lags))
+    # 95 % band for the largest of the 2 lags + 1 cross-correlations (Bonferroni)
+    bound = float(stats.norm.ppf(1 - 0.05 / (2 * (2 * lags + 1)))) / np.sqrt(n)
+    xmax = 0.0
+    if inputs is not None:
+        u = np.asarray(inputs, dtype=float)
+        u = u - u.mean()
+        nu = float(np.sqrt((u @ u) * denom))
+        if nu > 0:
+            xc = [float(r[max(0, -k): n - max(0, k)] @ u[max(0, k): n - max(0, -k)]) / nu
+                  for k in range(-lags, lags + 1)]
+            xmax = float(np.max(np.abs(xc)))
+    return {"ljung_box_q": q, "ljung_box_p": p, "acf": acf.tolist(), "max_abs_xcorr": xmax,
+            "xcorr_bound": float(bound), "white": bool(p >= 0.05 and xmax <= bound)}

@@ -1,0 +1,166 @@
+"""Periodic disturbances of a real feed drive that the base model leaves out (off by default).
+
+Both are written once for float, AutoDiffXd and symbolic Expression, so the compiled fast path keeps
+working; :func:`add_disturbances` wires them into the diagram only when their amplitude is non-zero
+(the diagram of the ``paper`` preset is unchanged).
+
+LeadError
+    Kinematic error of the screw-nut pair: the nut advances ``u(theta) = r theta + e(theta)`` with
+    ``r = Ph / 2 pi`` and ``e = a sin(2 pi r (theta - theta0) / P)`` (a lead-error harmonic of travel
+    period ``P``, e.g. the waviness left by ball passage in the nut). The screw's spring sees ``u``
+    instead of ``r theta``, and by virtual work the motor carries ``F du/dtheta = F (r + e')``; the
+    screw already returns ``F r``, this system adds ``F e'``. A semi-closed loop (motor encoder)
+    cannot see the error, so the table speed carries a ripple ``2 pi a / P`` of the feed, whatever
+    the feed.
+LoadRipple
+    A force ``-(A + r_l Fx) sin(2 pi f t)`` added to the screw's push on the table: ``A`` a vibration of
+    fixed frequency that does not depend on the load, ``r_l Fx`` a pulsation of the axial load of the
+    load case (the paper's air cylinders). The table-speed ripple it causes does not depend on the feed.
+"""
+
+import math
+
+import numpy as np
+import pydrake.math as dmath
+from pydrake.systems.framework import LeafSystem_
+from pydrake.systems.primitives import Adder
+from pydrake.systems.scalar_conversion import TemplateSystem
+
+from drakecreep.model._scalar import vector
+
+__all__ = ["LeadError", "LeadError_", "LoadRipple", "LoadRipple_", "add_disturbances", "sin", "cos"]
+
+
+def sin(x):
+    """Sine of a float, numpy array, AutoDiffXd or Expression."""
+    return np.sin(x) if isinstance(x, (float, int, np.floating, np.ndarray)) else dmath.sin(x)
+
+
+def cos(x):
+    """Cosine of a float, numpy array, AutoDiffXd or Expression."""
+    return np.cos(x) if isinstance(x, (float, int, np.floating, np.ndarray)) else dmath.cos(x)
+
+
+@TemplateSystem.define("LeadError_")
+def LeadError_(T):
+    class Impl(LeafSystem_[T]):
+        """Kinematic lead error between the motor rotation and the nut.
+
+        Input ports
+        -----------
+        motor_state : 2, ``[theta (rad), omega (rad/s)]``
+        axial_force : 1, screw force on the table (N)
+
+        Output ports
+        ------------
+        nut_motion : 2, ``[u / r (rad), du/dt / r (rad/s)]``: the rotation an error-free screw would
+            need for the nut's actual travel (feeds the screw's ``motor_state`` input)
+        torque : 1, ``F e'(theta)`` (N m), the reaction torque the screw's ``F r`` leaves out
+        """
+
+        def _construct(self, amplitude, period, lead, angle0=0.0, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.amplitude = float(amplitude)
+            self.period = float(period)
+            self.lead = float(lead)
+            self.angle0 = float(angle0)
+            self.ratio = self.lead / (2.0 * math.pi)
+            self._u_motor_state = self.DeclareVectorInputPort("motor_state", 2)
+            self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
+            self.DeclareVectorOutputPort("nut_motion", 2, self._calc_motion)
+            self.DeclareVectorOutputPort("torque", 1, self._calc_torque)
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.amplitude, other.period, other.lead, other.angle0, converter=converter)
+
+        def _phase(self, theta):
+            return 2.0 * math.pi * self.ratio * (theta - self.angle0) / self.period
+
+        def slope(self, theta):
+            """``de/dtheta`` (m/rad)."""
+            return self.amplitude * 2.0 * math.pi * self.ratio / self.period * cos(self._phase(theta))
+
+        def _calc_motion(self, context, output):
+            theta, omega = self._u_motor_state.Eval(context)
+            error = self.amplitude * sin(self._phase(theta))
+            output.SetFromVector(vector([theta + error / self.ratio, omega * (1.0 + self.slope(theta) / self.ratio)]))
+
+        def _calc_torque(self, context, output):
+            theta = self._u_motor_state.Eval(context)[0]
+            force = self._u_axial_force.Eval(context)[0]
+            output.SetAtIndex(0, force * self.slope(theta))
+
+    return Impl
+
+
+@TemplateSystem.define("LoadRipple_")
+def LoadRipple_(T):
+    class Impl(LeafSystem_[T]):
+        """Force ripple on the table: output ``force`` (1, N) ``= -amplitude sin(2 pi f t)``, added to the push."""
+
+        def _construct(self, amplitude, frequency, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.amplitude = float(amplitude)
+            self.frequency = float(frequency)
+            self.DeclareVectorOutputPort("force", 1, self._calc, prerequisites_of_calc={self.time_ticket()})
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.amplitude, other.frequency, converter=converter)
+
+        def _calc(self, context, output):
+            t = context.get_time()
+            output.SetAtIndex(0, -self.amplitude * sin(2.0 * math.pi * self.frequency * t))
+
+    return Impl
+
+
+LeadError = LeadError_[None]
+LoadRipple = LoadRipple_[None]
+
+
+def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
+    """Add the disturbances ``params.disturbance`` switches on; return the ports the plant's signals now feed.
+
+    Parameters
+    ----------
+    builder : DiagramBuilder
+    systems : dict
+        The diagram's systems by role (``motor``, ``screw``, ``table``); added systems go in here too.
+    params : drakecreep.params.DriveParams
+    scenario : drakecreep.scenario.Scenario
+    ports : dict
+        ``nut_motion`` (where the motor state goes for the screw), ``axial_force`` (where the screw
+        force goes for the table), ``load_torque`` (where the screw's reaction goes for the motor).
+    angle0 : float
+        Motor angle at the start (rad), the phase reference of the lead error.
+
+    Returns
+    -------
+    dict
+        ``ports`` with the entries replaced by the inputs of the added systems.
+    """
+    d = params.disturbance
+    ports = dict(ports)
+    if d.lead_error_amplitude > 0.0:
+        lead = builder.AddSystem(LeadError(d.lead_error_amplitude, d.lead_error_period, params.screw.lead, angle0))
+        lead.set_name("lead_error")
+        torque_sum = builder.AddSystem(Adder(2, 1))
+        torque_sum.set_name("load_torque_sum")
+        systems["lead_error"], systems["load_torque_sum"] = lead, torque_sum
+        builder.Connect(lead.GetOutputPort("nut_motion"), ports["nut_motion"])
+        builder.Connect(systems["screw"].GetOutputPort("axial_force"), lead.GetInputPort("axial_force"))
+        builder.Connect(lead.GetOutputPort("torque"), torque_sum.get_input_port(1))
+        builder.Connect(torque_sum.get_output_port(0), ports["load_torque"])
+        ports["nut_motion"] = lead.GetInputPort("motor_state")
+        ports["load_torque"] = torque_sum.get_input_port(0)
+    amplitude = d.force_ripple + d.load_ripple * abs(params.load_case(scenario.load_case).fx)
+    if amplitude > 0.0:
+        ripple = builder.AddSystem(LoadRipple(amplitude, d.ripple_frequency))
+        ripple.set_name("load_ripple")
+        push_sum = builder.AddSystem(Adder(2, 1))
+        push_sum.set_name("push_sum")
+        systems["load_ripple"], systems["push_sum"] = ripple, push_sum
+        builder.Connect(ripple.get_output_port(0), push_sum.get_input_port(1))
+        builder.Connect(push_sum.get_output_port(0), ports["axial_force"])
+        ports["axial_force"] = push_sum.get_input_port(0)
+    return ports

@@ -1,0 +1,71 @@
+"""The drive reduced to one mass on one spring: what the paper's creep theory (section 2) reads off the model.
+
+One place computes the lumped values every analytic result uses (eq. 11's critical speed, the sweep map's
+``v0`` curve, the paper reproduction, ``drakecreep critical``), from the same functions the Drake systems use.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from drakecreep.model.friction import FrictionLaw, make_friction_law
+from drakecreep.model.nut_table import friction_levels, moving_mass
+from drakecreep.model.screw import axial_damping, axial_stiffness
+
+__all__ = ["LumpedDrive", "lumped"]
+
+
+@dataclass(frozen=True)
+class LumpedDrive:
+    """A one-mass, one-spring drive with friction (SI units).
+
+    Attributes
+    ----------
+    stiffness : float
+        K, N/m: the whole axial chain (bearing, shaft, nut in series) with the table at ``x``.
+    damping : float
+        C, N s/m: the chain's structural damping.
+    mass : float
+        M, kg: table plus nut.
+    coulomb, breakaway : float
+        Fc (the paper's Fd) and Fs, N, for the load case.
+    law : FrictionLaw
+        The friction law of ``params.friction`` (its steady-state curve gives the slope C1).
+    load_case : int
+        The load case these levels belong to (0 = unloaded).
+    """
+
+    stiffness: float
+    damping: float
+    mass: float
+    coulomb: float
+    breakaway: float
+    law: FrictionLaw
+    load_case: int = 0
+
+    def steady_friction(self, v):
+        """Steady-sliding friction force (N) at speed ``v`` (m/s)."""
+        return self.law.steady_state_force(v, self.coulomb, self.breakaway)
+
+
+def lumped(params, load_case=0, x=0.0):
+    """The lumped drive of ``params`` under ``load_case`` with the table at ``x`` (m).
+
+    Parameters
+    ----------
+    params : DriveParams
+    load_case : int
+        0 = no external load, 1.. = ``params.loads.cases``.
+    x : float
+        Table position (m); the shaft's stiffness depends on it.
+    """
+    fc, fs = friction_levels(params, params.load_case(load_case))
+    return LumpedDrive(
+        stiffness=float(axial_stiffness(params.screw, params.nut, x)),
+        damping=float(axial_damping(params.screw, params.nut, x)),
+        mass=float(moving_mass(params)),
+        coulomb=float(fc),
+        breakaway=float(fs),
+        law=make_friction_law(params.friction),
+        load_case=int(load_case),
+    )

@@ -1,0 +1,139 @@
+"""Nut and table on rolling guides, with friction whose level follows the load case.
+
+Friction levels (Coulomb force) of the guides and of the nut::
+
+    Fc = seal_force + mu_guide (m g + |Fz| + |Fy|)        guides and seals
+       + 2 pi T_preload / Ph + mu_nut |Fx|                 ball nut: preload drag + axial load
+    Fs = static_ratio * Fc
+
+Where the nut's share acts is ``friction.nut_friction_on``:
+
+* ``"table"`` (default): lumped with the guides on the table, one friction law at the table speed.
+  Simple, and the slip speed is nearly the same (the nut contact is stiff: 51.6 N/um against ~8 N/um
+  for the whole chain), but the drag then loads the table rather than the screw.
+* ``"screw"``: as the drag torque it physically is, against the screw's rotation (on the motor side
+  of the screw's elasticity), in :mod:`drakecreep.model.nut_friction`; the table carries only the guides.
+
+The axial load ``Fx`` of the load case opposes the feed (+x) as a constant force, as the paper's air
+cylinders do.
+"""
+
+import math
+
+from pydrake.systems.framework import BasicVector_, LeafSystem_
+from pydrake.systems.scalar_conversion import TemplateSystem
+
+from drakecreep.model._scalar import vector
+from drakecreep.model.friction import make_friction_law
+
+__all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels", "friction_split", "table_friction_levels"]
+
+
+def moving_mass(params):
+    """Translating mass (kg): table plus nut."""
+    return params.table.mass + params.nut.mass
+
+
+def friction_levels(params, load):
+    """Coulomb and breakaway friction forces ``(Fc, Fs)`` in N for a :class:`~drakecreep.params.LoadCase`."""
+    fc = sum(friction_split(params, load))
+    return fc, params.friction.static_ratio * fc
+
+
+def friction_split(params, load):
+    """Coulomb levels (N) of the guides (seals + rolling guides) and of the nut (preload + axial load).
+
+    Returns
+    -------
+    guides, nut : float
+        Their sum is :func:`friction_levels`' ``Fc``.
+    """
+    normal = moving_mass(params) * params.loads.gravity + abs(load.fz) + abs(load.fy)
+    guides = params.table.seal_force + params.table.guide_friction_coefficient * normal
+    nut = 2.0 * math.pi * params.nut.preload_torque / params.screw.lead + params.nut.load_friction_coefficient * abs(load.fx)
+    return guides, nut
+
+
+def table_friction_levels(params, load):
+    """``(Fc, Fs)`` acting on the table: everything, or only the guides' share when
+    ``friction.nut_friction_on == "screw"`` (the nut's share then acts on the screw, see
+    :mod:`drakecreep.model.nut_friction`)."""
+    if params.friction.nut_friction_on == "screw":
+        fc = friction_split(params, load)[0]
+        return fc, params.friction.static_ratio * fc
+    return friction_levels(params, load)
+
+
+@TemplateSystem.define("NutTable_")
+def NutTable_(T):
+    class Impl(LeafSystem_[T]):
+        """Table mass with friction; state ``[x, v, z...]`` (``z``: the friction law's internal states).
+
+        Input ports
+        -----------
+        axial_force : 1, force of the screw on the table (N)
+
+        Output ports
+        ------------
+        table_state : 2, ``[x (m), v (m/s)]``
+        friction_force : 1, friction on the table (N, opposing +v)
+        friction_state : internal friction states (LuGre: bristle load / Fc), size 0 for stateless laws
+        """
+
+        def _construct(self, params, load, initial_state=None, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.params = params
+            self.load = load
+            self.law = make_friction_law(params.friction)
+            self.mass = moving_mass(params)
+            self.fc, self.fs = table_friction_levels(params, load)
+            n = 2 + self.law.num_states
+            self.initial_state = [0.0] * n if initial_state is None else list(initial_state)
+            if len(self.initial_state) != n:
+                raise ValueError(f"NutTable initial_state must have {n} entries")
+            self.DeclareContinuousState(
+                BasicVector_[T](self.initial_state), num_q=1, num_v=1, num_z=self.law.num_states
+            )
+            self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
+            state_only = {self.xc_ticket()}
+            self.DeclareVectorOutputPort("table_state", 2, self._calc_state, prerequisites_of_calc=state_only)
+            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction, prerequisites_of_calc=state_only)
+            self.DeclareVectorOutputPort(
+                "friction_state", self.law.num_states, self._calc_z, prerequisites_of_calc=state_only
+            )
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.params, other.load, initial_state=other.initial_state, converter=converter)
+
+        def _split(self, context):
+            x = context.get_continuous_state_vector().CopyToVector()
+            return x[0], x[1], x[2:]
+
+        def friction(self, context):
+            """Friction force (N) on the table in this context."""
+            _, v, z = self._split(context)
+            return self.law.force(v, z, self.fc, self.fs)
+
+        def DoCalcTimeDerivatives(self, context, derivatives):
+            _, v, z = self._split(context)
+            push = self._u_axial_force.Eval(context)[0]
+            accel = (push - self.load.fx - self.law.force(v, z, self.fc, self.fs)) / self.mass
+            rates = [v, accel] + list(self.law.state_rates(v, z, self.fc, self.fs))
+            derivatives.get_mutable_vector().SetFromVector(vector(rates))
+
+        def _calc_state(self, context, output):
+            x, v, _ = self._split(context)
+            output.SetFromVector(vector([x, v]))
+
+        def _calc_friction(self, context, output):
+            output.SetAtIndex(0, self.friction(context))
+
+        def _calc_z(self, context, output):
+            _, _, z = self._split(context)
+            if len(z):
+                output.SetFromVector(z)
+
+    return Impl
+
+
+NutTable = NutTable_[None]

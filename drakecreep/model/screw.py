@@ -1,0 +1,112 @@
+"""The flexible ball screw as the spring of a two-mass model.
+
+The motor-side rotation ``theta`` is mapped through the lead to an axial displacement
+``theta * Ph / (2 pi)``; the difference to the table position ``x`` stretches the axial stiffness
+chain: thrust bearing, screw shaft (its stiffness depends on where the nut is) and screw-nut contact,
+in series. The force acts on the table; its reaction, through the lead, loads the motor.
+
+The series damping of the chain uses the light-damping combination of Kelvin-Voigt elements,
+``C = K^2 sum(c_i / k_i^2)`` (each element's loss factor weighted by its share of the compliance);
+it is exact when every element has the same ``c_i / k_i``.
+"""
+
+import math
+
+from pydrake.systems.framework import LeafSystem_
+from pydrake.systems.scalar_conversion import TemplateSystem
+
+__all__ = [
+    "ScrewDrive",
+    "ScrewDrive_",
+    "shaft_section_area",
+    "shaft_axial_stiffness",
+    "axial_stiffness",
+    "axial_damping",
+    "screw_inertia",
+]
+
+
+def shaft_section_area(screw):
+    """Load-carrying cross-section (m^2) of the shaft, taken at the root diameter."""
+    return math.pi / 4.0 * screw.root_diameter**2
+
+
+def shaft_axial_stiffness(screw, x):
+    """Axial stiffness (N/m) of the shaft between its axial support(s) and the nut at table position ``x``.
+
+    ``fixed-free``: one thrust support, ``k = E A / a`` with ``a`` the support-to-nut distance.
+    ``fixed-fixed``: supports at both ends, ``k = E A L / (a (L - a))``.
+    Works for numpy arrays and any Drake scalar type.
+    """
+    ea = screw.youngs_modulus * shaft_section_area(screw)
+    a = screw.nut_start_distance + x
+    if screw.mounting == "fixed-fixed":
+        return ea * screw.length / (a * (screw.length - a))
+    return ea / a
+
+
+def axial_stiffness(screw, nut, x=0.0):
+    """Stiffness (N/m) of the whole chain, bearing + shaft + nut in series, with the table at ``x``."""
+    return 1.0 / (1.0 / screw.bearing_stiffness + 1.0 / shaft_axial_stiffness(screw, x) + 1.0 / nut.axial_stiffness)
+
+
+def axial_damping(screw, nut, x=0.0):
+    """Damping (N s/m) of the chain: ``K^2 (c_bearing / k_bearing^2 + c_nut / k_nut^2)`` (shaft undamped)."""
+    k = axial_stiffness(screw, nut, x)
+    return k**2 * (screw.bearing_damping / screw.bearing_stiffness**2 + nut.axial_damping / nut.axial_stiffness**2)
+
+
+def screw_inertia(screw):
+    """Rotating inertia (kg m^2) of the shaft as a solid cylinder of the nominal diameter."""
+    return math.pi / 32.0 * screw.density * screw.length * screw.nominal_diameter**4
+
+
+@TemplateSystem.define("ScrewDrive_")
+def ScrewDrive_(T):
+    class Impl(LeafSystem_[T]):
+        """Spring-damper of the screw between the motor rotation and the table (no state).
+
+        Input ports
+        -----------
+        motor_state : 2, ``[theta (rad), omega (rad/s)]``
+        table_state : 2, ``[x (m), v (m/s)]``
+
+        Output ports
+        ------------
+        axial_force : 1, force of the screw on the table (N, +x)
+        load_torque : 1, reaction torque on the motor (N m)
+        """
+
+        def _construct(self, screw, nut, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.screw = screw
+            self.nut = nut
+            self.ratio = screw.lead / (2.0 * math.pi)  # m per rad
+            self._u_motor_state = self.DeclareVectorInputPort("motor_state", 2)
+            self._u_table_state = self.DeclareVectorInputPort("table_state", 2)
+            self.DeclareVectorOutputPort("axial_force", 1, self._calc_force)
+            self.DeclareVectorOutputPort("load_torque", 1, self._calc_torque)
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.screw, other.nut, converter=converter)
+
+        def force(self, context):
+            """Axial force (N) on the table for the current inputs."""
+            theta, omega = self._u_motor_state.Eval(context)
+            x, v = self._u_table_state.Eval(context)
+            stretch = theta * self.ratio - x
+            rate = omega * self.ratio - v
+            k = axial_stiffness(self.screw, self.nut, x)
+            c = axial_damping(self.screw, self.nut, x)
+            return k * stretch + c * rate
+
+        def _calc_force(self, context, output):
+            output.SetAtIndex(0, self.force(context))
+
+        def _calc_torque(self, context, output):
+            output.SetAtIndex(0, self.force(context) * self.ratio)
+
+    return Impl
+
+
+ScrewDrive = ScrewDrive_[None]

@@ -1,0 +1,283 @@
+"""How physical parameters move the poles: loci, friction-slope crossings, stiffness x damping maps.
+
+Every point is a fresh Drake linearization (:mod:`drakecreep.servo.linearize`) of the continuous-controller
+diagram (``closed_loop``) or of the paper's mechanism with the motor motion prescribed (``mechanism``).
+
+The stiffness x damping plane (:func:`pole_map`) holds, at one feed speed ``v``:
+
+* the rightmost closed-loop pole of the linearized drive (colour; its zero contour is the *linear
+  stability boundary of the whole loop*),
+* the paper mechanism's linear boundary ``C + C1 = 0`` (exact for static friction laws),
+* the paper's creep condition ``D^2 = 4 pi zeta`` (eqs. 6, 10), i.e.
+  ``C + C1 = (Fs - Fc)^2 / (2 pi v^2 sqrt(K M))``: above it the paper predicts steady sliding,
+* optionally, creep found by simulating the nonlinear drive on a coarse grid.
+
+Axes: ``K`` is changed by scaling every stiffness of the screw chain (bearing, shaft modulus, nut)
+by the same factor, which leaves the chain damping ``C`` unchanged; ``C + C1`` is changed through the
+viscous friction coefficient ``Fv`` (part of ``C1``), so at a speed on the falling Stribeck branch the
+plane reaches negative effective damping.
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import brentq
+
+from drakecreep.errors import InputError
+from drakecreep.servo.linearize import linearize_closed_loop, linearize_mechanism, operating_point
+from drakecreep.params import with_value
+from drakecreep.scenario import Scenario
+
+__all__ = [
+    "scale_stiffness",
+    "rightmost_pole",
+    "parameter_locus",
+    "friction_slope_crossings",
+    "PoleMap",
+    "pole_map",
+    "paper_creep_damping",
+    "LOCUS_PARAMETERS",
+]
+
+#: parameters :func:`parameter_locus` can sweep, with their meaning
+LOCUS_PARAMETERS = {
+    "stiffness": "scale factor on every stiffness of the screw chain",
+    "feed": "feed speed (m/s): moves the friction slope C1 along the Stribeck curve",
+    "mass": "table mass (kg)",
+}
+
+
+def scale_stiffness(params, factor):
+    """``params`` with bearing, shaft (Young's modulus) and nut stiffness multiplied by ``factor``."""
+    if not (math.isfinite(factor) and factor > 0):
+        raise InputError("stiffness factor", factor, "> 0")
+    p = with_value(params, "screw.bearing_stiffness", params.screw.bearing_stiffness * factor)
+    p = with_value(p, "screw.youngs_modulus", params.screw.youngs_modulus * factor)
+    return with_value(p, "nut.axial_stiffness", params.nut.axial_stiffness * factor)
+
+
+def rightmost_pole(params, scenario, model="closed_loop"):
+    """The pole with the largest real part (rad/s) of the linearized ``closed_loop`` or ``mechanism``."""
+    fn = {"closed_loop": linearize_closed_loop, "mechanism": linearize_mechanism}.get(model)
+    if fn is None:
+        raise InputError("model", model, "closed_loop or mechanism")
+    poles = fn(params, scenario).poles()
+    return poles[np.argmax(poles.real)]
+
+
+def _with_parameter(params, scenario, name, value):
+    if name == "stiffness":
+        return scale_stiffness(params, value), scenario
+    if name == "feed":
+        return params, Scenario(feed=float(value), load_case=scenario.load_case, duration=scenario.duration)
+    if name == "mass":
+        return with_value(params, "table.mass", float(value)), scenario
+    raise InputError("parameter", name, "one of " + ", ".join(LOCUS_PARAMETERS))
+
+
+def parameter_locus(params, scenario, name, values, model="closed_loop"):
+    """Poles of the linearized drive as one physical parameter varies.
+
+    Parameters
+    ----------
+    name : {"stiffness", "feed", "mass"}
+        See :data:`LOCUS_PARAMETERS`.
+    values : array_like
+        Parameter values.
+
+    Returns
+    -------
+    dict
+        ``values``, ``poles`` (list of arrays), ``friction_slope`` and ``zeta`` at each value.
+    """
+    fn = {"closed_loop": linearize_closed_loop, "mechanism": linearize_mechanism}[model]
+    poles, c1, zeta = [], [], []
+    for v in values:
+        p, sc = _with_parameter(params, scenario, name, v)
+        op = operating_point(p, sc)
+        poles.append(fn(p, sc, op).poles())
+        c1.append(op.friction_slope)
+        zeta.append(op.zeta)
+    return dict(name=name, values=np.asarray(values, dtype=float), poles=poles,
+                friction_slope=np.asarray(c1), zeta=np.asarray(zeta))
+
+
+def friction_slope_crossings(params, load_case, speeds, model="closed_loop"):
+    """Feed speeds where the rightmost linearized pole crosses the imaginary axis, and where ``C + C1 = 0``.
+
+    Parameters
+    ----------
+    params : drakecreep.params.DriveParams
+    load_case : int
+    speeds : array_like
+        Increasing feed speeds (m/s) bracketing the crossings.
+    model : {"closed_loop", "mechanism"}
+
+    Returns
+    -------
+    dict
+        ``pole`` and ``theory``: sorted lists of crossing speeds (m/s), each refined with Brent's method.
+    """
+    speeds = np.asarray(speeds, dtype=float)
+
+    def sc(v):
+        return Scenario(feed=float(v), load_case=load_case)
+
+    def re_pole(v):
+        return float(rightmost_pole(params, sc(v), model).real)
+
+    def c_eff(v):
+        op = operating_point(params, sc(v))
+        return op.damping + op.friction_slope
+
+    out = {}
+    for key, f in (("pole", re_pole), ("theory", c_eff)):
+        vals = np.array([f(v) for v in speeds])
+        roots = []
+        for i in np.nonzero(np.sign(vals[:-1]) != np.sign(vals[1:]))[0]:
+            roots.append(float(brentq(f, speeds[i], speeds[i + 1], xtol=1e-12, rtol=1e-10)))
+        out[key] = roots
+    return out
+
+
+def paper_creep_damping(K, M, dF, v):
+    """``C + C1`` on the paper's creep boundary ``D^2 = 4 pi zeta``: ``dF^2 / (2 pi v^2 sqrt(K M))`` (N s/m)."""
+    return dF**2 / (2 * math.pi * v**2 * np.sqrt(np.asarray(K, dtype=float) * M))
+
+
+@dataclass
+class PoleMap:
+    """Result of :func:`pole_map` (SI units).
+
+    Attributes
+    ----------
+    stiffness : ndarray
+        ``K`` (N/m) of each column.
+    damping : ndarray
+        ``C + C1`` (N s/m), shape ``(n_damping, n_stiffness)``.
+    closed_loop, mechanism : ndarray
+        Real part (rad/s) of the rightmost pole of the whole loop / of the paper's mechanism, same shape.
+    sim_stiffness, sim_damping, sim_creep, sim_linear_unstable : ndarray
+        Coarse grid simulated with the nonlinear model (empty if not asked): creep = the table stuck at
+        some time in the metrics window; and whether the linearized whole loop is unstable there.
+    """
+
+    feed: float
+    mass: float
+    friction_drop: float
+    stiffness: np.ndarray
+    damping: np.ndarray
+    closed_loop: np.ndarray
+    mechanism: np.ndarray
+    nominal: tuple
+    sim_stiffness: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sim_damping: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sim_creep: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    sim_linear_unstable: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    def agreement(self):
+        """At the simulated points: how often simulated creep matches (a) the whole loop being linearly
+        unstable and (b) the paper's condition ``D^2 > 4 pi zeta`` (creep below its curve).
+
+        Returns
+        -------
+        dict
+            ``points``, ``linear`` and ``paper`` (counts of agreeing points).
+        """
+        paper = self.sim_damping < self.paper_boundary(self.sim_stiffness)
+        return dict(points=int(len(self.sim_creep)), linear=int(np.sum(self.sim_creep == self.sim_linear_unstable)),
+                    paper=int(np.sum(self.sim_creep == paper)))
+
+    def paper_boundary(self, K):
+        """``C + C1`` of the paper's creep condition at stiffness ``K``."""
+        return paper_creep_damping(K, self.mass, self.friction_drop, self.feed)
+
+
+def _viscous_for(params, scenario, target, k_scale):
+    """Viscous coefficient that puts ``C + C1`` at ``target`` (clipped at 0)."""
+    p = scale_stiffness(params, k_scale)
+    op = operating_point(p, scenario)
+    rest = op.damping + op.friction_slope - p.friction.viscous
+    return max(0.0, target - rest)
+
+
+def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, sim_grid=None, sim_duration=1.0):
+    """Rightmost poles over stiffness x effective damping at the scenario's feed.
+
+    Parameters
+    ----------
+    params, scenario
+        Drive and the feed speed / load case of the plane.
+    k_scales : array_like, optional
+        Stiffness factors (default 16 values, 0.25-4, log spaced).
+    n_damping : int
+        Rows of the damping axis.
+    damping_range : (float, float), optional
+        ``C + C1`` range (N s/m); default from the lowest value reachable (``Fv = 0``) to 1.3 x the
+        paper's boundary at the smallest stiffness.
+    sim_grid : (int, int), optional
+        Simulate the nonlinear drive on this many stiffness x damping points (e.g. ``(6, 6)``).
+    sim_duration : float
+        Simulated time per point (s); the metrics window is its second half.
+
+    Returns
+    -------
+    PoleMap
+    """
+    k_scales = np.geomspace(0.25, 4.0, 16) if k_scales is None else np.asarray(k_scales, dtype=float)
+    op0 = operating_point(params, scenario)
+    M = op0.mass
+    dF = op0.Fs - op0.Fc
+    v = abs(scenario.feed)
+    if damping_range is None:
+        lo = op0.damping + op0.friction_slope - params.friction.viscous
+        hi = 1.3 * float(paper_creep_damping(op0.stiffness * k_scales.min(), M, dF, v))
+        hi = max(hi, op0.damping + op0.friction_slope + 100.0, lo + 100.0)
+        damping_range = (lo, hi)
+    targets = np.linspace(damping_range[0], damping_range[1], n_damping)
+    K = np.zeros(len(k_scales))
+    Y = np.zeros((n_damping, len(k_scales)))
+    cl = np.zeros_like(Y)
+    mech = np.zeros_like(Y)
+    for j, s in enumerate(k_scales):
+        ps = scale_stiffness(params, s)
+        opj = operating_point(ps, scenario)
+        K[j] = opj.stiffness
+        rest = opj.damping + opj.friction_slope - ps.friction.viscous
+        for i, y in enumerate(targets):
+            p = with_value(ps, "friction.viscous", max(0.0, y - rest))
+            op = operating_point(p, scenario)
+            Y[i, j] = op.damping + op.friction_slope
+            cl[i, j] = linearize_closed_loop(p, scenario, op).poles().real.max()
+            mech[i, j] = linearize_mechanism(p, scenario, op).poles().real.max()
+    result = PoleMap(feed=v, mass=M, friction_drop=dF, stiffness=K, damping=Y, closed_loop=cl, mechanism=mech,
+                     nominal=(op0.stiffness, op0.damping + op0.friction_slope))
+    if sim_grid:
+        from drakecreep.sim.simulation import simulate
+
+        nk, ny = sim_grid
+        ks = np.geomspace(k_scales.min(), k_scales.max(), nk)
+        # rows from the lowest reachable damping (slightly inside, to stay visible on the plot) upwards
+        span = damping_range[1] - damping_range[0]
+        ys = np.linspace(damping_range[0], damping_range[1], ny + 1)[:-1] + 0.03 * span
+        psim = with_value(params, "simulation.steady_start", 0.5 * sim_duration)
+        sk, sy, creep, unstable = [], [], [], []
+        sc = Scenario(feed=scenario.feed, load_case=scenario.load_case, duration=sim_duration)
+        for s in ks:
+            ps = scale_stiffness(psim, s)
+            for y in ys:
+                fv = _viscous_for(ps, sc, y, 1.0)
+                p = with_value(ps, "friction.viscous", fv)
+                op = operating_point(p, sc)
+                r = simulate(p, sc)
+                m = r.metrics
+                sk.append(op.stiffness)
+                sy.append(op.damping + op.friction_slope)
+                unstable.append(bool(linearize_closed_loop(p, sc, op).poles().real.max() > 0))
+                creep.append(bool((not r.ok) or m is None or m.stick_fraction > 0.0))
+        result.sim_stiffness = np.asarray(sk)
+        result.sim_damping = np.asarray(sy)
+        result.sim_creep = np.asarray(creep, dtype=bool)
+        result.sim_linear_unstable = np.asarray(unstable, dtype=bool)
+    return result

@@ -1,0 +1,180 @@
+"""Gains of the cascade for a target velocity-loop bandwidth and phase margin.
+
+Rule: **loop shaping at the crossover** on the linearized, sampled loop (not the symmetric optimum,
+which assumes a rigid plant with one small lag; here the plant has the screw resonance, the current
+loop, the friction slope and the sampling, all of which the linearization carries):
+
+1. For a trial crossover ``wc``, the velocity loop with a unit proportional gain gives the plant part
+   ``Q(wc)`` (Drake-linearized plant, ZOH at the velocity period, backward-difference speed).
+2. The PI of the drive, ``C = kv + ki h(w)`` with ``h = T / (z - 1)`` (sampled) or ``1 / s``
+   (continuous), is linear in ``(kv, ki)``; ``C(wc) Q(wc) = exp(j (phase_margin - 180 deg))`` is two real
+   equations for the two gains: exact gain crossover at ``wc`` with exactly the target phase margin.
+3. ``wc`` is adjusted (Brent's method) until the closed velocity loop's -3 dB bandwidth is the target.
+4. Position loop: ``kp = 2 pi f_bw / 4`` (1/s) -- the position loop crosses over about four times below
+   the velocity-loop bandwidth, so that the closed velocity loop looks like unity to it.
+
+The resulting margins of both loops are measured afterwards with :func:`drakecreep.servo.loops.analyze_loops`
+(the resonance can add gain crossovers the rule does not see; they are reported, not hidden).
+"""
+
+import cmath
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from drakecreep.errors import InputError
+from drakecreep.servo.linearize import linearize_plant, operating_point
+from drakecreep.servo.loops import analyze_loops, loop_margins, loop_transfer
+from drakecreep.params import with_value
+
+__all__ = ["TuningResult", "tune", "POSITION_BANDWIDTH_RATIO", "RULE"]
+
+#: velocity-loop bandwidth / position-loop gain (rad/s per 1/s)
+POSITION_BANDWIDTH_RATIO = 4.0
+RULE = ("loop shaping at the crossover on the linearized sampled loop: PI (kv, ki) solved for |L| = 1 and "
+        "the target phase margin at wc, wc set for the target closed-loop bandwidth; kp = w_bw / 4")
+
+
+@dataclass
+class TuningResult:
+    """Tuned gains and what they give.
+
+    Attributes
+    ----------
+    velocity_gain : float
+        ``kv`` (N s/m).
+    velocity_integral_gain : float
+        ``ki`` (N/m); the PI corner is ``ki / kv`` rad/s.
+    position_gain : float
+        ``kp`` (1/s).
+    crossover_Hz : float
+        Velocity-loop gain crossover the rule placed.
+    params : drakecreep.params.DriveParams
+        The input parameters with the tuned gains.
+    analysis : drakecreep.servo.loops.LoopAnalysis
+        Both loops measured with the tuned gains.
+    """
+
+    velocity_gain: float
+    velocity_integral_gain: float
+    position_gain: float
+    crossover_Hz: float
+    target_bandwidth_Hz: float
+    target_phase_margin_deg: float
+    params: object
+    analysis: object
+    rule: str = RULE
+
+    def summary(self):
+        """JSON-ready dict: gains, targets, rule and the measured margins of both loops."""
+        out = dict(
+            rule=self.rule,
+            target_bandwidth_Hz=self.target_bandwidth_Hz,
+            target_phase_margin_deg=self.target_phase_margin_deg,
+            velocity_gain_Ns_per_m=self.velocity_gain,
+            velocity_integral_gain_N_per_m=self.velocity_integral_gain,
+            pi_corner_Hz=self.velocity_integral_gain / self.velocity_gain / (2 * math.pi),
+            position_gain_per_s=self.position_gain,
+            placed_crossover_Hz=self.crossover_Hz,
+        )
+        out.update(self.analysis.summary())
+        return out
+
+
+def _pi_response(params, w, sampled):
+    g = params.controller
+    if sampled:
+        z = cmath.exp(1j * w * g.velocity_period)
+        return g.velocity_period / (z - 1.0)
+    return 1.0 / (1j * w)
+
+
+def _gains_at(params, scenario, wc, pm_deg, q_loop, sampled):
+    Q = complex(np.asarray(q_loop(wc)).reshape(-1)[0])
+    target = cmath.exp(1j * math.radians(pm_deg - 180.0)) / Q
+    h = _pi_response(params, wc, sampled)
+    ki = target.imag / h.imag
+    kv = target.real - ki * h.real
+    return kv, ki
+
+
+def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
+    """PI gains for a velocity-loop bandwidth and phase margin, P gain for the position loop.
+
+    Parameters
+    ----------
+    params : drakecreep.params.DriveParams
+    scenario : drakecreep.scenario.Scenario
+        Operating point (feed, load case) of the linearization.
+    bandwidth_Hz : float
+        Target -3 dB bandwidth of the closed velocity loop.
+    phase_margin_deg : float
+        Target phase margin of the velocity loop at its crossover, in (0, 90).
+
+    Returns
+    -------
+    TuningResult
+
+    Raises
+    ------
+    InputError
+        Targets out of range, or not reachable with a PI (negative gains would be needed).
+    """
+    if not (math.isfinite(bandwidth_Hz) and bandwidth_Hz > 0):
+        raise InputError("bandwidth", bandwidth_Hz, "a bandwidth > 0 Hz")
+    sampled = params.controller.sampled
+    nyquist = 0.5 / params.controller.velocity_period
+    if sampled and bandwidth_Hz >= 0.25 * nyquist:
+        raise InputError("bandwidth", bandwidth_Hz, f"< {0.25 * nyquist:g} Hz (a quarter of the Nyquist frequency)")
+    if not (math.isfinite(phase_margin_deg) and 0 < phase_margin_deg < 90):
+        raise InputError("phase-margin", phase_margin_deg, "an angle in (0, 90) deg")
+    op = operating_point(params, scenario)
+    P = linearize_plant(params, scenario, op)
+    unit = with_value(with_value(params, "controller.velocity_gain", 1.0), "controller.velocity_integral_gain", 0.0)
+    Q = loop_transfer(unit, scenario, "velocity", sampled=sampled, op=op, plant=P,
+                      controller=None if sampled else _unit_controller(unit, scenario, op))
+
+    def q_loop(w):
+        import control
+
+        return control.frequency_response(Q, [w]).complex
+
+    def tuned(wc):
+        kv, ki = _gains_at(params, scenario, wc, phase_margin_deg, q_loop, sampled)
+        if not (kv > 0 and ki >= 0):
+            raise InputError(
+                "phase-margin", phase_margin_deg,
+                f"a target a PI can reach at {wc / 2 / math.pi:.3g} Hz (it would need kv = {kv:.3g}, ki = {ki:.3g})",
+            )
+        p = with_value(with_value(params, "controller.velocity_gain", kv), "controller.velocity_integral_gain", ki)
+        return kv, ki, p
+
+    def bw_gap(wc):
+        _, _, p = tuned(wc)
+        L = loop_transfer(p, scenario, "velocity", sampled=sampled, op=op, plant=P)
+        bw = loop_margins(L)["bandwidth_Hz"]
+        return (bw if math.isfinite(bw) else 0.0) - bandwidth_Hz
+
+    wb = 2 * math.pi * bandwidth_Hz
+    lo, hi = 0.3 * wb, 1.2 * wb
+    try:
+        wc = brentq(bw_gap, lo, hi, xtol=1e-6 * wb)
+    except ValueError:
+        raise InputError("bandwidth", bandwidth_Hz,
+                         "a bandwidth this PI can place (no crossover in 0.3-1.2 x the target gives it)") from None
+    kv, ki, p = tuned(wc)
+    kp = wb / POSITION_BANDWIDTH_RATIO
+    p = with_value(p, "controller.position_gain", kp)
+    return TuningResult(
+        velocity_gain=kv, velocity_integral_gain=ki, position_gain=kp, crossover_Hz=wc / (2 * math.pi),
+        target_bandwidth_Hz=bandwidth_Hz, target_phase_margin_deg=phase_margin_deg, params=p,
+        analysis=analyze_loops(p, scenario),
+    )
+
+
+def _unit_controller(params, scenario, op):
+    from drakecreep.servo.linearize import linearize_controller
+
+    return linearize_controller(params, scenario, op)

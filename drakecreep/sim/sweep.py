@@ -1,0 +1,688 @@
+"""Parameter sweeps at scale: grid or random cases -> simulations on an executor -> one tidy table.
+
+A *point* is a mapping of dotted parameter paths (``"nut.axial_stiffness"``, see
+:func:`drakecreep.params.with_value`) and scenario fields (``feed``, ``load_case``, ``duration``) to
+values. :func:`grid` and :func:`random_sample` expand axes into points; :func:`make_cases` turns
+points into validated :class:`Case` objects (full parameters + scenario + a hash of both);
+:func:`run_sweep` runs a function of each simulation result on
+
+* ``"serial"``: in this process;
+* ``"processes"`` (default): a local process pool, all cores unless ``workers`` says otherwise;
+* ``"dask"``: a ``dask.distributed`` cluster given its scheduler address (or a ``Client``).
+
+The same code runs on all three. With ``out_dir`` every finished case is cached as
+``cache/<key>.json`` (written to a temporary file, then ``os.replace``: a case is either fully there or
+not at all), so an interrupted sweep resumes without recomputing, and the table is written the same
+way as ``results.parquet`` and ``results.csv``. A case whose worker dies is resubmitted (process pool:
+the pool is rebuilt; Dask: the scheduler reschedules it, and a case that still fails is resubmitted
+by the sweep) up to ``retries`` times; one that fails every time becomes a row whose ``status`` says
+why, and is not cached.
+
+Parameter columns carry the path as name and SI values; metric columns are in report units with the
+unit in the name (``fluctuation_rate_percent``), as :meth:`drakecreep.sim.metrics.FeedMetrics.report`.
+"""
+
+import concurrent.futures as cf
+import dataclasses
+import hashlib
+import itertools
+import json
+import math
+import multiprocessing
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from drakecreep.model.drive_source import scenario_with_drive
+from drakecreep.errors import InputError
+from drakecreep.files import write_atomic, write_json
+from drakecreep.params import params_to_dict, with_value
+from drakecreep.scenario import Scenario
+
+__all__ = [
+    "SCENARIO_FIELDS",
+    "EXECUTORS",
+    "CACHE_VERSION",
+    "Case",
+    "SweepResult",
+    "grid",
+    "random_sample",
+    "make_cases",
+    "case_key",
+    "feed_report",
+    "run_case",
+    "run_sweep",
+    "SweepSpec",
+    "load_spec",
+    "metric_columns",
+]
+
+#: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter (``drive``:
+#: ``"cascade"`` or ``"constant_speed"``, see :class:`drakecreep.model.drive_source.DriveScenario`)
+SCENARIO_FIELDS = ("feed", "load_case", "duration", "drive")
+EXECUTORS = ("serial", "processes", "dask")
+#: bump when the meaning of a cached row changes (simulation semantics, report keys)
+CACHE_VERSION = 1
+
+
+# --------------------------------------------------------------------------- points
+
+def _axis_values(path, values):
+    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise InputError(f"axes.{path}", values, "a list of values")
+    values = list(values)
+    if not values:
+        raise InputError(f"axes.{path}", values, "a non-empty list of values")
+    return [v.item() if isinstance(v, np.generic) else v for v in values]
+
+
+def grid(axes):
+    """Every combination of the axes' values (the first axis varies slowest).
+
+    Parameters
+    ----------
+    axes : mapping
+        ``path -> list of values``; paths are parameter paths or scenario fields.
+
+    Returns
+    -------
+    list of dict
+        One ``{path: value}`` per point.
+    """
+    if not axes:
+        return [{}]
+    names = list(axes)
+    lists = [_axis_values(n, axes[n]) for n in names]
+    return [dict(zip(names, combo)) for combo in itertools.product(*lists)]
+
+
+def random_sample(axes, n, seed=0):
+    """``n`` random points.
+
+    Parameters
+    ----------
+    axes : mapping
+        ``path -> spec``; a list (uniform choice among its items) or a mapping
+        ``{"low": a, "high": b, "scale": "linear"|"log"}`` (uniform, or log-uniform for ``"log"``;
+        integers when both bounds are integers and the scale is linear).
+    n : int
+        Number of points (>= 1).
+    seed : int
+        Seed of :func:`numpy.random.default_rng`; the same seed gives the same points.
+
+    Returns
+    -------
+    list of dict
+    """
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise InputError("n", n, "an integer >= 1")
+    rng = np.random.default_rng(seed)
+    columns = {}
+    for path, spec in axes.items():
+        if isinstance(spec, dict):
+            low, high = spec.get("low"), spec.get("high")
+            scale = spec.get("scale", "linear")
+            if set(spec) - {"low", "high", "scale"}:
+                raise InputError(f"axes.{path}", spec, "a mapping with keys low, high, scale")
+            if not all(isinstance(b, (int, float)) and not isinstance(b, bool) for b in (low, high)) or not low <= high:
+                raise InputError(f"axes.{path}", spec, "low <= high, both numbers")
+            if scale == "log":
+                if low <= 0:
+                    raise InputError(f"axes.{path}.low", low, "> 0 for a log scale")
+                columns[path] = [float(v) for v in np.exp(rng.uniform(math.log(low), math.log(high), n))]
+            elif scale == "linear":
+                if isinstance(low, int) and isinstance(high, int):
+                    columns[path] = [int(v) for v in rng.integers(low, high + 1, n)]
+                else:
+                    columns[path] = [float(v) for v in rng.uniform(low, high, n)]
+            else:
+                raise InputError(f"axes.{path}.scale", scale, "linear or log")
+        else:
+            values = _axis_values(path, spec)
+            columns[path] = [values[i] for i in rng.integers(0, len(values), n)]
+    return [{p: columns[p][i] for p in columns} for i in range(n)]
+
+
+# --------------------------------------------------------------------------- cases
+
+@dataclass(frozen=True)
+class Case:
+    """One simulation of a sweep: where it sits in the sweep, and everything that defines it."""
+
+    index: int
+    point: dict
+    params: object
+    scenario: Scenario
+    key: str
+
+
+def case_key(params, scenario, metric_name):
+    """Hash of the full parameters, the scenario and the metric function: the cache key of a case."""
+    payload = dict(
+        version=CACHE_VERSION, params=params_to_dict(params), scenario=dataclasses.asdict(scenario),
+        metric=metric_name,
+    )
+    text = json.dumps(payload, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _metric_name(func):
+    return f"{getattr(func, '__module__', '?')}.{getattr(func, '__qualname__', repr(func))}"
+
+
+def make_cases(base, points, scenario=None, metric=None):
+    """Validated cases from points.
+
+    Parameters
+    ----------
+    base : drakecreep.params.DriveParams
+    points : list of dict
+        ``{path: value}``; scenario fields override ``scenario``.
+    scenario : Scenario or mapping, optional
+        Defaults of the scenario fields (default ``Scenario()``); ``drive`` picks the drive.
+    metric : callable, optional
+        The function of the result (part of the cache key); default :func:`feed_report`.
+
+    Raises
+    ------
+    InputError
+        Naming the path and value of the first invalid point.
+    """
+    metric = metric or feed_report
+    defaults = dataclasses.asdict(scenario) if isinstance(scenario, Scenario) else dict(scenario or {})
+    unknown = set(defaults) - set(SCENARIO_FIELDS)
+    if unknown:
+        name = sorted(unknown)[0]
+        raise InputError(f"scenario.{name}", defaults[name], "one of " + ", ".join(SCENARIO_FIELDS))
+    name = _metric_name(metric)
+    cases = []
+    for index, point in enumerate(points):
+        params = base
+        fields = dict(defaults)
+        for path, value in point.items():
+            if path in SCENARIO_FIELDS:
+                fields[path] = value
+            else:
+                params = with_value(params, path, value)
+        scen = scenario_with_drive(**fields)
+        if params.simulation.steady_start >= scen.duration:
+            raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
+        params.load_case(scen.load_case)  # validates the load case number
+        cases.append(Case(index=index, point=dict(point), params=params, scenario=scen,
+                          key=case_key(params, scen, name)))
+    return cases
+
+
+# --------------------------------------------------------------------------- one case
+
+def feed_report(result):
+    """Default metric: the :class:`~drakecreep.sim.metrics.FeedMetrics` report plus run information."""
+    row = dict(status=result.status, sim_time_s=float(result.time[-1]) if len(result.time) else 0.0,
+               wall_time_s=result.wall_time, steps=result.stats.get("steps"))
+    if result.metrics is not None:
+        row.update(result.metrics.report())
+    return row
+
+
+def run_case(case, metric=None):
+    """Simulate one case and apply ``metric`` (default :func:`feed_report`) to the result.
+
+    Returns
+    -------
+    dict
+        The metric's flat ``{column: value}``.
+    """
+    from drakecreep.sim.simulation import simulate
+
+    metric = metric or feed_report
+    result = simulate(case.params, case.scenario)
+    row = metric(result)
+    if not isinstance(row, dict):
+        raise TypeError(f"the sweep metric must return a dict, got {type(row).__name__}")
+    return {k: _plain(v) for k, v in row.items()}
+
+
+@dataclass(frozen=True)
+class _Batch:
+    """Cases simulated together in one system (:mod:`drakecreep.sim.batch`): a unit of work of the executors."""
+
+    cases: tuple
+
+    @property
+    def key(self):
+        return hashlib.sha1("".join(c.key for c in self.cases).encode()).hexdigest()[:20]
+
+
+def run_batch(batch):
+    """Simulate a :class:`_Batch` in one system; one :func:`feed_report`-shaped row per case."""
+    from drakecreep.sim.batch import simulate_batch
+
+    metrics, info = simulate_batch([(c.params, c.scenario) for c in batch.cases])
+    share = info["wall_time"] / len(batch.cases)
+    return [
+        {k: _plain(v) for k, v in dict(status="ok", sim_time_s=float(c.scenario.duration), wall_time_s=share,
+                                       steps=info["steps"], **m.report()).items()}
+        for c, m in zip(batch.cases, metrics)
+    ]
+
+
+def _work(unit, metric):
+    return run_batch(unit) if isinstance(unit, _Batch) else run_case(unit, metric)
+
+
+def _batches(todo, batch_size, metric):
+    """Group compatible cases into batches of at most ``batch_size``; the rest stay single cases."""
+    from drakecreep.sim.baseline import unsupported
+    from drakecreep.sim.batch import batch_key
+
+    if not batch_size or batch_size < 2 or metric is not feed_report:
+        return list(todo)
+    groups, units = {}, []
+    for case in todo:
+        if (getattr(case.scenario, "drive", "cascade") != "cascade" or not case.params.controller.sampled
+                or unsupported(case.params) is not None):
+            units.append(case)
+        else:
+            groups.setdefault(batch_key(case.params, case.scenario), []).append(case)
+    for members in groups.values():
+        # a batch steps as finely as its most demanding case: slow feeds (which creep, and need ~3x the
+        # steps of a smooth feed) go together, so that they do not slow the batches of smooth feeds
+        members.sort(key=lambda c: (abs(c.scenario.feed), c.key))
+        for i in range(0, len(members), batch_size):
+            chunk = tuple(members[i:i + batch_size])
+            units.append(_Batch(chunk) if len(chunk) > 1 else chunk[0])
+    return units
+
+
+def _plain(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+# --------------------------------------------------------------------------- files
+
+def _read_cache(path):
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+# --------------------------------------------------------------------------- running
+
+@dataclass
+class SweepResult:
+    """What a sweep produced.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per case: ``case``, ``key``, the swept paths, ``feed``/``load_case``/``duration``,
+        then the metric columns (``status`` says ``"ok"`` or why a case failed).
+    computed, cached, failed : int
+        Cases simulated in this run, taken from the cache, failed after every retry.
+    paths : dict
+        ``results_parquet``, ``results_csv`` when written.
+    wall_time : float
+        Seconds for the whole sweep.
+    """
+
+    table: object
+    computed: int
+    cached: int
+    failed: int
+    retried: int
+    paths: dict
+    wall_time: float
+
+
+class _Progress:
+    def __init__(self, total, enabled, desc):
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=desc, unit="case", file=sys.stderr, dynamic_ncols=True)
+
+    def update(self, n=1):
+        if self.bar is not None:
+            self.bar.update(n)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+
+
+def _run_serial(todo, metric, retries, done):
+    for case in todo:
+        error = None
+        for _attempt in range(retries + 1):
+            try:
+                done(case, _work(case, metric), None)
+                break
+            except Exception as err:  # noqa: BLE001 - reported in the row
+                error = err
+        else:
+            done(case, None, error)
+
+
+def _run_processes(todo, metric, retries, done, workers):
+    attempts = {c.key: 0 for c in todo}
+    pending = list(todo)
+    context = multiprocessing.get_context("spawn")
+    retried = 0
+    while pending:
+        broken = []
+        with cf.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+            futures = {pool.submit(_work, case, metric): case for case in pending}
+            for future in cf.as_completed(futures):
+                case = futures[future]
+                try:
+                    row = future.result()
+                except Exception as err:  # noqa: BLE001 - BrokenProcessPool (a worker died) or the case raised
+                    attempts[case.key] += 1
+                    if attempts[case.key] <= retries:
+                        broken.append(case)
+                    else:
+                        done(case, None, err)
+                    continue
+                done(case, row, None)
+        retried += len(broken)
+        pending = broken
+    return retried
+
+
+def _run_dask(todo, metric, retries, done, scheduler):
+    from distributed import Client, as_completed
+
+    own = not hasattr(scheduler, "submit")
+    client = Client(scheduler) if own else scheduler
+    retried = 0
+    try:
+        attempts = {c.key: 0 for c in todo}
+        cases = {}
+        futures = []
+        for case in todo:
+            f = client.submit(_work, case, metric, key=f"drakecreep-case-{case.key}-0", pure=False)
+            cases[f.key] = case
+            futures.append(f)
+        queue = as_completed(futures)
+        for future in queue:
+            case = cases.pop(future.key)
+            try:
+                row = future.result()
+            except Exception as err:  # noqa: BLE001 - KilledWorker, a worker's exception
+                attempts[case.key] += 1
+                if attempts[case.key] <= retries:
+                    retried += 1
+                    f = client.submit(_work, case, metric, pure=False,
+                                      key=f"drakecreep-case-{case.key}-{attempts[case.key]}")
+                    cases[f.key] = case
+                    queue.add(f)
+                else:
+                    done(case, None, err)
+                continue
+            finally:
+                future.release()
+            done(case, row, None)
+    finally:
+        if own:
+            client.close()
+    return retried
+
+
+def run_sweep(base, points, *, scenario=None, metric=None, executor="processes", workers=None, scheduler=None,
+              out_dir=None, progress=True, retries=2, columns=None, batch_size=None):
+    """Run a sweep and collect one row per case.
+
+    Parameters
+    ----------
+    base : drakecreep.params.DriveParams
+        Parameters every case starts from.
+    points : list of dict
+        From :func:`grid`, :func:`random_sample` or by hand.
+    scenario : Scenario or mapping, optional
+        Defaults of ``feed``, ``load_case``, ``duration``, ``drive``.
+    metric : callable, optional
+        ``metric(SimulationResult) -> dict``; a module-level function (it is pickled to the workers).
+        Default :func:`feed_report`.
+    executor : {"serial", "processes", "dask"}
+        ``"dask"`` needs ``scheduler``.
+    workers : int, optional
+        Processes of the local pool (default: all cores).
+    scheduler : str or distributed.Client, optional
+        Dask scheduler address (``"tcp://host:8786"``) or a connected client.
+    out_dir : path, optional
+        Cache (``cache/``) and tables (``results.parquet``, ``results.csv``); without it nothing is
+        cached or written.
+    progress : bool
+        tqdm progress bar on stderr.
+    retries : int
+        Extra attempts for a case whose worker died or that raised.
+    columns : list of str, optional
+        Metric columns to keep (default: all the metric returns).
+    batch_size : int, optional
+        Simulate up to this many compatible cases together in one Drake system
+        (:mod:`drakecreep.sim.batch`; several times the throughput for large sweeps). Only with the
+        default metric; cases the batch path cannot run (constant-speed drive, continuous
+        controller, disturbances, compensation, nut friction on the screw: see
+        :func:`drakecreep.sim.baseline.unsupported`) run one by one. The batches are the executors' units of work.
+
+    Returns
+    -------
+    SweepResult
+    """
+    if executor not in EXECUTORS:
+        raise InputError("executor", executor, "one of " + ", ".join(EXECUTORS))
+    if executor == "dask" and scheduler is None:
+        raise InputError("scheduler", scheduler, "a Dask scheduler address for the dask executor")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise InputError("workers", workers, "an integer >= 1")
+    if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
+        raise InputError("batch_size", batch_size, "an integer >= 1")
+    start = time.perf_counter()
+    metric = metric or feed_report
+    cases = make_cases(base, points, scenario, metric)
+    cache_dir = Path(out_dir) / "cache" if out_dir is not None else None
+    rows = {}
+    todo = []
+    for case in cases:
+        cached = _read_cache(cache_dir / f"{case.key}.json") if cache_dir is not None else None
+        if cached is not None and cached.get("key") == case.key:
+            rows[case.key] = cached["row"]
+        else:
+            todo.append(case)
+    n_cached = len(cases) - len(todo)
+    failed = 0
+    bar = _Progress(len(cases), progress, "sweep")
+    bar.update(n_cached)
+
+    def done(unit, result, error):
+        if isinstance(unit, _Batch):
+            for i, case in enumerate(unit.cases):
+                done_case(case, None if result is None else result[i], error)
+        else:
+            done_case(unit, result, error)
+
+    def done_case(case, row, error):
+        nonlocal failed
+        if row is None:
+            failed += 1
+            row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
+        elif cache_dir is not None:
+            write_json(cache_dir / f"{case.key}.json", dict(key=case.key, point=case.point, row=row))
+        rows[case.key] = row
+        bar.update()
+
+    retried = 0
+    units = _batches(todo, batch_size, metric)
+    try:
+        if units:
+            if executor == "serial":
+                _run_serial(units, metric, retries, done)
+            elif executor == "processes":
+                retried = _run_processes(units, metric, retries, done, workers or os.cpu_count() or 1)
+            else:
+                retried = _run_dask(units, metric, retries, done, scheduler)
+    finally:
+        bar.close()
+
+    table = _table(cases, rows, columns)
+    paths = {}
+    if out_dir is not None:
+        out = Path(out_dir)
+        paths["results_csv"] = write_atomic(out / "results.csv", lambda tmp: table.to_csv(tmp, index=False))
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
+            pass
+        else:
+            paths["results_parquet"] = write_atomic(out / "results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
+    return SweepResult(table=table, computed=len(todo) - failed, cached=n_cached, failed=failed, retried=retried,
+                       paths=paths, wall_time=time.perf_counter() - start)
+
+
+def _table(cases, rows, columns):
+    import pandas as pd
+
+    records = []
+    for case in cases:
+        rec = dict(case=case.index, key=case.key)
+        for path, value in case.point.items():
+            rec[path] = value
+        for name in SCENARIO_FIELDS:
+            rec.setdefault(name, getattr(case.scenario, name, "cascade"))
+        row = rows.get(case.key, {})
+        keep = row if columns is None else {k: row.get(k) for k in ["status", *columns] if k in row or k in columns}
+        for k, v in keep.items():
+            rec.setdefault(k, v)
+        records.append(rec)
+    return pd.DataFrame.from_records(records)
+
+
+# --------------------------------------------------------------------------- spec files
+
+def metric_columns():
+    """Column names :func:`feed_report` produces (what a spec's ``metrics`` may name)."""
+    from drakecreep.sim.metrics import FeedMetrics
+
+    names = [f.name for f in dataclasses.fields(FeedMetrics)]
+    dummy = FeedMetrics(**{n: 0 for n in names})
+    return ["status", "sim_time_s", "wall_time_s", "steps", *dummy.report()]
+
+
+@dataclass
+class SweepSpec:
+    """A sweep read from YAML (:func:`load_spec`)."""
+
+    base: object
+    points: list
+    scenario: dict
+    metrics: list
+    plot: dict
+    source: str = ""
+
+
+def _range(path, spec):
+    keys = set(spec)
+    if keys <= {"start", "stop", "num", "scale"} and {"start", "stop", "num"} <= keys:
+        start, stop, num, scale = spec["start"], spec["stop"], spec["num"], spec.get("scale", "linear")
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            raise InputError(f"axes.{path}.num", num, "an integer >= 1")
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop)):
+            raise InputError(f"axes.{path}", spec, "numbers start and stop")
+        if scale == "log":
+            if start <= 0 or stop <= 0:
+                raise InputError(f"axes.{path}", spec, "start, stop > 0 for a log scale")
+            return [float(v) for v in np.geomspace(start, stop, num)]
+        if scale != "linear":
+            raise InputError(f"axes.{path}.scale", scale, "linear or log")
+        return [float(v) for v in np.linspace(start, stop, num)]
+    raise InputError(f"axes.{path}", spec, "a list of values or {start, stop, num[, scale: linear|log]}")
+
+
+def load_spec(path):
+    """Read a sweep spec (YAML).
+
+    ::
+
+        base: {preset: paper}            # or {file: params.yaml} (relative to the spec); optional set: {path: value}
+        scenario: {feed: 1.0e-3, load_case: 3, duration: 2.0}   # defaults of the scenario fields (SI)
+        axes:                            # path -> list, or a range {start, stop, num, scale: linear|log}
+          nut.axial_stiffness: {start: 5.0e6, stop: 1.0e8, num: 8, scale: log}
+          feed: [0.2e-3, 0.5e-3, 1.0e-3]
+        sample: {mode: grid}             # or {mode: random, n: 100, seed: 0} (axes then: list or {low, high, scale})
+        metrics: [fluctuation_rate_percent, creep]      # columns to keep (default: all)
+        plot: {x: nut.axial_stiffness, y: feed, color: fluctuation_rate_percent}   # optional stability map
+
+    Raises
+    ------
+    InputError
+        Naming the key of the first problem.
+    """
+    import yaml
+
+    from drakecreep.params import load_params, preset
+
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        raise InputError(str(path), "invalid YAML" + (f" (line {mark.line + 1})" if mark else ""),
+                         "a YAML sweep spec") from None
+    if not isinstance(data, dict):
+        raise InputError(str(path), data, "a mapping with base, scenario, axes, sample, metrics, plot")
+    known = {"base", "scenario", "axes", "sample", "metrics", "plot"}
+    extra = sorted(set(data) - known)
+    if extra:
+        raise InputError(extra[0], data[extra[0]], "a spec key: " + ", ".join(sorted(known)))
+    base_spec = data.get("base") or {"preset": "paper"}
+    if not isinstance(base_spec, dict) or set(base_spec) - {"preset", "file", "set"} \
+            or ("preset" in base_spec and "file" in base_spec):
+        raise InputError("base", base_spec, "{preset: NAME} or {file: PATH}, optionally with set: {path: value}")
+    if "file" in base_spec:
+        file = Path(base_spec["file"])
+        base = load_params(file if file.is_absolute() else path.parent / file)
+    else:
+        base = preset(base_spec.get("preset", "paper"))
+    overrides = base_spec.get("set") or {}
+    if not isinstance(overrides, dict):
+        raise InputError("base.set", overrides, "a mapping path -> value")
+    for key, value in overrides.items():
+        base = with_value(base, key, value)
+    scenario = data.get("scenario") or {}
+    if not isinstance(scenario, dict):
+        raise InputError("scenario", scenario, "a mapping of " + ", ".join(SCENARIO_FIELDS))
+    axes = data.get("axes")
+    if not isinstance(axes, dict) or not axes:
+        raise InputError("axes", axes, "a non-empty mapping path -> values")
+    sample = data.get("sample") or {"mode": "grid"}
+    if not isinstance(sample, dict) or sample.get("mode", "grid") not in ("grid", "random") \
+            or set(sample) - {"mode", "n", "seed"}:
+        raise InputError("sample", sample, "{mode: grid} or {mode: random, n: N, seed: S}")
+    if sample.get("mode", "grid") == "grid":
+        expanded = {p: (_range(p, v) if isinstance(v, dict) else v) for p, v in axes.items()}
+        points = grid(expanded)
+    else:
+        points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0))
+    metrics = data.get("metrics")
+    known_metrics = metric_columns()
+    if metrics is not None:
+        if not isinstance(metrics, list) or not metrics:
+            raise InputError("metrics", metrics, "a list of: " + ", ".join(known_metrics))
+        for name in metrics:
+            if name not in known_metrics:
+                raise InputError("metrics", name, "one of " + ", ".join(known_metrics))
+    plot = data.get("plot") or {}
+    if not isinstance(plot, dict) or set(plot) - {"x", "y", "color"} or (plot and "x" not in plot):
+        raise InputError("plot", plot, "{x: PATH[, y: PATH, color: METRIC]}")
+    make_cases(base, points, scenario)  # validates every path and value before anything runs
+    return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))
+
+

@@ -1,0 +1,95 @@
+"""Smoke tests of the critical, hertz and modal subcommands through drakecreep.cli.main."""
+
+import importlib.util
+import json
+
+import numpy as np
+import pytest
+
+import drakecreep.cli as cli
+from drakecreep.model.lumped import lumped
+from drakecreep.paper.creep import critical_speed_of
+from drakecreep.paper.modal import synthetic_hammer_test
+
+
+@pytest.fixture(autouse=True)
+def _only_importable_commands(monkeypatch):
+    # other subcommands are being written concurrently; register the ones that exist
+    present = [c for c in cli.COMMANDS if importlib.util.find_spec(f"drakecreep.cli.{c}")]
+    monkeypatch.setattr(cli, "COMMANDS", present)
+
+
+def run_json(capsys, argv):
+    assert cli.main(argv + ["--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_critical_takes_the_presets_chain_and_load_case(capsys, paper):
+    out = run_json(capsys, ["critical"])
+    drive = lumped(paper, 3)
+    assert out["inputs"]["load_case"] == 3
+    assert out["inputs"]["stiffness_N_per_um"] == pytest.approx(drive.stiffness * 1e-6)
+    assert out["inputs"]["Fd_N"] == pytest.approx(drive.coulomb)
+    assert out["v0_self_consistent_mm_per_s"] == pytest.approx(critical_speed_of(drive) * 1e3)
+    assert out["D0"] == pytest.approx(np.sqrt(4 * np.pi * out["zeta"]))
+    # creep predicted exactly when the feed is below v0
+    assert out["creep_predicted"] == (out["inputs"]["feed_mm_per_s"] < out["v0_mm_per_s"])
+    # the same number the loop report gives for the preset (it reads the linearized operating point)
+    unloaded = run_json(capsys, ["critical", "--load-case", "0"])
+    assert unloaded["inputs"]["Fd_N"] < out["inputs"]["Fd_N"]
+
+
+def test_critical_negative_damping_reports_no_v0(capsys):
+    out = run_json(capsys, ["critical", "--damping", "0", "--feed", "0.01", "--friction", "stribeck",
+                            "--preset", "paper"])
+    assert out["C1_Ns_per_m"] < 0 and out["v0_mm_per_s"] is None and out["creep_predicted"]
+
+
+def test_hertz_json_keys_and_paper_inputs(capsys):
+    out = run_json(capsys, ["hertz"])
+    for key in ("ka_N_per_m", "kr_N_per_m", "fa_Hz", "fr_Hz", "ball_load_N"):
+        assert out[key] > 0
+    assert out["ball_load_N"] == pytest.approx(17.457, rel=1e-3)
+    more = run_json(capsys, ["hertz", "--preload", str(579 * 8)])
+    assert more["ka_N_per_m"] == pytest.approx(2 * out["ka_N_per_m"], rel=1e-9)  # K ~ Fa^(1/3)
+
+
+def test_modal_frf_csv(tmp_path, capsys):
+    m, c, k = 0.335, 1.68, 1.62e5
+    f = np.linspace(0, 300, 30001)
+    H = 1 / (k - m * (2 * np.pi * f) ** 2 + 1j * c * 2 * np.pi * f)
+    path = tmp_path / "frf.csv"
+    np.savetxt(path, np.column_stack([f, H.real, H.imag]), delimiter=",", header="f_Hz,re,im",
+               comments="")
+    out = run_json(capsys, ["modal", str(path), "--mass", str(m)])
+    assert out["half_power"]["k_N_per_m"] == pytest.approx(k, rel=0.01)
+    assert out["sdof_fit"]["c_Ns_per_m"] == pytest.approx(c, rel=0.01)
+
+
+def test_modal_time_csv(tmp_path, capsys):
+    m, c, k, fs = 1.0, 258.28, 52.3e6, 50e3
+    test = synthetic_hammer_test(m, c, k, fs, 0.2, 1e-4, delay=2e-4)
+    path = tmp_path / "hit.csv"
+    np.savetxt(path, np.column_stack([test.t, test.force[0], test.response[0]]), delimiter=",",
+               header="t,force,response", comments="")
+    out = run_json(capsys, ["modal", str(path), "--mass", "1.0"])
+    assert out["sdof_fit"]["k_N_per_m"] == pytest.approx(k, rel=0.03)
+    assert out["half_power"]["fn_Hz"] == pytest.approx(np.sqrt(k / m) / (2 * np.pi), rel=0.01)
+
+
+@pytest.mark.parametrize("argv", [
+    ["critical", "--mass", "-1"],
+    ["hertz", "--conformity", "0.4"],
+])
+def test_bad_argument_exits_2_with_one_line(argv, capsys):
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "error" in err
+
+
+def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
+    path = tmp_path / "bad.csv"
+    path.write_text("a,b,c\n1,2,3\n")
+    assert cli.main(["modal", str(path)]) == 2
+    assert "f_Hz,re,im" in capsys.readouterr().err
+    assert cli.main(["modal", str(tmp_path / "missing.csv")]) == 2

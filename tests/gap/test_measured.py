@@ -1,0 +1,286 @@
+import math
+
+import numpy as np
+import pytest
+import yaml
+
+from drakecreep.errors import InputError
+from drakecreep.gap.measured import (
+    EMPS_CONTROLLER,
+    ControllerMeta,
+    MeasuredData,
+    MeasuredMeta,
+    MeasuredRun,
+    emps_data_dir,
+    emps_path,
+    load_emps,
+    load_measured,
+    save_measured,
+)
+from drakecreep.params import params_to_dict, preset
+
+EMPS = emps_data_dir()
+
+META = {"u_units": "V", "u_gain": 35.0,
+        "controller": {"kind": "p_p_cascade", "kp": 100.0, "kv": 200.0, "saturation": 10.0,
+                       "sample_time": 0.001, "position_filter": [0.5, 0.5]},
+        "sensors": {"encoder_resolution": 5e-8}, "source": "synthetic"}
+
+
+def _rows(n=20, dt=1e-3):
+    t = np.arange(n) * dt
+    return {"t": t, "x_ref": 1e-3 * t, "x_motor": 1e-3 * t - 1e-7, "u": np.sin(t), "f_ext": 0 * t + 2.0}
+
+
+def _write(tmp_path, cols=None, header=None, meta=META, name="run.csv"):
+    cols = _rows() if cols is None else cols
+    names = list(cols)
+    csv_path = tmp_path / name
+    lines = [",".join(header or names)]
+    n = len(next(iter(cols.values())))
+    for i in range(n):
+        lines.append(",".join(repr(float(cols[c][i])) if isinstance(cols[c][i], (float, np.floating))
+                              else str(cols[c][i]) for c in names))
+    csv_path.write_text("\n".join(lines) + "\n")
+    if meta is not None:
+        (tmp_path / name.replace(".csv", ".yaml")).write_text(yaml.safe_dump(meta))
+    return csv_path
+
+
+def test_load_minimal_csv_with_units_in_header(tmp_path):
+    cols = _rows()
+    path = _write(tmp_path, cols, header=["t[s]", "x_ref [m]", "x_motor(m)", "u[V]", "f_ext[N]"])
+    data = load_measured(path)
+    run = data.run()
+    assert run.label == "run" and run.n == 20
+    assert run.dt == pytest.approx(1e-3)
+    np.testing.assert_array_equal(run.u, cols["u"])
+    np.testing.assert_allclose(run.force, 35.0 * cols["u"] + 2.0)
+    assert data.meta.controller.kp == 100.0 and data.meta.sensors.encoder_resolution == 5e-8
+    assert run.x_table is None
+
+
+@pytest.mark.parametrize("drop", ["t", "x_ref", "x_motor", "u"])
+def test_missing_column(tmp_path, drop):
+    cols = _rows()
+    del cols[drop]
+    with pytest.raises(InputError, match=f"the columns {drop} as well"):
+        load_measured(_write(tmp_path, cols))
+
+
+def test_unknown_column(tmp_path):
+    cols = _rows()
+    cols["speed"] = cols["t"]
+    with pytest.raises(InputError, match="speed"):
+        load_measured(_write(tmp_path, cols))
+
+
+def test_non_monotonic_time(tmp_path):
+    cols = _rows()
+    cols["t"][7], cols["t"][8] = cols["t"][8], cols["t"][7]
+    with pytest.raises(InputError, match="strictly increasing") as err:
+        load_measured(_write(tmp_path, cols))
+    assert "t[8]" in str(err.value)
+
+
+def test_repeated_time_is_non_monotonic(tmp_path):
+    cols = _rows()
+    cols["t"][5] = cols["t"][4]
+    with pytest.raises(InputError, match="strictly increasing"):
+        load_measured(_write(tmp_path, cols))
+
+
+def test_non_uniform_time_and_tolerance(tmp_path):
+    cols = _rows()
+    cols["t"][10:] += 2e-6  # one step 0.2 % longer
+    path = _write(tmp_path, cols)
+    with pytest.raises(InputError, match="uniform sampling within a relative tolerance of 0.001"):
+        load_measured(path)
+    assert load_measured(path, dt_rtol=5e-3).run().n == 20  # within a looser, explicit tolerance
+
+
+def test_nan(tmp_path):
+    cols = _rows()
+    cols["x_motor"][3] = float("nan")
+    with pytest.raises(InputError, match="NaN at data row 4") as err:
+        load_measured(_write(tmp_path, cols))
+    assert "x_motor" in err.value.field
+
+
+def test_not_a_number(tmp_path):
+    cols = {k: list(v) for k, v in _rows().items()}
+    cols["u"][2] = "abc"
+    with pytest.raises(InputError, match="abc"):
+        load_measured(_write(tmp_path, cols))
+
+
+def test_unknown_unit_of_u(tmp_path):
+    with pytest.raises(InputError, match="one of N, A, V") as err:
+        load_measured(_write(tmp_path, meta={**META, "u_units": "mV"}))
+    assert err.value.field == "u_units"
+
+
+def test_unit_of_u_in_header_must_match_metadata(tmp_path):
+    path = _write(tmp_path, header=["t", "x_ref", "x_motor", "u[A]", "f_ext"])
+    with pytest.raises(InputError, match="V \\(the u_units of the metadata\\)"):
+        load_measured(path)
+
+
+def test_non_si_unit_in_header(tmp_path):
+    path = _write(tmp_path, header=["t", "x_ref", "x_motor[mm]", "u", "f_ext"])
+    with pytest.raises(InputError, match="m \\(SI\\)") as err:
+        load_measured(path)
+    assert "x_motor" in err.value.field
+
+
+def test_gain_must_be_one_for_force(tmp_path):
+    with pytest.raises(InputError, match="1 when u_units is N"):
+        load_measured(_write(tmp_path, meta={**META, "u_units": "N", "u_gain": 35.0}))
+
+
+def test_gain_required_for_volts(tmp_path):
+    meta = {k: v for k, v in META.items() if k != "u_gain"}
+    with pytest.raises(InputError, match="N per V"):
+        load_measured(_write(tmp_path, meta=meta))
+
+
+def test_current_gain_derived_from_params(tmp_path):
+    p = preset("paper")
+    meta = {"u_units": "A", "params": params_to_dict(p)}
+    data = load_measured(_write(tmp_path, meta=meta))
+    assert data.meta.u_gain == pytest.approx(p.motor.torque_constant * 2 * math.pi / p.screw.lead)
+    assert data.meta.params == p
+
+
+def test_params_file_relative_to_metadata(tmp_path):
+    from drakecreep.params import save_params, with_value
+
+    p = with_value(preset("paper"), "screw.lead", 4e-3)
+    save_params(p, tmp_path / "rig.yaml")
+    data = load_measured(_write(tmp_path, meta={**META, "params": "rig.yaml"}))
+    assert data.meta.params.screw.lead == 4e-3
+
+
+def test_row_length_mismatch(tmp_path):
+    path = _write(tmp_path)
+    lines = path.read_text().splitlines()
+    lines[5] = lines[5] + ",1.0"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputError, match="6 fields") as err:
+        load_measured(path)
+    assert "line 6" in err.value.field
+
+
+def test_array_length_mismatch_in_constructor():
+    r = _rows()
+    meta = MeasuredMeta(u_units="N", u_gain=1.0)
+    with pytest.raises(InputError, match="length 20, the length of t") as err:
+        MeasuredRun(t=r["t"], x_ref=r["x_ref"], x_motor=r["x_motor"][:-1], u=r["u"], meta=meta)
+    assert err.value.field == "x_motor"
+
+
+def test_missing_metadata(tmp_path):
+    with pytest.raises(InputError, match="metadata YAML beside the CSV"):
+        load_measured(_write(tmp_path, meta=None))
+
+
+def test_bad_controller_metadata(tmp_path):
+    bad = {**META, "controller": {**META["controller"], "position_filter": [0.5, 0.4]}}
+    with pytest.raises(InputError, match="summing to 1"):
+        load_measured(_write(tmp_path, meta=bad))
+    bad = {**META, "controller": {**META["controller"], "kind": "pid"}}
+    with pytest.raises(InputError, match="p_p_cascade, drakecreep"):
+        load_measured(_write(tmp_path, meta=bad))
+
+
+def test_several_runs_and_round_trip(tmp_path):
+    a, b = _rows(12), _rows(15, dt=2e-3)
+    b["t"] = b["t"] + 5.0
+    cols = {k: list(a[k]) + list(b[k]) for k in a}
+    cols["x_table"] = cols["x_motor"]
+    cols["run"] = ["up"] * 12 + ["down"] * 15
+    data = load_measured(_write(tmp_path, cols))
+    assert data.labels == ("up", "down")
+    assert data.run("down").n == 15 and data.run("down").dt == pytest.approx(2e-3)
+    with pytest.raises(InputError, match="one of up, down"):
+        data.run("left")
+    with pytest.raises(InputError, match="a label"):
+        data.run()
+
+    out_csv, out_meta = save_measured(data, tmp_path / "copy.csv")
+    back = load_measured(out_csv)
+    assert out_meta == tmp_path / "copy.yaml"
+    assert back.meta == data.meta
+    for r0, r1 in zip(data, back):
+        assert r0.label == r1.label
+        for name in ("t", "x_ref", "x_motor", "x_table", "u", "f_ext"):
+            np.testing.assert_array_equal(getattr(r0, name), getattr(r1, name))
+
+
+def test_round_trip_with_params_and_single_run(tmp_path):
+    p = preset("paper")
+    r = _rows()
+    meta = MeasuredMeta(u_units="A", u_gain=500.0, params=p, controller=ControllerMeta(kind="drakecreep"),
+                        notes="unit test")
+    run = MeasuredRun(t=r["t"], x_ref=r["x_ref"], x_motor=r["x_motor"], u=r["u"], meta=meta, label="single")
+    save_measured(run, tmp_path / "single.csv")
+    back = load_measured(tmp_path / "single.csv").run()
+    assert back.meta == meta and back.label == "single" and back.f_ext is None
+    np.testing.assert_array_equal(back.x_motor, run.x_motor)
+
+
+def test_time_jitter_of_emps_size_is_accepted():
+    r = _rows(200)
+    rng = np.random.default_rng(0)
+    t = r["t"] + rng.normal(0, 2e-8, r["t"].size)  # EMPS: std 2e-8 s on 1 ms
+    run = MeasuredRun(t=t, x_ref=r["x_ref"][:200], x_motor=r["x_motor"], u=r["u"],
+                      meta=MeasuredMeta(u_units="N", u_gain=1.0))
+    assert run.dt == pytest.approx(1e-3, rel=1e-4)
+
+
+def test_emps_files_ship_with_the_package():
+    assert emps_path("validation") == emps_data_dir() / "DATA_EMPS_PULSES.mat"
+    assert emps_path("estimation").stat().st_size > 500_000
+    with pytest.raises(InputError, match="estimation, validation"):
+        emps_path("test")
+
+
+def test_emps_estimation_loader():
+    data = load_emps(emps_path("estimation"))
+    run = data.run()
+    assert isinstance(data, MeasuredData) and run.label == "DATA_EMPS"
+    assert run.n == 24841 and run.dt == pytest.approx(1e-3, rel=1e-6)
+    assert run.t[0] == 0 and run.t[-1] == pytest.approx(24.84)
+    assert run.meta.u_units == "V" and run.u_gain == pytest.approx(35.15065188)
+    assert run.meta.controller == EMPS_CONTROLLER
+    assert run.f_ext is None and run.x_table is None
+    assert run.x_ref[0] == pytest.approx(1.0782e-4, rel=1e-3)
+    assert 0.24 < run.x_motor.max() < 0.25  # m: the stroke is about a quarter metre
+    np.testing.assert_allclose(run.force[:2], 35.15065188 * np.array([2.53862809, 2.62483504]), rtol=1e-8)
+    # every qm is a whole number of 50 nm encoder counts
+    counts = run.x_motor / run.meta.sensors.encoder_resolution
+    assert np.max(np.abs(counts - np.round(counts))) < 1e-6
+
+
+def test_emps_controller_law_reproduces_the_recorded_output():
+    """The documented law, fed the recorded qm and qg, gives the recorded u (after removing the pulses)."""
+    for which, worst in (("estimation", 0.01), ("validation", 0.1)):
+        run = load_emps(which).run()
+        c = run.meta.controller
+        q = run.x_motor
+        qf = 0.5 * q + 0.5 * np.r_[q[0], q[:-1]]
+        dq = np.r_[0.0, np.diff(qf)] / c.sample_time
+        u = np.clip(c.kp * c.kv * (run.x_ref - q) - c.kv * dq, -c.saturation, c.saturation)
+        rms = np.sqrt(np.mean((run.u - u)[10:] ** 2))
+        assert rms < worst, which  # V; the recorded u is 1.5 V rms
+
+
+def test_emps_validation_pulses_are_drive_volts():
+    run = load_emps("validation").run()
+    pulses = run.f_ext / run.u_gain
+    assert set(np.unique(pulses)) == {0.0, 5.0}
+    np.testing.assert_allclose(run.force, run.u_gain * (run.u + pulses), rtol=1e-12, atol=1e-9)
+    edges = np.flatnonzero(np.diff(pulses))
+    recorded = run.u + pulses  # the file's vir
+    jumps = recorded[edges + 1] - recorded[edges]
+    np.testing.assert_allclose(np.abs(jumps), 5.0, atol=0.6)  # vir jumps by the pulse at every edge

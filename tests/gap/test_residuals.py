@@ -1,0 +1,79 @@
+import numpy as np
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.gap.benchmark import out_and_back
+from drakecreep.gap.residuals import (
+    REGIMES,
+    classify_regimes,
+    operating_map,
+    order_spectrum,
+    regime_shares,
+    time_spectrum,
+    whiteness,
+)
+
+T = np.arange(3000) * 1e-3
+X_REF = out_and_back(0.05, 0.0)
+V = np.gradient(X_REF, 1e-3)
+
+
+def test_regimes_of_an_out_and_back_move():
+    labels = classify_regimes(T, X_REF, V)
+    assert labels[100] == "dwell"  # before the first leg
+    assert labels[int(0.2 / 1e-3) + 650] == "constant_speed"  # middle of the out leg
+    assert labels[int(0.2 / 1e-3) + 100] == "acceleration"
+    assert set(labels) <= set(REGIMES)
+
+
+def test_stick_when_the_reference_moves_but_the_axis_does_not():
+    v = V.copy()
+    v[800:900] = 0.0
+    labels = classify_regimes(T, X_REF, v)
+    assert np.all(labels[830:870] == "stick") or np.all(np.isin(labels[830:870], ["stick", "reversal"]))
+    assert "stick" in set(labels[800:900])
+
+
+def test_regime_shares_sum_to_one_and_find_the_regime():
+    labels = classify_regimes(T, X_REF, V)
+    r = np.where(labels == "constant_speed", 1.0, 0.01)
+    shares = regime_shares(r, labels)
+    assert sum(s["energy_share"] for s in shares.values()) == pytest.approx(1.0)
+    assert sum(s["time_share"] for s in shares.values()) == pytest.approx(1.0)
+    assert max(shares, key=lambda k: shares[k]["energy_share"]) == "constant_speed"
+
+
+def test_order_spectrum_finds_a_periodic_residual_in_position():
+    lead = 5e-3
+    r = np.sin(2 * np.pi * 3 * X_REF / lead) + 0.1 * np.random.default_rng(0).normal(size=T.size)
+    spec = order_spectrum(X_REF, V, r, lead)
+    assert spec["peak_order"] == pytest.approx(3.0, abs=0.15)
+    assert spec["peak_ratio"] > 10
+    assert spec["n_segments"] == 2
+    with pytest.raises(InputError):
+        order_spectrum(X_REF, V, r, 0.0)
+
+
+def test_time_spectrum_peak():
+    r = np.sin(2 * np.pi * 40 * T)
+    assert time_spectrum(r, 1e-3)["peak_hz"] == pytest.approx(40, abs=1.0)
+
+
+def test_whiteness_separates_noise_from_structure():
+    rng = np.random.default_rng(1)
+    noise = rng.normal(size=2000)
+    u = rng.normal(size=2000)
+    assert whiteness(noise, u)["white"]
+    coloured = np.convolve(noise, np.ones(10) / 10, mode="same")
+    w = whiteness(coloured, u)
+    assert not w["white"] and w["ljung_box_p"] < 1e-6
+    correlated = 0.3 * noise + u  # white but driven by the input
+    w2 = whiteness(correlated, u)
+    assert w2["max_abs_xcorr"] > w2["xcorr_bound"] and not w2["white"]
+
+
+def test_operating_map_bins_cover_the_energy():
+    r = np.where(np.abs(V) > 0.04, 1.0, 0.0)
+    m = operating_map(r, V, X_REF, V * 100, bins=4)
+    assert sum(b["energy_share"] for b in m["speed"]) == pytest.approx(1.0)
+    assert m["speed"][-1]["rms"] > m["speed"][0]["rms"]

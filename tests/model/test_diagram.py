@@ -1,0 +1,38 @@
+import numpy as np
+import pytest
+
+from drakecreep.model.diagram import SIGNALS, build_diagram, build_plant, initial_conditions
+from drakecreep.scenario import Scenario
+
+
+@pytest.mark.parametrize("continuous", [False, True])
+def test_starts_in_equilibrium_under_load(paper, continuous):
+    drive = build_diagram(paper, Scenario(feed=1e-3, load_case=3), continuous=continuous)
+    d = drive.diagram
+    c = d.CreateDefaultContext()
+    np.testing.assert_allclose(d.EvalTimeDerivatives(c).CopyToVector(), 0.0, atol=1e-9)
+    assert d.GetOutputPort("screw.axial_force").Eval(c)[0] == pytest.approx(434.0)
+    ic = initial_conditions(paper, Scenario(load_case=3))
+    assert ic["force0"] == 434.0
+
+
+def test_named_ports_and_signals(paper):
+    drive = build_diagram(paper, Scenario())
+    names = {drive.diagram.get_output_port(i).get_name() for i in range(drive.diagram.num_output_ports())}
+    for _, (system, port, _), _ in SIGNALS:
+        assert f"{system}.{port}" in names
+    assert set(drive.systems) == {"reference", "controller", "motor", "screw", "table", "encoder", "scale"}
+    assert drive.signal_names[-1] == "friction_state_0"  # LuGre has one bristle state
+
+
+def test_whole_diagram_converts_to_autodiff_and_symbolic(paper):
+    drive = build_diagram(paper, Scenario(), continuous=True, ideal_sensors=True)
+    ad = drive.diagram.ToAutoDiffXd()
+    sym = drive.diagram.ToSymbolic()
+    assert ad.num_output_ports() == sym.num_output_ports() == drive.diagram.num_output_ports()
+
+
+def test_plant_has_the_torque_input(paper):
+    plant = build_plant(paper, 3)
+    assert plant.get_input_port(0).get_name() == "torque_command"
+    assert plant.CreateDefaultContext().num_continuous_states() == 6

@@ -1,0 +1,127 @@
+import math
+
+import control
+import numpy as np
+import pytest
+
+from drakecreep.servo import loops
+from drakecreep.errors import InputError
+from drakecreep.params import with_value
+from drakecreep.scenario import Scenario
+
+
+def test_textbook_loop_margins_by_hand():
+    """L = 1 / (s (s + 1)^2), margins worked out by hand."""
+    L = control.tf([1], [1, 2, 1, 0])
+    m = loops.loop_margins(L)
+    # phase -180 deg where -90 - 2 atan(w) = -180: w = 1, |L(j1)| = 1/2 -> GM = 2
+    assert m["gain_margin_dB"] == pytest.approx(20 * math.log10(2.0), abs=1e-6)
+    assert m["phase_crossover_Hz"] == pytest.approx(1 / (2 * math.pi), rel=1e-6)
+    # |L| = 1 where w (1 + w^2) = 1
+    wc = [r.real for r in np.roots([1, 0, 1, -1]) if abs(r.imag) < 1e-12 and r.real > 0][0]
+    pm = 90.0 - 2 * math.degrees(math.atan(wc))
+    assert m["crossover_Hz"] == pytest.approx(wc / (2 * math.pi), rel=1e-6)
+    assert m["phase_margin_deg"] == pytest.approx(pm, abs=1e-5)
+    assert m["delay_margin_ms"] == pytest.approx(math.radians(pm) / wc * 1e3, rel=1e-5)
+    # T = 1 / (s^3 + 2 s^2 + s + 1): |T| = 1/sqrt(2) where u = w^2 solves u^3 + 2u^2 - 3u - 1 = 0
+    u = [r.real for r in np.roots([1, 2, -3, -1]) if abs(r.imag) < 1e-12 and r.real > 0][0]
+    assert m["bandwidth_Hz"] == pytest.approx(math.sqrt(u) / (2 * math.pi), rel=1e-6)
+    # at w = 1, 1 + L = 1/2, so Ms >= 2; the peak of |S| on a fine grid
+    w = np.linspace(0.5, 2.0, 200001)
+    s = 1j * w
+    S = np.abs(s * (s + 1) ** 2 / (s * (s + 1) ** 2 + 1))
+    assert m["ms_peak"] == pytest.approx(S.max(), rel=1e-6)
+    assert m["ms_peak"] > 2.0
+    assert m["closed_loop_stable"]
+
+
+def test_sampled_integrator_loses_half_a_sample_of_phase():
+    """ZOH integrator k/s at period T: L(z) = kT / (z - 1); PM = 90 deg - wc T / 2, GM = 2 / (kT)."""
+    k, T = 200.0, 1e-3
+    L = control.tf([k * T], [1, -1], T)
+    m = loops.loop_margins(L)
+    wc = 2 / T * math.asin(k * T / 2)
+    assert m["crossover_Hz"] == pytest.approx(wc / (2 * math.pi), rel=1e-5)
+    assert m["phase_margin_deg"] == pytest.approx(90.0 - math.degrees(wc * T / 2), abs=1e-3)
+    assert m["gain_margin_dB"] == pytest.approx(20 * math.log10(2 / (k * T)), abs=1e-3)
+    assert m["phase_crossover_Hz"] == pytest.approx(0.5 / T, rel=1e-3)
+
+
+def test_lift_equals_zoh_at_the_slower_rate():
+    P = control.ss(control.tf([1.0, 3.0], [1.0, 0.4, 25.0, 0.0]))
+    fast = control.c2d(P, 2.5e-4, "zoh")
+    slow = control.c2d(P, 1e-3, "zoh")
+    lifted = loops.lift(fast, 4)
+    assert lifted.dt == pytest.approx(1e-3)
+    w = np.logspace(0, 3, 40)
+    a = control.frequency_response(lifted, w).complex.ravel()
+    b = control.frequency_response(slow, w).complex.ravel()
+    assert np.allclose(a, b, rtol=1e-8)
+
+
+def test_sampled_velocity_controller_matches_the_drake_controller(paper):
+    """The discrete PI used for the margins reproduces CascadeController's periodic update step by step."""
+    from drakecreep.model.controller import CascadeController, force_limit
+
+    p = with_value(with_value(paper, "controller.position_gain", 0.0), "controller.anti_windup", False)
+    g = p.controller
+    ctrl = CascadeController(g, p.screw.lead, force_limit(p), initial_force=0.0, initial_angle=0.0)
+    ctx = ctrl.CreateDefaultContext()
+    rng = np.random.default_rng(1)
+    v_ref = 1e-3
+    thetas = np.cumsum(rng.normal(1.0, 0.3, 12)) * 1e-4
+    ctrl.get_input_port(0).FixValue(ctx, [0.0, v_ref])
+    ctrl.get_input_port(2).FixValue(ctx, [0.0])
+    drake = []
+    for th in thetas:
+        ctrl.get_input_port(1).FixValue(ctx, [th, 0.0])
+        ctx.SetDiscreteState(ctrl.EvalUniquePeriodicDiscreteUpdate(ctx).value())
+        drake.append(ctrl.get_output_port(0).Eval(ctx)[0])
+    C = loops.sampled_velocity_controller(p)
+    x = np.zeros(2)
+    mine = []
+    for th in thetas:
+        u = np.array([v_ref, th])
+        mine.append((C.C @ x + C.D @ u)[0])
+        x = C.A @ x + C.B @ u
+    assert np.allclose(mine, drake, rtol=1e-12, atol=1e-12 * max(map(abs, drake)))
+
+
+@pytest.fixture(scope="module")
+def analysis(paper):
+    return loops.analyze_loops(paper, Scenario(feed=1e-3, load_case=3))
+
+
+def test_paper_preset_loops(analysis, paper):
+    s = analysis.summary()
+    for loop in loops.LOOPS:
+        for key in ("gain_margin_dB", "phase_margin_deg", "delay_margin_ms", "crossover_Hz", "bandwidth_Hz",
+                    "ms_peak"):
+            assert key in s[loop]
+        assert s[loop]["closed_loop_stable"]
+    # the loops are nested: the position loop is several times slower than the velocity loop
+    assert s["position"]["crossover_Hz"] < s["velocity"]["crossover_Hz"] / 2
+    # sampling costs phase: about wc * (ZOH T/2 + backward difference T/2) in the velocity loop
+    Tv = paper.controller.velocity_period
+    estimate = 360.0 * s["velocity"]["crossover_Hz"] * Tv
+    assert 0.8 * estimate < s["sampling_phase_cost_deg"]["velocity"] < 1.2 * estimate
+    # the first resonance is the screw's axial mode (two-mass: sqrt(K (1/M + r^2/J)))
+    assert 60 < s["resonance_Hz"] < 90 and 0 < s["resonance_damping"] < 0.05
+
+
+def test_sampled_loops_are_discrete(analysis, paper):
+    assert analysis.loops["sampled"]["velocity"].dt == paper.controller.velocity_period
+    assert analysis.loops["sampled"]["position"].dt == paper.controller.position_period
+    assert analysis.loops["continuous"]["velocity"].dt == 0
+
+
+def test_creeping_operating_point_is_flagged_unstable(paper):
+    a = loops.analyze_loops(paper, Scenario(feed=0.1e-3, load_case=3))
+    assert not a.margins["sampled"]["velocity"]["closed_loop_stable"]
+    assert a.margins["sampled"]["velocity"]["delay_margin_ms"] == 0.0
+    assert a.margins["sampled"]["velocity"]["open_loop_unstable_poles"] > 0
+
+
+def test_unknown_loop(paper):
+    with pytest.raises(InputError, match="loop"):
+        loops.loop_transfer(paper, Scenario(), "current")

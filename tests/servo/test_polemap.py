@@ -1,0 +1,60 @@
+import numpy as np
+import pytest
+
+from drakecreep.servo import polemap
+from drakecreep.errors import InputError
+from drakecreep.params import with_value
+from drakecreep.scenario import Scenario
+from drakecreep.model.screw import axial_damping, axial_stiffness
+
+SPEEDS = np.geomspace(0.02e-3, 3e-3, 16)
+
+
+def test_static_friction_pole_crosses_where_c_plus_c1_changes_sign(paper):
+    """Paper eq. 2: with the motor motion prescribed, the pole crosses the axis exactly at C + C1 = 0."""
+    p = with_value(paper, "friction.law", "stribeck")
+    c = polemap.friction_slope_crossings(p, 3, SPEEDS, model="mechanism")
+    assert len(c["theory"]) == 1 and len(c["pole"]) == 1
+    assert c["pole"][0] == pytest.approx(c["theory"][0], rel=1e-5)
+    below = polemap.rightmost_pole(p, Scenario(feed=0.9 * c["theory"][0], load_case=3), "mechanism")
+    above = polemap.rightmost_pole(p, Scenario(feed=1.1 * c["theory"][0], load_case=3), "mechanism")
+    assert below.real > 0 > above.real
+
+
+def test_whole_loop_crosses_at_a_different_speed(paper):
+    """The servo-controlled motor side is no prescribed motion: the whole loop's crossing moves (shown, not hidden)."""
+    p = with_value(paper, "friction.law", "stribeck")
+    c = polemap.friction_slope_crossings(p, 3, SPEEDS, model="closed_loop")
+    assert len(c["pole"]) == 1
+    assert c["pole"][0] < 0.98 * c["theory"][0]
+
+
+def test_scale_stiffness_keeps_damping(paper):
+    p = polemap.scale_stiffness(paper, 2.0)
+    assert axial_stiffness(p.screw, p.nut) == pytest.approx(2.0 * axial_stiffness(paper.screw, paper.nut), rel=1e-12)
+    assert axial_damping(p.screw, p.nut) == pytest.approx(axial_damping(paper.screw, paper.nut), rel=1e-12)
+    with pytest.raises(InputError):
+        polemap.scale_stiffness(paper, 0.0)
+
+
+def test_pole_map_small(paper):
+    sc = Scenario(feed=0.1e-3, load_case=3)
+    pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=3, sim_grid=(1, 2))
+    assert pm.closed_loop.shape == (3, 2) == pm.damping.shape
+    # the lowest damping row (no viscous friction on the falling branch) is unstable, the highest is stable
+    assert np.all(pm.closed_loop[0] > 0) and np.all(pm.closed_loop[-1] < 0)
+    assert np.all(np.diff(pm.damping, axis=0) > 0)
+    # paper's boundary: D^2 = 4 pi zeta at those points
+    K = pm.stiffness
+    y = pm.paper_boundary(K)
+    D = pm.friction_drop / (pm.feed * np.sqrt(K * pm.mass))
+    zeta = y / (2 * np.sqrt(K * pm.mass))
+    assert np.allclose(D**2, 4 * np.pi * zeta)
+    assert pm.sim_creep.shape == (2,) and pm.sim_creep[0] and not pm.sim_creep[1]
+
+
+def test_parameter_locus(paper):
+    loc = polemap.parameter_locus(paper, Scenario(feed=1e-3, load_case=3), "mass", [20.0, 80.0])
+    assert len(loc["poles"]) == 2
+    with pytest.raises(InputError):
+        polemap.parameter_locus(paper, Scenario(), "colour", [1.0])

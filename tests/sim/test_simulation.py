@@ -1,0 +1,90 @@
+import json
+
+import numpy as np
+import pytest
+
+import drakecreep.sim.simulation as simulation
+from drakecreep.errors import InputError
+from drakecreep.params import with_value
+from drakecreep.report.plots import plot_feed
+from drakecreep.scenario import Scenario
+from drakecreep.sim.simulation import simulate
+
+
+@pytest.fixture(scope="module")
+def low_feed(paper):
+    return simulate(with_value(paper, "simulation.steady_start", 0.5), Scenario(feed=1e-4, load_case=3, duration=1.5))
+
+
+def test_stick_slip_at_low_feed(low_feed):
+    m = low_feed.metrics
+    assert low_feed.ok
+    assert m.creep and m.stick_slip_cycles >= 20
+    assert m.min_speed <= 0.0  # the table stops
+    assert m.fluctuation_rate > 0.5
+
+
+@pytest.mark.parametrize("feed", [1e-3, 5e-3])
+def test_smooth_sliding_well_above_the_critical_speed(paper, feed):
+    r = simulate(paper, Scenario(feed=feed, load_case=3, duration=2.0))  # the preset's window: t >= 1 s
+    m = r.metrics
+    assert not m.creep
+    assert m.fluctuation_rate < 0.01
+    assert m.mean_speed == pytest.approx(feed, rel=1e-3)
+
+
+def test_determinism(short_paper):
+    scenario = Scenario(feed=1e-4, load_case=1, duration=0.5)
+    a, b = simulate(short_paper, scenario), simulate(short_paper, scenario)
+    for name in a.signals:
+        np.testing.assert_array_equal(a.signals[name], b.signals[name])
+    assert a.metrics == b.metrics
+
+
+def test_save_writes_csv_json_yaml_and_the_plot_reads_it(low_feed, tmp_path):
+    paths = low_feed.save(tmp_path)
+    header = paths["timeseries"].read_text().splitlines()[0].split(",")
+    assert header[0] == "t_s" and "table_speed_m_per_s" in header
+    data = np.loadtxt(paths["timeseries"], delimiter=",", skiprows=1)
+    assert data.shape == (len(low_feed.time), len(header))
+    summary = json.loads(paths["metrics"].read_text())["summary"]
+    assert summary["stick_slip_cycles"] == low_feed.metrics.stick_slip_cycles
+    plot_feed(low_feed, tmp_path / "speed.png")
+    assert (tmp_path / "speed.png").stat().st_size > 10_000
+
+
+def test_a_failing_run_keeps_what_was_computed(short_paper, monkeypatch):
+    real = simulation.make_simulator
+
+    def failing(system, context, sim):
+        simulator = real(system, context, sim)
+
+        class Breaks:
+            def AdvanceTo(self, t):
+                simulator.AdvanceTo(t / 2)
+                raise RuntimeError("integrator gave up\nmore detail")
+
+            def get_integrator(self):
+                return simulator.get_integrator()
+
+        return Breaks()
+
+    monkeypatch.setattr(simulation, "make_simulator", failing)
+    r = simulate(short_paper, Scenario(feed=1e-3, duration=1.0))
+    assert not r.ok and "integrator gave up" in r.status and "\n" not in r.status
+    assert r.time[-1] == pytest.approx(0.5, abs=1e-3)
+    assert r.metrics is not None and r.metrics.window_end == pytest.approx(0.5, abs=1e-3)
+
+
+def test_bad_scenarios():
+    with pytest.raises(InputError, match="feed"):
+        Scenario(feed=0.0)
+    with pytest.raises(InputError, match="duration"):
+        Scenario(duration=float("nan"))
+    with pytest.raises(InputError, match="load_case"):
+        Scenario(load_case=-1)
+
+
+def test_steady_window_must_fit(paper):
+    with pytest.raises(InputError, match="steady_start"):
+        simulate(paper, Scenario(duration=0.5))

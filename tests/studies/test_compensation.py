@@ -1,0 +1,139 @@
+import math
+
+import pytest
+
+from drakecreep.model.compensators import compensator_model, rigid_inertia
+from drakecreep.studies.compensation import (
+    DEFAULT_METHODS, creep_boundary, evaluate, robustness, summary_markdown, with_method,
+)
+from drakecreep.sim.compiled import compile_diagram
+from drakecreep.model.diagram import build_diagram
+from drakecreep.errors import InputError
+from drakecreep.params import preset, with_value
+from drakecreep.scenario import Scenario
+from drakecreep.sim.simulation import simulate
+
+METHODS = ("static", "lugre", "dob", "dither")
+
+
+@pytest.fixture(scope="module")
+def one_mm_s(paper):
+    p = with_value(paper, "simulation.steady_start", 0.6)
+    scenario = Scenario(feed=1e-3, load_case=3, duration=1.2)
+    return {m: simulate(with_method(p, m), scenario) for m in ("none",) + METHODS}
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_compensator_compiles_and_adds_its_torque(short_paper, method):
+    feed_drive = build_diagram(with_method(short_paper, method), Scenario(feed=1e-3, load_case=3, duration=0.3))
+    assert "compensation_torque" in feed_drive.signal_names
+    assert compile_diagram(feed_drive).plant is not None
+
+
+@pytest.mark.parametrize("method", ["lugre", "dob"])
+def test_compiled_compensator_matches_leaf_systems(short_paper, method):
+    p = with_method(short_paper, method)
+    scenario = Scenario(feed=1e-3, load_case=3, duration=0.4)
+    fast, leaf = simulate(p, scenario, backend="compiled"), simulate(p, scenario, backend="leaf")
+    assert fast.signals["compensation_torque"][-1] == pytest.approx(leaf.signals["compensation_torque"][-1], rel=1e-3)
+
+
+def test_static_and_lugre_supply_the_friction_the_integrator_held(short_paper, one_mm_s):
+    model = compensator_model(short_paper, 3)
+    friction = model.g(1e-3) + model.viscous * 1e-3
+    ratio = short_paper.screw.lead / (2 * math.pi)
+    held = one_mm_s["none"].signals["integrator"][-1]
+    for m in ("static", "lugre"):
+        r = one_mm_s[m]
+        assert r.signals["compensation_torque"][-1] / ratio == pytest.approx(friction, rel=1e-3)
+        assert held - r.signals["integrator"][-1] == pytest.approx(friction, rel=0.02)
+
+
+def test_dob_takes_over_the_whole_load_torque(short_paper, one_mm_s):
+    r = one_mm_s["dob"]
+    ratio = short_paper.screw.lead / (2 * math.pi)
+    assert r.signals["compensation_torque"][-1] / ratio == pytest.approx(one_mm_s["none"].signals["integrator"][-1], rel=1e-3)
+    assert abs(r.signals["integrator"][-1]) < 1.0
+    assert rigid_inertia(short_paper) > short_paper.motor.rotor_inertia
+
+
+def test_dither_adds_its_own_ripple_above_creep(one_mm_s):
+    assert one_mm_s["dither"].metrics.max_fluctuation > 10 * one_mm_s["none"].metrics.max_fluctuation
+
+
+def test_no_motor_side_compensator_removes_the_table_mode_creep(short_paper):
+    # the documented negative result: at 0.1 mm/s the table sticks and slips on the screw spring at
+    # ~70 Hz; a torque added at the motor (10x the table's inertia) does not remove it
+    rows = evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,), duration=1.0)
+    assert all(r["creep"] for r in rows)
+    assert all(r["stick_fraction_vs_none"] > 0.9 for r in rows)
+
+
+@pytest.fixture(scope="module")
+def within_reach():
+    """The ``rigid_axis`` preset: friction within the loop's reach (rigid transmission, kv below the slope)."""
+    rows = evaluate(preset("rigid_axis"), DEFAULT_METHODS, feeds_mm_s=(0.02, 0.05, 0.1), load_cases=(3,),
+                    duration=2.0)
+    return {(r["label"], r["feed_mm_s"]): r for r in rows}
+
+
+def test_rigid_axis_creeps_without_compensation(within_reach):
+    assert all(within_reach[("none", f)]["creep"] for f in (0.02, 0.05, 0.1))
+
+
+@pytest.mark.parametrize("method", ["static-measured", "lugre", "dob"])
+@pytest.mark.parametrize("feed", [0.05, 0.1])
+def test_model_based_compensators_remove_creep_within_reach(within_reach, method, feed):
+    # the issue's test, on the drive where the friction is within the loop's reach: nominal model
+    r = within_reach[(method, feed)]
+    assert not r["creep"]
+    assert r["fluctuation_vs_none"] < 0.05
+    assert r["following_error_max_um"] < 0.3 * within_reach[("none", feed)]["following_error_max_um"]
+
+
+def test_feedforward_and_dither_do_not_remove_creep_within_reach(within_reach):
+    # static feedforward at the reference speed is a constant at a constant feed: it cannot change
+    # the negative slope that drives the stick-slip; dither helps only at the lowest feed
+    for feed in (0.05, 0.1):
+        assert within_reach[("static", feed)]["creep"] and within_reach[("static", feed)]["fluctuation_vs_none"] > 0.9
+        assert within_reach[("dither", feed)]["creep"] and within_reach[("dither", feed)]["fluctuation_vs_none"] > 0.9
+    assert within_reach[("dither", 0.02)]["fluctuation_vs_none"] < 0.5
+    # the measured-speed model chatters about zero speed at the lowest feed
+    assert within_reach[("static-measured", 0.02)]["fluctuation_vs_none"] > 1.0
+
+
+def test_lugre_lowers_the_critical_speed_within_reach():
+    rigid = preset("rigid_axis")
+    none, lugre = creep_boundary(rigid, "none", 3), creep_boundary(rigid, "lugre", 3)
+    assert 0.1e-3 < none < 0.3e-3
+    assert lugre < 0.25 * none
+
+
+def test_variant_rows_are_labelled_and_summarised(within_reach):
+    rows = list(within_reach.values())
+    assert {r["label"] for r in rows} == set(DEFAULT_METHODS)
+    assert within_reach[("static-measured", 0.05)]["method"] == "static-measured"
+    text = summary_markdown(rows, critical=[dict(method="dob", load_case=3, critical_mm_s=0.0, lowest_tested_mm_s=0.01)])
+    assert "| static-measured | 3 | 0.05 |" in text
+    assert "no creep down to 0.01" in text
+
+
+def test_with_method_applies_a_variant(short_paper):
+    p = with_method(short_paper, "static-measured")
+    assert p.compensation.method == "static" and p.compensation.velocity_blend == 1.0
+    assert with_method(short_paper, "static-measured", velocity_blend=0.5).compensation.velocity_blend == 0.5
+
+
+def test_robustness_labels_every_mismatch(short_paper):
+    rows = robustness(short_paper, ("dob",), feeds_mm_s=(1.0,), duration=0.8)
+    assert [r["label"] for r in rows] == ["none", "dob nominal", "dob inertia_factor x0.7", "dob inertia_factor x1.3"]
+    assert all(r["status"] == "ok" for r in rows)
+
+
+def test_bad_method_is_an_input_error(short_paper):
+    with pytest.raises(InputError):
+        with_method(short_paper, "magic")
+    with pytest.raises(InputError):
+        creep_boundary(short_paper, "magic", 3)
+    with pytest.raises(InputError):
+        with_value(short_paper, "compensation.coulomb_factor", -1.0)
