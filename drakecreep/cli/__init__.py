@@ -25,7 +25,7 @@ COMMANDS = [
     "diagram",
     "critical",
     "hertz",
-    "modal",
+    "modal", "modes",
     "margins", "tune", "report",
     "sweep",
     "emps",
