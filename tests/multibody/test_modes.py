@@ -2,7 +2,9 @@
 
 import math
 
+import numpy as np
 import pytest
+import scipy.linalg
 
 from drakecreep.errors import InputError
 from drakecreep.model.lumped import lumped
@@ -52,6 +54,15 @@ def test_rigid_joints_and_a_massless_screw_give_the_two_mass_axial_mode(paper, x
     reflected = motor_inertia(light.motor, screw_inertia(light.screw)) / (light.screw.lead / (2.0 * math.pi)) ** 2
     m = lumped(light).mass
     assert mode.shares["axial"] == pytest.approx(reflected / (m + reflected), abs=1e-3)
+    # and its damping: the two-mass chain damping C (model.screw.axial_damping) and the motor's viscous drag,
+    # phi^T C phi / 2 w of the hand-built 2x2 model; the bearing and nut dampers are separate elements here.
+    # The torsional compliance above shifts the deflections by < 5e-4: tolerance 2e-3.
+    chain, drag = lumped(light, x=x).damping, light.motor.viscous_damping / (light.screw.lead / (2.0 * math.pi)) ** 2
+    k2 = lumped(light, x=x).stiffness * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    c2 = chain * np.array([[1.0, -1.0], [-1.0, 1.0]]) + np.diag([drag, 0.0])
+    w2, shapes = scipy.linalg.eigh(k2, np.diag([reflected, m]))
+    phi = shapes[:, 1]
+    assert mode.damping_ratio == pytest.approx(phi @ c2 @ phi / (2.0 * math.sqrt(w2[1])), rel=2e-3)
 
 
 def test_rigid_joints_with_the_steel_screw_lie_just_below_the_two_mass_mode(paper):
