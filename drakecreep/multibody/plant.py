@@ -13,6 +13,9 @@ Bodies (x along the screw, z up, the thrust bearing at x = 0)::
   ``kappa G A / l`` (the rigid-finite-element method; ``l = L / N``). The motor rotor and coupling are
   rigidly attached to the first segment (the two-mass model's assumption), as a thin disc (its tilt
   inertia ``J / 2`` keeps the segment's inertia physical; the thrust bearing is at that segment).
+* Axial stiffness and damping of the thrust bearing and of the screw-nut pair come from the parameters
+  (``screw.bearing_*``, ``nut.axial_*``: the two-mass chain's values, Tables 4 and 6 in the paper preset);
+  every other joint value comes from the paper's tables (:func:`drakecreep.multibody.rig.paper_joints`).
 * The nut rides on the segment under it through a ``ScrewJoint`` (kinematic lead; ``+theta`` of the screw
   feeds ``+x``, as in the two-mass model); the compliance of the ball contacts (Table 4) sits in the
   bushing nut - nut seat, in series with the flange's bolted face (Table 1, "nut-nut seat").
@@ -34,6 +37,7 @@ the identity at the undeformed pose: a clean setting for :mod:`drakecreep.multib
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -227,7 +231,9 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
                 k_seg_torque, [0.0] * 3, k_seg_force, [0.0] * 3)
 
     # ------------------------------------------------------------------ bearings and their seats
-    bearing, outer, inner = jd["bearing"], jd["bearing seat-outer ring"], jd["inner ring-screw shaft"]
+    # axial values from the parameters (the two-mass chain's), radial ones from Table 6
+    bearing = dataclasses.replace(jd["bearing"], kt=screw.bearing_stiffness, ct=screw.bearing_damping)
+    outer, inner = jd["bearing seat-outer ring"], jd["inner ring-screw shaft"]
     fits = [] if rigid_joints else [outer, inner]
     k_ax = series(bearing.kt, *(f.kt for f in fits))
     c_ax = series_damping([(bearing.kt, bearing.ct)] + [(f.kt, f.ct) for f in fits])
@@ -294,7 +300,7 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
     home["nut"] = np.array([a_nut, 0.0, 0.0])
     plant.AddJoint(ScrewJoint("screw_nut", frame_at(segments[j], [a_nut, 0.0, 0.0], "nut"), nut_body.body_frame(),
                               [1.0, 0.0, 0.0], -screw.lead, 0.0))
-    sn = jd["screw-nut"]
+    sn = dataclasses.replace(jd["screw-nut"], kt=nut.axial_stiffness, ct=nut.axial_damping)  # radial: Table 4
     tilt, tilt_c = sn.kn * rig.nut_length**2 / 12.0, sn.cn * rig.nut_length**2 / 12.0
     ratio = screw.lead / (2.0 * math.pi)
     if rigid_joints:

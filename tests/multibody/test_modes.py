@@ -36,14 +36,21 @@ def test_two_mass_axial_frequency_is_the_paper_presets_73_5_hz(paper):
     assert two_mass_axial_frequency(paper) == pytest.approx(73.515, abs=0.01)
 
 
-@pytest.mark.parametrize("x", [0.0, 0.2])
-def test_rigid_joints_and_a_massless_screw_give_the_two_mass_axial_mode(paper, x):
+@pytest.mark.parametrize("x, changes", [
+    (0.0, {}),
+    (0.2, {}),
+    # the chain's axial values are the parameters', not the paper tables': a stiffer bearing and nut, other damping
+    (0.0, {"screw.bearing_stiffness": 3e7, "nut.axial_stiffness": 2e8, "nut.axial_damping": 3000.0}),
+])
+def test_rigid_joints_and_a_massless_screw_give_the_two_mass_axial_mode(paper, x, changes):
     # With the fixed joints rigid, the screw 1000x lighter and the nut 1 g, the multibody model is the two-mass
     # model plus one thing it neglects: the shaft's torsional compliance between motor and nut (1.4e-4 of the
     # frequency at x = 0, 4.2e-4 at x = 0.2 m), added here as a series spring by hand. N = 12 puts a segment
     # boundary exactly at the nut (a / l = 2 and 6), so the shaft's axial compliance is exact. What remains is
     # the residual 2.3 g of screw and 1 g of nut on 40 kg (~2e-5): tolerance 1e-4.
     light = with_value(with_value(paper, "screw.density", 7.85), "nut.mass", 1e-3)
+    for path, value in changes.items():
+        light = with_value(light, path, value)
     mode = modal_analysis(build_multibody(light, n_segments=12, rigid_joints=True, table_position=x)).axial_mode()
     a = light.screw.nut_start_distance + x
     expected = _two_mass(light, series(lumped(light, x=x).stiffness, _torsion_as_axial(light, a)))
