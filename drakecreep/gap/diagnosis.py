@@ -40,6 +40,8 @@ from drakecreep.gap.effects import (
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, regressor
 from drakecreep.gap.replay import RigidModel
+from drakecreep.gap import claims as claims_mod
+from drakecreep.gap.claims import identifiable
 from drakecreep.gap.residuals import (
     classify_regimes,
     operating_map,
@@ -79,7 +81,10 @@ class DiagnosisConfig:
     min_gain : float
         ... and it removes at least this share of the held-out inverse-dynamics residual energy.
     max_effects : int
-        Effects combined at most (1: single effects, 2: pairs).
+        Unused since claims go through :mod:`drakecreep.gap.claims` (single effects only).
+    max_candidates : int
+        Best-ranked effects put to the claim tests (:func:`drakecreep.gap.claims.decide`), in ranking order;
+        the first that passes is claimed.
     effects : tuple of str or None
         Subset of the library to try (default: all).
     v_min_frac : float
@@ -96,6 +101,7 @@ class DiagnosisConfig:
     min_gain: float = 0.05
     max_effects: int = 2
     effects: tuple | None = None
+    max_candidates: int = 3
     v_min_frac: float = 0.01
     progress: bool = False
 
@@ -447,34 +453,37 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
     _log(cfg, f"nominal: " + ", ".join(f"{k}={v:.4g}" for k, v in nominal.items()))
     names = cfg.effects or tuple(e.name for e in EFFECTS)
     ranking = []
+    not_identifiable = []
     for name in names:
         eff = get_effect(name)
         if not eff.applicable(train):
+            continue
+        if not identifiable(name, train, ctx, nominal):
+            not_identifiable.append(name)  # nothing to fit: never ranked (no 0.0 score in a top-3)
             continue
         fit = fit_effect((name,), train, test, ctx, nominal, base=base, n_eff_ratio=ratio)
         _log(cfg, f"effect {name}: held-out score {fit.score:+.1f}, gain {100 * fit.gain:.1f} %")
         ranking.append(fit)
     ranking.sort(key=lambda f: (not f.physical, f.score))
 
-    def claimable(f, threshold=cfg.claim_score):
-        return f.physical and f.score < -threshold and f.gain >= cfg.min_gain
-
+    # claims (drakecreep.gap.claims): permutation null, run-to-run spread, held-out closed-loop replay
+    replay_nominal = None
+    if replay:
+        try:
+            replay_nominal = claims_mod.replay_energy(base, test_runs, ctx)
+        except InputError as err:
+            replay_nominal = err
+    decisions = {}
     claimed = []
-    if ranking and claimable(ranking[0]):
-        claimed = [ranking[0]]
-        if cfg.max_effects >= 2:
-            pairs = []
-            for other in ranking[1:]:
-                if other.effects[0] == "quantization":
-                    continue
-                pf = fit_effect(ranking[0].effects + other.effects, train, test, ctx, nominal,
-                                base=ranking[0], n_eff_ratio=ratio)
-                pairs.append(pf)
-            pairs.sort(key=lambda f: (not f.physical, f.score))
-            if pairs:
-                _log(cfg, f"best pair {pairs[0].label}: incremental score {pairs[0].score:+.1f}")
-            if pairs and claimable(pairs[0], cfg.pair_claim_score):
-                claimed.append(pairs[0])
+    for f in ranking[: cfg.max_candidates]:
+        if not f.physical or f.gain <= 0:
+            continue
+        d = claims_mod.decide(f, base, train, test, test_runs, ctx, replay_nominal=replay_nominal)
+        decisions[f.label] = d
+        _log(cfg, f"claim test {f.label}: {d['reason']}")
+        if d["claim"]:
+            claimed = [f]
+            break
     final = claimed[-1] if claimed else base
     idim_test_nom = math.sqrt(base.sse_test / test.n)
     idim_test_fin = math.sqrt(final.sse_test / test.n)
@@ -488,6 +497,16 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
         "idim_rms_N": {"before": idim_test_nom, "after": idim_test_fin},
         "idim_error_percent": {"before": _rel(base.sse_test, test), "after": _rel(final.sse_test, test)},
     }
+    result["claims"] = {
+        "rule": "permutation null + run-to-run spread on inverse dynamics, then the held-out closed-loop replay "
+                "(drakecreep.gap.claims)",
+        "replay_available": replay and not isinstance(replay_nominal, Exception),
+        "replay_error": str(replay_nominal) if isinstance(replay_nominal, Exception) else None,
+        "decisions": _jsonable(decisions),
+        "provisional": [k for k, d in decisions.items() if d["provisional"]],
+        "not_identifiable": not_identifiable,
+    }
+    replay = replay and not isinstance(replay_nominal, Exception)
     if replay:
         _log(cfg, "closed-loop replay of the nominal on the held-out runs")
         gap0 = replay_gap(base, test_runs, ctx)
@@ -521,6 +540,18 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
                           "params": claimed[1].params()}
     result["summary"] = _summary(result)
     return result
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {k: _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return x
 
 
 def _summary(res):

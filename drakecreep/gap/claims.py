@@ -1,0 +1,284 @@
+"""When may the diagnosis claim an effect? Thresholds from the data's own run-to-run variation.
+
+An effect is **claimed** only when all of these hold (:func:`decide`):
+
+1. **Identifiable**: it adds a regressor (or changes the target) of the inverse-dynamics model. An effect
+   with nothing to fit (quantisation today) is reported as not identifiable and never ranked.
+2. **Inverse dynamics beats a permutation null**: the held-out gain ``1 - SSE_eff / SSE_nom`` exceeds the
+   ``1 - alpha`` quantile of the same gain when the effect's regressor columns are circularly shifted
+   within each run (the shift keeps the columns' autocorrelation, their run structure and the
+   nonlinear-parameter search, and breaks their alignment with the force). The threshold therefore
+   grows with the noise, the drift between runs and the freedom of the effect (:func:`permutation_null`).
+3. **Consistent across runs**: per-run out-of-sample gains (each training run left out in turn and
+   refitted on the others, plus each held-out run) have a one-sided ``t`` lower bound above the null
+   threshold: the improvement is larger than the spread between runs explains (:func:`run_gains`).
+4. **The held-out closed-loop replay improves**, in every sense the inverse-dynamics fit cannot check:
+   the per-run log ratio ``log(E_eff / E_nom)`` of the normalised replay residual energy
+   (:func:`replay_energy`: force and speed) has a one-sided ``t`` upper bound below 0 over the held-out
+   runs, i.e. the replay gets better by more than its run-to-run spread.
+
+When the replay is not available for a run's controller (today: ``kind: drakecreep``, until the Drake
+replay lands), no effect is claimed; candidates that pass 1-3 are reported as ``provisional``.
+
+The replay goes through :func:`drakecreep.gap.diagnosis.replay_gap` only (:data:`REPLAY`), so the Drake
+replay can be swapped in at one place.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats
+
+from drakecreep.errors import InputError
+
+__all__ = [
+    "ALPHA",
+    "N_PERMUTATIONS",
+    "identifiable",
+    "permutation_null",
+    "run_gains",
+    "replay_energy",
+    "replay_test",
+    "decide",
+]
+
+#: One-sided level of every test of a claim.
+ALPHA = 0.05
+#: Circular-shift permutations of the null (the null quantile is the ``1 - ALPHA`` one).
+N_PERMUTATIONS = 39
+
+
+def _replay(fit, runs, ctx):
+    from drakecreep.gap.diagnosis import replay_gap
+
+    return replay_gap(fit, runs, ctx)
+
+
+#: The closed-loop replay used by the claims: ``REPLAY(fit, runs, ctx) -> replay_gap`` dict.
+REPLAY = _replay
+
+
+def identifiable(name, sig, ctx, nominal):
+    """Whether effect ``name`` adds anything to fit (a regressor column or a changed target)."""
+    from drakecreep.gap.effects import get_effect
+
+    eff = get_effect(name)
+    h = eff.grid(ctx)[0]
+    cols = eff.columns(sig, ctx, h, nominal)
+    return bool(np.asarray(cols).ndim == 2 and np.asarray(cols).shape[1] > 0) or eff.target(sig, h) is not sig.tau
+
+
+def _design_all(name, sig, ctx, nominal):
+    """``{hyper: (X, y)}`` of the nominal + effect design on ``sig`` for every grid value."""
+    from drakecreep.gap.diagnosis import _design
+    from drakecreep.gap.effects import get_effect
+
+    out = {}
+    for h in get_effect(name).grid(ctx):
+        X, y, _ = _design((name,), (h,), sig, ctx, nominal)
+        out[h] = (X, y)
+    return out
+
+
+def _shift(cols, run_index, shifts):
+    out = np.empty_like(cols)
+    for r, s in shifts.items():
+        m = run_index == r
+        out[m] = np.roll(cols[m], s, axis=0)
+    return out
+
+
+def _fit_score(designs, n_nom):
+    """Best grid value on the training part; held-out SSE with those parameters."""
+    best = None
+    for h, (Xtr, ytr, Xte, yte) in designs.items():
+        theta, *_ = np.linalg.lstsq(Xtr, ytr, rcond=None)
+        r = ytr - Xtr @ theta
+        sse = float(r @ r)
+        if best is None or sse < best[0]:
+            rt = yte - Xte @ theta
+            best = (sse, float(rt @ rt))
+    return best
+
+
+def permutation_null(name, train, test, ctx, nominal, sse_nom_test, n=N_PERMUTATIONS, seed=0):
+    """Held-out inverse-dynamics gains of effect ``name`` with its columns circularly shifted per run.
+
+    Parameters
+    ----------
+    name : str
+        Effect.
+    train, test : drakecreep.gap.effects.IdimData
+    ctx, nominal
+        As for :func:`drakecreep.gap.diagnosis.fit_effect`.
+    sse_nom_test : float
+        Held-out SSE of the nominal model.
+    n : int
+        Permutations.
+    seed : int
+        Seed of the shifts.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``n`` null gains (empty when the effect has no columns: its null is ``gain <= 0``).
+    """
+    dtr, dte = _design_all(name, train, ctx, nominal), _design_all(name, test, ctx, nominal)
+    if next(iter(dtr.values()))[0].shape[1] <= 4:
+        return np.zeros(0)
+    rng = np.random.default_rng(seed)
+    gains = []
+    for _ in range(n):
+        sh_tr = {r: int(rng.uniform(0.25, 0.75) * np.sum(train.run_index == r)) for r in np.unique(train.run_index)}
+        sh_te = {r: int(rng.uniform(0.25, 0.75) * np.sum(test.run_index == r)) for r in np.unique(test.run_index)}
+        designs = {}
+        for h in dtr:
+            Xtr, ytr = dtr[h]
+            Xte, yte = dte[h]
+            Xtr = np.column_stack([Xtr[:, :4], _shift(Xtr[:, 4:], train.run_index, sh_tr)])
+            Xte = np.column_stack([Xte[:, :4], _shift(Xte[:, 4:], test.run_index, sh_te)])
+            designs[h] = (Xtr, ytr, Xte, yte)
+        _, sse_te = _fit_score(designs, 4)
+        gains.append(1.0 - sse_te / sse_nom_test)
+    return np.array(gains)
+
+
+def run_gains(name, train, test, ctx, nominal):
+    """Per-run out-of-sample inverse-dynamics gains of effect ``name`` over the nominal.
+
+    Each training run is left out in turn (nominal and effect refitted on the other training runs, the
+    grid value chosen there), then each held-out run is scored with the fit on all training runs.
+
+    Returns
+    -------
+    numpy.ndarray
+        One gain ``1 - SSE_eff / SSE_nom`` per run (training runs first).
+    """
+    from drakecreep.gap.idim import regressor
+
+    dtr, dte = _design_all(name, train, ctx, nominal), _design_all(name, test, ctx, nominal)
+    out = []
+    runs_tr = np.unique(train.run_index)
+
+    for r in (runs_tr if runs_tr.size > 1 else []):
+        fit_m, ev_m = train.run_index != r, train.run_index == r
+        W = regressor(train.dq, train.ddq)
+        th0, *_ = np.linalg.lstsq(W[fit_m], train.tau[fit_m], rcond=None)
+        r0 = train.tau[ev_m] - W[ev_m] @ th0
+        designs = {h: (X[fit_m], y[fit_m], X[ev_m], y[ev_m]) for h, (X, y) in dtr.items()}
+        _, sse1 = _fit_score(designs, 4)
+        out.append(1.0 - sse1 / float(r0 @ r0))
+    W = regressor(train.dq, train.ddq)
+    th0, *_ = np.linalg.lstsq(W, train.tau, rcond=None)
+    Wt = regressor(test.dq, test.ddq)
+    best = None
+    for h, (X, y) in dtr.items():
+        theta, *_ = np.linalg.lstsq(X, y, rcond=None)
+        rr = y - X @ theta
+        if best is None or float(rr @ rr) < best[0]:
+            best = (float(rr @ rr), h, theta)
+    _, h, theta = best
+    Xt, yt = dte[h]
+    for r in np.unique(test.run_index):
+        m = test.run_index == r
+        r0 = test.tau[m] - Wt[m] @ th0
+        r1 = yt[m] - Xt[m] @ theta
+        out.append(1.0 - float(r1 @ r1) / float(r0 @ r0))
+    return np.array(out)
+
+
+def replay_energy(fit, runs, ctx):
+    """Normalised closed-loop replay residual energy per run (mean of the force and the speed part).
+
+    ``E = (||F - F_sim||^2 / ||F - mean F||^2 + ||v - v_sim||^2 / ||v||^2) / 2`` on each run, with ``F``
+    the drive force and ``v`` the filtered motor speed.
+
+    Raises
+    ------
+    drakecreep.errors.InputError
+        When the replay cannot run these runs (e.g. their controller kind).
+    """
+    gap = REPLAY(fit, runs, ctx)
+    out = []
+    for p in gap["per_run"]:
+        f = p["force"] - np.mean(p["force"])
+        ef = float(p["e_force"] @ p["e_force"]) / max(float(f @ f), 1e-30)
+        ev = float(p["e_speed"] @ p["e_speed"]) / max(float(p["v"] @ p["v"]), 1e-30)
+        out.append(0.5 * (ef + ev))
+    return np.array(out)
+
+
+def _t_bound(x, upper):
+    """One-sided ``1 - ALPHA`` t bound of the mean of ``x`` (upper or lower)."""
+    x = np.asarray(x, dtype=float)
+    if x.size < 2:
+        return float(x.mean()) if x.size else math.nan
+    half = stats.t.ppf(1 - ALPHA, x.size - 1) * float(np.std(x, ddof=1)) / math.sqrt(x.size)
+    return float(x.mean() + half if upper else x.mean() - half)
+
+
+def replay_test(e_nom, e_eff):
+    """Per-run log ratios of the replay energies and their one-sided upper bound (claim needs < 0)."""
+    lr = np.log(np.maximum(e_eff, 1e-300) / np.maximum(e_nom, 1e-300))
+    return {"log_ratios": lr.tolist(), "mean": float(lr.mean()), "upper_bound": _t_bound(lr, upper=True),
+            "shrink": float(1.0 - np.sum(e_eff) / np.sum(e_nom)), "passes": bool(_t_bound(lr, upper=True) < 0)}
+
+
+def decide(fit, base, train, test, test_runs, ctx, replay_nominal=None, seed=0):
+    """Decide whether the fitted single effect ``fit`` may be claimed.
+
+    Parameters
+    ----------
+    fit, base : drakecreep.gap.diagnosis.EffectFit
+        The effect's fit and the nominal.
+    train, test : drakecreep.gap.effects.IdimData
+    test_runs : sequence of MeasuredRun
+        The held-out runs (closed-loop replay).
+    ctx : drakecreep.gap.effects.EffectContext
+    replay_nominal : numpy.ndarray or None or Exception
+        Per-run replay energies of the nominal on ``test_runs`` (computed once by the caller); an
+        :class:`~drakecreep.errors.InputError` when the replay is unavailable.
+    seed : int
+        Seed of the permutation null.
+
+    Returns
+    -------
+    dict
+        ``claim`` (bool), ``provisional`` (passes the inverse-dynamics tests, replay unavailable),
+        ``idim`` (gain, null threshold, run gains, lower bound), ``replay`` (see :func:`replay_test`),
+        ``reason``.
+    """
+    name = fit.effects[0]
+    nominal = base.nominal
+    null = permutation_null(name, train, test, ctx, nominal, base.sse_test, seed=seed)
+    thr = float(np.quantile(null, 1 - ALPHA)) if null.size else 0.0
+    thr = max(thr, 0.0)
+    gains = run_gains(name, train, test, ctx, nominal)
+    lower = _t_bound(gains, upper=False)
+    idim = {"gain": float(fit.gain), "null_threshold": thr, "null_median": float(np.median(null)) if null.size else None,
+            "run_gains": gains.tolist(), "run_lower_bound": lower,
+            "passes": bool(fit.physical and fit.gain > thr and lower > thr)}
+    out = {"effect": name, "idim": idim, "replay": None, "claim": False, "provisional": False}
+    if not idim["passes"]:
+        why = "not physical" if not fit.physical else (
+            f"held-out gain {100 * fit.gain:.1f} % <= null {100 * thr:.1f} %" if fit.gain <= thr else
+            f"run-to-run lower bound {100 * lower:.1f} % <= null {100 * thr:.1f} %")
+        out["reason"] = "inverse dynamics: " + why
+        return out
+    if isinstance(replay_nominal, Exception) or replay_nominal is None:
+        out["provisional"] = True
+        out["reason"] = f"closed-loop replay unavailable ({replay_nominal})"
+        return out
+    try:
+        e_eff = replay_energy(fit, test_runs, ctx)
+    except InputError as err:
+        out["reason"] = f"replay with the effect failed: {err}"
+        return out
+    rt = replay_test(replay_nominal, e_eff)
+    out["replay"] = rt
+    out["claim"] = rt["passes"]
+    out["reason"] = ("claimed" if rt["passes"] else
+                     f"held-out replay: upper bound of the log energy ratio {rt['upper_bound']:+.3f} >= 0")
+    return out

@@ -1,0 +1,444 @@
+"""A truth simulator richer than the diagnosis model: independent "measured" data for the gap benchmark.
+
+Why a second implementation of the equations
+--------------------------------------------
+The gap diagnosis is scored on data whose answer is known. If those data came from the model under test
+(the rigid replay of :mod:`drakecreep.gap.replay` / :mod:`drakecreep.gap.effects`, or the Drake diagram
+the diagnosis will replay through), every modelling shortcut of that model would be invisible: the truth
+would share its integrator, its friction law and its sensor model, and a benchmark could not tell a good
+diagnosis from one that only recognises its own equations. This module is therefore written separately
+(vectorised NumPy, no import of the diagnosis model) and is *richer* than any model the diagnosis fits:
+
+* **two bodies with an axial mode**: a motor-side mass ``m1`` (rotor, coupling and screw reflected to the
+  table) and the table ``m2`` on an axial spring ``k, c`` (screw + nut + bearing in series). ``flexible``
+  axes have the mode at 150-300 Hz (the paper rig: about 180 Hz), ``rigid`` axes at 500-700 Hz;
+* **LuGre friction on the table** (bristle state ``z``, ``sigma0``, ``sigma1``, viscous ``Fv``), with a
+  small Stribeck rise (``Fs/Fc`` <= 1.05) always present; bearing friction (smooth Coulomb + viscous) on
+  the motor side;
+* **run-to-run drift**: the friction levels of each run follow a random walk over the runs (1-4 % per
+  run); the runs are interleaved between training, held-out and audit sets;
+* **sensor realism**: motor encoder and linear scale quantisation, a current loop (first-order lag
+  50-150 us), white and low-pass (5 Hz) unknown force noise;
+* the **controller kinds** of the metadata schema: ``p_p_cascade`` (the EMPS law at 1 kHz, ``u`` in V
+  through ``u_gain``) and ``drakecreep`` (the project's cascade: position P with speed feed-forward at
+  1 kHz, speed PI at 4 kHz on the encoder's backward difference, conditional integration, force output).
+
+Integration: semi-implicit (symplectic) Euler at ``h = 50 us`` (20 substeps per 1 ms sample); the LuGre
+bristle state is advanced with the exact solution of ``dz/dt = v - |v| z sigma0 / g(v)`` for ``v`` held
+over the substep, so the stiff bristle dynamics stay stable at any ``sigma0``. Nothing here is the
+diagnosis model's exact per-sample rigid step or its ``sign`` friction.
+
+Withheld effects
+----------------
+* in the library (:data:`LIBRARY_EFFECTS`): a strong Stribeck drop, asymmetric friction, position-dependent
+  friction (a smooth ``tanh`` ramp, not the library's knots), a lead error with harmonics (kinematic: the
+  nut follows the screw angle with a periodic error, so it acts through the table's inertia and the
+  spring; it shows on the scale), cogging with harmonics (motor side), an extra structural mode (a
+  payload on a spring, 10-120 Hz), a control delay of 1-2 samples, load-dependent nut friction;
+* outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a bearing defect (a
+  force periodic in screw angle at a *non-integer* order 2.3-3.7) and a force ripple at a fixed time
+  frequency (6-25 Hz, e.g. a pump).
+
+Cross-test: in the limit of one stiff body, ``Fs = Fc``, stiff bristles, no noise, drift or delay, the
+P-P cascade of this module and the exact rigid stepper of :func:`drakecreep.gap.replay.replay` give the
+same trajectories (``tests/gap/test_truth.py`` states the tolerances).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+
+from drakecreep.errors import InputError
+from drakecreep.gap.measured import ControllerMeta, EMPS_CONTROLLER, MeasuredMeta, MeasuredRun, SensorMeta
+
+__all__ = [
+    "LIBRARY_EFFECTS",
+    "OUT_OF_LIBRARY",
+    "WITHHELD",
+    "CONTROLLER_KINDS",
+    "AXES",
+    "DT",
+    "SUBSTEPS",
+    "GTAU",
+    "Truth",
+    "draw_truth",
+    "out_and_back",
+    "draw_profiles",
+    "simulate_truth",
+    "make_runs",
+]
+
+#: Withheld effects the diagnosis library has a candidate for (names as in :mod:`drakecreep.gap.effects`).
+LIBRARY_EFFECTS = ("stribeck", "asymmetric_friction", "position_friction", "lead_error", "cogging",
+                   "structural_mode", "control_delay", "load_friction")
+#: Withheld effects without a library candidate (the answer must be "unexplained").
+OUT_OF_LIBRARY = ("bearing_defect", "time_ripple")
+WITHHELD = LIBRARY_EFFECTS + OUT_OF_LIBRARY
+CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
+AXES = ("flexible", "rigid")
+
+DT = 1e-3          # recording and position-loop sample time [s]
+SUBSTEPS = 20      # integration substeps per sample (h = 50 us)
+GTAU = 35.15       # N/V of the P-P cascade drive (EMPS)
+VEL_DIV = 4        # PI cascade: speed-loop ticks per sample (4 kHz)
+
+
+@dataclass
+class Truth:
+    """Every parameter of one truth (SI). Hidden from the diagnosis; the benchmark scores against it."""
+
+    kind: str
+    axis: str
+    M: float
+    table_share: float
+    f_axial: float
+    zeta_axial: float
+    lead: float
+    Fc: float
+    Fv: float
+    motor_friction_share: float
+    offset: float
+    Fs_ratio: float
+    vs: float
+    sigma0: float
+    sigma1: float
+    current_lag: float
+    noise_N: float
+    lowpass_noise_N: float
+    encoder: float
+    scale: float
+    drift_sd: float
+    effects: dict = field(default_factory=dict)
+
+    @property
+    def m1(self):
+        return (1.0 - self.table_share) * self.M
+
+    @property
+    def m2(self):
+        return self.table_share * self.M
+
+    @property
+    def k_axial(self):
+        mu = self.m1 * self.m2 / self.M
+        return mu * (2 * math.pi * self.f_axial) ** 2
+
+    @property
+    def c_axial(self):
+        mu = self.m1 * self.m2 / self.M
+        return 2 * self.zeta_axial * math.sqrt(self.k_axial * mu)
+
+    def to_dict(self):
+        return dataclasses.asdict(self)
+
+
+def draw_truth(rng, kind, axis, withheld=()):
+    """Draw a truth for a controller ``kind`` and an ``axis`` (flexible / rigid) with ``withheld`` effects.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+    kind : str
+        One of :data:`CONTROLLER_KINDS`.
+    axis : str
+        One of :data:`AXES`.
+    withheld : sequence of str
+        Effects of :data:`WITHHELD`.
+
+    Returns
+    -------
+    Truth
+    """
+    if kind not in CONTROLLER_KINDS:
+        raise InputError("kind", kind, "one of " + ", ".join(CONTROLLER_KINDS))
+    if axis not in AXES:
+        raise InputError("axis", axis, "one of " + ", ".join(AXES))
+    for w in withheld:
+        if w not in WITHHELD:
+            raise InputError("withheld", w, "one of " + ", ".join(WITHHELD))
+    lead = float(rng.choice([2.5e-3, 5e-3, 1e-2]))
+    f_ax = rng.uniform(150.0, 300.0) if axis == "flexible" else rng.uniform(500.0, 700.0)
+    Fc = rng.uniform(10.0, 30.0)
+    tr = Truth(kind=kind, axis=axis, M=rng.uniform(60.0, 120.0), table_share=rng.uniform(0.35, 0.6),
+               f_axial=f_ax, zeta_axial=rng.uniform(0.05, 0.1), lead=lead, Fc=Fc, Fv=rng.uniform(100.0, 300.0),
+               motor_friction_share=rng.uniform(0.2, 0.4), offset=rng.uniform(-4.0, 4.0),
+               Fs_ratio=rng.uniform(1.0, 1.05), vs=rng.uniform(5e-4, 2e-3), sigma0=rng.uniform(2e6, 2e7),
+               sigma1=0.0, current_lag=rng.uniform(5e-5, 1.5e-4), noise_N=rng.uniform(0.3, 1.5),
+               lowpass_noise_N=rng.uniform(0.1, 0.6), encoder=float(rng.choice([2e-8, 5e-8, 1e-7])),
+               scale=float(rng.choice([5e-8, 1e-7])), drift_sd=rng.uniform(0.01, 0.04))
+    tr.sigma1 = 2 * 0.5 * math.sqrt(tr.sigma0 * tr.m2)  # bristles critically damped on the table mass
+    p = {}
+    sgn = lambda: float(rng.choice([-1.0, 1.0]))  # noqa: E731
+    for h in withheld:
+        if h == "stribeck":
+            p[h] = {"Fs_ratio": rng.uniform(1.4, 2.0), "vs_m_s": rng.uniform(0.003, 0.012)}
+        elif h == "asymmetric_friction":
+            p[h] = {"beta": rng.uniform(0.15, 0.4) * sgn(), "coulomb_asym": rng.uniform(-0.05, 0.05)}
+        elif h == "position_friction":
+            p[h] = {"gamma": rng.uniform(0.25, 0.5) * sgn(), "width_m": rng.uniform(0.02, 0.06)}
+        elif h == "lead_error":
+            p[h] = {"amplitude_m": rng.uniform(2e-6, 8e-6), "phase": rng.uniform(0, 2 * np.pi),
+                    "h2": rng.uniform(0.1, 0.4), "phase2": rng.uniform(0, 2 * np.pi)}
+        elif h == "cogging":
+            p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": int(rng.integers(1, 7)),
+                    "phase": rng.uniform(0, 2 * np.pi), "h2": rng.uniform(0.1, 0.4)}
+        elif h == "structural_mode":
+            p[h] = {"mass_share": rng.uniform(0.1, 0.25), "fn_Hz": rng.uniform(10.0, 120.0),
+                    "zeta": rng.uniform(0.02, 0.08)}
+        elif h == "control_delay":
+            p[h] = {"delay_samples": int(rng.integers(1, 3))}
+        elif h == "load_friction":
+            p[h] = {"mu": rng.uniform(0.05, 0.12)}
+        elif h == "bearing_defect":
+            o = int(rng.integers(2, 4)) + rng.uniform(0.3, 0.7)
+            p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": o, "phase": rng.uniform(0, 2 * np.pi)}
+        elif h == "time_ripple":
+            p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "freq_Hz": rng.uniform(6.0, 25.0),
+                    "phase": rng.uniform(0, 2 * np.pi)}
+    tr.effects = p
+    return tr
+
+
+def out_and_back(speed, x0, n=3000, dt=DT, leg=1.3, starts=(0.2, 1.7)):
+    """Out-and-back reference [m]: two legs of ``leg`` seconds at ``speed`` (cosine ramps, 20 % each).
+
+    Parameters
+    ----------
+    speed : float
+        Cruise speed [m/s].
+    x0 : float
+        Start position [m].
+    n, dt : int, float
+        Samples and sample time.
+    leg : float
+        Duration of each leg [s].
+    starts : tuple of float
+        Start times of the out and the back leg [s].
+    """
+    t = np.arange(n) * dt
+    s = np.zeros_like(t)
+    ramp = 0.2
+    for start, sign in zip(starts, (1.0, -1.0)):
+        tau = np.clip((t - start) / leg, 0, 1)
+        vshape = np.where(tau < ramp, 0.5 * (1 - np.cos(np.pi * tau / ramp)),
+                          np.where(tau > 1 - ramp, 0.5 * (1 - np.cos(np.pi * (1 - tau) / ramp)), 1.0))
+        vshape = vshape * ((t >= start) & (t <= start + leg))
+        s = s + sign * np.cumsum(vshape) * dt
+    return x0 + speed * s
+
+
+def draw_profiles(rng, n_runs, n=3000):
+    """References (out-and-back, speeds log-uniform 5-150 mm/s, shuffled) and known force pulses [N]."""
+    speeds = np.exp(rng.uniform(np.log(0.005), np.log(0.15), n_runs))
+    refs, pulses = [], []
+    for v in speeds:
+        refs.append(out_and_back(v, rng.uniform(0.0, 0.12), n=n))
+        p = np.zeros(n)
+        for _ in range(3):
+            k = int(rng.integers(100, n - 100))
+            p[k: k + 50] = rng.choice([-1, 1]) * rng.uniform(7.0, 20.0)
+        pulses.append(p)
+    return np.array(refs), np.array(pulses), speeds
+
+
+def _controller_gains(tr):
+    if tr.kind == "p_p_cascade":
+        return {"kp": EMPS_CONTROLLER.kp, "kv": EMPS_CONTROLLER.kv, "sat": EMPS_CONTROLLER.saturation}
+    wv = 2 * math.pi * 40.0  # speed-loop bandwidth [rad/s]
+    return {"kp": wv / 5.0, "kv": tr.M * wv, "ki": tr.M * wv * wv / 5.0, "ff": 1.0, "sat": 2000.0}
+
+
+def simulate_truth(tr, refs, pulses, rng_noise, with_effects=True):
+    """Closed-loop simulation of all runs of a truth at once (columns = runs).
+
+    Parameters
+    ----------
+    tr : Truth
+    refs, pulses : numpy.ndarray
+        ``(runs, samples)`` reference [m] and known external force [N].
+    rng_noise : numpy.random.Generator
+        Draws the noise and the drift (pass equal generators to get the same noise with and without the
+        effects).
+    with_effects : bool
+        Include ``tr.effects`` (False: the effect-free twin).
+
+    Returns
+    -------
+    dict
+        ``x_motor``, ``x_table`` (quantised), ``u`` (controller output: V for P-P, N for the PI cascade),
+        ``drift`` (friction multiplier per run), all ``(runs, samples)`` except ``drift``.
+    """
+    S, n = refs.shape
+    eff = tr.effects if with_effects else {}
+    g = _controller_gains(tr)
+    gain = GTAU if tr.kind == "p_p_cascade" else 1.0
+    drift = 1.0 + np.cumsum(rng_noise.normal(0.0, tr.drift_sd, S))
+    white = rng_noise.normal(0.0, tr.noise_N, (S, n))
+    lp = rng_noise.normal(0.0, 1.0, (S, n))
+    b, a = signal.butter(2, 5.0 / (0.5 / DT))
+    lp = signal.lfilter(b, a, lp, axis=1)
+    lp = tr.lowpass_noise_N * lp / max(float(np.std(lp)), 1e-12)
+    noise = white + lp
+    m1, m2, k, c = tr.m1, tr.m2, tr.k_axial, tr.c_axial
+    Fc_m = tr.motor_friction_share * tr.Fc * drift
+    Fv_m = tr.motor_friction_share * tr.Fv * drift
+    Fc_t = (1 - tr.motor_friction_share) * tr.Fc * drift
+    Fv_t = (1 - tr.motor_friction_share) * tr.Fv * drift
+    Fs_ratio, vs = tr.Fs_ratio, tr.vs
+    if "stribeck" in eff:
+        Fs_ratio, vs = eff["stribeck"]["Fs_ratio"], eff["stribeck"]["vs_m_s"]
+    xc = float(np.mean(refs))
+    v_eps = 1e-4
+    sm = eff.get("structural_mode")
+    if sm:
+        mp = sm["mass_share"] * m2
+        m2 = m2 - mp
+        kp_ = mp * (2 * math.pi * sm["fn_Hz"]) ** 2
+        cp_ = 2 * sm["zeta"] * math.sqrt(kp_ * mp)
+    delay = eff.get("control_delay", {}).get("delay_samples", 0)
+    h = DT / SUBSTEPS
+    lag = 1.0 - math.exp(-h / tr.current_lag)
+
+    def lead_err(x):
+        if "lead_error" not in eff:
+            return 0.0
+        e = eff["lead_error"]
+        th = 2 * np.pi * x / tr.lead
+        return e["amplitude_m"] * (np.sin(th + e["phase"]) + e["h2"] * np.sin(2 * th + e["phase2"]))
+
+    def table_g(x, v, f_load):
+        fc = Fc_t * np.ones(S)
+        if "asymmetric_friction" in eff:
+            fc = fc * (1 + np.sign(v) * eff["asymmetric_friction"]["coulomb_asym"])
+        if "position_friction" in eff:
+            e = eff["position_friction"]
+            fc = fc * (1 + e["gamma"] * np.tanh((x - xc) / e["width_m"]))
+        if "load_friction" in eff:
+            fc = fc + eff["load_friction"]["mu"] * np.abs(f_load)
+        return fc * (1 + (Fs_ratio - 1) * np.exp(-(v / vs) ** 2))
+
+    def fv_table(v):
+        if "asymmetric_friction" in eff:
+            return Fv_t * (1 + np.sign(v) * eff["asymmetric_friction"]["beta"])
+        return Fv_t
+
+    def motor_extra(x, t):
+        f = 0.0
+        if "cogging" in eff:
+            e = eff["cogging"]
+            th = 2 * np.pi * e["order"] * x / tr.lead
+            f = f + e["amplitude_N"] * (np.sin(th + e["phase"]) + e["h2"] * np.sin(2 * th))
+        if "bearing_defect" in eff:
+            e = eff["bearing_defect"]
+            f = f + e["amplitude_N"] * np.sin(2 * np.pi * e["order"] * x / tr.lead + e["phase"])
+        if "time_ripple" in eff:
+            e = eff["time_ripple"]
+            f = f + e["amplitude_N"] * np.sin(2 * np.pi * e["freq_Hz"] * t + e["phase"])
+        return f
+
+    # state: motor-side x1, v1; table x2, v2; payload xp, vp; bristles z; applied force
+    x1 = refs[:, 0].copy()
+    v1 = np.zeros(S)
+    x2 = x1 + lead_err(x1)
+    v2 = np.zeros(S)
+    xp, vp = x2.copy(), np.zeros(S)
+    z = np.zeros(S)
+    f_app = np.zeros(S)
+    enc = lambda x: np.round(x / tr.encoder) * tr.encoder  # noqa: E731
+    xm = np.empty((S, n))
+    xt = np.empty((S, n))
+    u_rec = np.empty((S, n))
+    # controller memory
+    q_prev = enc(x1)
+    qf_prev = q_prev.copy()
+    integ = np.zeros(S)
+    v_cmd = np.zeros(S)
+    queue = [np.zeros(S) for _ in range(delay * (1 if tr.kind == "p_p_cascade" else VEL_DIV))]
+    v_ref = np.gradient(refs, DT, axis=1)
+    cmd = np.zeros(S)
+    ticks = 1 if tr.kind == "p_p_cascade" else VEL_DIV
+    sub = SUBSTEPS // ticks
+    tv = DT / ticks
+    for kk in range(n):
+        for j in range(ticks):
+            q = enc(x1)
+            if tr.kind == "p_p_cascade":
+                qf = 0.5 * q + 0.5 * q_prev
+                dq = (qf - qf_prev) / DT
+                out = np.clip(g["kp"] * g["kv"] * (refs[:, kk] - q) - g["kv"] * dq, -g["sat"], g["sat"])
+                qf_prev = qf
+            else:
+                if j == 0:
+                    v_cmd = g["kp"] * (refs[:, kk] - q) + g["ff"] * v_ref[:, kk]
+                vm = (q - q_prev) / tv
+                err = v_cmd - vm
+                raw = g["kv"] * err + integ + g["ki"] * err * tv
+                sat = np.abs(raw) >= g["sat"]
+                integ = np.where(sat, integ, integ + g["ki"] * err * tv)
+                out = np.clip(g["kv"] * err + integ, -g["sat"], g["sat"])
+            q_prev = q
+            if j == 0:
+                xm[:, kk] = q
+                xt[:, kk] = np.round(x2 / tr.scale) * tr.scale
+                u_rec[:, kk] = out
+            queue.append(out)
+            applied = queue.pop(0)
+            cmd = gain * applied + pulses[:, kk] + noise[:, kk]
+            for i in range(sub):
+                t = (kk + (j * sub + i) / SUBSTEPS) * DT
+                f_app = f_app + (cmd - f_app) * lag
+                stretch = x1 + lead_err(x1) - x2
+                dstretch = v1 * (1 + (lead_err(x1 + 1e-7) - lead_err(x1)) / 1e-7) - v2 if "lead_error" in eff \
+                    else v1 - v2
+                fk = k * stretch + c * dstretch
+                fm = Fc_m * np.tanh(v1 / v_eps) + Fv_m * v1 + tr.offset
+                a1 = (f_app - fm - fk - motor_extra(x1, t)) / m1
+                gz = table_g(x2, v2, fk)
+                # exact bristle update for v2 held over the substep
+                rate = tr.sigma0 * np.abs(v2) / np.maximum(gz, 1e-9)
+                zss = np.where(rate > 0, v2 / np.maximum(rate, 1e-300), 0.0)
+                z_new = np.where(rate > 0, zss + (z - zss) * np.exp(-rate * h), z + v2 * h)
+                dz = (z_new - z) / h
+                z = z_new
+                ft = tr.sigma0 * z + tr.sigma1 * dz + fv_table(v2) * v2
+                fp = kp_ * (x2 - xp) + cp_ * (v2 - vp) if sm else 0.0
+                a2 = (fk - ft - fp) / m2
+                v1 = v1 + h * a1
+                v2 = v2 + h * a2
+                x1 = x1 + h * v1
+                x2 = x2 + h * v2
+                if sm:
+                    vp = vp + h * fp / mp
+                    xp = xp + h * vp
+    return {"x_motor": xm, "x_table": xt, "u": u_rec, "drift": drift}
+
+
+def controller_meta(tr):
+    """The metadata a user of the rig would write (controller, units, sensors, drive parameters)."""
+    sensors = SensorMeta(encoder_resolution=tr.encoder, scale_resolution=tr.scale)
+    if tr.kind == "p_p_cascade":
+        return MeasuredMeta(u_units="V", u_gain=GTAU, controller=EMPS_CONTROLLER, sensors=sensors,
+                            source="drakecreep.gap.truth (P-P cascade)")
+    from drakecreep.params import ControllerParams, DriveParams, ScrewParams
+
+    g = _controller_gains(tr)
+    ctrl = ControllerParams(position_gain=g["kp"], velocity_feedforward=g["ff"], velocity_gain=g["kv"],
+                            velocity_integral_gain=g["ki"], velocity_period=DT / VEL_DIV, position_period=DT)
+    params = DriveParams(controller=ctrl, screw=ScrewParams(lead=tr.lead))
+    return MeasuredMeta(u_units="N", u_gain=1.0, params=params,
+                        controller=ControllerMeta(kind="drakecreep", sample_time=DT), sensors=sensors,
+                        source="drakecreep.gap.truth (PI cascade)")
+
+
+def make_runs(tr, refs, pulses, sim, label="run"):
+    """:class:`~drakecreep.gap.measured.MeasuredRun` objects of a simulation (with the linear scale)."""
+    meta = controller_meta(tr)
+    n = refs.shape[1]
+    t = np.arange(n) * DT
+    return [MeasuredRun(t=t, x_ref=refs[i], x_motor=sim["x_motor"][i], x_table=sim["x_table"][i], u=sim["u"][i],
+                        f_ext=pulses[i], meta=meta, label=f"{label}{i}") for i in range(refs.shape[0])]
