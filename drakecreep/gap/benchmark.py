@@ -52,7 +52,9 @@ __all__ = [
     "Dataset",
     "out_and_back",
     "design",
+    "generate_datasets",
     "generate_dataset",
+    "benchmark_specs",
     "diagnose_dataset",
     "audit_replay",
     "evaluate",
@@ -97,7 +99,7 @@ class Dataset:
 
 
 def design(index, kinds=T.CONTROLLER_KINDS):
-    """What dataset ``index`` holds: ``(withheld, kind, axis)``.
+    """What dataset ``index`` holds in a plain sequence: ``(withheld, kind, axis)``.
 
     Cycles through the 8 library effects, 2 out-of-library effects and 2 nulls (12 slots), and through
     the controller kinds and axes so that every effect meets each combination.
@@ -109,6 +111,54 @@ def design(index, kinds=T.CONTROLLER_KINDS):
     kind = kinds[combo % len(kinds)]
     axis = T.AXES[(combo // len(kinds) + index) % len(T.AXES)]
     return withheld, kind, axis
+
+
+def _draw(seed, withheld, kind, axis, n_samples):
+    rng = np.random.default_rng(seed)
+    tr = T.draw_truth(rng, kind, axis, tuple(withheld))
+    n_runs = N_TRAIN + N_TEST + N_AUDIT
+    refs, pulses, _ = T.draw_profiles(rng, n_runs, n=n_samples)
+    drift, noise = T.noise_draws(tr, n_runs, n_samples, rng)
+    return tr, refs, pulses, drift, noise
+
+
+def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
+    """Generate datasets in batches (one vectorised truth simulation per ``chunk`` datasets).
+
+    Parameters
+    ----------
+    specs : sequence of tuple
+        ``(seed, withheld, kind, axis)`` per dataset.
+    n_samples : int
+        Samples per run.
+    chunk : int
+        Datasets per batch.
+
+    Returns
+    -------
+    list of Dataset
+    """
+    out = []
+    specs = list(specs)
+    for c in range(0, len(specs), chunk):
+        part = specs[c: c + chunk]
+        draws = [_draw(sd, w, k, a, n_samples) for sd, w, k, a in part]
+        jobs = []
+        for (sd, w, k, a), (tr, refs, pulses, drift, noise) in zip(part, draws):
+            jobs.append((tr, refs, pulses, drift, noise, True))
+            if w:  # the effect-free twin: same references, drift and noise
+                jobs.append((tr, refs, pulses, drift, noise, False))
+        sims = iter(T.simulate_batch(jobs))
+        for (sd, w, k, a), (tr, refs, pulses, drift, noise) in zip(part, draws):
+            runs = T.make_runs(tr, refs, pulses, next(sims))
+            i, j = N_TRAIN, N_TRAIN + N_TEST
+            ds = Dataset(seed=sd, withheld=tuple(w), truth=tr, train=runs[:i], test=runs[i:j], audit=runs[j:])
+            if w:
+                twin = next(sims)
+                ds.twin_train = T.make_runs(tr, refs[:i], pulses[:i], {key: v[:i] for key, v in twin.items()})
+                ds.snr = _snr(ds.train, ds.twin_train, tr.lead)
+            out.append(ds)
+    return out
 
 
 def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_samples=N_SAMPLES):
@@ -133,21 +183,7 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
     withheld = tuple(d[0] if withheld is None else withheld)
     kind = d[1] if kind is None else kind
     axis = d[2] if axis is None else axis
-    rng = np.random.default_rng(seed)
-    tr = T.draw_truth(rng, kind, axis, withheld)
-    n_runs = N_TRAIN + N_TEST + N_AUDIT
-    refs, pulses, _ = T.draw_profiles(rng, n_runs, n=n_samples)
-    noise_seed = int(rng.integers(0, 2**31))
-    sim = T.simulate_truth(tr, refs, pulses, np.random.default_rng(noise_seed), with_effects=True)
-    runs = T.make_runs(tr, refs, pulses, sim)
-    a, b = N_TRAIN, N_TRAIN + N_TEST
-    ds = Dataset(seed=seed, withheld=withheld, truth=tr, train=runs[:a], test=runs[a:b], audit=runs[b:])
-    if withheld:
-        # same references, drift and noise draws (the same generator state), no withheld effect
-        twin = T.simulate_truth(tr, refs, pulses, np.random.default_rng(noise_seed), with_effects=False)
-        ds.twin_train = T.make_runs(tr, refs[:a], pulses[:a], {k: v[:a] for k, v in twin.items() if k != "drift"})
-        ds.snr = _snr(ds.train, ds.twin_train, tr.lead)
-    return ds
+    return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples)[0]
 
 
 def _snr(runs, twin, lead):
@@ -171,8 +207,8 @@ def diagnose_dataset(ds, replay=True, config=None):
     return diagnose(ds.train, ds.test, cfg, replay=replay)
 
 
-def audit_replay(result, runs):
-    """Closed-loop replay RMS on the audit runs: nominal, claimed model, and each ranked effect.
+def audit_replay(result, runs, also=()):
+    """Closed-loop replay on the audit runs: nominal, claimed model, and the ranked effects named in ``also``.
 
     Returns
     -------
@@ -184,7 +220,7 @@ def audit_replay(result, runs):
 
     fits = result["_fits"]
     out = {}
-    for f in [fits["base"]] + list(fits["ranking"]) + [fits["final"]]:
+    for f in [fits["base"]] + [f for f in fits["ranking"] if f.label in also] + [fits["final"]]:
         if f.label in out:
             continue
         try:
@@ -202,9 +238,10 @@ def evaluate(ds, replay=True):
     row = {"seed": ds.seed, "withheld": list(ds.withheld), "category": ds.category, "kind": ds.kind,
            "axis": ds.axis, "snr": ds.snr, "claimed": claimed, "top3": ranked[:3],
            "unexplained": res.get("unexplained", {}).get("verdict"),
-           "replay_available": res.get("claims", {}).get("replay_available")}
+           "replay_available": res.get("claims", {}).get("replay_available"),
+           "provisional": list(res.get("claims", {}).get("provisional", []))}
     if replay:
-        audit = audit_replay(res, ds.audit)
+        audit = audit_replay(res, ds.audit, also=ds.withheld)
         row["audit_energy"] = audit
         nom = audit.get("nominal")
         fin = audit.get("+".join(claimed)) if claimed else nom
@@ -215,24 +252,66 @@ def evaluate(ds, replay=True):
     return row
 
 
-def run_benchmark(n=24, seed=HELDOUT_SEEDS, replay=True, progress=False, kinds=T.CONTROLLER_KINDS):
-    """Generate ``n`` datasets (seeds ``seed .. seed+n-1``, design index ``0 .. n-1``), diagnose, score.
+def benchmark_specs(seed, kinds=T.CONTROLLER_KINDS, n_per_effect=10, tries=2.5, n_null=10, n_ool=6):
+    """The dataset list of a benchmark: ``(seed, withheld, kind, axis)``.
+
+    Per controller kind: ``ceil(tries * n_per_effect)`` candidates per library effect (the first
+    ``n_per_effect`` with SNR >= 3 are diagnosed, see :func:`run_benchmark`), ``n_ool`` per out-of-library
+    effect and ``n_null`` nulls; axes alternate. Seeds are ``seed + 10000 * kind + 1000 * slot + j``.
+    """
+    specs = []
+    slots = [(e,) for e in T.LIBRARY_EFFECTS] + [(e,) for e in T.OUT_OF_LIBRARY] + [()]
+    for ki, kind in enumerate(kinds):
+        for si, w in enumerate(slots):
+            if not w:
+                count = n_null
+            elif w[0] in T.OUT_OF_LIBRARY:
+                count = n_ool
+            else:
+                count = int(math.ceil(tries * n_per_effect))
+            for j in range(count):
+                specs.append((seed + 10000 * T.CONTROLLER_KINDS.index(kind) + 1000 * si + j, w, kind,
+                              T.AXES[j % len(T.AXES)]))
+    return specs
+
+
+def run_benchmark(seed=HELDOUT_SEEDS, kinds=T.CONTROLLER_KINDS, n_per_effect=10, n_null=10, n_ool=6,
+                  replay=True, progress=False, tries=2.5):
+    """Generate the datasets of :func:`benchmark_specs`, diagnose each blind, score.
+
+    Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
+    diagnosed; the others are only counted (``low_snr_skipped``). Nulls and out-of-library datasets are
+    all diagnosed.
 
     Returns
     -------
     dict
-        ``scores`` (:func:`score_rows`) and ``datasets`` (rows).
+        ``scores`` (:func:`score_rows`), ``datasets`` (rows), ``low_snr_skipped`` (per effect).
     """
-    rows = []
-    for i in range(n):
-        w, k, a = design(i, kinds)
-        ds = generate_dataset(seed + i, withheld=w, kind=k, axis=a)
+    specs = benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool)
+    if progress:
+        print(f"[gap-benchmark] generating {len(specs)} candidate datasets", file=sys.stderr, flush=True)
+    datasets = generate_datasets(specs)
+    rows, kept, skipped = [], {}, {}
+    todo = []
+    for ds in datasets:
+        key = (ds.kind, ds.withheld)
+        if ds.category == "library":
+            if kept.get(key, 0) >= n_per_effect:
+                continue
+            if ds.snr < 3:
+                skipped[f"{ds.kind}/{ds.withheld[0]}"] = skipped.get(f"{ds.kind}/{ds.withheld[0]}", 0) + 1
+                continue
+        kept[key] = kept.get(key, 0) + 1
+        todo.append(ds)
+    for i, ds in enumerate(todo):
         row = evaluate(ds, replay=replay)
         rows.append(row)
         if progress:
-            print(f"[gap-benchmark] {i + 1}/{n} seed {seed + i} {k}/{a}: withheld {list(w) or 'none'} "
-                  f"(SNR {ds.snr:.1f}) -> claimed {row['claimed'] or 'nothing'}", file=sys.stderr, flush=True)
-    return {"scores": score_rows(rows), "datasets": rows}
+            print(f"[gap-benchmark] {i + 1}/{len(todo)} seed {ds.seed} {ds.kind}/{ds.axis}: withheld "
+                  f"{list(ds.withheld) or 'none'} (SNR {ds.snr:.1f}) -> claimed {row['claimed'] or 'nothing'}"
+                  + ("" if row["replay_available"] else " (replay unavailable)"), file=sys.stderr, flush=True)
+    return {"scores": score_rows(rows), "datasets": rows, "low_snr_skipped": skipped}
 
 
 def score_rows(rows):
@@ -254,6 +333,8 @@ def score_rows(rows):
             "top1_snr3": rate(strong, lambda r: r["claimed"] and r["claimed"][0] == r["withheld"][0]),
             "top1_all": rate(lib, lambda r: r["claimed"] and r["claimed"][0] == r["withheld"][0]),
             "claims_on_nulls": rate(null, lambda r: r["claimed"]),
+            "provisional_top1_snr3": rate(strong, lambda r: r.get("provisional") and r["provisional"][0] == r["withheld"][0]),
+            "provisional_on_nulls": rate(null, lambda r: r.get("provisional")),
             "out_of_library_unexplained": rate(ool, lambda r: not r["claimed"]),
             "median_relative_shrink_snr3": float(np.median(rel)) if rel else None,
             "claims_making_audit_worse": sum(1 for r in rs if r.get("worse")),

@@ -44,6 +44,9 @@ from drakecreep.gap import claims as claims_mod
 from drakecreep.gap.claims import identifiable
 from drakecreep.gap.residuals import (
     classify_regimes,
+    frequency_bands,
+    independence,
+    motor_table_split,
     operating_map,
     order_spectrum,
     regime_shares,
@@ -322,6 +325,7 @@ def replay_gap(fit, runs, ctx):
         _, v_meas, _ = filtered_derivatives(run.x_motor, run.dt)
         _, v_sim, _ = filtered_derivatives(sim["x"], run.dt)
         per.append({"t": run.t, "x": run.x_motor, "x_ref": run.x_ref, "v": v_meas, "force": run.force,
+                    "x_sim": sim["x"], "x_table": run.x_table,
                     "u": run.u, "e_speed": v_meas - v_sim, "e_position": run.x_motor - sim["x"],
                     "e_force": run.force - sim["force"]})
     cat = {k: np.concatenate([p[k] for p in per]) for k in ("e_speed", "e_position", "e_force")}
@@ -341,7 +345,7 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
         frequency per signal), ``map`` (per signal), ``whiteness`` (of the IDIM residual), ``sentences``.
     """
     per = gap["per_run"]
-    cat = {k: np.concatenate([p[k] for p in per]) for k in per[0] if k != "t"}
+    cat = {k: np.concatenate([p[k] for p in per]) for k in per[0] if k not in ("t", "x_table")}
     labels = np.concatenate([classify_regimes(p["t"], p["x_ref"], p["v"]) for p in per])
     dt = float(per[0]["t"][1] - per[0]["t"][0])
     signals = {"speed": "e_speed", "position": "e_position", "force": "e_force"}
@@ -375,6 +379,14 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
         out["time"][name] = {"peak_hz": ts["peak_hz"]}
         out["spectra"][name]["time"] = (ts["freq"], ts["psd"])
         out["map"][name] = operating_map(cat[key], cat["v"], cat["x"], cat["force"])
+    out["bands"] = {name: frequency_bands([p[key] for p in per], dt) for name, key in signals.items()}
+    v_ref = np.concatenate([np.gradient(p["x_ref"], dt) for p in per])
+    try:
+        out["independence"] = independence(cat["e_force"], {"reference_speed": v_ref, "force": cat["force"]})
+    except InputError:
+        out["independence"] = {}
+    if all(p["x_table"] is not None for p in per):
+        out["motor_table"] = motor_table_split(cat["x"], np.concatenate([p["x_table"] for p in per]), cat["x_sim"])
     if idim_residual is not None:
         out["whiteness"] = whiteness(idim_residual, idim_input)
     out["sentences"] = _sentences(out)
@@ -402,6 +414,20 @@ def _sentences(w):
             order_txt = ", no sharp order against screw angle"
         lines.append(f"{100 * reg[top]['energy_share']:.0f} % of the {name} residual energy lies in "
                      f"{top.replace('_', '-')} phases ({100 * reg[top]['time_share']:.0f} % of the time){order_txt}.")
+    if "bands" in w:
+        b = w["bands"]["force"]["top"]
+        hi = "Nyquist" if b["hi_Hz"] >= 0.5 / 1e-3 - 1 else f"{b['hi_Hz']:g} Hz"
+        lines.append(f"{100 * b['share']:.0f} % of the force residual energy lies between {b['lo_Hz']:g} Hz and "
+                     f"{hi} (peak at {w['bands']['force']['peak_hz']:.3g} Hz).")
+    if "motor_table" in w:
+        m = w["motor_table"]
+        lines.append(f"Position gap: {1e6 * m['motor_rms_m']:.3g} um RMS at the motor, {1e6 * m['transmission_rms_m']:.3g} "
+                     f"um RMS added by the transmission: {m['where']} ({100 * m['after_screw_share']:.0f} % after).")
+    if w.get("independence"):
+        dep = [f"{k} (max |r| {v['max_abs']:.2f} at lag {v['lag_of_max']} > band {v['band']:.2f})"
+               for k, v in w["independence"].items() if not v["independent"]]
+        lines.append("The replay force residual is " + ("correlated with " + "; ".join(dep) if dep else
+                     "independent of the reference speed and the force (99 % band)") + ".")
     if "whiteness" in w:
         wh = w["whiteness"]
         lines.append("The inverse-dynamics residual is " + ("white (noise)" if wh["white"] else
@@ -473,12 +499,17 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
             replay_nominal = claims_mod.replay_energy(base, test_runs, ctx)
         except InputError as err:
             replay_nominal = err
+    rnull = {"ratios": [], "threshold": 0.0}
+    if replay and not isinstance(replay_nominal, Exception):
+        rnull = claims_mod.replay_null(train, test, test_runs, ctx, replay_nominal)
+        _log(cfg, f"replay threshold from run-to-run variation: {100 * rnull['threshold']:.1f} %")
     decisions = {}
     claimed = []
     for f in ranking[: cfg.max_candidates]:
         if not f.physical or f.gain <= 0:
             continue
-        d = claims_mod.decide(f, base, train, test, test_runs, ctx, replay_nominal=replay_nominal)
+        d = claims_mod.decide(f, base, train, test, test_runs, ctx, replay_nominal=replay_nominal,
+                              replay_threshold=rnull["threshold"])
         decisions[f.label] = d
         _log(cfg, f"claim test {f.label}: {d['reason']}")
         if d["claim"]:
@@ -502,6 +533,7 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
                 "(drakecreep.gap.claims)",
         "replay_available": replay and not isinstance(replay_nominal, Exception),
         "replay_error": str(replay_nominal) if isinstance(replay_nominal, Exception) else None,
+        "replay_null": rnull,
         "decisions": _jsonable(decisions),
         "provisional": [k for k, d in decisions.items() if d["provisional"]],
         "not_identifiable": not_identifiable,

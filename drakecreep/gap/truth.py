@@ -23,7 +23,7 @@ diagnosis from one that only recognises its own equations. This module is theref
   through ``u_gain``) and ``drakecreep`` (the project's cascade: position P with speed feed-forward at
   1 kHz, speed PI at 4 kHz on the encoder's backward difference, conditional integration, force output).
 
-Integration: semi-implicit (symplectic) Euler at ``h = 50 us`` (20 substeps per 1 ms sample); the LuGre
+Integration: semi-implicit (symplectic) Euler at ``h = 83 us`` (12 substeps per 1 ms sample); the LuGre
 bristle state is advanced with the exact solution of ``dz/dt = v - |v| z sigma0 / g(v)`` for ``v`` held
 over the substep, so the stiff bristle dynamics stay stable at any ``sigma0``. Nothing here is the
 diagnosis model's exact per-sample rigid step or its ``sign`` friction.
@@ -34,7 +34,7 @@ Withheld effects
   friction (a smooth ``tanh`` ramp, not the library's knots), a lead error with harmonics (kinematic: the
   nut follows the screw angle with a periodic error, so it acts through the table's inertia and the
   spring; it shows on the scale), cogging with harmonics (motor side), an extra structural mode (a
-  payload on a spring, 10-120 Hz), a control delay of 1-2 samples, load-dependent nut friction;
+  payload on a spring, 10-120 Hz), a control delay of 1-3 samples, load-dependent nut friction;
 * outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a bearing defect (a
   force periodic in screw angle at a *non-integer* order 2.3-3.7) and a force ripple at a fixed time
   frequency (6-25 Hz, e.g. a pump).
@@ -69,6 +69,8 @@ __all__ = [
     "draw_truth",
     "out_and_back",
     "draw_profiles",
+    "noise_draws",
+    "simulate_batch",
     "simulate_truth",
     "make_runs",
 ]
@@ -83,7 +85,7 @@ CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 AXES = ("flexible", "rigid")
 
 DT = 1e-3          # recording and position-loop sample time [s]
-SUBSTEPS = 20      # integration substeps per sample (h = 50 us)
+SUBSTEPS = 12      # integration substeps per sample (h = 83 us; a multiple of VEL_DIV)
 GTAU = 35.15       # N/V of the P-P cascade drive (EMPS)
 VEL_DIV = 4        # PI cascade: speed-loop ticks per sample (4 kHz)
 
@@ -188,12 +190,12 @@ def draw_truth(rng, kind, axis, withheld=()):
             p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": int(rng.integers(1, 7)),
                     "phase": rng.uniform(0, 2 * np.pi), "h2": rng.uniform(0.1, 0.4)}
         elif h == "structural_mode":
-            p[h] = {"mass_share": rng.uniform(0.1, 0.25), "fn_Hz": rng.uniform(10.0, 120.0),
-                    "zeta": rng.uniform(0.02, 0.08)}
+            p[h] = {"mass_share": rng.uniform(0.2, 0.4), "fn_Hz": rng.uniform(10.0, 120.0),
+                    "zeta": rng.uniform(0.01, 0.05)}
         elif h == "control_delay":
-            p[h] = {"delay_samples": int(rng.integers(1, 3))}
+            p[h] = {"delay_samples": int(rng.integers(1, 4))}
         elif h == "load_friction":
-            p[h] = {"mu": rng.uniform(0.05, 0.12)}
+            p[h] = {"mu": rng.uniform(0.1, 0.3)}
         elif h == "bearing_defect":
             o = int(rng.integers(2, 4)) + rng.uniform(0.3, 0.7)
             p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": o, "phase": rng.uniform(0, 2 * np.pi)}
@@ -253,8 +255,215 @@ def _controller_gains(tr):
     return {"kp": wv / 5.0, "kv": tr.M * wv, "ki": tr.M * wv * wv / 5.0, "ff": 1.0, "sat": 2000.0}
 
 
+def noise_draws(tr, n_runs, n, rng_noise):
+    """Drift multipliers ``(runs,)`` and unknown force noise ``(runs, n)`` [N] of one truth's runs."""
+    drift = 1.0 + np.cumsum(rng_noise.normal(0.0, tr.drift_sd, n_runs))
+    white = rng_noise.normal(0.0, tr.noise_N, (n_runs, n))
+    lp = rng_noise.normal(0.0, 1.0, (n_runs, n))
+    b, a = signal.butter(2, 5.0 / (0.5 / DT))
+    lp = signal.lfilter(b, a, lp, axis=1)
+    lp = tr.lowpass_noise_N * lp / max(float(np.std(lp)), 1e-12)
+    return drift, white + lp
+
+
+def _columns(jobs):
+    """Per-column parameter arrays of a batch (see :func:`simulate_batch`)."""
+    cols = {}
+
+    def put(name, values):
+        cols.setdefault(name, []).extend(values)
+
+    for tr, refs, pulses, drift, noise, with_effects in jobs:
+        S = refs.shape[0]
+        eff = tr.effects if with_effects else {}
+        g = _controller_gains(tr)
+        one = lambda v: [float(v)] * S  # noqa: E731
+        put("pp", one(tr.kind == "p_p_cascade"))
+        put("gain", one(GTAU if tr.kind == "p_p_cascade" else 1.0))
+        for k_ in ("kp", "kv", "sat"):
+            put(k_, one(g[k_]))
+        put("ki", one(g.get("ki", 0.0)))
+        put("ff", one(g.get("ff", 0.0)))
+        sm = eff.get("structural_mode")
+        mp = sm["mass_share"] * tr.m2 if sm else 0.0
+        put("mp", one(mp))
+        put("kpl", one(mp * (2 * math.pi * sm["fn_Hz"]) ** 2 if sm else 0.0))
+        put("cpl", one(2 * sm["zeta"] * math.sqrt(mp * (2 * math.pi * sm["fn_Hz"]) ** 2 * mp) if sm else 0.0))
+        put("m1", one(tr.m1))
+        put("m2", one(tr.m2 - mp))
+        put("k", one(tr.k_axial))
+        put("c", one(tr.c_axial))
+        sh = tr.motor_friction_share
+        put("Fc_m", list(sh * tr.Fc * drift))
+        put("Fv_m", list(sh * tr.Fv * drift))
+        put("Fc_t", list((1 - sh) * tr.Fc * drift))
+        put("Fv_t", list((1 - sh) * tr.Fv * drift))
+        put("offset", one(tr.offset))
+        st = eff.get("stribeck")
+        put("Fs_ratio", one(st["Fs_ratio"] if st else tr.Fs_ratio))
+        put("vs", one(st["vs_m_s"] if st else tr.vs))
+        put("sigma0", one(tr.sigma0))
+        put("sigma1", one(tr.sigma1))
+        put("lag", one(tr.current_lag))
+        put("enc", one(tr.encoder))
+        put("scale", one(tr.scale))
+        put("lead", one(tr.lead))
+        put("xc", one(float(np.mean(refs))))
+        e = eff.get("asymmetric_friction", {})
+        put("beta", one(e.get("beta", 0.0)))
+        put("casym", one(e.get("coulomb_asym", 0.0)))
+        e = eff.get("position_friction", {})
+        put("gamma", one(e.get("gamma", 0.0)))
+        put("width", one(e.get("width_m", 1.0)))
+        put("mu", one(eff.get("load_friction", {}).get("mu", 0.0)))
+        e = eff.get("lead_error", {})
+        for k_ in ("amplitude_m", "phase", "h2", "phase2"):
+            put("le_" + k_, one(e.get(k_, 0.0)))
+        e = eff.get("cogging", {})
+        for k_ in ("amplitude_N", "order", "phase", "h2"):
+            put("cg_" + k_, one(e.get(k_, 0.0)))
+        e = eff.get("bearing_defect", {})
+        for k_ in ("amplitude_N", "order", "phase"):
+            put("bd_" + k_, one(e.get(k_, 0.0)))
+        e = eff.get("time_ripple", {})
+        for k_ in ("amplitude_N", "freq_Hz", "phase"):
+            put("tr_" + k_, one(e.get(k_, 0.0)))
+        put("delay", one(eff.get("control_delay", {}).get("delay_samples", 0)))
+    return {k: np.array(v) for k, v in cols.items()}
+
+
+def simulate_batch(jobs):
+    """Closed-loop simulation of many runs of many truths at once (one column per run).
+
+    Parameters
+    ----------
+    jobs : sequence of tuple
+        ``(truth, refs, pulses, drift, noise, with_effects)``: a :class:`Truth`, ``(runs, n)`` references [m],
+        known external forces [N], the drift multipliers and unknown force noise of :func:`noise_draws`,
+        and whether the truth's withheld effects are on (False: the effect-free twin). All jobs have the
+        same ``n``.
+
+    Returns
+    -------
+    list of dict
+        Per job: ``x_motor``, ``x_table`` (quantised), ``u`` (controller output: V for the P-P cascade,
+        N for the PI cascade), ``(runs, n)`` each.
+    """
+    p = _columns(jobs)
+    refs = np.concatenate([j[1] for j in jobs])
+    pulses = np.concatenate([j[2] for j in jobs])
+    noise = np.concatenate([j[4] for j in jobs])
+    S, n = refs.shape
+    v_ref = np.gradient(refs, DT, axis=1)
+    h = DT / SUBSTEPS
+    sub = SUBSTEPS // VEL_DIV
+    tv = DT / VEL_DIV
+    lagc = 1.0 - np.exp(-h / p["lag"])
+    pp = p["pp"] > 0.5
+    mp_safe = np.where(p["mp"] > 0, p["mp"], 1.0)
+    has_le = bool(np.any(p["le_amplitude_m"] != 0))
+    w_lead = 2 * np.pi / p["lead"]
+    v_eps = 1e-4
+
+    def lead_err(x):
+        th = w_lead * x
+        return p["le_amplitude_m"] * (np.sin(th + p["le_phase"]) + p["le_h2"] * np.sin(2 * th + p["le_phase2"]))
+
+    def lead_err_slope(x):
+        th = w_lead * x
+        return p["le_amplitude_m"] * w_lead * (np.cos(th + p["le_phase"])
+                                               + 2 * p["le_h2"] * np.cos(2 * th + p["le_phase2"]))
+
+    x1 = refs[:, 0].copy()
+    v1 = np.zeros(S)
+    x2 = x1 + (lead_err(x1) if has_le else 0.0)
+    v2 = np.zeros(S)
+    xp, vp = x2.copy(), np.zeros(S)
+    z = np.zeros(S)
+    f_app = np.zeros(S)
+    enc = lambda x: np.round(x / p["enc"]) * p["enc"]  # noqa: E731
+    xm, xt, u_rec = np.empty((S, n)), np.empty((S, n)), np.empty((S, n))
+    q_prev = enc(x1)
+    q_prev_sample = q_prev.copy()
+    qf_prev = q_prev.copy()
+    integ = np.zeros(S)
+    v_cmd = np.zeros(S)
+    out = np.zeros(S)
+    dmax = int(p["delay"].max()) * VEL_DIV
+    ring = np.zeros((dmax + 1, S))
+    dticks = (p["delay"] * VEL_DIV).astype(int)
+    cols = np.arange(S)
+    tick = 0
+    for kk in range(n):
+        for j in range(VEL_DIV):
+            q = enc(x1)
+            if j == 0:
+                # P-P cascade (1 kHz): u = kp kv (r - q) - kv d/dt(0.5 q + 0.5 q_prev)
+                qf = 0.5 * q + 0.5 * q_prev_sample
+                out_pp = np.clip(p["kp"] * p["kv"] * (refs[:, kk] - q) - p["kv"] * (qf - qf_prev) / DT,
+                                 -p["sat"], p["sat"])
+                qf_prev, q_prev_sample = qf, q
+                v_cmd = p["kp"] * (refs[:, kk] - q) + p["ff"] * v_ref[:, kk]
+            # PI cascade speed loop (4 kHz), conditional integration
+            err = v_cmd - (q - q_prev) / tv
+            raw = p["kv"] * err + integ + p["ki"] * err * tv
+            integ = np.where(np.abs(raw) >= p["sat"], integ, integ + p["ki"] * err * tv)
+            out_pi = np.clip(p["kv"] * err + integ, -p["sat"], p["sat"])
+            out = np.where(pp, out_pp if j == 0 else out, out_pi) if j == 0 else np.where(pp, out, out_pi)
+            q_prev = q
+            if j == 0:
+                xm[:, kk] = q
+                xt[:, kk] = np.round(x2 / p["scale"]) * p["scale"]
+                u_rec[:, kk] = out
+            ring[tick % (dmax + 1)] = out
+            applied = ring[(tick - dticks) % (dmax + 1), cols] if dmax else out
+            tick += 1
+            cmd = p["gain"] * applied + pulses[:, kk] + noise[:, kk]
+            for i in range(sub):
+                t = (kk + (j * sub + i) / SUBSTEPS) * DT
+                f_app = f_app + (cmd - f_app) * lagc
+                if has_le:
+                    stretch = x1 + lead_err(x1) - x2
+                    dstretch = v1 * (1.0 + lead_err_slope(x1)) - v2
+                else:
+                    stretch, dstretch = x1 - x2, v1 - v2
+                fk = p["k"] * stretch + p["c"] * dstretch
+                fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
+                th = w_lead * x1
+                extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])
+                                                + p["cg_h2"] * np.sin(2 * p["cg_order"] * th))
+                         + p["bd_amplitude_N"] * np.sin(p["bd_order"] * th + p["bd_phase"])
+                         + p["tr_amplitude_N"] * np.sin(2 * np.pi * p["tr_freq_Hz"] * t + p["tr_phase"]))
+                a1 = (f_app - fm - fk - extra) / p["m1"]
+                sg = np.sign(v2)
+                fc = p["Fc_t"] * (1 + sg * p["casym"]) * (1 + p["gamma"] * np.tanh((x2 - p["xc"]) / p["width"]))
+                gz = (fc + p["mu"] * np.abs(fk)) * (1 + (p["Fs_ratio"] - 1) * np.exp(-(v2 / p["vs"]) ** 2))
+                # exact bristle update for v2 held over the substep
+                rate = p["sigma0"] * np.abs(v2) / np.maximum(gz, 1e-9)
+                moving = rate > 0
+                zss = np.where(moving, v2 / np.where(moving, rate, 1.0), 0.0)
+                z_new = np.where(moving, zss + (z - zss) * np.exp(-rate * h), z)
+                dz = (z_new - z) / h
+                z = z_new
+                ft = p["sigma0"] * z + p["sigma1"] * dz + p["Fv_t"] * (1 + sg * p["beta"]) * v2
+                fp = p["kpl"] * (x2 - xp) + p["cpl"] * (v2 - vp)
+                a2 = (fk - ft - fp) / p["m2"]
+                v1 = v1 + h * a1
+                v2 = v2 + h * a2
+                x1 = x1 + h * v1
+                x2 = x2 + h * v2
+                vp = vp + h * fp / mp_safe
+                xp = xp + h * vp
+    res, i0 = [], 0
+    for j in jobs:
+        m = j[1].shape[0]
+        res.append({"x_motor": xm[i0: i0 + m], "x_table": xt[i0: i0 + m], "u": u_rec[i0: i0 + m]})
+        i0 += m
+    return res
+
+
 def simulate_truth(tr, refs, pulses, rng_noise, with_effects=True):
-    """Closed-loop simulation of all runs of a truth at once (columns = runs).
+    """Closed-loop simulation of all runs of one truth (columns = runs); see :func:`simulate_batch`.
 
     Parameters
     ----------
@@ -262,160 +471,19 @@ def simulate_truth(tr, refs, pulses, rng_noise, with_effects=True):
     refs, pulses : numpy.ndarray
         ``(runs, samples)`` reference [m] and known external force [N].
     rng_noise : numpy.random.Generator
-        Draws the noise and the drift (pass equal generators to get the same noise with and without the
-        effects).
+        Draws the drift and the noise (:func:`noise_draws`).
     with_effects : bool
         Include ``tr.effects`` (False: the effect-free twin).
 
     Returns
     -------
     dict
-        ``x_motor``, ``x_table`` (quantised), ``u`` (controller output: V for P-P, N for the PI cascade),
-        ``drift`` (friction multiplier per run), all ``(runs, samples)`` except ``drift``.
+        ``x_motor``, ``x_table``, ``u`` and ``drift``.
     """
-    S, n = refs.shape
-    eff = tr.effects if with_effects else {}
-    g = _controller_gains(tr)
-    gain = GTAU if tr.kind == "p_p_cascade" else 1.0
-    drift = 1.0 + np.cumsum(rng_noise.normal(0.0, tr.drift_sd, S))
-    white = rng_noise.normal(0.0, tr.noise_N, (S, n))
-    lp = rng_noise.normal(0.0, 1.0, (S, n))
-    b, a = signal.butter(2, 5.0 / (0.5 / DT))
-    lp = signal.lfilter(b, a, lp, axis=1)
-    lp = tr.lowpass_noise_N * lp / max(float(np.std(lp)), 1e-12)
-    noise = white + lp
-    m1, m2, k, c = tr.m1, tr.m2, tr.k_axial, tr.c_axial
-    Fc_m = tr.motor_friction_share * tr.Fc * drift
-    Fv_m = tr.motor_friction_share * tr.Fv * drift
-    Fc_t = (1 - tr.motor_friction_share) * tr.Fc * drift
-    Fv_t = (1 - tr.motor_friction_share) * tr.Fv * drift
-    Fs_ratio, vs = tr.Fs_ratio, tr.vs
-    if "stribeck" in eff:
-        Fs_ratio, vs = eff["stribeck"]["Fs_ratio"], eff["stribeck"]["vs_m_s"]
-    xc = float(np.mean(refs))
-    v_eps = 1e-4
-    sm = eff.get("structural_mode")
-    if sm:
-        mp = sm["mass_share"] * m2
-        m2 = m2 - mp
-        kp_ = mp * (2 * math.pi * sm["fn_Hz"]) ** 2
-        cp_ = 2 * sm["zeta"] * math.sqrt(kp_ * mp)
-    delay = eff.get("control_delay", {}).get("delay_samples", 0)
-    h = DT / SUBSTEPS
-    lag = 1.0 - math.exp(-h / tr.current_lag)
-
-    def lead_err(x):
-        if "lead_error" not in eff:
-            return 0.0
-        e = eff["lead_error"]
-        th = 2 * np.pi * x / tr.lead
-        return e["amplitude_m"] * (np.sin(th + e["phase"]) + e["h2"] * np.sin(2 * th + e["phase2"]))
-
-    def table_g(x, v, f_load):
-        fc = Fc_t * np.ones(S)
-        if "asymmetric_friction" in eff:
-            fc = fc * (1 + np.sign(v) * eff["asymmetric_friction"]["coulomb_asym"])
-        if "position_friction" in eff:
-            e = eff["position_friction"]
-            fc = fc * (1 + e["gamma"] * np.tanh((x - xc) / e["width_m"]))
-        if "load_friction" in eff:
-            fc = fc + eff["load_friction"]["mu"] * np.abs(f_load)
-        return fc * (1 + (Fs_ratio - 1) * np.exp(-(v / vs) ** 2))
-
-    def fv_table(v):
-        if "asymmetric_friction" in eff:
-            return Fv_t * (1 + np.sign(v) * eff["asymmetric_friction"]["beta"])
-        return Fv_t
-
-    def motor_extra(x, t):
-        f = 0.0
-        if "cogging" in eff:
-            e = eff["cogging"]
-            th = 2 * np.pi * e["order"] * x / tr.lead
-            f = f + e["amplitude_N"] * (np.sin(th + e["phase"]) + e["h2"] * np.sin(2 * th))
-        if "bearing_defect" in eff:
-            e = eff["bearing_defect"]
-            f = f + e["amplitude_N"] * np.sin(2 * np.pi * e["order"] * x / tr.lead + e["phase"])
-        if "time_ripple" in eff:
-            e = eff["time_ripple"]
-            f = f + e["amplitude_N"] * np.sin(2 * np.pi * e["freq_Hz"] * t + e["phase"])
-        return f
-
-    # state: motor-side x1, v1; table x2, v2; payload xp, vp; bristles z; applied force
-    x1 = refs[:, 0].copy()
-    v1 = np.zeros(S)
-    x2 = x1 + lead_err(x1)
-    v2 = np.zeros(S)
-    xp, vp = x2.copy(), np.zeros(S)
-    z = np.zeros(S)
-    f_app = np.zeros(S)
-    enc = lambda x: np.round(x / tr.encoder) * tr.encoder  # noqa: E731
-    xm = np.empty((S, n))
-    xt = np.empty((S, n))
-    u_rec = np.empty((S, n))
-    # controller memory
-    q_prev = enc(x1)
-    qf_prev = q_prev.copy()
-    integ = np.zeros(S)
-    v_cmd = np.zeros(S)
-    queue = [np.zeros(S) for _ in range(delay * (1 if tr.kind == "p_p_cascade" else VEL_DIV))]
-    v_ref = np.gradient(refs, DT, axis=1)
-    cmd = np.zeros(S)
-    ticks = 1 if tr.kind == "p_p_cascade" else VEL_DIV
-    sub = SUBSTEPS // ticks
-    tv = DT / ticks
-    for kk in range(n):
-        for j in range(ticks):
-            q = enc(x1)
-            if tr.kind == "p_p_cascade":
-                qf = 0.5 * q + 0.5 * q_prev
-                dq = (qf - qf_prev) / DT
-                out = np.clip(g["kp"] * g["kv"] * (refs[:, kk] - q) - g["kv"] * dq, -g["sat"], g["sat"])
-                qf_prev = qf
-            else:
-                if j == 0:
-                    v_cmd = g["kp"] * (refs[:, kk] - q) + g["ff"] * v_ref[:, kk]
-                vm = (q - q_prev) / tv
-                err = v_cmd - vm
-                raw = g["kv"] * err + integ + g["ki"] * err * tv
-                sat = np.abs(raw) >= g["sat"]
-                integ = np.where(sat, integ, integ + g["ki"] * err * tv)
-                out = np.clip(g["kv"] * err + integ, -g["sat"], g["sat"])
-            q_prev = q
-            if j == 0:
-                xm[:, kk] = q
-                xt[:, kk] = np.round(x2 / tr.scale) * tr.scale
-                u_rec[:, kk] = out
-            queue.append(out)
-            applied = queue.pop(0)
-            cmd = gain * applied + pulses[:, kk] + noise[:, kk]
-            for i in range(sub):
-                t = (kk + (j * sub + i) / SUBSTEPS) * DT
-                f_app = f_app + (cmd - f_app) * lag
-                stretch = x1 + lead_err(x1) - x2
-                dstretch = v1 * (1 + (lead_err(x1 + 1e-7) - lead_err(x1)) / 1e-7) - v2 if "lead_error" in eff \
-                    else v1 - v2
-                fk = k * stretch + c * dstretch
-                fm = Fc_m * np.tanh(v1 / v_eps) + Fv_m * v1 + tr.offset
-                a1 = (f_app - fm - fk - motor_extra(x1, t)) / m1
-                gz = table_g(x2, v2, fk)
-                # exact bristle update for v2 held over the substep
-                rate = tr.sigma0 * np.abs(v2) / np.maximum(gz, 1e-9)
-                zss = np.where(rate > 0, v2 / np.maximum(rate, 1e-300), 0.0)
-                z_new = np.where(rate > 0, zss + (z - zss) * np.exp(-rate * h), z + v2 * h)
-                dz = (z_new - z) / h
-                z = z_new
-                ft = tr.sigma0 * z + tr.sigma1 * dz + fv_table(v2) * v2
-                fp = kp_ * (x2 - xp) + cp_ * (v2 - vp) if sm else 0.0
-                a2 = (fk - ft - fp) / m2
-                v1 = v1 + h * a1
-                v2 = v2 + h * a2
-                x1 = x1 + h * v1
-                x2 = x2 + h * v2
-                if sm:
-                    vp = vp + h * fp / mp
-                    xp = xp + h * vp
-    return {"x_motor": xm, "x_table": xt, "u": u_rec, "drift": drift}
+    drift, noise = noise_draws(tr, refs.shape[0], refs.shape[1], rng_noise)
+    out = simulate_batch([(tr, refs, pulses, drift, noise, with_effects)])[0]
+    out["drift"] = drift
+    return out
 
 
 def controller_meta(tr):
