@@ -39,15 +39,17 @@ def main():
     ap.add_argument("--n-ool", type=int, default=6, help="datasets per out-of-library effect and controller kind")
     ap.add_argument("--seeds", choices=("heldout", "dev"), default="heldout")
     ap.add_argument("--kinds", nargs="+", default=list(CONTROLLER_KINDS), choices=CONTROLLER_KINDS)
+    ap.add_argument("--tries", type=float, default=4.0, help="candidates per library effect / --n-per-effect")
     ap.add_argument("--json", help="write scores and rows to this file")
     args = ap.parse_args()
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     t0 = time.perf_counter()
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
-                        n_ool=args.n_ool, progress=True)
+                        n_ool=args.n_ool, progress=True, tries=args.tries)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, kinds {args.kinds}, "
-          f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}")
+          f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "
+          f"effects short of {args.n_per_effect} datasets with SNR >= 3: {res['short'] or 'none'}")
     print_scores(s)
     for k, b in s["per_kind"].items():
         print(f"controller {k}:")

@@ -252,66 +252,77 @@ def evaluate(ds, replay=True):
     return row
 
 
-def benchmark_specs(seed, kinds=T.CONTROLLER_KINDS, n_per_effect=10, tries=2.5, n_null=10, n_ool=6):
-    """The dataset list of a benchmark: ``(seed, withheld, kind, axis)``.
+def benchmark_specs(seed, kinds=T.CONTROLLER_KINDS, n_per_effect=10, tries=4.0, n_null=10, n_ool=6):
+    """The candidate dataset list of a benchmark: ``(seed, withheld, kind, axis)``, round-robin over effects.
 
-    Per controller kind: ``ceil(tries * n_per_effect)`` candidates per library effect (the first
+    Per controller kind: up to ``ceil(tries * n_per_effect)`` candidates per library effect (the first
     ``n_per_effect`` with SNR >= 3 are diagnosed, see :func:`run_benchmark`), ``n_ool`` per out-of-library
-    effect and ``n_null`` nulls; axes alternate. Seeds are ``seed + 10000 * kind + 1000 * slot + j``.
+    effect and ``n_null`` nulls; axes alternate. Seeds are ``seed + 100000 * kind + 1000 * slot + j``.
     """
-    specs = []
     slots = [(e,) for e in T.LIBRARY_EFFECTS] + [(e,) for e in T.OUT_OF_LIBRARY] + [()]
-    for ki, kind in enumerate(kinds):
-        for si, w in enumerate(slots):
-            if not w:
-                count = n_null
-            elif w[0] in T.OUT_OF_LIBRARY:
-                count = n_ool
-            else:
-                count = int(math.ceil(tries * n_per_effect))
-            for j in range(count):
-                specs.append((seed + 10000 * T.CONTROLLER_KINDS.index(kind) + 1000 * si + j, w, kind,
-                              T.AXES[j % len(T.AXES)]))
+    counts = [n_null if not w else (n_ool if w[0] in T.OUT_OF_LIBRARY else int(math.ceil(tries * n_per_effect)))
+              for w in slots]
+    specs = []
+    for j in range(max(counts + [0])):
+        for kind in kinds:
+            for si, (w, count) in enumerate(zip(slots, counts)):
+                if j < count:
+                    specs.append((seed + 100000 * T.CONTROLLER_KINDS.index(kind) + 1000 * si + j, w, kind,
+                                  T.AXES[j % len(T.AXES)]))
     return specs
 
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=T.CONTROLLER_KINDS, n_per_effect=10, n_null=10, n_ool=6,
-                  replay=True, progress=False, tries=2.5):
-    """Generate the datasets of :func:`benchmark_specs`, diagnose each blind, score.
+                  replay=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24):
+    """Generate the datasets of :func:`benchmark_specs` (in batches), diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
-    diagnosed; the others are only counted (``low_snr_skipped``). Nulls and out-of-library datasets are
-    all diagnosed.
+    diagnosed; the others are only counted (``low_snr_skipped``), and no further candidate of an effect
+    is generated once it has enough. Nulls and out-of-library datasets are all diagnosed.
 
     Returns
     -------
     dict
-        ``scores`` (:func:`score_rows`), ``datasets`` (rows), ``low_snr_skipped`` (per effect).
+        ``scores`` (:func:`score_rows`), ``datasets`` (rows), ``low_snr_skipped`` (per effect) and
+        ``short`` (effects that did not reach ``n_per_effect`` datasets with SNR >= 3).
     """
     specs = benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool)
-    if progress:
-        print(f"[gap-benchmark] generating {len(specs)} candidate datasets", file=sys.stderr, flush=True)
-    datasets = generate_datasets(specs)
     rows, kept, skipped = [], {}, {}
-    todo = []
-    for ds in datasets:
-        key = (ds.kind, ds.withheld)
-        if ds.category == "library":
-            if kept.get(key, 0) >= n_per_effect:
+    pos = 0
+    done = 0
+    while pos < len(specs):
+        part = []
+        while pos < len(specs) and len(part) < chunk:
+            sd, w, k, a = specs[pos]
+            pos += 1
+            if w and w[0] in T.LIBRARY_EFFECTS and kept.get((k, w), 0) >= n_per_effect:
                 continue
-            if ds.snr < 3:
-                skipped[f"{ds.kind}/{ds.withheld[0]}"] = skipped.get(f"{ds.kind}/{ds.withheld[0]}", 0) + 1
-                continue
-        kept[key] = kept.get(key, 0) + 1
-        todo.append(ds)
-    for i, ds in enumerate(todo):
-        row = evaluate(ds, replay=replay)
-        rows.append(row)
+            part.append(specs[pos - 1])
+        if not part:
+            break
         if progress:
-            print(f"[gap-benchmark] {i + 1}/{len(todo)} seed {ds.seed} {ds.kind}/{ds.axis}: withheld "
-                  f"{list(ds.withheld) or 'none'} (SNR {ds.snr:.1f}) -> claimed {row['claimed'] or 'nothing'}"
-                  + ("" if row["replay_available"] else " (replay unavailable)"), file=sys.stderr, flush=True)
-    return {"scores": score_rows(rows), "datasets": rows, "low_snr_skipped": skipped}
+            print(f"[gap-benchmark] generating {len(part)} datasets (candidate {pos}/{len(specs)})",
+                  file=sys.stderr, flush=True)
+        for ds in generate_datasets(part, n_samples=n_samples, chunk=chunk):
+            key = (ds.kind, ds.withheld)
+            if ds.category == "library":
+                if kept.get(key, 0) >= n_per_effect:
+                    continue
+                if ds.snr < 3:
+                    name = f"{ds.kind}/{ds.withheld[0]}"
+                    skipped[name] = skipped.get(name, 0) + 1
+                    continue
+            kept[key] = kept.get(key, 0) + 1
+            row = evaluate(ds, replay=replay)
+            rows.append(row)
+            done += 1
+            if progress:
+                print(f"[gap-benchmark] {done} seed {ds.seed} {ds.kind}/{ds.axis}: withheld "
+                      f"{list(ds.withheld) or 'none'} (SNR {ds.snr:.1f}) -> claimed {row['claimed'] or 'nothing'}"
+                      + ("" if row["replay_available"] else " (replay unavailable)"), file=sys.stderr, flush=True)
+    short = {f"{k}/{e}": kept.get((k, (e,)), 0) for k in kinds for e in T.LIBRARY_EFFECTS
+             if kept.get((k, (e,)), 0) < n_per_effect}
+    return {"scores": score_rows(rows), "datasets": rows, "low_snr_skipped": skipped, "short": short}
 
 
 def score_rows(rows):

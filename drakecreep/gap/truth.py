@@ -178,13 +178,13 @@ def draw_truth(rng, kind, axis, withheld=()):
     sgn = lambda: float(rng.choice([-1.0, 1.0]))  # noqa: E731
     for h in withheld:
         if h == "stribeck":
-            p[h] = {"Fs_ratio": rng.uniform(1.4, 2.0), "vs_m_s": rng.uniform(0.003, 0.012)}
+            p[h] = {"Fs_ratio": rng.uniform(1.6, 2.5), "vs_m_s": rng.uniform(0.003, 0.012)}
         elif h == "asymmetric_friction":
-            p[h] = {"beta": rng.uniform(0.15, 0.4) * sgn(), "coulomb_asym": rng.uniform(-0.05, 0.05)}
+            p[h] = {"beta": rng.uniform(0.25, 0.5) * sgn(), "coulomb_asym": rng.uniform(-0.05, 0.05)}
         elif h == "position_friction":
             p[h] = {"gamma": rng.uniform(0.25, 0.5) * sgn(), "width_m": rng.uniform(0.02, 0.06)}
         elif h == "lead_error":
-            p[h] = {"amplitude_m": rng.uniform(2e-6, 8e-6), "phase": rng.uniform(0, 2 * np.pi),
+            p[h] = {"amplitude_m": rng.uniform(4e-6, 12e-6), "phase": rng.uniform(0, 2 * np.pi),
                     "h2": rng.uniform(0.1, 0.4), "phase2": rng.uniform(0, 2 * np.pi)}
         elif h == "cogging":
             p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": int(rng.integers(1, 7)),
@@ -195,7 +195,7 @@ def draw_truth(rng, kind, axis, withheld=()):
         elif h == "control_delay":
             p[h] = {"delay_samples": int(rng.integers(1, 4))}
         elif h == "load_friction":
-            p[h] = {"mu": rng.uniform(0.1, 0.3)}
+            p[h] = {"mu": rng.uniform(0.2, 0.4)}
         elif h == "bearing_defect":
             o = int(rng.integers(2, 4)) + rng.uniform(0.3, 0.7)
             p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "order": o, "phase": rng.uniform(0, 2 * np.pi)}
@@ -235,15 +235,16 @@ def out_and_back(speed, x0, n=3000, dt=DT, leg=1.3, starts=(0.2, 1.7)):
 
 
 def draw_profiles(rng, n_runs, n=3000):
-    """References (out-and-back, speeds log-uniform 5-150 mm/s, shuffled) and known force pulses [N]."""
+    """References (out-and-back, speeds log-uniform 5-150 mm/s, shuffled) and known force pulses [N] (10-50 ms)."""
     speeds = np.exp(rng.uniform(np.log(0.005), np.log(0.15), n_runs))
     refs, pulses = [], []
+    r = n / 3000.0  # shorter runs: the same out-and-back, faster
     for v in speeds:
-        refs.append(out_and_back(v, rng.uniform(0.0, 0.12), n=n))
+        refs.append(out_and_back(v, rng.uniform(0.0, 0.12), n=n, leg=1.3 * r, starts=(0.2 * r, 1.7 * r)))
         p = np.zeros(n)
         for _ in range(3):
             k = int(rng.integers(100, n - 100))
-            p[k: k + 50] = rng.choice([-1, 1]) * rng.uniform(7.0, 20.0)
+            p[k: k + int(rng.integers(10, 51))] = rng.choice([-1, 1]) * rng.uniform(7.0, 20.0)
         pulses.append(p)
     return np.array(refs), np.array(pulses), speeds
 
