@@ -43,8 +43,8 @@ def test_limit_case_agrees_with_the_exact_rigid_replay():
 def test_batch_equals_single_and_the_twin_differs_only_by_the_effect():
     rng = np.random.default_rng(3)
     tr = T.draw_truth(rng, "drakecreep", "flexible", ("cogging",))
-    refs, pulses, _ = T.draw_profiles(rng, 2, n=600)
-    drift, noise = T.noise_draws(tr, 2, 600, rng)
+    refs, pulses, _ = T.draw_profiles(rng, 2, n=300)
+    drift, noise = T.noise_draws(tr, 2, 300, rng)
     both = T.simulate_batch([(tr, refs, pulses, drift, noise, True), (tr, refs, pulses, drift, noise, False)])
     single = T.simulate_batch([(tr, refs, pulses, drift, noise, True)])[0]
     np.testing.assert_array_equal(both[0]["x_motor"], single["x_motor"])
