@@ -8,14 +8,16 @@ Pipeline (:func:`diagnose`):
    (:func:`drakecreep.gap.effects.replay_with_effects`); speed, position and force residuals decomposed by
    time regime, by order against screw / motor angle and table position, by operating map
    (:mod:`drakecreep.gap.residuals`); whiteness of the inverse-dynamics residual.
-3. **Which**: every applicable effect of :data:`drakecreep.gap.effects.EFFECTS` is refitted with the nominal
-   friction (linear least squares on the inverse-dynamics residual, the nonlinear parameter on a grid)
-   on the training runs, then scored on the held-out runs with the parameters fixed. The score is a
-   penalized held-out log-likelihood ``n_eff ln(SSE_eff / SSE_nom) + k ln(n_train)`` with ``n_eff`` the
-   held-out sample count reduced for the residual's lag-1 autocorrelation; negative is evidence. An
-   effect is *claimed* when its score is below ``-claim_score`` and it removes at least ``min_gain`` of
-   the held-out residual energy. When the best claimed effect leaves a claimable remainder, a second
-   effect is added greedily (pairs).
+3. **Which**: every identifiable effect of :data:`drakecreep.gap.effects.EFFECTS` (one that adds a
+   regressor; quantization does not and is never ranked) is refitted with the nominal friction (linear
+   least squares on the inverse-dynamics residual, the nonlinear parameter on a grid) on the training
+   runs, then scored on the held-out runs with the parameters fixed and ranked by the penalized held-out
+   log-likelihood ``n_eff ln(SSE_eff / SSE_nom) + k ln(n_train)``. The best-ranked candidates are put to
+   the claim tests of :mod:`drakecreep.gap.claims` (held-out inverse-dynamics gain above a circular-shift
+   permutation null and better on most held-out runs, then a held-out closed-loop replay shrink above the
+   run-to-run variation of the nominal); the first that passes is claimed. Without a replay for the
+   runs' controller nothing is claimed and the candidates that pass the inverse-dynamics tests are
+   listed as provisional. What stays is located by :func:`locate` ("unexplained" and where).
 4. **Shrink**: RMS of the speed, position and force residuals of the closed-loop replay on the held-out
    runs, before and after adding the claimed effect(s), and of the inverse-dynamics force residual.
 """
@@ -64,6 +66,7 @@ __all__ = [
     "where",
     "diagnose",
     "score_fixed",
+    "locate",
 ]
 
 NOMINAL = ("M", "Fv", "Fc", "offset")
@@ -557,6 +560,13 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
             result["_gap_after"] = replay_gap(final, test_runs, ctx)
         result["shrink"] = {"before": gap0["rms"], "after": gaps.get(final.label, gap0["rms"]),
                             "model": final.label, "replays": gaps}
+        w_after = where(result["_gap_after"], ctx) if claimed else result["where"]
+        result["unexplained"] = locate(w_after, claimed=list(final.effects),
+                                       remaining_share=result["unexplained_share"])
+    else:
+        result["unexplained"] = {"verdict": "explained" if claimed else "unexplained", "where": None,
+                                 "sentence": "Where the gap lies needs the closed-loop replay "
+                                             f"({result['claims']['replay_error'] or 'not run'})."}
     for f in ranking:
         row = {"effect": f.label, "score": f.score, "gain": f.gain, "bic_delta": f.bic_delta,
                "physical": f.physical,
@@ -572,6 +582,56 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
                           "params": claimed[1].params()}
     result["summary"] = _summary(result)
     return result
+
+
+def locate(w, claimed=(), remaining_share=1.0):
+    """Where the gap no claimed effect explains lies, from a :func:`where` decomposition.
+
+    Parameters
+    ----------
+    w : dict
+        :func:`where` of the replay residual left by the claimed model (or the nominal).
+    claimed : sequence of str
+        Claimed effects (empty: the whole gap is unexplained).
+    remaining_share : float
+        Held-out inverse-dynamics residual energy left, relative to the nominal's.
+
+    Returns
+    -------
+    dict
+        ``verdict`` ("unexplained" or "partly explained by ..."), ``regime``, ``band``, ``order``,
+        ``operating_point``, ``dependent_on`` (inputs the force residual correlates with), ``sentence``.
+    """
+    reg = w["regimes"]["force"]
+    top_reg = max(reg, key=lambda r: reg[r]["energy_share"])
+    band = w["bands"]["force"]["top"] if "bands" in w else None
+    order = None
+    for axis in ("screw", "motor"):
+        o = w["orders"]["force"].get(axis, {})
+        if o.get("peak_order") is not None and o.get("peak_ratio", 0) >= 10 and not o.get("at_band_edge"):
+            order = {"axis": axis, "order": o["peak_order"], "share": o["peak_share"]}
+            break
+    op = None
+    for dim in ("speed", "position", "load"):
+        rows = w["map"]["force"][dim]
+        k = max(range(len(rows)), key=lambda i: rows[i]["energy_share"])
+        if op is None or rows[k]["energy_share"] > op["energy_share"]:
+            op = dict(rows[k], dimension=dim)
+    dep = [k for k, v in w.get("independence", {}).items() if not v["independent"]]
+    verdict = "unexplained" if not claimed else "partly explained by " + " + ".join(claimed)
+    unit = {"speed": (1e3, "mm/s"), "position": (1e3, "mm"), "load": (1.0, "N")}[op["dimension"]]
+    parts = [f"{100 * reg[top_reg]['energy_share']:.0f} % in {top_reg.replace('_', '-')} phases"]
+    if band is not None:
+        parts.append(f"{100 * band['share']:.0f} % between {band['lo_Hz']:g} and {band['hi_Hz']:.0f} Hz")
+    parts.append(f"{100 * op['energy_share']:.0f} % at {op['dimension']} {unit[0] * op['lo']:.3g}-"
+                 f"{unit[0] * op['hi']:.3g} {unit[1]}")
+    parts.append(f"a sharp {order['axis']} order {order['order']:.2f}" if order else "no sharp order")
+    if dep:
+        parts.append("correlated with " + " and ".join(d.replace("_", " ") for d in dep))
+    head = ("Unexplained gap" if not claimed else
+            f"Gap left after {' + '.join(claimed)} ({100 * remaining_share:.0f} % of the inverse-dynamics residual)")
+    return {"verdict": verdict, "regime": top_reg, "band": band, "order": order, "operating_point": op,
+            "dependent_on": dep, "sentence": f"{head} (replay force residual): " + "; ".join(parts) + "."}
 
 
 def _jsonable(x):
@@ -594,7 +654,13 @@ def _summary(res):
                      f"it removes {100 * (1 - res['unexplained_share']):.0f} % of the held-out inverse-dynamics "
                      f"residual energy, {100 * res['unexplained_share']:.0f} % stays unexplained.")
     else:
-        lines.append("Unexplained: no effect of the library passes the held-out evidence threshold.")
+        lines.append("Unexplained: no effect of the library passes the claim tests (held-out inverse dynamics "
+                     "against a permutation null, and the held-out closed-loop replay against run-to-run variation).")
+        prov = res.get("claims", {}).get("provisional", [])
+        if prov:
+            lines.append("Provisional (inverse dynamics only, the replay is unavailable): " + ", ".join(prov) + ".")
+    if res.get("unexplained", {}).get("sentence"):
+        lines.append(res["unexplained"]["sentence"])
     if "shrink" in res:
         b, a = res["shrink"]["before"], res["shrink"]["after"]
         if "speed_mm_s" in a:

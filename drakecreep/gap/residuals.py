@@ -313,7 +313,8 @@ def independence(residual, inputs, lags=25, level=0.99):
     """Cross-correlation of a residual with each input, with its confidence band (residual analysis).
 
     As system-identification tools do (e.g. ``resid``), the normalised cross-correlation
-    ``r_eu(k)`` for ``k = -lags .. lags`` is compared with a band that holds with probability ``level``
+    ``r_eu(k) = corr(e[t], u[t - k])`` for ``k = -lags .. lags`` (positive lags: the residual follows the
+    input) is compared with a band that holds with probability ``level``
     if residual and input are independent. The band uses Bartlett's variance of a cross-correlation of
     two independent autocorrelated series, ``var r_eu(k) = (1/N) sum_j rho_e(j) rho_u(j)``, so slowly
     varying residuals and inputs (filtered or closed-loop data) do not give false alarms.
@@ -326,7 +327,7 @@ def independence(residual, inputs, lags=25, level=0.99):
     lags : int
         Largest lag (samples).
     level : float
-        Coverage of the band (0.99 like ``resid``).
+        Family-wise coverage of the band over all lags (0.99; ``resid`` uses 0.99 pointwise).
 
     Returns
     -------
@@ -339,7 +340,9 @@ def independence(residual, inputs, lags=25, level=0.99):
     n = e.size
     if n < 4 * lags:
         raise InputError("residual", f"{n} samples", f"at least {4 * lags} samples for {lags} lags")
-    z = float(stats.norm.ppf(0.5 + level / 2))
+    # family-wise over the 2 lags + 1 values tested (Bonferroni): a pointwise band would flag about
+    # (2 lags + 1) (1 - level) lags of an independent pair by chance
+    z = float(stats.norm.ppf(1 - (1 - level) / (2 * (2 * lags + 1))))
     rho_e = _acf(e, n // 4)
     out = {}
     for name, u in inputs.items():
@@ -352,7 +355,8 @@ def independence(residual, inputs, lags=25, level=0.99):
         if den == 0:
             xc = np.zeros(ks.size)
         else:
-            xc = np.array([float(e[max(0, -k): n - max(0, k)] @ u[max(0, k): n - max(0, -k)]) / den for k in ks])
+            # xc[k] = corr(e[t], u[t - k]): a residual that follows the input by d samples peaks at k = +d
+            xc = np.array([float(e[max(0, k): n - max(0, -k)] @ u[max(0, -k): n - max(0, k)]) / den for k in ks])
         rho_u = _acf(u, n // 4) if den > 0 else np.zeros(rho_e.size)
         var = (1.0 + 2.0 * float(np.sum(rho_e[1:] * rho_u[1:]))) / n
         band = z * math.sqrt(max(var, 1.0 / n))
