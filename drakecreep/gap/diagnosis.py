@@ -649,7 +649,7 @@ def _jsonable(x):
 def _summary(res):
     lines = list(res.get("where", {}).get("sentences", []))
     if res["claimed"]:
-        top = res["ranking"][0]
+        top = next(r for r in res["ranking"] if r["effect"] == "+".join(res["claimed"]))
         lines.append(f"Best explanation: {' + '.join(res['claimed'])} (held-out score {top['score']:+.1f}); "
                      f"it removes {100 * (1 - res['unexplained_share']):.0f} % of the held-out inverse-dynamics "
                      f"residual energy, {100 * res['unexplained_share']:.0f} % stays unexplained.")
