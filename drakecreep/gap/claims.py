@@ -20,8 +20,8 @@ An effect is **claimed** only when all of these hold (:func:`decide`):
 When the replay is not available for a run's controller (today: ``kind: drakecreep``, until the Drake
 replay lands), no effect is claimed; candidates that pass 1-3 are reported as ``provisional``.
 
-The replay goes through :func:`drakecreep.gap.diagnosis.replay_gap` only (:data:`REPLAY`), so the Drake
-replay can be swapped in at one place.
+The replay goes through the function registered with :func:`use` only (today
+:func:`drakecreep.gap.diagnosis.replay_gap`), so the Drake replay can be swapped in at one place.
 """
 
 from __future__ import annotations
@@ -35,6 +35,8 @@ from drakecreep.errors import InputError
 
 __all__ = [
     "ALPHA",
+    "HOOKS",
+    "use",
     "N_PERMUTATIONS",
     "identifiable",
     "permutation_null",
@@ -51,14 +53,24 @@ ALPHA = 0.05
 N_PERMUTATIONS = 39
 
 
-def _replay(fit, runs, ctx):
-    from drakecreep.gap.diagnosis import replay_gap
+#: The model functions the claims call, registered by :func:`use` (``drakecreep.gap.diagnosis`` does it on
+#: import, so that this module does not import the diagnosis that imports it):
+#: ``design(effects, hypers, sig, ctx, nominal) -> (X, y, names)``, ``fit_effect`` as
+#: :func:`drakecreep.gap.diagnosis.fit_effect`, ``replay(fit, runs, ctx)`` as
+#: :func:`drakecreep.gap.diagnosis.replay_gap` (the Drake replay replaces this one).
+HOOKS = {}
 
-    return replay_gap(fit, runs, ctx)
+
+def use(design, fit_effect, replay):
+    """Register the design-matrix, fitting and closed-loop replay functions the claim tests call."""
+    HOOKS.update(design=design, fit_effect=fit_effect, replay=replay)
 
 
-#: The closed-loop replay used by the claims: ``REPLAY(fit, runs, ctx) -> replay_gap`` dict.
-REPLAY = _replay
+def _hook(name):
+    if name not in HOOKS:
+        raise RuntimeError("drakecreep.gap.claims needs its model functions: import drakecreep.gap.diagnosis "
+                           "(it calls claims.use on import)")
+    return HOOKS[name]
 
 
 def identifiable(name, sig, ctx, nominal):
@@ -73,9 +85,9 @@ def identifiable(name, sig, ctx, nominal):
 
 def _design_all(name, sig, ctx, nominal):
     """``{hyper: (X, y)}`` of the nominal + effect design on ``sig`` for every grid value."""
-    from drakecreep.gap.diagnosis import _design
     from drakecreep.gap.effects import get_effect
 
+    _design = _hook("design")
     out = {}
     for h in get_effect(name).grid(ctx):
         X, y, _ = _design((name,), (h,), sig, ctx, nominal)
@@ -201,7 +213,7 @@ def replay_energy(fit, runs, ctx):
     drakecreep.errors.InputError
         When the replay cannot run these runs (e.g. their controller kind).
     """
-    gap = REPLAY(fit, runs, ctx)
+    gap = _hook("replay")(fit, runs, ctx)
     out = []
     for p in gap["per_run"]:
         f = p["force"] - np.mean(p["force"])
@@ -232,8 +244,7 @@ def replay_null(train, test, test_runs, ctx, e_nom):
     dict
         ``ratios`` (pooled energy of each refit / of the full nominal) and ``threshold``.
     """
-    from drakecreep.gap.diagnosis import fit_effect
-
+    fit_effect = _hook("fit_effect")
     ratios = []
     for r in np.unique(train.run_index):
         sub = train.select(train.run_index != r)

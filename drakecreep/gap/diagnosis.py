@@ -338,6 +338,9 @@ def replay_gap(fit, runs, ctx):
     return {"rms": rms, "per_run": per}
 
 
+claims_mod.use(design=_design, fit_effect=fit_effect, replay=replay_gap)
+
+
 def where(gap, ctx, idim_residual=None, idim_input=None):
     """Decompose replay residuals (from :func:`replay_gap`) by regime, order and operating map.
 
@@ -419,9 +422,8 @@ def _sentences(w):
                      f"{top.replace('_', '-')} phases ({100 * reg[top]['time_share']:.0f} % of the time){order_txt}.")
     if "bands" in w:
         b = w["bands"]["force"]["top"]
-        hi = "Nyquist" if b["hi_Hz"] >= 0.5 / 1e-3 - 1 else f"{b['hi_Hz']:g} Hz"
-        lines.append(f"{100 * b['share']:.0f} % of the force residual energy lies between {b['lo_Hz']:g} Hz and "
-                     f"{hi} (peak at {w['bands']['force']['peak_hz']:.3g} Hz).")
+        lines.append(f"{100 * b['share']:.0f} % of the force residual energy lies between {b['lo_Hz']:g} and "
+                     f"{b['hi_Hz']:g} Hz (peak at {w['bands']['force']['peak_hz']:.3g} Hz).")
     if "motor_table" in w:
         m = w["motor_table"]
         lines.append(f"Position gap: {1e6 * m['motor_rms_m']:.3g} um RMS at the motor, {1e6 * m['transmission_rms_m']:.3g} "
@@ -628,10 +630,11 @@ def locate(w, claimed=(), remaining_share=1.0):
     parts.append(f"a sharp {order['axis']} order {order['order']:.2f}" if order else "no sharp order")
     if dep:
         parts.append("correlated with " + " and ".join(d.replace("_", " ") for d in dep))
-    head = ("Unexplained gap" if not claimed else
-            f"Gap left after {' + '.join(claimed)} ({100 * remaining_share:.0f} % of the inverse-dynamics residual)")
+    head = ("Unexplained gap, in the replay force residual" if not claimed else
+            f"Gap left after {' + '.join(claimed)} ({100 * remaining_share:.0f} % of the inverse-dynamics "
+            "residual remains), in the replay force residual")
     return {"verdict": verdict, "regime": top_reg, "band": band, "order": order, "operating_point": op,
-            "dependent_on": dep, "sentence": f"{head} (replay force residual): " + "; ".join(parts) + "."}
+            "dependent_on": dep, "sentence": f"{head}: " + "; ".join(parts) + "."}
 
 
 def _jsonable(x):
