@@ -27,7 +27,7 @@ COMMANDS = [
     "hertz",
     "modal",
     "margins", "tune", "report",
-    "sweep",
+    "sweep", "uncertainty",
     "emps",
     "reproduce_paper", "compensate",
     "diagnose", "gap_benchmark",
