@@ -436,7 +436,7 @@ def save_params(params, path):
     Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
 
 
-PRESETS = ("paper", "paper_calibrated", "rigid_axis")
+PRESETS = ("paper", "paper_calibrated", "rigid_axis", "paper_catalogue")
 
 
 def preset_text(name="paper"):

@@ -100,7 +100,11 @@ class Distribution:
 
 @dataclass(frozen=True)
 class UncertaintySpec:
-    """The distributions of a preset's sampled assumptions and the assumptions held fixed."""
+    """The distributions of a preset's sampled assumptions and the assumptions held fixed.
+
+    ``preset`` is the preset the spec was read for (a spec file may name several presets that share
+    their assumptions, e.g. ``paper`` and ``paper_catalogue``).
+    """
 
     preset: str
     distributions: tuple
@@ -126,17 +130,22 @@ def load_uncertainty(path):
 
 
 def uncertainty_spec(name="paper"):
-    """The packaged uncertainty spec of preset ``name`` (``presets/<name>_uncertainty.yaml``)."""
-    from drakecreep.params import PRESETS
+    """The packaged uncertainty spec of preset ``name``: the ``presets/*_uncertainty.yaml`` whose ``preset`` names it."""
+    from drakecreep.params import PRESETS, _yaml_load
 
-    file = resources.files("drakecreep").joinpath("presets", f"{name}_uncertainty.yaml")
-    if name not in PRESETS or not file.is_file():
-        have = [p for p in PRESETS if resources.files("drakecreep").joinpath("presets", f"{p}_uncertainty.yaml").is_file()]
-        raise InputError("preset", name, "a preset with an uncertainty spec: " + ", ".join(have))
-    return _spec_from_text(file.read_text(), f"presets/{name}_uncertainty.yaml")
+    folder = resources.files("drakecreep").joinpath("presets")
+    files = sorted((f for f in folder.iterdir() if f.name.endswith("_uncertainty.yaml")), key=lambda f: f.name)
+    have = []
+    for file in files:
+        names = _yaml_load(file.read_text()).get("preset", "paper")
+        names = [names] if isinstance(names, str) else list(names)
+        if name in PRESETS and name in names:
+            return _spec_from_text(file.read_text(), f"presets/{file.name}", name)
+        have += names
+    raise InputError("preset", name, "a preset with an uncertainty spec: " + ", ".join(have))
 
 
-def _spec_from_text(text, where):
+def _spec_from_text(text, where, name=None):
     from drakecreep.params import PRESETS, _yaml_load, preset
 
     try:
@@ -146,9 +155,11 @@ def _spec_from_text(text, where):
     if not isinstance(data, dict) or set(data) - {"preset", "sample", "fixed"} or "sample" not in data:
         raise InputError(where, data if not isinstance(data, dict) else sorted(data),
                          "a mapping with preset, sample and (optional) fixed")
-    name = data.get("preset", "paper")
-    if name not in PRESETS:
-        raise InputError("preset", name, "one of " + ", ".join(PRESETS))
+    names = data.get("preset", "paper")
+    names = [names] if isinstance(names, str) else names
+    if not isinstance(names, list) or not names or any(n not in PRESETS for n in names):
+        raise InputError("preset", names, "a preset name or a list of them: " + ", ".join(PRESETS))
+    name = name or names[0]
     sample = data["sample"]
     if not isinstance(sample, dict) or not sample:
         raise InputError("sample", sample, "a mapping path -> {dist, low, high, source}")
