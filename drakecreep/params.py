@@ -215,7 +215,7 @@ class LoadParams(_Params):
 class FrictionParams(_Params):
     """Friction law and the shape of its curve; the levels come from the load case."""
 
-    law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre"), doc="friction law")
+    law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre", "gms"), doc="friction law")
     static_ratio: float = _q(1.5, "-", 1.0, 10.0, doc="breakaway / Coulomb force Fs/Fc")
     stribeck_velocity: float = _q(1.0e-4, "m/s", 0.0, 1.0, lo_open=True, doc="vs")
     stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
@@ -228,6 +228,10 @@ class FrictionParams(_Params):
     nut_friction_on: str = _q(
         "table", "-", choices=("table", "screw"),
         doc="nut friction lumped on the table, or as a drag torque on the screw's rotation",
+    )
+    gms_elements: int = _q(4, "-", 1, 50, doc="GMS: number of Maxwell-slip elements (sum of stiffnesses = sigma0)")
+    gms_attraction: float = _q(
+        1.0e4, "N/s", 0.0, lo_open=True, doc="GMS: attraction C of a sliding element to its Stribeck share",
     )
 
 

@@ -27,9 +27,11 @@ __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
 def unsupported(params):
     """Why these plain-Python equations cannot run ``params``: ``(field, value, allowed)``, or None.
 
-    They cover the base drive: no disturbances, no friction compensation, nut friction on the table.
+    They cover the base drive (coulomb, stribeck or lugre friction): no disturbances, no friction compensation, nut friction on the table.
     """
     p = params
+    if p.friction.law not in ("coulomb", "stribeck", "lugre"):
+        return ("friction.law", p.friction.law, "coulomb, stribeck or lugre (the plain-Python equations)")
     if p.friction.nut_friction_on != "table":
         return ("friction.nut_friction_on", p.friction.nut_friction_on,
                 "table (the plain-Python equations lump the nut's friction on the table)")
