@@ -166,6 +166,20 @@ class ScrewParams(_Params):
     )
     bearing_stiffness: float = _q(9.38e6, "N/m", 0.0, lo_open=True, doc="bearing axial stiffness (Table 6)")
     bearing_damping: float = _q(60.61, "N s/m", 0.0, doc="bearing axial damping (Table 6)")
+    chain_damping: str = _q(
+        "viscous", "-", choices=("viscous", "loss_factor"),
+        doc="bearing/nut damping as identified (viscous), or as hysteretic loss factors evaluated at damping_frequency",
+    )
+    damping_frequency: float = _q(
+        73.5, "Hz", 0.0, 1e5, lo_open=True, doc="loss_factor: frequency of the mode the damping acts on (paper rig: 73.5)",
+    )
+    bearing_test_mass: float = _q(
+        2.31, "kg", 0.0, lo_open=True, doc="loss_factor: mass of the bearing's hammer test (identification frequency)",
+    )
+    seat_joint_stiffness: float = _q(
+        0.0, "N/m", 0.0, doc="fixed joints of the bearing seat in series with the bearing (0 = rigid, off)",
+    )
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the bearing seat joints")
 
     def _check(self):
         if self.root_diameter > self.nominal_diameter:
@@ -183,6 +197,10 @@ class NutParams(_Params):
     mass: float = _q(0.335, "kg", 0.0, doc="nut mass (Table 3), lumped into the table")
     preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
     load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
+    seat_joint_stiffness: float = _q(
+        0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
+    )
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the nut seat joints")
 
 
 @dataclass(frozen=True)
