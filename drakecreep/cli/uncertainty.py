@@ -39,7 +39,7 @@ def add_parser(subparsers):
         description=(
             "Sample the preset's [assumed] parameters over their plausible ranges (presets/<preset>_uncertainty.yaml, "
             "a distribution and source per parameter; a seeded Latin hypercube), simulate every rig at every feed and "
-            "load case with the sweep engine, and print per feed and load the share of rigs that creep, with a 95 %% "
+            "load case with the sweep engine, and print per feed and load the share of rigs that creep, with a 95 % "
             "interval, the spread of the speed fluctuation, and which parameters decide it (Spearman rank "
             "correlation with the creep verdict). Writes results.csv/.parquet (one row per rig, feed, load), "
             "summary.csv, sensitivity.csv and uncertainty.json to --out."
@@ -47,7 +47,7 @@ def add_parser(subparsers):
     )
     add_params_options(p)
     p.add_argument("--spec", metavar="FILE",
-                   help="uncertainty spec (YAML; default: the preset's presets/<preset>_uncertainty.yaml; needed with --params)")
+                   help="uncertainty spec (YAML; default: the packaged presets/*_uncertainty.yaml that names the preset; needed with --params)")
     p.add_argument("--samples", type=int, default=200, metavar="N", help="number of plausible rigs (default 200)")
     p.add_argument("--feeds", default=",".join(f"{f:g}" for f in DEFAULT_FEEDS_MM_S), metavar="MM_S,...",
                    help="feeds in mm/s (default " + ",".join(f"{f:g}" for f in DEFAULT_FEEDS_MM_S) + ")")
