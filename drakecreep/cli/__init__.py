@@ -30,7 +30,7 @@ COMMANDS = [
     "hertz",
     "modal", "modes",
     "margins", "tune", "report",
-    "sweep",
+    "sweep", "uncertainty",
     "emps",
     "reproduce_paper", "compensate",
     "diagnose", "gap_benchmark",
