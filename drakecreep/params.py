@@ -492,6 +492,21 @@ def get_value(params, path):
     return obj
 
 
+def field_unit(params, path):
+    """SI unit of the field at dotted ``path`` (``"N/m"``, ``"-"`` for dimensionless; ``""`` when unknown)."""
+    obj, unit = params, ""
+    for part in path.split("."):
+        name, index = _split_index(part)
+        fields = {f.name: f for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else {}
+        if name not in fields:
+            raise InputError(path, part, "a dotted path of existing parameter fields")
+        unit = fields[name].metadata.get("unit", "") or ""
+        obj = getattr(obj, name)
+        if index is not None:
+            obj = obj[index]
+    return unit
+
+
 def with_value(params, path, value):
     """A copy of ``params`` with the field at dotted ``path`` set to ``value`` (validated).
 
