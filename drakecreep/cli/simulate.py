@@ -34,6 +34,7 @@ def add_parser(subparsers):
 
 
 def run(args):
+    from drakecreep.files import check_output_dir
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
     from drakecreep.sim.simulation import simulate
@@ -50,6 +51,7 @@ def run(args):
             f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window",
         )
     scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
+    check_output_dir(args.out)  # before the run, not after it
     result = simulate(params, scenario, backend=args.backend)
     paths = result.save(args.out)
     if not args.no_plot:

@@ -28,33 +28,45 @@ def add_parser(subparsers):
     p.add_argument("--batch", type=int, default=200, metavar="N",
                    help="simulate up to N compatible cases together in one Drake system (default 200; "
                         "1 = one case at a time)")
+    p.add_argument("--max-cases", type=int, default=None, metavar="N",
+                   help="refuse sweeps of more cases than N (default 100000; raise it deliberately)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=run)
     return p
 
 
 def run(args):
+    from drakecreep.files import check_output_dir
     from drakecreep.report.plots import plot_stability_map
-    from drakecreep.sim.sweep import load_spec, run_sweep
+    from drakecreep.sim.sweep import MAX_CASES, connect_dask, load_spec, run_sweep
 
-    if args.scheduler and args.workers:
+    if args.scheduler is not None and args.workers:
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")
     if args.retries < 0:
         raise InputError("--retries", args.retries, "an integer >= 0")
     if args.batch is not None and args.batch < 1:
         raise InputError("--batch", args.batch, "an integer >= 1")
-    spec = load_spec(args.spec)
-    if args.scheduler:
+    if args.max_cases is not None and args.max_cases < 1:
+        raise InputError("--max-cases", args.max_cases, "an integer >= 1")
+    # everything is checked before the first case runs: the spec, the output folder, the scheduler
+    spec = load_spec(args.spec, max_cases=args.max_cases or MAX_CASES)
+    check_output_dir(args.out)
+    scheduler = connect_dask(args.scheduler) if args.scheduler is not None else None
+    if scheduler is not None:
         executor = "dask"
     elif args.workers == 1:
         executor = "serial"
     else:
         executor = "processes"
-    result = run_sweep(
-        spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
-        scheduler=args.scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
-        columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
-    )
+    try:
+        result = run_sweep(
+            spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
+            scheduler=scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
+            columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
+        )
+    finally:
+        if scheduler is not None:
+            scheduler.close()
     paths = {k: str(v) for k, v in result.paths.items()}
     if spec.plot:
         color = spec.plot.get("color", "fluctuation_rate_percent")

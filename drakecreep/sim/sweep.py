@@ -59,6 +59,8 @@ __all__ = [
     "SweepSpec",
     "load_spec",
     "metric_columns",
+    "connect_dask",
+    "MAX_CASES",
 ]
 
 #: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter (``drive``:
@@ -67,12 +69,24 @@ SCENARIO_FIELDS = ("feed", "load_case", "duration", "drive")
 EXECUTORS = ("serial", "processes", "dask")
 #: bump when the meaning of a cached row changes (simulation semantics, report keys)
 CACHE_VERSION = 1
+#: default largest number of cases of one sweep (``max_cases`` / ``--max-cases`` raise it): 100 000 cases
+#: of a few seconds each are days of computing, and the case list alone must fit in memory
+MAX_CASES = 100_000
+
+
+def _check_size(n, max_cases, what="the sweep"):
+    if n > max_cases:
+        digits = len(str(int(n))) if n < 10**4000 else 4000
+        raise InputError("axes", f"about 10^{digits - 1} cases" if n >= 10**6 else f"{n} cases",
+                         f"at most {max_cases} cases in {what} (raise the cap with --max-cases / max_cases)")
 
 
 # --------------------------------------------------------------------------- points
 
 def _axis_values(path, values):
-    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+    if not isinstance(path, str):
+        raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
+    if isinstance(values, dict) or isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise InputError(f"axes.{path}", values, "a list of values")
     values = list(values)
     if not values:
@@ -80,13 +94,16 @@ def _axis_values(path, values):
     return [v.item() if isinstance(v, np.generic) else v for v in values]
 
 
-def grid(axes):
+def grid(axes, max_cases=MAX_CASES):
     """Every combination of the axes' values (the first axis varies slowest).
 
     Parameters
     ----------
     axes : mapping
         ``path -> list of values``; paths are parameter paths or scenario fields.
+
+    max_cases : int
+        Refuse grids of more points (an :class:`InputError` before any is made).
 
     Returns
     -------
@@ -97,10 +114,11 @@ def grid(axes):
         return [{}]
     names = list(axes)
     lists = [_axis_values(n, axes[n]) for n in names]
+    _check_size(math.prod(len(v) for v in lists), max_cases, "the grid")
     return [dict(zip(names, combo)) for combo in itertools.product(*lists)]
 
 
-def random_sample(axes, n, seed=0):
+def random_sample(axes, n, seed=0, max_cases=MAX_CASES):
     """``n`` random points.
 
     Parameters
@@ -120,16 +138,22 @@ def random_sample(axes, n, seed=0):
     """
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InputError("n", n, "an integer >= 1")
+    _check_size(n, max_cases, "the sample")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
+        raise InputError("seed", seed, "an integer in [0, 2^63)")
     rng = np.random.default_rng(seed)
     columns = {}
     for path, spec in axes.items():
+        if not isinstance(path, str):
+            raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
         if isinstance(spec, dict):
             low, high = spec.get("low"), spec.get("high")
             scale = spec.get("scale", "linear")
             if set(spec) - {"low", "high", "scale"}:
                 raise InputError(f"axes.{path}", spec, "a mapping with keys low, high, scale")
-            if not all(isinstance(b, (int, float)) and not isinstance(b, bool) for b in (low, high)) or not low <= high:
-                raise InputError(f"axes.{path}", spec, "low <= high, both numbers")
+            if not all(isinstance(b, (int, float)) and not isinstance(b, bool) and abs(b) < 1e300 and math.isfinite(b)
+                       for b in (low, high)) or not low <= high:
+                raise InputError(f"axes.{path}", spec, "low <= high, both finite numbers")
             if scale == "log":
                 if low <= 0:
                     raise InputError(f"axes.{path}.low", low, "> 0 for a log scale")
@@ -397,11 +421,46 @@ def _run_processes(todo, metric, retries, done, workers):
     return retried
 
 
+#: seconds to wait for a Dask scheduler to answer, and for its first worker
+DASK_TIMEOUT = 10.0
+
+
+def connect_dask(scheduler, timeout=None):
+    """A ``distributed.Client`` of ``scheduler`` that has at least one worker, within ``timeout`` seconds each.
+
+    ``timeout`` defaults to :data:`DASK_TIMEOUT`.
+
+    Raises
+    ------
+    InputError
+        Naming ``--scheduler``: a malformed address, no scheduler answering, or no worker joining in time.
+    """
+    from distributed import Client
+
+    timeout = DASK_TIMEOUT if timeout is None else timeout
+    if not isinstance(scheduler, str) or not scheduler.strip():
+        raise InputError("--scheduler", scheduler, "a Dask scheduler address such as tcp://host:8786")
+    try:
+        client = Client(scheduler, timeout=f"{timeout}s")
+    except Exception as err:  # noqa: BLE001 - OSError, TimeoutError, a bad address, a non-Dask server's reply
+        reason = "malformed address" if isinstance(err, (ValueError, TypeError)) else type(err).__name__
+        raise InputError("--scheduler", scheduler,
+                         f"a reachable Dask scheduler address such as tcp://host:8786 (none answered within "
+                         f"{timeout:g} s: {reason})") from None
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except Exception:  # noqa: BLE001 - TimeoutError (no worker), a lost connection
+        client.close()
+        raise InputError("--scheduler", scheduler,
+                         f"a scheduler with at least one worker (none joined within {timeout:g} s)") from None
+    return client
+
+
 def _run_dask(todo, metric, retries, done, scheduler):
-    from distributed import Client, as_completed
+    from distributed import as_completed
 
     own = not hasattr(scheduler, "submit")
-    client = Client(scheduler) if own else scheduler
+    client = connect_dask(scheduler) if own else scheduler
     retried = 0
     try:
         attempts = {c.key: 0 for c in todo}
@@ -588,14 +647,18 @@ class SweepSpec:
     source: str = ""
 
 
-def _range(path, spec):
+def _range(path, spec, max_cases=MAX_CASES):
+    if not isinstance(path, str):
+        raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
     keys = set(spec)
     if keys <= {"start", "stop", "num", "scale"} and {"start", "stop", "num"} <= keys:
         start, stop, num, scale = spec["start"], spec["stop"], spec["num"], spec.get("scale", "linear")
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise InputError(f"axes.{path}.num", num, "an integer >= 1")
-        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop)):
-            raise InputError(f"axes.{path}", spec, "numbers start and stop")
+        _check_size(num, max_cases, f"axes.{path}")
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) < 1e300 and math.isfinite(v)
+                   for v in (start, stop)):
+            raise InputError(f"axes.{path}", spec, "finite numbers start and stop")
         if scale == "log":
             if start <= 0 or stop <= 0:
                 raise InputError(f"axes.{path}", spec, "start, stop > 0 for a log scale")
@@ -606,7 +669,7 @@ def _range(path, spec):
     raise InputError(f"axes.{path}", spec, "a list of values or {start, stop, num[, scale: linear|log]}")
 
 
-def load_spec(path):
+def load_spec(path, max_cases=MAX_CASES):
     """Read a sweep spec (YAML).
 
     ::
@@ -620,22 +683,18 @@ def load_spec(path):
         metrics: [fluctuation_rate_percent, creep]      # columns to keep (default: all)
         plot: {x: nut.axial_stiffness, y: feed, color: fluctuation_rate_percent}   # optional stability map
 
+    ``max_cases`` caps the number of cases (:data:`MAX_CASES` by default).
+
     Raises
     ------
     InputError
         Naming the key of the first problem.
     """
-    import yaml
-
-    from drakecreep.params import load_params, preset
+    from drakecreep.files import resolve_reference
+    from drakecreep.params import load_params, load_yaml_file, preset
 
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        raise InputError(str(path), "invalid YAML" + (f" (line {mark.line + 1})" if mark else ""),
-                         "a YAML sweep spec") from None
+    data = load_yaml_file(path, str(path), "a YAML sweep spec (a mapping with axes)")
     if not isinstance(data, dict):
         raise InputError(str(path), data, "a mapping with base, scenario, axes, sample, metrics, plot")
     known = {"base", "scenario", "axes", "sample", "metrics", "plot"}
@@ -647,14 +706,15 @@ def load_spec(path):
             or ("preset" in base_spec and "file" in base_spec):
         raise InputError("base", base_spec, "{preset: NAME} or {file: PATH}, optionally with set: {path: value}")
     if "file" in base_spec:
-        file = Path(base_spec["file"])
-        base = load_params(file if file.is_absolute() else path.parent / file)
+        base = load_params(resolve_reference(base_spec["file"], path, "base.file"))
     else:
         base = preset(base_spec.get("preset", "paper"))
     overrides = base_spec.get("set") or {}
     if not isinstance(overrides, dict):
         raise InputError("base.set", overrides, "a mapping path -> value")
     for key, value in overrides.items():
+        if not isinstance(key, str):
+            raise InputError("base.set", key, "parameter paths (text such as table.mass)")
         base = with_value(base, key, value)
     scenario = data.get("scenario") or {}
     if not isinstance(scenario, dict):
@@ -667,10 +727,10 @@ def load_spec(path):
             or set(sample) - {"mode", "n", "seed"}:
         raise InputError("sample", sample, "{mode: grid} or {mode: random, n: N, seed: S}")
     if sample.get("mode", "grid") == "grid":
-        expanded = {p: (_range(p, v) if isinstance(v, dict) else v) for p, v in axes.items()}
-        points = grid(expanded)
+        expanded = {p: (_range(p, v, max_cases) if isinstance(v, dict) else v) for p, v in axes.items()}
+        points = grid(expanded, max_cases)
     else:
-        points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0))
+        points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0), max_cases=max_cases)
     metrics = data.get("metrics")
     known_metrics = metric_columns()
     if metrics is not None:
@@ -682,6 +742,13 @@ def load_spec(path):
     plot = data.get("plot") or {}
     if not isinstance(plot, dict) or set(plot) - {"x", "y", "color"} or (plot and "x" not in plot):
         raise InputError("plot", plot, "{x: PATH[, y: PATH, color: METRIC]}")
+    # the map is drawn after the whole sweep: its axes are checked now, not after hours of computing
+    swept = list(axes) + [f for f in SCENARIO_FIELDS if f not in axes]
+    for key in ("x", "y"):
+        if key in plot and plot[key] not in swept:
+            raise InputError(f"plot.{key}", plot[key], "a swept path or scenario field: " + ", ".join(map(str, swept)))
+    if "color" in plot and plot["color"] not in known_metrics:
+        raise InputError("plot.color", plot["color"], "one of " + ", ".join(known_metrics))
     make_cases(base, points, scenario)  # validates every path and value before anything runs
     return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))
 
