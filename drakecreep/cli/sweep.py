@@ -58,23 +58,24 @@ def run(args):
         executor = "serial"
     else:
         executor = "processes"
+    extra = {}
+    if spec.plot:
+        color = spec.plot.get("color", "fluctuation_rate_percent")
+        if spec.metrics is None or color in spec.metrics:
+            def write_map(table, path):
+                plot_stability_map(table, spec.plot["x"], path, y=spec.plot.get("y", "feed"), color=color,
+                                   base=spec.base)
+            extra["map.png"] = write_map
     try:
         result = run_sweep(
             spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
             scheduler=scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
-            columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
+            columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None, extra_outputs=extra,
         )
     finally:
         if scheduler is not None:
             scheduler.close()
     paths = {k: str(v) for k, v in result.paths.items()}
-    if spec.plot:
-        color = spec.plot.get("color", "fluctuation_rate_percent")
-        if color in result.table.columns:
-            paths["map"] = str(plot_stability_map(
-                result.table, spec.plot["x"], os.path.join(args.out, "map.png"), y=spec.plot.get("y", "feed"),
-                color=color, base=spec.base,
-            ))
     print_json(dict(cases=len(result.table), computed=result.computed, cached=result.cached, failed=result.failed,
                     retried=result.retried, wall_time_s=round(result.wall_time, 3), executor=executor, **paths))
     return 0 if result.failed == 0 else 1

@@ -39,7 +39,7 @@ import numpy as np
 
 from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.errors import InputError
-from drakecreep.files import write_atomic, write_json
+from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.scenario import Scenario
 
@@ -330,11 +330,22 @@ def _plain(value):
 
 # --------------------------------------------------------------------------- files
 
-def _read_cache(path):
+def _read_cache(path, key):
+    """The cached row of case ``key``, or None when absent, unreadable or not a well-formed row of that case."""
     try:
-        return json.loads(Path(path).read_text())
+        if not path.is_file() or path.stat().st_size > 1_000_000:
+            return None
+        entry = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
+    if not isinstance(entry, dict) or entry.get("key") != key:
+        return None
+    row = entry.get("row")
+    if not isinstance(row, dict) or not isinstance(row.get("status"), str):
+        return None
+    if not all(isinstance(k, str) and (v is None or isinstance(v, (bool, int, float, str))) for k, v in row.items()):
+        return None
+    return row
 
 
 # --------------------------------------------------------------------------- running
@@ -395,30 +406,66 @@ def _run_serial(todo, metric, retries, done):
             done(case, None, error)
 
 
+def _watch_parent(parent_pid, period=1.0):
+    """Pool worker initializer: exit as soon as the sweep's process is gone (SIGKILL leaves no one to stop us)."""
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(period)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="drakecreep-parent-watch", daemon=True).start()
+
+
+def _stop_pool(pool):
+    """Cancel queued work and end the running workers now (Ctrl-C must not wait for every case)."""
+    processes = list(getattr(pool, "_processes", {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        try:
+            proc.terminate()
+        except Exception:  # noqa: BLE001 - already gone
+            pass
+    for proc in processes:
+        proc.join(timeout=5)
+
+
 def _run_processes(todo, metric, retries, done, workers):
-    attempts = {c.key: 0 for c in todo}
+    attempts = {_unit_key(c): 0 for c in todo}
     pending = list(todo)
     context = multiprocessing.get_context("spawn")
     retried = 0
     while pending:
         broken = []
-        with cf.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_watch_parent,
+                                      initargs=(os.getpid(),))
+        try:
             futures = {pool.submit(_work, case, metric): case for case in pending}
             for future in cf.as_completed(futures):
                 case = futures[future]
                 try:
                     row = future.result()
                 except Exception as err:  # noqa: BLE001 - BrokenProcessPool (a worker died) or the case raised
-                    attempts[case.key] += 1
-                    if attempts[case.key] <= retries:
+                    attempts[_unit_key(case)] += 1
+                    if attempts[_unit_key(case)] <= retries:
                         broken.append(case)
                     else:
                         done(case, None, err)
                     continue
                 done(case, row, None)
+        except BaseException:
+            _stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
         retried += len(broken)
         pending = broken
     return retried
+
+
+def _unit_key(unit):
+    return unit.key
 
 
 #: seconds to wait for a Dask scheduler to answer, and for its first worker
@@ -496,7 +543,7 @@ def _run_dask(todo, metric, retries, done, scheduler):
 
 
 def run_sweep(base, points, *, scenario=None, metric=None, executor="processes", workers=None, scheduler=None,
-              out_dir=None, progress=True, retries=2, columns=None, batch_size=None):
+              out_dir=None, progress=True, retries=2, columns=None, batch_size=None, extra_outputs=None):
     """Run a sweep and collect one row per case.
 
     Parameters
@@ -525,16 +572,27 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         Extra attempts for a case whose worker died or that raised.
     columns : list of str, optional
         Metric columns to keep (default: all the metric returns).
+    extra_outputs : dict, optional
+        ``file name -> write(table, path)`` of further files of the output set (e.g. a map).
     batch_size : int, optional
         Simulate up to this many compatible cases together in one Drake system
         (:mod:`drakecreep.sim.batch`; several times the throughput for large sweeps). Only with the
         default metric; cases the batch path cannot run (constant-speed drive, continuous
         controller, disturbances, compensation, nut friction on the screw: see
-        :func:`drakecreep.sim.baseline.unsupported`) run one by one. The batches are the executors' units of work.
+        :func:`drakecreep.sim.baseline.unsupported`) run one by one. The batches are the executors' units of
+        work; they are made no larger than needed to give every worker one (a kill or Ctrl-C loses at most
+        the batches under way: every finished batch is cached at once).
 
     Returns
     -------
     SweepResult
+
+    Notes
+    -----
+    The tables (and ``extra_outputs``) are one :class:`drakecreep.files.OutputSet` whose ``manifest.json``
+    is written last. On Ctrl-C the queued cases are cancelled, the running workers stopped, the tables
+    written with the finished cases (the others ``status: "not run (interrupted)"``) and
+    ``KeyboardInterrupt`` raised again. Pool workers exit by themselves when the sweep's process dies.
     """
     if executor not in EXECUTORS:
         raise InputError("executor", executor, "one of " + ", ".join(EXECUTORS))
@@ -551,13 +609,13 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     rows = {}
     todo = []
     for case in cases:
-        cached = _read_cache(cache_dir / f"{case.key}.json") if cache_dir is not None else None
-        if cached is not None and cached.get("key") == case.key:
-            rows[case.key] = cached["row"]
+        cached = _read_cache(cache_dir / f"{case.key}.json", case.key) if cache_dir is not None else None
+        if cached is not None:
+            rows[case.key] = cached
         else:
             todo.append(case)
     n_cached = len(cases) - len(todo)
-    failed = 0
+    failed = computed = 0
     bar = _Progress(len(cases), progress, "sweep")
     bar.update(n_cached)
 
@@ -569,7 +627,9 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
             done_case(unit, result, error)
 
     def done_case(case, row, error):
-        nonlocal failed
+        nonlocal failed, computed
+        if row is not None:
+            computed += 1
         if row is None:
             failed += 1
             row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
@@ -579,30 +639,50 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         bar.update()
 
     retried = 0
+    n_workers = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
+    if executor == "dask" and hasattr(scheduler, "scheduler_info"):
+        n_workers = max(1, len(scheduler.scheduler_info().get("workers", {})))
+    if batch_size and todo:
+        batch_size = max(1, min(batch_size, math.ceil(len(todo) / n_workers)))
     units = _batches(todo, batch_size, metric)
+    interrupted = False
     try:
         if units:
             if executor == "serial":
                 _run_serial(units, metric, retries, done)
             elif executor == "processes":
-                retried = _run_processes(units, metric, retries, done, workers or os.cpu_count() or 1)
+                retried = _run_processes(units, metric, retries, done, n_workers)
             else:
                 retried = _run_dask(units, metric, retries, done, scheduler)
+    except KeyboardInterrupt:
+        interrupted = True
     finally:
         bar.close()
 
+    for case in cases:
+        if interrupted and case.key not in rows:
+            rows[case.key] = dict(status="not run (interrupted)")
     table = _table(cases, rows, columns)
     paths = {}
     if out_dir is not None:
-        out = Path(out_dir)
-        paths["results_csv"] = write_atomic(out / "results.csv", lambda tmp: table.to_csv(tmp, index=False))
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
-            pass
-        else:
-            paths["results_parquet"] = write_atomic(out / "results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
-    return SweepResult(table=table, computed=len(todo) - failed, cached=n_cached, failed=failed, retried=retried,
+        from drakecreep.files import OutputSet
+
+        with OutputSet(out_dir, "manifest.json") as out:
+            paths["results_csv"] = out.write("results.csv", lambda tmp: table.to_csv(tmp, index=False))
+            try:
+                import pyarrow  # noqa: F401
+            except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
+                pass
+            else:
+                paths["results_parquet"] = out.write("results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
+            if not interrupted:
+                for name, write in (extra_outputs or {}).items():
+                    paths[Path(name).stem] = out.write(name, lambda tmp, w=write: w(table, tmp))
+            paths["manifest"] = out.commit(dict(cases=len(cases), interrupted=interrupted,
+                                                computed=computed, cached=n_cached, failed=failed))
+    if interrupted:
+        raise KeyboardInterrupt
+    return SweepResult(table=table, computed=computed, cached=n_cached, failed=failed, retried=retried,
                        paths=paths, wall_time=time.perf_counter() - start)
 
 
