@@ -273,12 +273,16 @@ class OutputSet:
         self.files = {}
         self.committed = False
 
-    def __enter__(self):
+    def start(self):
+        """Remove the previous manifest (step 1); ``with OutputSet(...)`` does it on entry. Returns ``self``."""
         try:
             self.manifest.unlink()
         except FileNotFoundError:
             pass
         return self
+
+    def __enter__(self):
+        return self.start()
 
     def __exit__(self, *exc):
         return False
