@@ -330,15 +330,17 @@ def _plain(value):
 
 # --------------------------------------------------------------------------- files
 
-def _read_cache(path, key):
-    """The cached row of case ``key``, or None when absent, unreadable or not a well-formed row of that case."""
+def _read_cache(path, key, batch=None):
+    """The cached row of case ``key``, or None when absent, unreadable, not a well-formed row of that case, or
+    computed in another batch than ``batch`` (a batched row depends on its batch: it steps as finely as the
+    batch's most demanding member)."""
     try:
         if not path.is_file() or path.stat().st_size > 1_000_000:
             return None
         entry = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
-    if not isinstance(entry, dict) or entry.get("key") != key:
+    if not isinstance(entry, dict) or entry.get("key") != key or entry.get("batch") != batch:
         return None
     row = entry.get("row")
     if not isinstance(row, dict) or not isinstance(row.get("status"), str):
@@ -466,6 +468,10 @@ def _run_processes(todo, metric, retries, done, workers):
 
 def _unit_key(unit):
     return unit.key
+
+
+def _members(unit):
+    return unit.cases if isinstance(unit, _Batch) else (unit,)
 
 
 #: seconds to wait for a Dask scheduler to answer, and for its first worker
@@ -606,14 +612,30 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     metric = metric or feed_report
     cases = make_cases(base, points, scenario, metric)
     cache_dir = Path(out_dir) / "cache" if out_dir is not None else None
+    n_workers = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
+    if executor == "dask" and hasattr(scheduler, "scheduler_info"):
+        n_workers = max(1, len(scheduler.scheduler_info().get("workers", {})))
+    if batch_size and cases:
+        # no larger than needed to give every worker a batch: a kill loses at most the batches under way
+        batch_size = max(1, min(batch_size, math.ceil(len(cases) / n_workers)))
+    # batches are formed from the whole sweep, so a case always shares its batch with the same cases; the
+    # batch is part of what a cached row is valid for, and a batch is run (and cached) whole or not at all
+    all_units = _batches(cases, batch_size, metric)
+    batch_of = {}
+    for unit in all_units:
+        for case in _members(unit):
+            batch_of[case.key] = unit.key if isinstance(unit, _Batch) else None
     rows = {}
-    todo = []
-    for case in cases:
-        cached = _read_cache(cache_dir / f"{case.key}.json", case.key) if cache_dir is not None else None
-        if cached is not None:
-            rows[case.key] = cached
+    units = []
+    for unit in all_units:
+        got = {}
+        if cache_dir is not None:
+            got = {c.key: _read_cache(cache_dir / f"{c.key}.json", c.key, batch_of[c.key]) for c in _members(unit)}
+        if got and all(row is not None for row in got.values()):
+            rows.update(got)
         else:
-            todo.append(case)
+            units.append(unit)
+    todo = [case for unit in units for case in _members(unit)]
     n_cached = len(cases) - len(todo)
     failed = computed = 0
     bar = _Progress(len(cases), progress, "sweep")
@@ -633,18 +655,15 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         if row is None:
             failed += 1
             row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
+            rows[case.key] = row
         elif cache_dir is not None:
-            write_json(cache_dir / f"{case.key}.json", dict(key=case.key, point=case.point, row=row))
+            rows[case.key] = row  # kept even if Ctrl-C lands while the cache file is written
+            write_json(cache_dir / f"{case.key}.json",
+                       dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row))
         rows[case.key] = row
         bar.update()
 
     retried = 0
-    n_workers = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
-    if executor == "dask" and hasattr(scheduler, "scheduler_info"):
-        n_workers = max(1, len(scheduler.scheduler_info().get("workers", {})))
-    if batch_size and todo:
-        batch_size = max(1, min(batch_size, math.ceil(len(todo) / n_workers)))
-    units = _batches(todo, batch_size, metric)
     interrupted = False
     try:
         if units:

@@ -52,15 +52,20 @@ def _alive(pid):
     return state != "Z"
 
 
+def _cached(cache):
+    """Finished cache entries (not the hidden temporary files of a write under way)."""
+    return [p for p in cache.glob("*.json") if not p.name.startswith(".")] if cache.is_dir() else []
+
+
 def _start(tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, str(tmp_path / "out")], cwd=_ROOT,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout.readline().strip() == "START"
     cache = tmp_path / "out" / "cache"
     deadline = time.time() + 120
-    while time.time() < deadline and not (cache.is_dir() and any(cache.glob("*.json"))):
+    while time.time() < deadline and not _cached(cache):
         time.sleep(0.2)
-    assert any(cache.glob("*.json")), "no case finished in time"
+    assert _cached(cache), "no case finished in time"
     return proc, cache
 
 
@@ -77,7 +82,7 @@ def test_ctrl_c_cancels_the_queue_and_keeps_finished_cases(tmp_path):
     assert set(table.status) <= {"ok", "not run (interrupted)"}
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     assert manifest["interrupted"] is True and "results.csv" in manifest["files"]
-    assert len(list(cache.glob("*.json"))) >= len(finished)
+    assert len(_cached(cache)) >= len(finished)
 
 
 def test_sigkill_of_the_sweep_does_not_orphan_its_workers(tmp_path):
@@ -112,3 +117,24 @@ def test_corrupt_cache_entries_are_recomputed(tmp_path, paper):
         r = run_sweep(base, points, scenario=scen, executor="serial", out_dir=tmp_path, progress=False)
         assert r.computed == 1 and r.cached == 0
         assert r.table.status.iloc[0] == "ok"
+
+
+def test_a_batched_row_is_reused_only_for_the_same_batch(tmp_path, paper):
+    from drakecreep.params import with_value
+    from drakecreep.sim.sweep import run_sweep
+
+    base = with_value(paper, "simulation.steady_start", 0.2)
+    points = [{"table.mass": 40.0}, {"table.mass": 44.0}]
+    scen = {"feed": 2e-3, "load_case": 3, "duration": 0.4}
+
+    def run(batch):
+        return run_sweep(base, points, scenario=scen, executor="serial", out_dir=tmp_path, progress=False,
+                         batch_size=batch)
+
+    first = run(2)
+    assert first.computed == 2 and (first.table.status == "ok").all()
+    assert json.loads(next(p for p in (tmp_path / "cache").glob("*.json")).read_text())["batch"]
+    assert run(2).cached == 2  # the same batch: reused
+    single = run(None)  # one case at a time steps differently: not the same result, so not reused
+    assert single.cached == 0 and single.computed == 2
+    assert run(None).cached == 2
