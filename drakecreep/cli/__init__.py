@@ -11,6 +11,7 @@ the error and pointing to ``--debug`` (which shows the traceback) and exits with
 """
 
 import argparse
+import errno
 import importlib
 import os
 import sys
@@ -75,15 +76,29 @@ def main(argv=None):
         _debug_traceback(debug)
         print(f"{prefix}: error: {err.strerror}: {_one_line(err.filename)}", file=sys.stderr)
         return 2
+    except OSError as err:
+        _debug_traceback(debug)
+        if err.filename is not None and err.errno in _PATH_ERRNOS:  # a bad path the user gave
+            print(f"{prefix}: error: {err.strerror}: {_one_line(err.filename)}", file=sys.stderr)
+            return 2
+        hint = "" if debug else " (run again with --debug for the traceback)"
+        print(f"{prefix}: internal error: {type(err).__name__}: {_one_line(err.strerror or err)}"
+              f"{': ' + _one_line(err.filename) if err.filename else ''}{hint}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print(f"{prefix}: interrupted", file=sys.stderr)
         return 130
     except Exception as err:  # noqa: BLE001 - the one top-level guard: one line, the traceback on --debug
         _debug_traceback(debug)
-        what = f"{err.strerror}: {err.filename}" if isinstance(err, OSError) and err.strerror else _one_line(err)
+        what = _one_line(err)
         hint = "" if debug else " (run again with --debug for the traceback)"
         print(f"{prefix}: internal error: {type(err).__name__}: {what}{hint}", file=sys.stderr)
         return 1
+
+
+#: errors of a path given by the user (exit 2); other OSErrors (a full disk, I/O errors) exit 1
+_PATH_ERRNOS = {errno.ENAMETOOLONG, errno.ELOOP, errno.ENOTDIR, errno.EISDIR, errno.ENOENT, errno.EACCES,
+                errno.EROFS, errno.EEXIST}
 
 
 def _one_line(obj, limit=400):

@@ -21,8 +21,13 @@ def add_parser(subparsers):
 
 def run(args):
     """Run and print the scores."""
+    from drakecreep.errors import InputError
     from drakecreep.gap.benchmark import run_benchmark
 
+    if not 0 <= args.seed < 2**32 - 10_000:
+        raise InputError("--seed", args.seed, "an integer in [0, 2^32 - 10000)")
+    if args.n > 10_000:
+        raise InputError("--n", args.n, "at most 10000 datasets (each takes seconds)")
     res = run_benchmark(n=args.n, seed=args.seed, replay=not args.no_replay, progress=True)
     if args.json:
         print_json(res)

@@ -322,3 +322,43 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     assert "ZeroDivisionError: a bug" in err and "--debug" in err
     code, _, err = _run(["--debug", "params"], capsys)
     assert code == 1 and "Traceback" in err and "ZeroDivisionError: a bug" in err.strip().splitlines()[-1]
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["hertz", "--balls", "9" * 400], "--balls"),
+    (["hertz", "--balls", "0"], "--balls"),
+    (["hertz", "--youngs-modulus", "1e308"], "--youngs-modulus"),
+    (["hertz", "--preload", "inf"], "--preload"),
+    (["hertz", "--lead", "-1"], "--lead"),
+    (["gap-benchmark", "--seed", "-1"], "--seed"),
+    (["gap-benchmark", "--n", "1000000000"], "--n"),
+    (["margins", "--feed", "1e-300"], "--feed"),
+    (["report", "--out", "{tmp}/r", "--low-feed", "1e-300"], "--low-feed"),
+    (["simulate", "--out", "{tmp}/s", "--feed", "1e-300"], "--feed"),
+    (["modal", "{tmp}/u16.csv"], "UTF-8"),
+    (["modal", "/dev/zero"], "regular file"),
+    (["sweep", "{tmp}/spec.yaml", "--max-cases", "0"], "--max-cases"),
+])
+def test_bad_options(argv, fragment, tmp_path, capsys):
+    (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
+    (tmp_path / "spec.yaml").write_text("axes:\n  table.mass: [30, 40]\n")
+    code, _, err = _run([a.format(tmp=tmp_path) for a in argv], capsys)
+    _one_line_exit_2(code, err, fragment)
+
+
+def test_full_disk_is_one_line_exit_1(monkeypatch, capsys):
+    import errno
+
+    import drakecreep.cli.params as cmd
+
+    def full(args):
+        raise OSError(errno.ENOSPC, "No space left on device", "/out/results.csv")
+
+    monkeypatch.setattr(cmd, "run", full)
+    code, _, err = _run(["params"], capsys)
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "No space left on device" in err
+
+
+def test_too_long_a_path_is_bad_input(capsys):
+    code, _, err = _run(["emps", "--data", "9" * 400], capsys)
+    _one_line_exit_2(code, err, "File name too long")
