@@ -166,10 +166,11 @@ def _allowed(meta):
     return f"a finite number{unit}"
 
 
-#: largest magnitude of a float field without a stated upper bound, in its SI unit: every quantity of a
-#: feed drive is far below (the stiffest field, Young's modulus, is ~2e11 Pa); beyond it the model's
-#: arithmetic loses all digits (1e300 kg) and a run gives nonsense or never ends
-ABSURD = 1e13
+#: largest magnitude of a float field without a stated upper bound, in its SI unit: 1e8 times the largest
+#: real quantity of a feed drive (Young's modulus, ~2e11 Pa), so "rigid" idealisations (a 2e19 Pa shaft)
+#: stay possible, while products and squares of fields stay far from float overflow (1e300 kg gave
+#: nonsense or runs that never end)
+ABSURD = 1e20
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
