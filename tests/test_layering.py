@@ -18,12 +18,13 @@ BASE = {"errors", "scenario", "params", "data", "files"}
 ALLOWED = {
     "model": set(),
     "paper": {"model"},
-    "sim": {"model", "paper"},
-    "servo": {"model", "paper", "sim"},
-    "studies": {"model", "paper", "sim", "servo"},
-    "gap": {"model", "paper", "sim", "servo"},
-    "report": {"model", "paper", "sim", "servo", "studies", "gap"},
-    "cli": {"model", "paper", "sim", "servo", "studies", "gap", "report"},
+    "multibody": {"model"},
+    "sim": {"model", "paper", "multibody"},
+    "servo": {"model", "paper", "sim", "multibody"},
+    "studies": {"model", "paper", "sim", "servo", "multibody"},
+    "gap": {"model", "paper", "sim", "servo", "multibody"},
+    "report": {"model", "paper", "sim", "servo", "studies", "gap", "multibody"},
+    "cli": {"model", "paper", "sim", "servo", "studies", "gap", "report", "multibody"},
 }
 
 

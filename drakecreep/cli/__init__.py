@@ -13,10 +13,13 @@ the error and pointing to ``--debug`` (which shows the traceback) and exits with
 import argparse
 import errno
 import importlib
+import re
+import textwrap
 import os
 import sys
 import traceback
 
+from drakecreep import __version__
 from drakecreep.errors import DrakecreepError
 
 __all__ = ["main", "build_parser", "COMMANDS"]
@@ -28,17 +31,39 @@ COMMANDS = [
     "diagram",
     "critical",
     "hertz",
-    "modal",
+    "modal", "modes",
     "margins", "tune", "report",
-    "sweep",
+    "sweep", "uncertainty",
     "emps",
     "reproduce_paper", "compensate",
     "diagnose", "gap_benchmark",
 ]
 
 
+def plain(text):
+    """Help text without reStructuredText markup (``code``, :func:`name`, :class:`~a.b.C`)."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", lambda m: m.group(1).rpartition(".")[2] if m.group(0).count("~") else m.group(1), text)
+    return text.replace("``", "'").replace("`", "'")
+
+
+class _Formatter(argparse.HelpFormatter):
+    """Wraps the description paragraph by paragraph; strips reStructuredText markup from every help text."""
+
+    def _fill_text(self, text, width, indent):
+        paragraphs = [" ".join(p.split()) for p in plain(text).split("\n\n")]
+        return "\n\n".join(textwrap.fill(p, width, initial_indent=indent, subsequent_indent=indent)
+                             for p in paragraphs if p)
+
+    def _expand_help(self, action):
+        return plain(super()._expand_help(action))
+
+
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit code 2."""
+    """ArgumentParser whose errors are one line and exit code 2; help without reStructuredText markup."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
@@ -50,6 +75,7 @@ def build_parser():
         prog="drakecreep",
         description="Ball-screw feed drive in Drake: simulate creep, analyse servo loops, diagnose sim-to-real gaps.",
     )
+    parser.add_argument("--version", action="version", version=f"drakecreep {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an unexpected error")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True

@@ -1,7 +1,9 @@
 """``drakecreep diagnose``: where the sim-to-real gap of the rigid model lies, which effect explains it, how far it shrinks.
 
-DATA is an EMPS ``.mat`` file (``estimation`` / ``validation`` name the benchmark files) or a measured CSV
-(metadata YAML beside it or ``--meta``). A single-run file is split into out-and-back cycles; the
+DATA is an EMPS .mat file ('estimation' / 'validation' name the benchmark files) or a measured run: CSV,
+Parquet, HDF5 or .mat with a metadata YAML beside it or given with --meta; units in the column headers
+(t[ms], x_motor[mm], u[V]) are converted. The format is documented in docs/measured_format.md; an example
+ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split into out-and-back cycles; the
 training runs are fitted, the held-out runs only scored. ``--score FILE`` finally scores the finished
 diagnosis, with every parameter fixed, on another file (e.g. the EMPS validation set).
 """
@@ -18,8 +20,9 @@ __all__ = ["add_parser", "run", "load_runs", "pick"]
 def add_parser(subparsers):
     """Register ``diagnose``."""
     p = subparsers.add_parser("diagnose", help="sim-to-real gap diagnosis of measured runs (where, which effect, shrink)",
-                              description=__doc__.split("\n\n")[0])
-    p.add_argument("data", metavar="DATA", help="EMPS .mat file (or 'estimation'), or a measured CSV")
+                              description="\n\n".join(__doc__.split("\n\n")[:2]))
+    p.add_argument("data", metavar="DATA", help="EMPS .mat file (or 'estimation'), or a measured run "
+                   "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
                    "(default: even indices)")
@@ -40,7 +43,7 @@ def load_runs(data, meta=None):
     from drakecreep.gap.diagnosis import split_cycles
     from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
-    if data in EMPS_FILES or str(data).endswith(".mat"):
+    if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):
         md = load_emps(data)
     else:
         if not Path(data).exists():

@@ -36,7 +36,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
-import re
+
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +45,7 @@ import yaml
 
 from drakecreep.data import emps_data_dir
 from drakecreep.errors import InputError
+from drakecreep.gap.formats import read_signals
 
 __all__ = [
     "U_UNITS",
@@ -390,7 +391,7 @@ def _meta_from_dict(data, meta_path):
     where = str(meta_path)
     if not isinstance(data, dict):
         raise InputError(where, data, "a YAML mapping with at least u_units and u_gain")
-    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes"}
+    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "file"}
     for key in data:
         if key not in known:
             raise InputError(f"{where}: {key}", data[key], "no such key; known: " + ", ".join(sorted(known)))
@@ -445,30 +446,21 @@ def _meta_to_dict(meta):
 
 # --------------------------------------------------------------------------- CSV
 
-_HEADER = re.compile(r"^\s*([A-Za-z_]\w*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
-
-
-def _parse_header(cells, path, u_units):
-    names, seen = [], set()
-    for cell in cells:
-        m = _HEADER.match(cell)
-        if not m:
-            raise InputError(f"{path}: header", cell, "a column name, optionally with [unit]")
-        name, unit = m.group(1), m.group(2)
-        if name not in COLUMNS:
-            raise InputError(f"{path}: header", name, "columns among " + ", ".join(COLUMNS))
-        if name in seen:
-            raise InputError(f"{path}: header", name, "each column once")
-        seen.add(name)
-        want = u_units if name == "u" else COLUMNS[name][0]
-        if unit is not None and unit != "" and unit != want:
-            what = f"{want} (the u_units of the metadata)" if name == "u" else f"{want} (SI)"
-            raise InputError(f"{path}: column {name} unit", unit, what)
-        names.append(name)
-    missing = [c for c, (_, req) in COLUMNS.items() if req and c not in seen]
-    if missing:
-        raise InputError(f"{path}: header", ",".join(names), "the columns " + ", ".join(missing) + " as well")
-    return names
+def _file_options(opts, meta_path):
+    """The metadata's ``file:`` mapping (``columns``, ``units``, ``key``) as keyword arguments of read_signals."""
+    if opts is None:
+        return {}
+    where = f"{meta_path}: file"
+    if not isinstance(opts, dict) or set(opts) - {"columns", "units", "key"}:
+        raise InputError(where, opts, "a mapping with columns (signal: file column), units (signal: unit), key (HDF5)")
+    for name in ("columns", "units"):
+        value = opts.get(name)
+        if value is not None and not (isinstance(value, dict) and all(isinstance(v, str) for v in value.values())):
+            raise InputError(f"{where}.{name}", value, "a mapping of signal names to strings")
+    key = opts.get("key")
+    if key is not None and not isinstance(key, str):
+        raise InputError(f"{where}.key", key, "a string (the HDF5 table's key)")
+    return dict(columns=opts.get("columns"), units=opts.get("units"), key=key)
 
 
 def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
@@ -477,7 +469,10 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     Parameters
     ----------
     csv_path : str or pathlib.Path
-        The CSV (header of column names, ``#`` comment lines ignored).
+        The data file: CSV (``#`` comment lines ignored), Parquet, HDF5 or MATLAB ``.mat``; column names
+        with units in brackets (``t[ms]``, ``x_motor[mm]``) are converted to SI, and the metadata's
+        ``file.columns`` / ``file.units`` map a file's own names (:mod:`drakecreep.gap.formats`,
+        ``docs/measured_format.md``).
     meta_path : str or pathlib.Path, optional
         The metadata YAML; default: the CSV path with suffix ``.yaml`` (or ``.yml``).
     dt_rtol : float
@@ -491,8 +486,8 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     Raises
     ------
     InputError
-        Missing or unknown column, wrong unit in the header, unknown ``u_units``, a row with the wrong
-        number of fields, a non-number, NaN, non-monotonic or non-uniform time, missing metadata.
+        Missing or unknown column, unknown unit, unknown ``u_units``, a non-number, NaN, non-monotonic or
+        non-uniform time, missing metadata.
     FileNotFoundError
         If the CSV does not exist.
     """
@@ -509,46 +504,35 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     meta_data = load_yaml_file(meta_path, str(meta_path), "a YAML mapping with at least u_units and u_gain")
     meta = _meta_from_dict(meta_data, meta_path)
 
-    check_input_file(csv_path, str(csv_path), MAX_DATA_BYTES)
-    try:
-        with open(csv_path, newline="", encoding="utf-8-sig") as fh:
-            rows = [(i + 1, r) for i, r in enumerate(csv.reader(fh))
-                    if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
-    except UnicodeDecodeError as err:
-        raise InputError(str(csv_path), f"byte 0x{err.object[err.start]:02x} at offset {err.start} is not UTF-8",
-                         "a UTF-8 text CSV (not binary, not UTF-16)") from None
-    except csv.Error as err:
-        raise InputError(str(csv_path), f"unreadable CSV ({str(err)[:80]})", "a CSV text file") from None
-    if not rows:
-        raise InputError(str(csv_path), "empty", "a header line and data rows")
-    names = _parse_header(rows[0][1], csv_path, meta.u_units)
-    width = len(names)
-    cols = {name: [] for name in names}
-    for line, row in rows[1:]:
-        if len(row) != width:
-            raise InputError(f"{csv_path}: line {line}", f"{len(row)} fields", f"{width} fields like the header")
-        for name, cell in zip(names, row):
-            cols[name].append(cell.strip())
-    if not rows[1:]:
+    check_input_file(csv_path, str(csv_path), MAX_DATA_BYTES)  # a regular file of bounded size, before reading
+    file_opts = meta_data.get("file") if isinstance(meta_data, dict) else None
+    signals = read_signals(csv_path, meta.u_units, **_file_options(file_opts, meta_path))
+    unknown = [name for name in signals if name not in COLUMNS]
+    if unknown:
+        raise InputError(f"{csv_path}: header", unknown[0],
+                         "columns among " + ", ".join(COLUMNS) + " (or map the file's names in file.columns)")
+    missing = [c for c, (_, req) in COLUMNS.items() if req and c not in signals]
+    if missing:
+        raise InputError(f"{csv_path}: header", ",".join(signals), "the columns " + ", ".join(missing) + " as well")
+    n_rows = len(next(iter(signals.values())))
+    if n_rows < 1:
         raise InputError(str(csv_path), "no data rows", "at least 3 rows")
     arrays = {}
-    for name in names:
+    for name, values in signals.items():
         if name == "run":
             continue
-        try:
-            arrays[name] = np.array([float(c) for c in cols[name]], dtype=float)
-        except ValueError as err:
-            raise InputError(f"{csv_path}: column {name}", str(err).split(": ")[-1], "numbers") from None
-        bad = np.flatnonzero(np.isnan(arrays[name]))
+        arrays[name] = values
+        bad = np.flatnonzero(np.isnan(values))
         if bad.size:
-            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN)",
+            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN or empty)",
                              "finite numbers")
+    cols = {"run": signals["run"]} if "run" in signals else {}
     if "run" in cols:
         labels = np.array(cols["run"], dtype=object)
         order = list(dict.fromkeys(labels.tolist()))
         groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
     else:
-        groups = [(csv_path.stem, np.arange(len(rows) - 1))]
+        groups = [(csv_path.stem, np.arange(n_rows))]
     runs = []
     for label, idx in groups:
         kw = {name: (arrays[name][idx] if name in arrays else None) for name in _ARRAYS}

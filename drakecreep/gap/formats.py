@@ -1,0 +1,181 @@
+"""Reading measured runs from files: CSV (pandas), Parquet, HDF5 and MATLAB ``.mat``, with units converted to SI.
+
+A file holds one column per signal. The column names are the project's (``t``, ``x_ref``, ``x_motor``,
+``x_table``, ``u``, ``f_ext``, ``run``), optionally with a unit in brackets (``t[ms]``, ``x_motor[mm]``,
+``u[V]``), or the file's own names mapped to the project's by the metadata's ``file.columns``. Units come from
+the header or from ``file.units``; a column without a unit is in SI (``u``: in the metadata's ``u_units``).
+See ``docs/measured_format.md``.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from drakecreep.errors import InputError
+
+__all__ = ["FORMATS", "UNITS", "read_signals", "unit_factor", "parse_column"]
+
+#: file suffix -> format name
+FORMATS = {".csv": "csv", ".txt": "csv", ".parquet": "parquet", ".pq": "parquet", ".h5": "hdf5",
+           ".hdf5": "hdf5", ".hdf": "hdf5", ".mat": "mat"}
+
+#: quantity -> unit -> factor to SI
+UNITS = {
+    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6},
+    "length": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "nm": 1e-9},
+    "force": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    # the controller output keeps the metadata's u_units; only a scale prefix is converted
+    "N": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    "V": {"V": 1.0, "mV": 1e-3},
+    "A": {"A": 1.0, "mA": 1e-3},
+}
+
+#: signal -> quantity (u: the metadata's u_units)
+QUANTITY = {"t": "time", "x_ref": "length", "x_motor": "length", "x_table": "length", "f_ext": "force"}
+
+_HEADER = re.compile(r"^\s*([^\[\]()]*?)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
+
+
+def parse_column(cell):
+    """``"x_motor [mm]"`` -> ``("x_motor", "mm")``; ``"t"`` -> ``("t", None)``."""
+    m = _HEADER.match(str(cell))
+    if not m or not m.group(1):
+        return str(cell).strip(), None
+    return m.group(1), (m.group(2) or None)
+
+
+def unit_factor(signal, unit, u_units, where):
+    """Factor from ``unit`` to SI for ``signal`` (``u``: to ``u_units``), or an InputError naming the column."""
+    quantity = u_units if signal == "u" else QUANTITY.get(signal)
+    if quantity is None or unit is None:
+        return 1.0
+    table = UNITS[quantity]
+    if unit not in table:
+        raise InputError(f"{where}: column {signal} unit", unit,
+                         "one of " + ", ".join(table) + (" (u is in the metadata's u_units)" if signal == "u" else ""))
+    return table[unit]
+
+
+def _frame(path, fmt, key):
+    import pandas as pd
+
+    if fmt == "csv":
+        try:
+            return pd.read_csv(path, comment="#", skipinitialspace=True, skip_blank_lines=True)
+        except UnicodeDecodeError as err:
+            raise InputError(str(path), f"byte 0x{err.object[err.start]:02x} at offset {err.start} is not UTF-8",
+                             "a UTF-8 text CSV (not binary, not UTF-16)") from None
+        except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+            raise InputError(str(path), f"unreadable CSV ({str(err).splitlines()[0][:80]})",
+                             "a CSV with a header line and data rows") from None
+    if fmt == "parquet":
+        try:
+            return pd.read_parquet(path)
+        except Exception as err:  # noqa: BLE001 - pyarrow raises many types for a corrupt file
+            raise InputError(str(path), f"not a readable Parquet file ({type(err).__name__})",
+                             "a Parquet table") from None
+    if fmt == "hdf5":
+        try:
+            return pd.read_hdf(path, key=key)
+        except ImportError:
+            raise InputError(str(path), "HDF5", "CSV, Parquet or .mat (HDF5 needs the 'tables' package: "
+                             "pip install tables)") from None
+        except (KeyError, ValueError, OSError, TypeError) as err:
+            raise InputError(f"{path}: file.key", key, f"the key of one pandas table in the file ({err})"[:200]) from None
+    import scipy.io
+
+    try:
+        mat = scipy.io.loadmat(str(path))
+    except Exception as err:  # noqa: BLE001 - empty, truncated, corrupt: OSError, IndexError, MatReadError, zlib.error
+        raise InputError(str(path), f"not a readable MATLAB file ({type(err).__name__})",
+                         "a MATLAB .mat file (v4-v7.2)") from None
+    columns = {}
+    for name, value in mat.items():
+        if name.startswith("__"):
+            continue
+        a = np.asarray(value)
+        if a.dtype.kind in "fiu" and a.ndim <= 2 and 1 in (a.shape + (1,))[:2] and a.size > 1:
+            columns[name] = a.astype(float).ravel()
+    lengths = {a.size for a in columns.values()}
+    if len(lengths) > 1:
+        longest = max(lengths)
+        columns = {k: v for k, v in columns.items() if v.size == longest}
+    return pd.DataFrame(columns)
+
+
+def read_signals(path, u_units, columns=None, units=None, key=None):
+    """Read a measured file into SI arrays of the project's signal names.
+
+    Parameters
+    ----------
+    path : path-like
+        ``.csv``/``.txt``, ``.parquet``/``.pq``, ``.h5``/``.hdf5`` or ``.mat``.
+    u_units : str
+        The metadata's unit of ``u`` (``N``, ``V`` or ``A``); ``u`` is scaled to it, not converted.
+    columns : dict, optional
+        Project signal name -> the file's column (or MATLAB variable) name.
+    units : dict, optional
+        Project signal name -> unit, for columns whose name carries none.
+    key : str, optional
+        The HDF5 key of the table.
+
+    Returns
+    -------
+    dict
+        Signal name -> ``numpy`` array (``run`` -> array of labels as str); the file's column order.
+    """
+    path = Path(path)
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise InputError(str(path), path.suffix or "(no suffix)", "a file ending in " + ", ".join(FORMATS))
+    frame = _frame(path, fmt, key)
+    if frame.shape[1] == 0 or frame.shape[0] == 0:
+        raise InputError(str(path), "no data", "a header line and data rows")
+    mapping = dict(columns or {})
+    units = dict(units or {})
+    for signal in list(mapping) + list(units):
+        if signal not in QUANTITY and signal not in ("u", "run"):
+            raise InputError(f"{path}: file.columns/units", signal,
+                             "signals among t, x_ref, x_motor, x_table, u, f_ext, run")
+    by_file = {str(c): c for c in frame.columns}
+    out = {}
+    if mapping:
+        for signal, column in mapping.items():
+            if str(column) not in by_file:
+                raise InputError(f"{path}: file.columns.{signal}", column,
+                                 "a column of the file: " + ", ".join(list(by_file)[:20]))
+            _, unit = parse_column(column)
+            out[signal] = (by_file[str(column)], units.get(signal, unit))
+    else:
+        for name, column in by_file.items():
+            signal, unit = parse_column(name)
+            if signal in out:
+                raise InputError(f"{path}: header", signal, "each column once")
+            out[signal] = (column, units.get(signal, unit))
+    signals = {}
+    for signal, (column, unit) in out.items():
+        values = frame[column]
+        if signal == "run":
+            signals["run"] = values.astype(str).to_numpy()
+            continue
+        if signal not in QUANTITY and signal != "u":
+            signals[signal] = values  # unknown: the caller names it
+            continue
+        try:
+            data = values.to_numpy(dtype=float)
+        except (TypeError, ValueError):
+            bad = next((v for v in values if not _is_number(v)), values.iloc[0])
+            raise InputError(f"{path}: column {signal}", str(bad)[:40], "numbers") from None
+        signals[signal] = data * unit_factor(signal, unit, u_units, str(path))
+    return signals
+
+
+def _is_number(value):
+    try:
+        float(value)
+    except (TypeError, ValueError):
+        return False
+    return True
