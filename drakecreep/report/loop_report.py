@@ -19,7 +19,7 @@ from drakecreep.paper import creep
 
 from drakecreep.report import loop_plots
 from drakecreep.errors import InputError
-from drakecreep.files import to_jsonable
+from drakecreep.files import OutputSet, to_jsonable
 from drakecreep.report.html import figure, page, table
 from drakecreep.servo.loops import LOOPS, analyze_loops
 from drakecreep.model.motor import motor_inertia
@@ -148,17 +148,20 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
 
     fmt_cross = ", ".join(f"{v * 1e3:.3g}" for v in crossings["closed_loop"]["pole"]) or "none"
     th_cross = ", ".join(f"{v * 1e3:.3g}" for v in crossings["closed_loop"]["theory"]) or "none"
+    # the files form one output set: the old manifest goes first, every file is replaced atomically, and
+    # manifest.json, written last, names the files of this run (a kill part way leaves no manifest)
+    outset = OutputSet(out, "manifest.json").start()
     png = {}
-    png["bode"] = loop_plots.plot_bode(analysis, out / "bode.png")
-    png["nyquist"] = loop_plots.plot_nyquist(analysis, out / "nyquist.png")
-    png["gain_locus"] = loop_plots.plot_gain_locus(analysis, out / "root_locus_gain.png")
-    png["loci"] = loop_plots.plot_parameter_loci(
-        loci, out / "root_locus_parameters.png",
+    png["bode"] = outset.write("bode.png", lambda p: loop_plots.plot_bode(analysis, p))
+    png["nyquist"] = outset.write("nyquist.png", lambda p: loop_plots.plot_nyquist(analysis, p))
+    png["gain_locus"] = outset.write("root_locus_gain.png", lambda p: loop_plots.plot_gain_locus(analysis, p))
+    png["loci"] = outset.write("root_locus_parameters.png", lambda p: loop_plots.plot_parameter_loci(
+        loci, p,
         labels={"stiffness": "stiffness factor", "feed": "feed, mm/s", "mass": "table mass, kg"},
         crossings=f"axis crossings at {fmt_cross} mm/s; C + C1 = 0 at {th_cross} mm/s",
-    )
-    png["pole_map"] = loop_plots.plot_pole_map(pm, out / "pole_map.png")
-    png["sims"] = loop_plots.plot_step_and_feed(step, low_run, out / "simulations.png")
+    ))
+    png["pole_map"] = outset.write("pole_map.png", lambda p: loop_plots.plot_pole_map(pm, p))
+    png["sims"] = outset.write("simulations.png", lambda p: loop_plots.plot_step_and_feed(step, low_run, p))
     t = lap("plots", t)
 
     payload = to_jsonable(dict(
@@ -169,15 +172,14 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
         low_feed=low_run.summary(), step=step.summary(),
         pole_map_agreement=pm.agreement() if len(pm.sim_creep) else None,
     ))
-    json_path = out / "margins.json"
-    json_path.write_text(json.dumps(payload, indent=2) + "\n")
+    json_path = outset.write_text("margins.json", json.dumps(payload, indent=2) + "\n")
 
     html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v0, v0_sc, png, low_feed,
                       timings)
     timings["total"] = time.perf_counter() - t_start
     html_text = html_text.replace("@@TOTAL@@", f"{timings['total']:.1f}")
-    html_path = out / "index.html"
-    html_path.write_text(html_text)
+    html_path = outset.write_text("index.html", html_text)
+    outset.commit(dict(report="servo-loop report", source=source, html="index.html", json="margins.json"))
     return dict(html=html_path, json=json_path, timings=timings, pngs=png)
 
 
