@@ -25,10 +25,9 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from drakecreep.errors import InputError
-from drakecreep.params import get_value, with_value
+from drakecreep.params import PRESETS, get_value, load_yaml_file, preset, with_value
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -126,32 +125,25 @@ def load_uncertainty(path):
         For bad YAML, an unknown key, a bad distribution or an unknown parameter path.
     """
     path = Path(path)
-    return _spec_from_text(path.read_text(), str(path))
+    return _spec_from_data(load_yaml_file(path, str(path), "a YAML uncertainty spec"), str(path))
 
 
 def uncertainty_spec(name="paper"):
     """The packaged uncertainty spec of preset ``name``: the ``presets/*_uncertainty.yaml`` whose ``preset`` names it."""
-    from drakecreep.params import PRESETS, _yaml_load
-
     folder = resources.files("drakecreep").joinpath("presets")
     files = sorted((f for f in folder.iterdir() if f.name.endswith("_uncertainty.yaml")), key=lambda f: f.name)
     have = []
     for file in files:
-        names = _yaml_load(file.read_text()).get("preset", "paper")
+        data = load_yaml_file(Path(str(file)), f"presets/{file.name}", "a YAML uncertainty spec")
+        names = data.get("preset", "paper")
         names = [names] if isinstance(names, str) else list(names)
         if name in PRESETS and name in names:
-            return _spec_from_text(file.read_text(), f"presets/{file.name}", name)
+            return _spec_from_data(data, f"presets/{file.name}", name)
         have += names
     raise InputError("preset", name, "a preset with an uncertainty spec: " + ", ".join(have))
 
 
-def _spec_from_text(text, where, name=None):
-    from drakecreep.params import PRESETS, _yaml_load, preset
-
-    try:
-        data = _yaml_load(text)  # the parameter files' reader: 2.0e11 is a number, as in the presets
-    except yaml.YAMLError:
-        raise InputError(where, "invalid YAML", "a YAML uncertainty spec") from None
+def _spec_from_data(data, where, name=None):
     if not isinstance(data, dict) or set(data) - {"preset", "sample", "fixed"} or "sample" not in data:
         raise InputError(where, data if not isinstance(data, dict) else sorted(data),
                          "a mapping with preset, sample and (optional) fixed")
