@@ -278,13 +278,25 @@ class SimulationParams(_Params):
     """Integrator, logging and the window over which metrics are taken."""
 
     integrator: str = _q("runge_kutta3", "-", choices=INTEGRATORS, doc="Drake integrator")
-    accuracy: float = _q(1e-4, "-", 0.0, 0.1, lo_open=True, doc="integrator target accuracy (scaled states)")
+    accuracy: float = _q(
+        0.0, "-", 0.0, 0.1,
+        doc="integrator target accuracy (scaled states); 0 = the friction law's default (sim.simulation.ACCURACY_BY_LAW)",
+    )
     max_step: float = _q(1e-3, "s", 0.0, 1.0, lo_open=True, doc="largest integrator step")
     log_period: float = _q(2.5e-4, "s", 0.0, 1.0, lo_open=True, doc="sample time of the recorded signals")
     acceleration_time: float = _q(0.05, "s", 0.0, 100.0, doc="reference ramps up to the feed in this time")
     steady_start: float = _q(1.0, "s", 0.0, doc="metrics are taken from this time to the end")
     stick_threshold: float = _q(0.05, "-", 0.0, 1.0, lo_open=True, doc="stuck when |v| < this x feed")
     backend: str = _q("compiled", "-", choices=("compiled", "leaf"), doc="symbolic fast path or leaf systems")
+    convergence_check: bool = field(
+        default=True, metadata=dict(unit="-", doc="rerun the start at 10x tighter accuracy and compare the verdict"),
+    )
+    convergence_window: float = _q(
+        0.5, "s", 0.0, 3600.0, lo_open=True, doc="steady-window time compared by the convergence check"
+    )
+    convergence_tolerance: float = _q(
+        0.1, "-", 0.0, 10.0, lo_open=True, doc="largest fluctuation change accepted by the check, x feed"
+    )
 
 
 @dataclass(frozen=True)

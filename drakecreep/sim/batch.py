@@ -24,7 +24,7 @@ from pydrake.systems.primitives import VectorLogSink
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
-from drakecreep.sim.simulation import make_simulator
+from drakecreep.sim.simulation import make_simulator, target_accuracy
 
 __all__ = ["BatchedFeedDrive", "batch_key", "simulate_batch"]
 
@@ -37,7 +37,7 @@ def batch_key(params, scenario):
         p.controller.position_feedback, p.controller.anti_windup, p.motor.current_loop_time_constant > 0,
         p.screw.mounting, p.sensors.encoder_counts_per_rev == 0, p.sensors.scale_resolution == 0,
         scenario.duration, p.simulation.log_period, p.simulation.steady_start, p.simulation.stick_threshold,
-        p.simulation.integrator, p.simulation.accuracy, p.simulation.max_step,
+        p.simulation.integrator, target_accuracy(p), p.simulation.max_step,
         getattr(scenario, "drive", "cascade"),
     )
 
@@ -243,7 +243,7 @@ def simulate_batch(cases):
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     start = time.perf_counter()
-    simulator = make_simulator(diagram, context, sim)
+    simulator = make_simulator(diagram, context, sim, target_accuracy(params))
     simulator.AdvanceTo(scenario.duration)
     wall = time.perf_counter() - start
     data = log.FindLog(context)

@@ -94,6 +94,7 @@ class FeedMetrics:
     following_error_rms: float  # m
     min_speed: float  # m/s
     max_speed: float  # m/s
+    converged: object = None  # True/False: the run's convergence check agreed; None: not checked
 
     @property
     def creep(self):
@@ -117,6 +118,7 @@ class FeedMetrics:
             "following_error_rms_um": self.following_error_rms * 1e6,
             "min_speed_mm_s": self.min_speed * 1e3,
             "max_speed_mm_s": self.max_speed * 1e3,
+            "converged": self.converged,
         }
 
     def as_dict(self):
