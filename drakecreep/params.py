@@ -196,11 +196,16 @@ class TableParams(_Params):
 
 @dataclass(frozen=True)
 class LoadCase(_Params):
-    """External load on the table (air cylinders in the paper): X axial, Y lateral, Z vertical."""
+    """External load on the table (air cylinders in the paper): X axial, Y lateral, Z vertical.
+
+    Sign convention: ``fx`` > 0 opposes a feed in +x; ``fz`` > 0 pushes the table down onto its guides
+    (adds to its weight), ``fz`` < 0 lifts it; ``fy`` either way. The guides' normal load is
+    ``|m g + fz| + |fy|`` (:func:`drakecreep.model.nut_table.friction_split`).
+    """
 
     fx: float = _q(0.0, "N", doc="axial force opposing the feed")
     fy: float = _q(0.0, "N", doc="lateral force on the guides")
-    fz: float = _q(0.0, "N", doc="vertical force on the guides (downwards positive)")
+    fz: float = _q(0.0, "N", doc="vertical force on the table, downwards positive (< 0 lifts)")
 
 
 @dataclass(frozen=True)

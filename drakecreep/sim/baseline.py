@@ -62,7 +62,7 @@ class BaselineModel:
         self.inertia = (p.motor.rotor_inertia + p.motor.coupling_inertia
                         + math.pi / 32 * sc.density * sc.length * sc.nominal_diameter**4)
         self.mass = p.table.mass + nut.mass
-        normal = self.mass * p.loads.gravity + abs(load.fz) + abs(load.fy)
+        normal = abs(self.mass * p.loads.gravity + load.fz) + abs(load.fy)
         self.fc = (p.table.seal_force + p.table.guide_friction_coefficient * normal
                    + 2 * math.pi * nut.preload_torque / sc.lead + nut.load_friction_coefficient * abs(load.fx))
         self.fs = p.friction.static_ratio * self.fc
