@@ -181,8 +181,12 @@ class NutParams(_Params):
     axial_stiffness: float = _q(51.6e6, "N/m", 0.0, lo_open=True, doc="screw-nut axial stiffness (Table 4)")
     axial_damping: float = _q(898.88, "N s/m", 0.0, doc="screw-nut axial damping (Table 4)")
     mass: float = _q(0.335, "kg", 0.0, doc="nut mass (Table 3), lumped into the table")
-    preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
-    load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
+    preload_torque: float = _q(
+        0.09, "N m", 0.0, doc="preload drag torque of the nut (THK: 0.05 tan(lead angle)^-0.5 Fa0 Ph / 2 pi)"
+    )
+    load_friction_coefficient: float = _q(
+        0.08, "-", 0.0, 1.0, doc="nut friction per N of axial load, 1/efficiency - 1 (0.05-0.11 for 0.9-0.95)"
+    )
 
 
 @dataclass(frozen=True)
@@ -231,7 +235,7 @@ class FrictionParams(_Params):
         1.0e-6, "m/s", 0.0, 1.0, lo_open=True, doc="tanh width replacing sign() in coulomb/stribeck"
     )
     nut_friction_on: str = _q(
-        "table", "-", choices=("table", "screw"),
+        "screw", "-", choices=("table", "screw"),
         doc="nut friction lumped on the table, or as a drag torque on the screw's rotation",
     )
 

@@ -6,7 +6,7 @@ import pytest
 from drakecreep.params import LoadCase, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
-from drakecreep.model.nut_table import NutTable, friction_levels, friction_split, moving_mass
+from drakecreep.model.nut_table import NutTable, friction_levels, friction_split, moving_mass, table_friction_levels
 
 
 def test_friction_levels_by_hand(paper):
@@ -45,7 +45,7 @@ def test_derivatives_by_hand(paper):
     c = table.CreateDefaultContext()
     table.get_input_port(0).FixValue(c, [500.0])
     f = paper.friction
-    fc, fs = friction_levels(paper, load)
+    fc, fs = table_friction_levels(paper, load)  # the guides' share: the nut's drag is on the screw
     x, v, z = 1e-3, 2e-4, 1e-7  # z: bristle deflection (m); the state is sigma0 z / Fc
     c.SetContinuousState([x, v, f.bristle_stiffness * z / fc])
     g = fc + (fs - fc) * math.exp(-((v / f.stribeck_velocity) ** 2))
@@ -67,6 +67,6 @@ def test_friction_dissipates_energy_over_a_run(short_paper, law):
     energy = np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(r.time))
     assert energy > 0
     # and it is most of the work the friction level would do over the travel
-    fc, _ = friction_levels(p, p.load_case(3))
+    fc, _ = table_friction_levels(p, p.load_case(3))
     travel = r.signals["table_position"][-1] - r.signals["table_position"][0]
     assert energy > 0.5 * fc * travel
