@@ -295,7 +295,10 @@ class SimulationParams(_Params):
     log_period: float = _q(2.5e-4, "s", 0.0, 1.0, lo_open=True, doc="sample time of the recorded signals")
     acceleration_time: float = _q(0.05, "s", 0.0, 100.0, doc="reference ramps up to the feed in this time")
     steady_start: float = _q(1.0, "s", 0.0, doc="metrics are taken from this time to the end")
-    stick_threshold: float = _q(0.05, "-", 0.0, 1.0, lo_open=True, doc="stuck when |v| < this x feed")
+    stick_threshold: float = _q(
+        0.2, "-", 0.0, 1.0, lo_open=True,
+        doc="stuck when v < this x feed (above the regularized laws' creep while stuck, see sim.metrics.stick_slip)",
+    )
     backend: str = _q("compiled", "-", choices=("compiled", "leaf"), doc="symbolic fast path or leaf systems")
     convergence_check: bool = field(
         default=True, metadata=dict(unit="-", doc="rerun the start at 10x tighter accuracy and compare the verdict"),
