@@ -20,8 +20,11 @@ A creep verdict must not depend on the integrator. Two things see to it:
   tighter again; ``metrics.converged`` says whether the last check agreed. The check restarts from t = 0
   because the missed stick-slip is decided in the start-up transient: steady sliding at 0.5 mm/s is
   locally stable (the Stribeck slope has faded), so switching a smooth run to 1e-6 after 1 s stays smooth.
-  Cost: the window (1.5 s of a 5 s run by default) at 10x tighter accuracy, about +70 % wall time on
-  LuGre runs; fixed-step integrators are not checked.
+  Cost: the start up to ``steady_start + convergence_window`` (1.5 s of a 5 s run by default) at 10x
+  tighter accuracy; measured +45 % wall time on a 3 s LuGre run at 0.1 mm/s (3.1 -> 4.4 s) and about
+  2x on static Stribeck (1e-6 is expensive there). Off for sweeps that must be fast
+  (``simulation.convergence_check: false``); the batched sweep path has no check. Fixed-step
+  integrators are not checked.
 
 The default backend compiles the diagram into ``SymbolicVectorSystem``s (:mod:`drakecreep.sim.compiled`);
 ``backend="leaf"`` simulates the Python leaf systems directly (same equations, slower; kept as the
