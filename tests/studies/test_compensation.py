@@ -61,12 +61,19 @@ def test_dither_adds_its_own_ripple_above_creep(one_mm_s):
     assert one_mm_s["dither"].metrics.max_fluctuation > 10 * one_mm_s["none"].metrics.max_fluctuation
 
 
-def test_no_motor_side_compensator_removes_the_table_mode_creep(short_paper):
-    # the documented negative result: at 0.1 mm/s the table sticks and slips on the screw spring at
-    # ~70 Hz; a torque added at the motor (10x the table's inertia) does not remove it
-    rows = evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,), duration=1.0)
-    assert all(r["creep"] for r in rows)
-    assert all(r["stick_fraction_vs_none"] > 0.9 for r in rows)
+def test_motor_side_compensators_cut_but_do_not_remove_the_paper_rig_creep(short_paper):
+    # issue 15 defect 2: with the ball nut's drag on the screw (its physical place, catalogue-sized: 148 N of
+    # the 157 N at load case 3), most of the friction is on the motor side of the screw's spring, within a
+    # motor torque's reach. At 0.1 mm/s the table still sticks and slips (the guides' share on the ~70 Hz
+    # screw mode), but the model-based compensators and dither cut the fluctuation ~2x (measured 0.42-0.46 of
+    # none in this 1 s run) while feedforward at the reference speed does not. With the nut lumped on the
+    # table (the former default) no compensator changed the stick fraction by more than 10 %.
+    rows = {r["method"]: r for r in evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,),
+                                             duration=1.0)}
+    assert all(r["creep"] for r in rows.values())
+    for method in ("lugre", "dob", "dither"):
+        assert rows[method]["fluctuation_vs_none"] < 0.6, method
+    assert rows["static"]["fluctuation_vs_none"] > 0.9
 
 
 @pytest.fixture(scope="module")
