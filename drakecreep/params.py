@@ -289,8 +289,12 @@ class NutParams(_Params):
     axial_stiffness: float = _q(51.6e6, "N/m", 0.0, lo_open=True, doc="screw-nut axial stiffness (Table 4)")
     axial_damping: float = _q(898.88, "N s/m", 0.0, doc="screw-nut axial damping (Table 4)")
     mass: float = _q(0.335, "kg", 0.0, 1e3, doc="nut mass (Table 3), lumped into the table")
-    preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
-    load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
+    preload_torque: float = _q(
+        0.09, "N m", 0.0, doc="preload drag torque of the nut (THK: 0.05 tan(lead angle)^-0.5 Fa0 Ph / 2 pi)"
+    )
+    load_friction_coefficient: float = _q(
+        0.08, "-", 0.0, 1.0, doc="nut friction per N of axial load, 1/efficiency - 1 (0.05-0.11 for 0.9-0.95)"
+    )
     seat_joint_stiffness: float = _q(
         0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
     )
@@ -308,11 +312,16 @@ class TableParams(_Params):
 
 @dataclass(frozen=True)
 class LoadCase(_Params):
-    """External load on the table (air cylinders in the paper): X axial, Y lateral, Z vertical."""
+    """External load on the table (air cylinders in the paper): X axial, Y lateral, Z vertical.
+
+    Sign convention: ``fx`` > 0 opposes a feed in +x; ``fz`` > 0 pushes the table down onto its guides
+    (adds to its weight), ``fz`` < 0 lifts it; ``fy`` either way. The guides' normal load is
+    ``|m g + fz| + |fy|`` (:func:`drakecreep.model.nut_table.friction_split`).
+    """
 
     fx: float = _q(0.0, "N", doc="axial force opposing the feed")
     fy: float = _q(0.0, "N", doc="lateral force on the guides")
-    fz: float = _q(0.0, "N", doc="vertical force on the guides (downwards positive)")
+    fz: float = _q(0.0, "N", doc="vertical force on the table, downwards positive (< 0 lifts)")
 
 
 @dataclass(frozen=True)
@@ -338,7 +347,7 @@ class FrictionParams(_Params):
         1.0e-6, "m/s", 0.0, 1.0, lo_open=True, doc="tanh width replacing sign() in coulomb/stribeck"
     )
     nut_friction_on: str = _q(
-        "table", "-", choices=("table", "screw"),
+        "screw", "-", choices=("table", "screw"),
         doc="nut friction lumped on the table, or as a drag torque on the screw's rotation",
     )
     gms_elements: int = _q(4, "-", 1, 50, doc="GMS: number of Maxwell-slip elements (sum of stiffnesses = sigma0)")
@@ -394,13 +403,28 @@ class SimulationParams(_Params):
     """Integrator, logging and the window over which metrics are taken."""
 
     integrator: str = _q("runge_kutta3", "-", choices=INTEGRATORS, doc="Drake integrator")
-    accuracy: float = _q(1e-4, "-", 0.0, 0.1, lo_open=True, doc="integrator target accuracy (scaled states)")
+    accuracy: float = _q(
+        0.0, "-", 0.0, 0.1,
+        doc="integrator target accuracy (scaled states); 0 = the friction law's default (sim.simulation.ACCURACY_BY_LAW)",
+    )
     max_step: float = _q(1e-3, "s", 0.0, 1.0, lo_open=True, doc="largest integrator step")
     log_period: float = _q(2.5e-4, "s", 0.0, 1.0, lo_open=True, doc="sample time of the recorded signals")
     acceleration_time: float = _q(0.05, "s", 0.0, 100.0, doc="reference ramps up to the feed in this time")
     steady_start: float = _q(1.0, "s", 0.0, doc="metrics are taken from this time to the end")
-    stick_threshold: float = _q(0.05, "-", 0.0, 1.0, lo_open=True, doc="stuck when |v| < this x feed")
+    stick_threshold: float = _q(
+        0.2, "-", 0.0, 1.0, lo_open=True,
+        doc="stuck when v < this x feed (above the regularized laws' creep while stuck, see sim.metrics.stick_slip)",
+    )
     backend: str = _q("compiled", "-", choices=("compiled", "leaf"), doc="symbolic fast path or leaf systems")
+    convergence_check: bool = field(
+        default=True, metadata=dict(unit="-", doc="rerun the start at 10x tighter accuracy and compare the verdict"),
+    )
+    convergence_window: float = _q(
+        0.5, "s", 0.0, 3600.0, lo_open=True, doc="steady-window time compared by the convergence check"
+    )
+    convergence_tolerance: float = _q(
+        0.1, "-", 0.0, 10.0, lo_open=True, doc="largest fluctuation change accepted by the check, x feed"
+    )
 
 
 @dataclass(frozen=True)

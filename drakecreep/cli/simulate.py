@@ -122,9 +122,21 @@ def _print_text(result, paths):
             ("stick fraction", f"{s['stick_fraction'] * 100:.2f} %"),
             ("stick-slip cycles", f"{s['stick_slip_cycles']} ({s['stick_slip_frequency_Hz']:.1f} Hz)"),
             ("creep (stick-slip)", "yes" if s["creep"] else "no"),
+            ("converged", _converged_text(s)),
             ("travel error max / rms", f"{s['following_error_max_um']:.3f} / {s['following_error_rms_um']:.3f} um"),
         ]
         width = max(len(r[0]) for r in rows)
         for name, value in rows:
             print(f"  {name:<{width}}  {value}")
     print("wrote " + ", ".join(str(p) for p in paths.values()))
+
+
+def _converged_text(summary):
+    """The convergence check's verdict in words (drakecreep.sim.simulation)."""
+    c = summary.get("converged")
+    if c is None:
+        return "not checked"
+    acc = summary.get("accuracy")
+    where = f" at accuracy {acc:g}" if acc else ""
+    return (f"yes{where}, checked at 10x tighter" if c else
+            f"NO{where}: a 10x tighter run differs (verdict or fluctuation); read the figures as indicative")

@@ -2,7 +2,7 @@
 
 Friction levels (Coulomb force) of the guides and of the nut::
 
-    Fc = seal_force + mu_guide (m g + |Fz| + |Fy|)        guides and seals
+    Fc = seal_force + mu_guide (|m g + Fz| + |Fy|)        guides and seals
        + 2 pi T_preload / Ph + mu_nut |Fx|                 ball nut: preload drag + axial load
     Fs = static_ratio * Fc
 
@@ -15,7 +15,11 @@ Where the nut's share acts is ``friction.nut_friction_on``:
   of the screw's elasticity), in :mod:`drakecreep.model.nut_friction`; the table carries only the guides.
 
 The axial load ``Fx`` of the load case opposes the feed (+x) as a constant force, as the paper's air
-cylinders do.
+cylinders do. The vertical load ``Fz`` is positive downwards, pressing the table onto its guides like
+its weight (the paper's Table 7 cylinders load the table from above); a lifting load (``Fz < 0``)
+unloads the guides, down to zero at ``Fz = -m g`` and lifting the table against the guides' upper
+raceways beyond that (rolling guides carry load in both directions, hence the absolute value).
+The lateral load ``Fy`` loads the guides' side raceways either way: ``|Fy|``.
 """
 
 import math
@@ -48,7 +52,7 @@ def friction_split(params, load):
     guides, nut : float
         Their sum is :func:`friction_levels`' ``Fc``.
     """
-    normal = moving_mass(params) * params.loads.gravity + abs(load.fz) + abs(load.fy)
+    normal = abs(moving_mass(params) * params.loads.gravity + load.fz) + abs(load.fy)
     guides = params.table.seal_force + params.table.guide_friction_coefficient * normal
     nut = 2.0 * math.pi * params.nut.preload_torque / params.screw.lead + params.nut.load_friction_coefficient * abs(load.fx)
     return guides, nut

@@ -28,14 +28,12 @@ __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
 def unsupported(params):
     """Why these plain-Python equations cannot run ``params``: ``(field, value, allowed)``, or None.
 
-    They cover the base drive (coulomb, stribeck or lugre friction): no disturbances, no friction compensation, nut friction on the table.
+    They cover the base drive (coulomb, stribeck or lugre friction): no disturbances, no friction compensation;
+    the nut's friction on the table or on the screw.
     """
     p = params
     if p.friction.law not in ("coulomb", "stribeck", "lugre"):
         return ("friction.law", p.friction.law, "coulomb, stribeck or lugre (the plain-Python equations)")
-    if p.friction.nut_friction_on != "table":
-        return ("friction.nut_friction_on", p.friction.nut_friction_on,
-                "table (the plain-Python equations lump the nut's friction on the table)")
     d = p.disturbance
     if d.lead_error_amplitude > 0 or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
@@ -65,10 +63,15 @@ class BaselineModel:
         self.inertia = (p.motor.rotor_inertia + p.motor.coupling_inertia
                         + math.pi / 32 * sc.density * sc.length * sc.nominal_diameter**4)
         self.mass = p.table.mass + nut.mass
-        normal = self.mass * p.loads.gravity + abs(load.fz) + abs(load.fy)
-        self.fc = (p.table.seal_force + p.table.guide_friction_coefficient * normal
-                   + 2 * math.pi * nut.preload_torque / sc.lead + nut.load_friction_coefficient * abs(load.fx))
+        normal = abs(self.mass * p.loads.gravity + load.fz) + abs(load.fy)
+        guides = p.table.seal_force + p.table.guide_friction_coefficient * normal
+        nut_fc = 2 * math.pi * nut.preload_torque / sc.lead + nut.load_friction_coefficient * abs(load.fx)
+        # the nut's share acts on the table with the guides, or on the screw's rotation (its own law state)
+        on_screw = p.friction.nut_friction_on == "screw" and nut_fc > 0
+        self.fc = guides if on_screw else guides + nut_fc
         self.fs = p.friction.static_ratio * self.fc
+        self.fc_nut = nut_fc if on_screw else 0.0
+        self.fs_nut = p.friction.static_ratio * self.fc_nut
         self.limit = p.motor.peak_torque * 2 * math.pi / sc.lead
         g = p.controller
         self.tracking = g.velocity_integral_gain / g.velocity_gain if (g.anti_windup and g.velocity_integral_gain > 0) else 0.0
@@ -77,6 +80,7 @@ class BaselineModel:
         self.ic = initial_conditions(p, scenario)
         self.lag = p.motor.current_loop_time_constant
         self.nz = 1 if p.friction.law == "lugre" else 0
+        self.nz_nut = self.nz if self.fc_nut > 0 else 0
 
     # ---------------------------------------------------------------- pieces
     def stiffness(self, x):
@@ -88,20 +92,23 @@ class BaselineModel:
         c = k * k * (cb / kb**2 + cn / kn**2)
         return k, c
 
-    def g(self, v):
+    def g(self, v, fc=None, fs=None):
         f = self.p.friction
-        return self.fc + (self.fs - self.fc) * math.exp(-abs(v / f.stribeck_velocity) ** f.stribeck_exponent)
+        fc, fs = (self.fc, self.fs) if fc is None else (fc, fs)
+        return fc + (fs - fc) * math.exp(-abs(v / f.stribeck_velocity) ** f.stribeck_exponent)
 
-    def friction(self, v, z):
+    def friction(self, v, z, fc=None, fs=None):
+        """Friction force and its state rate at speed ``v``; levels default to the table's."""
         f = self.p.friction
+        fc, fs = (self.fc, self.fs) if fc is None else (fc, fs)
         if f.law == "coulomb":
-            return self.fc * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
+            return fc * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
         if f.law == "stribeck":
-            return self.g(v) * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
+            return self.g(v, fc, fs) * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
         # z is the bristle load as a fraction of Fc, w = sigma0 z_deflection / Fc (see LuGreFriction)
-        deflection_rate = v - abs(v) * z * self.fc / self.g(v)
-        friction = self.fc * z + f.bristle_damping * deflection_rate + f.viscous * v
-        return friction, f.bristle_stiffness / self.fc * deflection_rate
+        deflection_rate = v - abs(v) * z * fc / self.g(v, fc, fs)
+        friction = fc * z + f.bristle_damping * deflection_rate + f.viscous * v
+        return friction, f.bristle_stiffness / fc * deflection_rate
 
     def reference(self, t):
         v, ta, x0 = self.scenario.feed, self.p.simulation.acceleration_time, self.ic["x_ref0"]
@@ -133,6 +140,7 @@ class BaselineModel:
         tau_state = s[i + 2] if self.lag > 0 else None
         x, v = s[i + 2 + (self.lag > 0)], s[i + 3 + (self.lag > 0)]
         z = s[i + 4 + (self.lag > 0)] if self.nz else 0.0
+        z_nut = s[i + 4 + (self.lag > 0) + self.nz] if self.nz_nut else 0.0
         if not self.sampled:
             x_ref, v_ref = self.reference(t)
             g = self.p.controller
@@ -144,12 +152,15 @@ class BaselineModel:
         k, c = self.stiffness(x)
         spring = k * (theta * self.ratio - x) + c * (omega * self.ratio - v)
         friction, zdot = self.friction(v, z)
-        out += [omega, (tau - spring * self.ratio - self.p.motor.viscous_damping * omega) / self.inertia]
+        nut, znut_dot = self.friction(omega * self.ratio, z_nut, self.fc_nut, self.fs_nut) if self.fc_nut > 0 else (0.0, 0.0)
+        out += [omega, (tau - (spring + nut) * self.ratio - self.p.motor.viscous_damping * omega) / self.inertia]
         if self.lag > 0:
             out.append((tau_cmd - tau) / self.lag)
         out += [v, (spring - self.fx - friction) / self.mass]
         if self.nz:
             out.append(zdot)
+        if self.nz_nut:
+            out.append(znut_dot)
         return out
 
     def update(self, t, s, xd):
@@ -174,7 +185,7 @@ class BaselineModel:
         ic = self.ic
         s = [] if self.sampled else [ic["force0"]]
         s += [ic["theta0"], 0.0] + ([ic["force0"] * self.ratio] if self.lag > 0 else [])
-        s += [0.0, 0.0] + [0.0] * self.nz
+        s += [0.0, 0.0] + [0.0] * (self.nz + self.nz_nut)
         xd = [0.0, ic["force0"], ic["theta_counted0"], ic["force0"], 0.0]
         return np.array(s), xd
 

@@ -22,10 +22,11 @@ from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import VectorLogSink
 
 from drakecreep.model.screw import bearing_element, nut_element
+from drakecreep.model.nut_friction import nut_friction_levels
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
-from drakecreep.sim.simulation import make_simulator
+from drakecreep.sim.simulation import make_simulator, target_accuracy
 
 __all__ = ["BatchedFeedDrive", "batch_key", "simulate_batch"]
 
@@ -38,8 +39,9 @@ def batch_key(params, scenario):
         p.controller.position_feedback, p.controller.anti_windup, p.motor.current_loop_time_constant > 0,
         p.screw.mounting, p.sensors.encoder_counts_per_rev == 0, p.sensors.scale_resolution == 0,
         scenario.duration, p.simulation.log_period, p.simulation.steady_start, p.simulation.stick_threshold,
-        p.simulation.integrator, p.simulation.accuracy, p.simulation.max_step,
+        p.simulation.integrator, target_accuracy(p), p.simulation.max_step,
         getattr(scenario, "drive", "cascade"),
+        nut_friction_levels(p, p.load_case(scenario.load_case))[0] > 0,  # nut friction on the screw: one more law
     )
 
 
@@ -67,6 +69,8 @@ class _Columns:
         self.inertia = col(lambda m: m.inertia)
         self.mass = col(lambda m: m.mass)
         self.fc, self.fs, self.fx = col(lambda m: m.fc), col(lambda m: m.fs), col(lambda m: m.fx)
+        self.nut = first.fc_nut > 0  # the nut's friction on the screw (batch_key: all cases or none)
+        self.fc_nut, self.fs_nut = col(lambda m: m.fc_nut), col(lambda m: m.fs_nut)
         self.limit, self.tracking = col(lambda m: m.limit), col(lambda m: m.tracking)
         self.enc = col(lambda m: m.enc)
         self.tc = col(lambda m: m.lag if m.lag > 0 else 1.0)
@@ -97,6 +101,8 @@ class _Columns:
         self.gaussian = bool(np.all(self.delta == 2.0))
         self.drop = self.fs - self.fc
         self.s0_per_fc = self.s0 / self.fc
+        self.drop_nut = self.fs_nut - self.fc_nut
+        self.s0_per_fc_nut = self.s0 / np.where(self.nut, self.fc_nut, 1.0)
 
 
 def _quantize(x, res):
@@ -107,7 +113,7 @@ def _quantize(x, res):
 class BatchedFeedDrive(LeafSystem):
     """N feed-drive cases (sampled cascade) in one system.
 
-    Continuous state: the N cases' ``[theta, omega(, tau), x, v(, w)]`` stacked state-major
+    Continuous state: the N cases' ``[theta, omega(, tau), x, v(, w(, w_nut))]`` stacked state-major
     (``state[i * N + k]`` is state ``i`` of case ``k``); discrete state: the controllers'
     ``[v_cmd, integrator, theta_prev, force, tick]``, stacked the same way. Output ``table``:
     ``[x_ref, x, v]`` of every case, stacked.
@@ -137,11 +143,22 @@ class BatchedFeedDrive(LeafSystem):
         v = np.where(ramping, c.feed * t / ta, c.feed)
         return x, v
 
-    def _g(self, v):
+    def _g(self, v, fc=None, drop=None):
         c = self.c
+        fc, drop = (c.fc, c.drop) if fc is None else (fc, drop)
         q = v * c.inv_vs
         shape = q * q if c.gaussian else np.abs(q) ** c.delta
-        return c.fc + c.drop * np.exp(-shape)
+        return fc + drop * np.exp(-shape)
+
+    def _friction(self, v, w, fc, drop):
+        """Friction force and (LuGre) bristle-state rate of every case at speeds ``v``."""
+        c = self.c
+        if c.law == "lugre":
+            rate = v - np.abs(v) * w * fc / self._g(v, fc, drop)
+            return fc * w + c.s1 * rate + c.fv * v, rate
+        if c.law == "stribeck":
+            return self._g(v, fc, drop) * np.tanh(v / c.vreg) + c.fv * v, None
+        return fc * np.tanh(v / c.vreg) + c.fv * v, None
 
     def _split(self, s):
         c, lag = self.c, self.c.lag
@@ -171,19 +188,19 @@ class BatchedFeedDrive(LeafSystem):
         k = 1.0 / (c.inv_kb_kn + 1.0 / ks)
         damping = k * k * c.damping_per_k2
         spring = k * (theta * c.ratio - x) + damping * (omega * c.ratio - v)
-        if c.law == "lugre":
-            rate = v - np.abs(v) * w * c.fc / self._g(v)
-            friction = c.fc * w + c.s1 * rate + c.fv * v
-        elif c.law == "stribeck":
-            friction = self._g(v) * np.tanh(v / c.vreg) + c.fv * v
-        else:
-            friction = c.fc * np.tanh(v / c.vreg) + c.fv * v
-        rows = [omega, (tau - spring * c.ratio - c.bm * omega) / c.inertia]
+        friction, rate = self._friction(v, w, c.fc, c.drop)
+        nut, nut_rate = 0.0, None
+        if c.nut:
+            w_nut = s.reshape(self.ns, c.n)[5 + c.lag] if c.nz else None
+            nut, nut_rate = self._friction(omega * c.ratio, w_nut, c.fc_nut, c.drop_nut)
+        rows = [omega, (tau - (spring + nut) * c.ratio - c.bm * omega) / c.inertia]
         if c.lag:
             rows.append((tau_cmd - tau) / c.tc)
         rows += [v, (spring - c.fx - friction) / c.mass]
         if c.nz:
             rows.append(c.s0_per_fc * rate)
+        if c.nz and c.nut:
+            rows.append(c.s0_per_fc_nut * nut_rate)
         derivatives.get_mutable_vector().SetFromVector(np.concatenate(rows))
 
     def _update(self, context, discrete_state):
@@ -242,7 +259,7 @@ def simulate_batch(cases):
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     start = time.perf_counter()
-    simulator = make_simulator(diagram, context, sim)
+    simulator = make_simulator(diagram, context, sim, target_accuracy(params))
     simulator.AdvanceTo(scenario.duration)
     wall = time.perf_counter() - start
     data = log.FindLog(context)

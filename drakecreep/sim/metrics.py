@@ -46,7 +46,13 @@ def stick_slip(speed, feed, threshold):
     """Stick fraction and number of stick-slip cycles of a speed record.
 
     Speeds are taken in the feed direction. The table is stuck while it moves slower than
-    ``threshold * |feed|`` (including a presliding rebound backwards); it must exceed the feed itself
+    ``threshold * |feed|`` (including a presliding rebound backwards). The threshold is a share of the
+    feed, not an absolute speed, and must stand above the speed a stuck table still creeps at in the
+    model: the regularized ``coulomb``/``stribeck`` laws (``tanh(v / v_reg)``) hold the breakaway force only
+    while creeping at ``v_reg atanh(F / Fs)``, 1-3 um/s for ``v_reg`` = 1 um/s, and LuGre creeps at the
+    bristles' presliding rate. With the default 0.2 that creep reads as stuck down to feeds of about
+    0.01 mm/s (0.2 x 10 um/s = 2 um/s); the former 0.05 counted it as sliding below about 0.05 mm/s.
+    It must exceed the feed itself
     to count as slipping again. A slip that makes up for a stick overshoots the feed, while noise at the
     threshold and the ringing after a slip do not, so they are not counted as cycles.
     A cycle is one entry into sticking from slipping.
@@ -94,6 +100,7 @@ class FeedMetrics:
     following_error_rms: float  # m
     min_speed: float  # m/s
     max_speed: float  # m/s
+    converged: object = None  # True/False: the run's convergence check agreed; None: not checked
 
     @property
     def creep(self):
@@ -117,6 +124,7 @@ class FeedMetrics:
             "following_error_rms_um": self.following_error_rms * 1e6,
             "min_speed_mm_s": self.min_speed * 1e3,
             "max_speed_mm_s": self.max_speed * 1e3,
+            "converged": self.converged,
         }
 
     def as_dict(self):

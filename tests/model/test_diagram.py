@@ -21,8 +21,11 @@ def test_named_ports_and_signals(paper):
     names = {drive.diagram.get_output_port(i).get_name() for i in range(drive.diagram.num_output_ports())}
     for _, (system, port, _), _ in SIGNALS:
         assert f"{system}.{port}" in names
-    assert set(drive.systems) == {"reference", "controller", "motor", "screw", "table", "encoder", "scale"}
-    assert drive.signal_names[-1] == "friction_state_0"  # LuGre has one bristle state
+    # the ball nut's drag torque on the screw (the default) and the adder that puts it on the motor's load
+    assert set(drive.systems) == {"reference", "controller", "motor", "screw", "table", "encoder", "scale",
+                                  "nut_friction", "motor_load_sum"}
+    assert drive.signal_names[-2] == "friction_state_0"  # LuGre has one bristle state
+    assert drive.signal_names[-1] == "nut_friction_force"  # the nut's drag on the screw
 
 
 def test_whole_diagram_converts_to_autodiff_and_symbolic(paper):

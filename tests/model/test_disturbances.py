@@ -11,7 +11,8 @@ from drakecreep.sim.simulation import simulate
 
 def test_disturbances_off_leave_the_diagram_unchanged(paper):
     names = {s.get_name() for s in build_diagram(paper, Scenario()).diagram.GetSystems()}
-    assert names == {"reference", "controller", "motor", "screw", "table", "encoder", "scale"}
+    assert names == {"reference", "controller", "motor", "screw", "table", "encoder", "scale",
+                     "nut_friction", "motor_load_sum"}  # the nut's drag on the screw (the default)
 
 
 @pytest.fixture(scope="module")

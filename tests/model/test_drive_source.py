@@ -19,7 +19,12 @@ SOFT = 1.0e6  # N/m screw-nut stiffness: a soft spring dominating the axial chai
 
 @pytest.fixture(scope="module")
 def soft():
-    return with_value(preset("paper"), "nut.axial_stiffness", SOFT)
+    # the paper's Fig. 2 mechanism: all friction on the driven mass, as eq. 11 and lumped() assume
+    # (with the nut's drag on the screw, the motor turning at a fixed speed would take it out of the dynamics)
+    # and the nut at the friction level this test was measured with (0.01 N m, 0.01: 26 N at load case 3);
+    # the catalogue nut (157 N) moves v0 to 7.9 mm/s, above the speeds below
+    p = with_value(with_value(preset("paper"), "nut.axial_stiffness", SOFT), "friction.nut_friction_on", "table")
+    return with_value(with_value(p, "nut.preload_torque", 0.01), "nut.load_friction_coefficient", 0.01)
 
 
 def test_diagram_has_no_controller_and_the_motor_turns_at_the_feed(soft):

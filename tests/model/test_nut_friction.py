@@ -22,9 +22,12 @@ def test_levels_split_and_sum(paper, on_screw):
     load = paper.load_case(3)
     guides, nut = friction_split(paper, load)
     assert guides + nut == pytest.approx(friction_levels(paper, load)[0])
-    assert nut == pytest.approx(2 * math.pi * 0.01 / 5e-3 + 0.01 * 434)
-    assert table_friction_levels(paper, load) == friction_levels(paper, load)  # default: all on the table
-    assert nut_friction_levels(paper, load) == (0.0, 0.0)
+    # the preset's catalogue values: Tp = 0.09 N m (THK formula, Fa0 = 579 N), 1/efficiency - 1 = 0.08
+    assert nut == pytest.approx(2 * math.pi * 0.09 / 5e-3 + 0.08 * 434)
+    assert paper.friction.nut_friction_on == "screw"  # the default: the nut's drag on the screw
+    on_table = with_value(paper, "friction.nut_friction_on", "table")
+    assert table_friction_levels(on_table, load) == friction_levels(on_table, load)  # all on the table
+    assert nut_friction_levels(on_table, load) == (0.0, 0.0)
     assert table_friction_levels(on_screw, load)[0] == pytest.approx(guides)
     assert nut_friction_levels(on_screw, load)[0] == pytest.approx(nut)
 
@@ -71,8 +74,7 @@ def test_compiled_equals_leaf_with_the_nut_on_the_screw(on_screw):
 
 
 def test_plain_python_and_batch_paths_refuse_what_they_do_not_model(on_screw, paper):
-    with pytest.raises(InputError, match="nut_friction_on"):
-        BaselineModel(on_screw, Scenario())
+    assert BaselineModel(on_screw, Scenario()).fc_nut > 0  # the plain-Python equations model the nut on the screw
     with pytest.raises(InputError, match="disturbance"):
         BaselineModel(preset("paper_calibrated"), Scenario())
     with pytest.raises(InputError, match="compensation"):
@@ -80,4 +82,4 @@ def test_plain_python_and_batch_paths_refuse_what_they_do_not_model(on_screw, pa
     cases = make_cases(paper, [dict(feed=1e-3), dict(feed=2e-3)], dict(duration=1.5), feed_report)
     assert isinstance(_batches(cases, 10, feed_report)[0], _Batch)
     cases = make_cases(on_screw, [dict(feed=1e-3), dict(feed=2e-3)], dict(duration=0.8), feed_report)
-    assert not any(isinstance(u, _Batch) for u in _batches(cases, 10, feed_report))
+    assert isinstance(_batches(cases, 10, feed_report)[0], _Batch)

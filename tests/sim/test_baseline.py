@@ -11,6 +11,11 @@ from drakecreep.sim.simulation import simulate
 def test_independent_scipy_model_agrees_with_drake(short_paper, sampled):
     """The plain-Python equations and the Drake leaf systems are written separately: they must agree."""
     p = with_value(with_value(short_paper, "controller.sampled", sampled), "simulation.accuracy", 1e-8)
+    p = with_value(p, "simulation.convergence_check", False)  # an equation check, not a verdict
+    if not sampled:
+        # the continuous LSODA run with the nut's LuGre state on the screw takes ~4 min on this machine
+        # (measured); the sampled case checks the nut on the screw, this one the nut lumped on the table
+        p = with_value(p, "friction.nut_friction_on", "table")
     scenario = Scenario(feed=1e-3, load_case=3, duration=0.4)
     base = simulate_baseline(p, scenario, rtol=1e-9, atol=1e-13)
     drake = simulate(p, scenario)

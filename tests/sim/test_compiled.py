@@ -10,10 +10,11 @@ from drakecreep.sim.simulation import simulate
 def test_symbolic_equations_evaluate_like_the_leaf_systems(paper):
     drive = build_diagram(paper, Scenario(feed=1e-3))
     eq = symbolic_equations(drive)
-    assert len(eq.xc) == 6 and len(eq.xd) == 5 and eq.period == paper.controller.velocity_period
+    # 7 states: motor 2, current lag 1, table 2, LuGre bristles of the table and of the nut on the screw
+    assert len(eq.xc) == 7 and len(eq.xd) == 5 and eq.period == paper.controller.velocity_period
     c = drive.diagram.CreateDefaultContext()
     c.SetTime(0.02)
-    xc = eq.xc0 + np.array([1e-3, 0.5, 0.01, 2e-6, 1e-4, 0.3])
+    xc = eq.xc0 + np.array([1e-3, 0.5, 0.01, 2e-6, 1e-4, 0.3, 0.2])
     c.SetContinuousState(xc)
     env = {eq.time: 0.02, **dict(zip(eq.xc, xc)), **dict(zip(eq.xd, eq.xd0))}
     expected = drive.diagram.EvalTimeDerivatives(c).CopyToVector()
@@ -33,4 +34,4 @@ def test_compiled_and_leaf_backends_give_the_same_trajectory(short_paper):
 def test_continuous_controller_compiles_without_discrete_state(paper):
     drive = build_diagram(with_value(paper, "controller.sampled", False), Scenario())
     compiled = compile_diagram(drive)
-    assert compiled.sampler is None and len(compiled.equations.xc) == 7
+    assert compiled.sampler is None and len(compiled.equations.xc) == 8  # + the nut's LuGre state

@@ -44,3 +44,17 @@ def test_following_error_and_window():
     assert m.report()["following_error_max_um"] == pytest.approx(2.0)
     with pytest.raises(InputError, match="steady_start"):
         feed_metrics(t, t, t, t, 1e-3, 5.0, 0.05)
+
+
+def test_default_threshold_reads_the_regularized_creep_of_a_stuck_table_as_stuck():
+    """At 0.01 mm/s a stuck table under a tanh-regularized law (v_reg = 1 um/s) still creeps at
+    v_reg atanh(F/Fs), 1.5 um/s at 90 % of breakaway: the default share of the feed must call that stuck."""
+    from drakecreep.params import FrictionParams, SimulationParams
+
+    feed = 1e-5
+    creep = FrictionParams().regularization_velocity * np.arctanh(0.9)
+    phase = np.arange(4000) % 400
+    v = np.where(phase < 300, creep, 3.0 * feed)  # stuck 3/4 of each cycle, then a slip past the feed
+    fraction, cycles = stick_slip(v, feed, SimulationParams().stick_threshold)
+    assert fraction == pytest.approx(0.75, abs=0.01)
+    assert cycles == 9

@@ -56,8 +56,8 @@ def test_save_writes_csv_json_yaml_and_the_plot_reads_it(low_feed, tmp_path):
 def test_a_failing_run_keeps_what_was_computed(short_paper, monkeypatch):
     real = simulation.make_simulator
 
-    def failing(system, context, sim):
-        simulator = real(system, context, sim)
+    def failing(system, context, sim, *args):
+        simulator = real(system, context, sim, *args)
 
         class Breaks:
             def AdvanceTo(self, t):
@@ -102,5 +102,41 @@ def test_gms_friction_runs_in_the_drake_diagram_and_sticks_at_low_feed():
     p = with_value(preset("paper"), "friction.law", "gms")
     r = simulate(p, Scenario(feed=0.1e-3, load_case=3, duration=1.3))
     assert r.ok
+    # with the nut's friction on the screw (issue 15, defect 2) the cycles are slower than when this test was
+    # written (10+ in the 0.3 s window then, 5 now); the mean speed over so short a window of stick-slip is
+    # not the feed (8.9e-5 m/s here; 2.6 % off over a 1 s window, measured, too slow for a unit test)
+    assert r.metrics.creep and r.metrics.stick_slip_cycles >= 3
+
+
+def test_accuracy_defaults_per_friction_law(paper):
+    assert paper.simulation.accuracy == 0.0  # the presets leave it to the friction law
+    assert simulation.target_accuracy(with_value(paper, "friction.law", "lugre")) == 1e-4
+    for law in ("stribeck", "coulomb"):
+        assert simulation.target_accuracy(with_value(paper, "friction.law", law)) == 1e-5
+    assert simulation.target_accuracy(with_value(paper, "simulation.accuracy", 3e-6)) == 3e-6
+
+
+def test_convergence_check_catches_a_missed_stick_slip(short_paper):
+    """Static Stribeck at 0.5 mm/s reads smooth at accuracy 1e-4 (measured) but stick-slips at 1e-5 and
+    1e-6: the check sees the verdict change, reruns at 1e-5 and confirms it against 1e-6."""
+    p = with_value(with_value(short_paper, "friction.law", "stribeck"), "simulation.accuracy", 1e-4)
+    # measured with the nut's former place and size (on the table, 0.01 N m, 0.01); with the nut on the
+    # screw this drive no longer creeps at 0.5 mm/s, at any accuracy
+    for path, value in (("friction.nut_friction_on", "table"), ("nut.preload_torque", 0.01),
+                        ("nut.load_friction_coefficient", 0.01)):
+        p = with_value(p, path, value)
+    r = simulate(p, Scenario(feed=0.5e-3, load_case=3, duration=0.6))
     assert r.metrics.creep and r.metrics.stick_slip_cycles >= 10
-    assert r.metrics.mean_speed == pytest.approx(0.1e-3, rel=0.05)
+    assert r.metrics.converged is True
+    assert r.stats["accuracy"] == pytest.approx(1e-5)
+    summary = r.summary()
+    assert summary["converged"] is True and summary["creep"] is True
+
+
+def test_convergence_check_reports_disagreement_and_can_be_off(short_paper):
+    p = with_value(short_paper, "simulation.convergence_tolerance", 1e-9)  # no two accuracies agree to 1e-12 m/s
+    r = simulate(p, Scenario(feed=1e-4, load_case=3, duration=0.5))
+    assert r.metrics.creep and r.metrics.converged is False
+    assert r.summary()["converged"] is False
+    off = simulate(with_value(short_paper, "simulation.convergence_check", False), Scenario(feed=1e-4, duration=0.5))
+    assert off.metrics.converged is None and "convergence_runs" not in off.stats

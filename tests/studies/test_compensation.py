@@ -61,12 +61,19 @@ def test_dither_adds_its_own_ripple_above_creep(one_mm_s):
     assert one_mm_s["dither"].metrics.max_fluctuation > 10 * one_mm_s["none"].metrics.max_fluctuation
 
 
-def test_no_motor_side_compensator_removes_the_table_mode_creep(short_paper):
-    # the documented negative result: at 0.1 mm/s the table sticks and slips on the screw spring at
-    # ~70 Hz; a torque added at the motor (10x the table's inertia) does not remove it
-    rows = evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,), duration=1.0)
-    assert all(r["creep"] for r in rows)
-    assert all(r["stick_fraction_vs_none"] > 0.9 for r in rows)
+def test_motor_side_compensators_cut_but_do_not_remove_the_paper_rig_creep(short_paper):
+    # issue 15 defect 2: with the ball nut's drag on the screw (its physical place, catalogue-sized: 148 N of
+    # the 157 N at load case 3), most of the friction is on the motor side of the screw's spring, within a
+    # motor torque's reach. At 0.1 mm/s the table still sticks and slips (the guides' share on the ~70 Hz
+    # screw mode), but the model-based compensators and dither cut the fluctuation ~2x (measured 0.42-0.46 of
+    # none in this 1 s run) while feedforward at the reference speed does not. With the nut lumped on the
+    # table (the former default) no compensator changed the stick fraction by more than 10 %.
+    rows = {r["method"]: r for r in evaluate(short_paper, ("none",) + METHODS, feeds_mm_s=(0.1,), load_cases=(3,),
+                                             duration=1.0)}
+    assert all(r["creep"] for r in rows.values())
+    for method in ("lugre", "dob", "dither"):
+        assert rows[method]["fluctuation_vs_none"] < 0.6, method
+    assert rows["static"]["fluctuation_vs_none"] > 0.9
 
 
 @pytest.fixture(scope="module")
@@ -98,8 +105,11 @@ def test_feedforward_and_dither_do_not_remove_creep_within_reach(within_reach):
         assert within_reach[("static", feed)]["creep"] and within_reach[("static", feed)]["fluctuation_vs_none"] > 0.9
         assert within_reach[("dither", feed)]["creep"] and within_reach[("dither", feed)]["fluctuation_vs_none"] > 0.9
     assert within_reach[("dither", 0.02)]["fluctuation_vs_none"] < 0.5
-    # the measured-speed model chatters about zero speed at the lowest feed
-    assert within_reach[("static-measured", 0.02)]["fluctuation_vs_none"] > 1.0
+    # The earlier claim "the measured-speed model chatters about zero speed at 0.02 mm/s" (1.6-2.3x none) does
+    # not survive the merged model's convergence check: run at 1e-4 and checked against 1e-5 and 1e-6, the
+    # static-measured run at 0.02 mm/s slides (0.0012 mm/s against 0.18 without compensation, converged).
+    # That is the converged answer; the assertion of chatter was removed rather than kept on an unconverged run.
+    assert not within_reach[("static-measured", 0.02)]["creep"]
 
 
 def test_lugre_lowers_the_critical_speed_within_reach():
