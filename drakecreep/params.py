@@ -45,6 +45,7 @@ __all__ = [
     "params_to_dict",
     "with_value",
     "get_value",
+    "load_yaml",
 ]
 
 class _Loader(yaml.SafeLoader):
@@ -67,6 +68,32 @@ _Loader.add_implicit_resolver(
 
 def _yaml_load(text):
     return yaml.load(text, Loader=_Loader)
+
+
+def load_yaml(path, what):
+    """Read a YAML file the way every drakecreep file is read (``5.0e6`` is a float, as in YAML 1.2).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+    what : str
+        What the file should hold, for the error message (e.g. ``"a YAML sweep spec"``).
+
+    Raises
+    ------
+    InputError
+        Naming the file and the line of a YAML syntax error.
+    FileNotFoundError
+        If ``path`` does not exist.
+    """
+    text = Path(path).read_text()
+    try:
+        return _yaml_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise InputError(str(path), "invalid YAML" + where, what) from None
 
 
 INTEGRATORS = ("runge_kutta2", "runge_kutta3", "runge_kutta5", "bogacki_shampine3", "radau3", "implicit_euler")
@@ -421,14 +448,7 @@ def load_params(path):
     FileNotFoundError
         If ``path`` does not exist.
     """
-    text = Path(path).read_text()
-    try:
-        data = _yaml_load(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(str(path), "invalid YAML" + where, "a YAML mapping of parameter groups") from None
-    return params_from_dict(data)
+    return params_from_dict(load_yaml(path, "a YAML mapping of parameter groups"))
 
 
 def save_params(params, path):

@@ -1,7 +1,9 @@
 """Measured runs of a real feed drive: validated arrays in SI units plus the metadata needed to replay them.
 
-A run is a CSV with a header of SI signal names (a unit may follow a name in brackets, ``x_motor[m]``,
-and must then be the SI one; ``u`` must carry the unit of the metadata, ``u[V]``):
+A run is a table (CSV, Parquet, HDF5 or MATLAB ``.mat``, read by :mod:`drakecreep.gap.formats`) of these
+signals; a unit may follow a name in brackets, ``x_motor[mm]``, ``t[ms]``, and the values are converted to
+SI (``u`` stays in the unit of the metadata, ``u[mV]`` is converted to V). The format, with the metadata
+keys, is documented in ``docs/measured_format.md``:
 
 ========== ======== ===================================================================
 column     unit     meaning
@@ -36,7 +38,6 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -56,6 +57,7 @@ __all__ = [
     "MeasuredRun",
     "MeasuredData",
     "load_measured",
+    "default_meta_path",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -389,7 +391,7 @@ def _meta_from_dict(data, meta_path):
     where = str(meta_path)
     if not isinstance(data, dict):
         raise InputError(where, data, "a YAML mapping with at least u_units and u_gain")
-    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes"}
+    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "columns"}
     for key in data:
         if key not in known:
             raise InputError(f"{where}: {key}", data[key], "no such key; known: " + ", ".join(sorted(known)))
@@ -444,43 +446,27 @@ def _meta_to_dict(meta):
     return d
 
 
-# --------------------------------------------------------------------------- CSV
+# --------------------------------------------------------------------------- reading (drakecreep.gap.formats)
 
-_HEADER = re.compile(r"^\s*([A-Za-z_]\w*)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
-
-
-def _parse_header(cells, path, u_units):
-    names, seen = [], set()
-    for cell in cells:
-        m = _HEADER.match(cell)
-        if not m:
-            raise InputError(f"{path}: header", cell, "a column name, optionally with [unit]")
-        name, unit = m.group(1), m.group(2)
-        if name not in COLUMNS:
-            raise InputError(f"{path}: header", name, "columns among " + ", ".join(COLUMNS))
-        if name in seen:
-            raise InputError(f"{path}: header", name, "each column once")
-        seen.add(name)
-        want = u_units if name == "u" else COLUMNS[name][0]
-        if unit is not None and unit != "" and unit != want:
-            what = f"{want} (the u_units of the metadata)" if name == "u" else f"{want} (SI)"
-            raise InputError(f"{path}: column {name} unit", unit, what)
-        names.append(name)
-    missing = [c for c, (_, req) in COLUMNS.items() if req and c not in seen]
-    if missing:
-        raise InputError(f"{path}: header", ",".join(names), "the columns " + ", ".join(missing) + " as well")
-    return names
+def default_meta_path(data_path):
+    """The metadata YAML beside a data file (``<stem>.yaml`` or ``.yml``), or None."""
+    data_path = Path(data_path)
+    candidates = [data_path.with_suffix(".yaml"), data_path.with_suffix(".yml")]
+    return next((p for p in candidates if p.exists()), None)
 
 
 def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
-    """Load measured runs from a CSV and its metadata YAML.
+    """Load measured runs from a data file (CSV, Parquet, HDF5, MATLAB) and its metadata YAML.
 
     Parameters
     ----------
     csv_path : str or pathlib.Path
-        The CSV (header of column names, ``#`` comment lines ignored).
+        The data file; the format follows the suffix (:func:`drakecreep.gap.formats.read_table`):
+        ``.csv`` (header of column names with optional units, ``#`` comment lines ignored),
+        ``.parquet``, ``.h5``/``.hdf5`` or ``.mat``. Units in the names are converted to SI.
     meta_path : str or pathlib.Path, optional
-        The metadata YAML; default: the CSV path with suffix ``.yaml`` (or ``.yml``).
+        The metadata YAML; default: the data path with suffix ``.yaml`` (or ``.yml``). Its optional
+        ``columns`` key maps measured names to the file's names (``{x_motor[mm]: qm}``).
     dt_rtol : float
         Allowed relative deviation of a time step from the median step of its run.
 
@@ -492,60 +478,33 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     Raises
     ------
     InputError
-        Missing or unknown column, wrong unit in the header, unknown ``u_units``, a row with the wrong
+        Missing or unknown column, unknown unit in a name, unknown ``u_units``, a row with the wrong
         number of fields, a non-number, NaN, non-monotonic or non-uniform time, missing metadata.
     FileNotFoundError
-        If the CSV does not exist.
+        If the data file does not exist.
     """
+    from drakecreep.gap.formats import read_table
+    from drakecreep.params import load_yaml
+
     csv_path = Path(csv_path)
     if meta_path is None:
-        candidates = [csv_path.with_suffix(".yaml"), csv_path.with_suffix(".yml")]
-        meta_path = next((p for p in candidates if p.exists()), None)
+        meta_path = default_meta_path(csv_path)
         if meta_path is None:
-            raise InputError("meta_path", str(candidates[0]), "a metadata YAML beside the CSV (or pass meta_path)")
+            raise InputError("metadata", str(csv_path.with_suffix(".yaml")),
+                             "a metadata YAML beside the data file (or name it: diagnose --meta FILE)")
     meta_path = Path(meta_path)
-    try:
-        meta_data = yaml.safe_load(meta_path.read_text())
-    except yaml.YAMLError:
-        raise InputError(str(meta_path), "invalid YAML", "a YAML mapping") from None
+    meta_data = load_yaml(meta_path, "a YAML mapping with at least u_units and u_gain")
+    columns = meta_data.pop("columns", None) if isinstance(meta_data, dict) else None
     meta = _meta_from_dict(meta_data, meta_path)
-
-    with open(csv_path, newline="") as fh:
-        rows = [(i + 1, r) for i, r in enumerate(csv.reader(fh))
-                if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]
-    if not rows:
-        raise InputError(str(csv_path), "empty", "a header line and data rows")
-    names = _parse_header(rows[0][1], csv_path, meta.u_units)
-    width = len(names)
-    cols = {name: [] for name in names}
-    for line, row in rows[1:]:
-        if len(row) != width:
-            raise InputError(f"{csv_path}: line {line}", f"{len(row)} fields", f"{width} fields like the header")
-        for name, cell in zip(names, row):
-            cols[name].append(cell.strip())
-    if not rows[1:]:
-        raise InputError(str(csv_path), "no data rows", "at least 3 rows")
-    arrays = {}
-    for name in names:
-        if name == "run":
-            continue
-        try:
-            arrays[name] = np.array([float(c) for c in cols[name]], dtype=float)
-        except ValueError as err:
-            raise InputError(f"{csv_path}: column {name}", str(err).split(": ")[-1], "numbers") from None
-        bad = np.flatnonzero(np.isnan(arrays[name]))
-        if bad.size:
-            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN)",
-                             "finite numbers")
-    if "run" in cols:
-        labels = np.array(cols["run"], dtype=object)
-        order = list(dict.fromkeys(labels.tolist()))
-        groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
+    table = read_table(csv_path, meta.u_units, columns)
+    if "run" in table:
+        labels = table["run"].to_numpy()
+        groups = [(lab, np.flatnonzero(labels == lab)) for lab in dict.fromkeys(labels.tolist())]
     else:
-        groups = [(csv_path.stem, np.arange(len(rows) - 1))]
+        groups = [(csv_path.stem, np.arange(len(table)))]
     runs = []
     for label, idx in groups:
-        kw = {name: (arrays[name][idx] if name in arrays else None) for name in _ARRAYS}
+        kw = {name: (table[name].to_numpy()[idx] if name in table else None) for name in _ARRAYS}
         try:
             runs.append(MeasuredRun(meta=meta, label=str(label), dt_rtol=dt_rtol, **kw))
         except InputError as err:

@@ -625,17 +625,10 @@ def load_spec(path):
     InputError
         Naming the key of the first problem.
     """
-    import yaml
-
-    from drakecreep.params import load_params, preset
+    from drakecreep.params import load_params, load_yaml, preset
 
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        raise InputError(str(path), "invalid YAML" + (f" (line {mark.line + 1})" if mark else ""),
-                         "a YAML sweep spec") from None
+    data = load_yaml(path, "a YAML sweep spec")
     if not isinstance(data, dict):
         raise InputError(str(path), data, "a mapping with base, scenario, axes, sample, metrics, plot")
     known = {"base", "scenario", "axes", "sample", "metrics", "plot"}

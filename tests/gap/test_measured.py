@@ -122,15 +122,15 @@ def test_unknown_unit_of_u(tmp_path):
 
 def test_unit_of_u_in_header_must_match_metadata(tmp_path):
     path = _write(tmp_path, header=["t", "x_ref", "x_motor", "u[A]", "f_ext"])
-    with pytest.raises(InputError, match="V \\(the u_units of the metadata\\)"):
+    with pytest.raises(InputError, match="one of V, mV \\(u_units of the metadata is V\\)"):
         load_measured(path)
 
 
-def test_non_si_unit_in_header(tmp_path):
-    path = _write(tmp_path, header=["t", "x_ref", "x_motor[mm]", "u", "f_ext"])
-    with pytest.raises(InputError, match="m \\(SI\\)") as err:
+def test_unknown_unit_in_header_names_column_unit_and_allowed(tmp_path):
+    path = _write(tmp_path, header=["t", "x_ref", "x_motor[inch]", "u", "f_ext"])
+    with pytest.raises(InputError, match="one of m, mm, um") as err:
         load_measured(path)
-    assert "x_motor" in err.value.field
+    assert "x_motor" in err.value.field and err.value.value == "inch"
 
 
 def test_gain_must_be_one_for_force(tmp_path):
@@ -180,7 +180,7 @@ def test_array_length_mismatch_in_constructor():
 
 
 def test_missing_metadata(tmp_path):
-    with pytest.raises(InputError, match="metadata YAML beside the CSV"):
+    with pytest.raises(InputError, match="metadata YAML beside the data file .*--meta"):
         load_measured(_write(tmp_path, meta=None))
 
 
