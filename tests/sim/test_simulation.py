@@ -88,3 +88,14 @@ def test_bad_scenarios():
 def test_steady_window_must_fit(paper):
     with pytest.raises(InputError, match="steady_start"):
         simulate(paper, Scenario(duration=0.5))
+
+
+def test_to_dataframe_has_si_columns_and_matches_the_saved_csv(low_feed, tmp_path):
+    import pandas as pd
+
+    frame = low_feed.to_dataframe()
+    assert frame.columns[0] == "t_s" and "table_speed_m_per_s" in frame and "spring_force_N" in frame
+    np.testing.assert_array_equal(frame["table_speed_m_per_s"].to_numpy(), low_feed.signals["table_speed"])
+    saved = pd.read_csv(low_feed.save(tmp_path)["timeseries"])
+    assert list(saved.columns) == list(frame.columns)
+    np.testing.assert_allclose(saved["table_speed_m_per_s"], frame["table_speed_m_per_s"], rtol=1e-9, atol=1e-15)
