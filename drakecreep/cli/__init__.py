@@ -12,11 +12,14 @@ and exit with code 2, never a traceback.
 import argparse
 import importlib
 import os
+import re
 import sys
+import threading
+import time
 
 from drakecreep.errors import DrakecreepError
 
-__all__ = ["main", "build_parser", "COMMANDS"]
+__all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "plain"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = [
@@ -34,24 +37,79 @@ COMMANDS = [
 ]
 
 
+#: Commands that can take more than ~2 s and report no progress of their own: an elapsed-time bar on stderr.
+HEARTBEAT = ("report", "compensate", "reproduce-paper", "margins", "tune", "critical", "modal", "emps", "simulate")
+
+
+def plain(text):
+    """Help text without reStructuredText markup (``x`` and :func:`x` become x)."""
+    text = re.sub(r":[a-z]+:`~?([^`]*)`", r"\1", text)
+    return re.sub(r"``([^`]*)``", r"\1", text)
+
+
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit code 2."""
+    """ArgumentParser whose errors are one line and exit code 2, and whose help is plain text."""
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
+    def format_help(self):
+        return plain(super().format_help())
+
+    def format_usage(self):
+        return plain(super().format_usage())
+
+
+def _add_common(parser, suppress):
+    """``-q/--quiet`` and ``-v/--verbose``, before or after the command."""
+    default = argparse.SUPPRESS if suppress else None
+    parser.add_argument("-q", "--quiet", action="store_true", default=default or False,
+                        help="no progress on stderr (results and errors only)")
+    parser.add_argument("-v", "--verbose", action="count", default=default or 0,
+                        help="more detail on stderr: INFO logging, -vv DEBUG and a traceback with errors")
+
+
+def _heartbeat(command):
+    """Start an elapsed-time tqdm bar on stderr; returns a function that stops it."""
+    from tqdm import tqdm
+
+    stop = threading.Event()
+    bar = tqdm(desc=f"drakecreep {command}", bar_format="{desc}: {elapsed} elapsed", file=sys.stderr,
+               delay=2.0, mininterval=0.5)
+
+    start = time.monotonic()
+
+    def tick():
+        while not stop.wait(0.5):
+            if time.monotonic() - start >= 2.0:  # short jobs stay silent
+                bar.refresh()
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+
+    def done():
+        stop.set()
+        thread.join()
+        bar.close()
+
+    return done
+
 
 def build_parser():
     """Build the top-level parser with every registered subcommand."""
+    from drakecreep import __version__
+
     parser = _Parser(
         prog="drakecreep",
         description="Ball-screw feed drive in Drake: simulate creep, analyse servo loops, diagnose sim-to-real gaps.",
     )
+    parser.add_argument("--version", action="version", version=f"drakecreep {__version__}")
+    _add_common(parser, suppress=False)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
         module = importlib.import_module(f"drakecreep.cli.{name}")
-        module.add_parser(sub)
+        _add_common(module.add_parser(sub), suppress=True)
     return parser
 
 
@@ -60,9 +118,21 @@ def main(argv=None):
     os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.verbose:
+        import logging
+
+        logging.basicConfig(level=logging.DEBUG if args.verbose > 1 else logging.INFO, stream=sys.stderr)
+    saved = os.environ.get("TQDM_DISABLE")
+    if args.quiet:
+        os.environ["TQDM_DISABLE"] = "1"  # every tqdm bar of the library (tqdm >= 4.66), also in worker processes
+    stop = _heartbeat(args.command) if args.command in HEARTBEAT and not args.quiet else None
     try:
         return int(args.func(args) or 0)
     except DrakecreepError as err:
+        if args.verbose > 1:
+            import traceback
+
+            traceback.print_exc()
         print(f"drakecreep {args.command}: error: {err}", file=sys.stderr)
         return 2
     except (FileNotFoundError, IsADirectoryError, PermissionError) as err:
@@ -71,6 +141,14 @@ def main(argv=None):
     except KeyboardInterrupt:
         print(f"drakecreep {args.command}: interrupted", file=sys.stderr)
         return 130
+    finally:
+        if stop is not None:
+            stop()
+        if args.quiet:
+            if saved is None:
+                os.environ.pop("TQDM_DISABLE", None)
+            else:
+                os.environ["TQDM_DISABLE"] = saved
 
 
 if __name__ == "__main__":  # pragma: no cover
