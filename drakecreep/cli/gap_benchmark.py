@@ -23,7 +23,7 @@ def run(args):
     """Run and print the scores."""
     from drakecreep.gap.benchmark import run_benchmark
 
-    res = run_benchmark(n=args.n, seed=args.seed, replay=not args.no_replay, progress=True)
+    res = run_benchmark(n=args.n, seed=args.seed, replay=not args.no_replay, progress=not args.quiet)
     if args.json:
         print_json(res)
         return 0

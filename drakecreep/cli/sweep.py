@@ -52,7 +52,7 @@ def run(args):
         executor = "processes"
     result = run_sweep(
         spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
-        scheduler=args.scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
+        scheduler=args.scheduler, out_dir=args.out, progress=not (args.no_progress or args.quiet), retries=args.retries,
         columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
     )
     paths = {k: str(v) for k, v in result.paths.items()}

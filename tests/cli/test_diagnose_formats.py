@@ -35,3 +35,9 @@ def test_missing_metadata_names_the_option(tmp_path, capsys):
     assert cli.main(["diagnose", str(tmp_path / "run.csv")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--meta" in err[0] and "meta_path" not in err[0]
+
+
+def test_bad_run_selection_names_the_option(capsys):
+    assert cli.main(["diagnose", "example", "--test", "r9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("drakecreep diagnose: error: --test: got 'r9'")
