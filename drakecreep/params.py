@@ -193,6 +193,20 @@ class ScrewParams(_Params):
     )
     bearing_stiffness: float = _q(9.38e6, "N/m", 0.0, lo_open=True, doc="bearing axial stiffness (Table 6)")
     bearing_damping: float = _q(60.61, "N s/m", 0.0, doc="bearing axial damping (Table 6)")
+    chain_damping: str = _q(
+        "viscous", "-", choices=("viscous", "loss_factor"),
+        doc="bearing/nut damping as identified (viscous), or as hysteretic loss factors evaluated at damping_frequency",
+    )
+    damping_frequency: float = _q(
+        73.5, "Hz", 0.0, 1e5, lo_open=True, doc="loss_factor: frequency of the mode the damping acts on (paper rig: 73.5)",
+    )
+    bearing_test_mass: float = _q(
+        2.31, "kg", 0.0, lo_open=True, doc="loss_factor: mass of the bearing's hammer test (identification frequency)",
+    )
+    seat_joint_stiffness: float = _q(
+        0.0, "N/m", 0.0, doc="fixed joints of the bearing seat in series with the bearing (0 = rigid, off)",
+    )
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the bearing seat joints")
 
     def _check(self):
         if self.root_diameter > self.nominal_diameter:
@@ -210,6 +224,10 @@ class NutParams(_Params):
     mass: float = _q(0.335, "kg", 0.0, doc="nut mass (Table 3), lumped into the table")
     preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
     load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
+    seat_joint_stiffness: float = _q(
+        0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
+    )
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the nut seat joints")
 
 
 @dataclass(frozen=True)
@@ -242,7 +260,7 @@ class LoadParams(_Params):
 class FrictionParams(_Params):
     """Friction law and the shape of its curve; the levels come from the load case."""
 
-    law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre"), doc="friction law")
+    law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre", "gms"), doc="friction law")
     static_ratio: float = _q(1.5, "-", 1.0, 10.0, doc="breakaway / Coulomb force Fs/Fc")
     stribeck_velocity: float = _q(1.0e-4, "m/s", 0.0, 1.0, lo_open=True, doc="vs")
     stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
@@ -255,6 +273,10 @@ class FrictionParams(_Params):
     nut_friction_on: str = _q(
         "table", "-", choices=("table", "screw"),
         doc="nut friction lumped on the table, or as a drag torque on the screw's rotation",
+    )
+    gms_elements: int = _q(4, "-", 1, 50, doc="GMS: number of Maxwell-slip elements (sum of stiffnesses = sigma0)")
+    gms_attraction: float = _q(
+        1.0e4, "N/s", 0.0, lo_open=True, doc="GMS: attraction C of a sliding element to its Stribeck share",
     )
 
 
@@ -456,7 +478,7 @@ def save_params(params, path):
     Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
 
 
-PRESETS = ("paper", "paper_calibrated", "rigid_axis")
+PRESETS = ("paper", "paper_calibrated", "rigid_axis", "paper_catalogue")
 
 
 def preset_text(name="paper"):

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-PAGES = ["tutorial.md", "measured_format.md"]
+PAGES = ["tutorial.md"]
 
 
 def _blocks(page):

@@ -14,16 +14,17 @@ import drakecreep
 PACKAGE = Path(drakecreep.__file__).parent
 
 #: each room and the rooms it may import (besides itself); the base modules may be imported by every room
-BASE = {"errors", "scenario", "params", "data"}
+BASE = {"errors", "scenario", "params", "data", "files"}
 ALLOWED = {
     "model": set(),
     "paper": {"model"},
-    "sim": {"model", "paper"},
-    "servo": {"model", "paper", "sim"},
-    "studies": {"model", "paper", "sim", "servo"},
-    "gap": {"model", "paper", "sim", "servo"},
-    "report": {"model", "paper", "sim", "servo", "studies", "gap"},
-    "cli": {"model", "paper", "sim", "servo", "studies", "gap", "report"},
+    "multibody": {"model"},
+    "sim": {"model", "paper", "multibody"},
+    "servo": {"model", "paper", "sim", "multibody"},
+    "studies": {"model", "paper", "sim", "servo", "multibody"},
+    "gap": {"model", "paper", "sim", "servo", "multibody"},
+    "report": {"model", "paper", "sim", "servo", "studies", "gap", "multibody"},
+    "cli": {"model", "paper", "sim", "servo", "studies", "gap", "report", "multibody"},
 }
 
 

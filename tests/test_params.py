@@ -59,7 +59,7 @@ def test_exponent_without_sign_is_a_float(tmp_path):
         ({"motor": {"rotor_inertia": "big"}}, "motor.rotor_inertia", "finite number"),
         ({"table": {"mas": 3}}, "table.mas", "no such field"),
         ({"controller": {"sampled": "yes"}}, "controller.sampled", "true or false"),
-        ({"friction": {"law": "gms"}}, "friction.law", "one of coulomb, stribeck, lugre"),
+        ({"friction": {"law": "maxwell"}}, "friction.law", "one of coulomb, stribeck, lugre, gms"),
         ({"loads": {"cases": [{"fx": 1.0}, {"fz": "x"}]}}, "loads.cases[1].fz", "finite"),
         ({"controller": {"position_period": 3e-4}}, "controller.position_period", "integer multiple"),
         ({"screw": {"root_diameter": 0.03}}, "screw.root_diameter", "nominal_diameter"),

@@ -11,12 +11,14 @@ and exit with code 2, never a traceback.
 
 import argparse
 import importlib
-import os
 import re
+import textwrap
+import os
 import sys
 import threading
 import time
 
+from drakecreep import __version__
 from drakecreep.errors import DrakecreepError
 
 __all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "plain"]
@@ -28,9 +30,9 @@ COMMANDS = [
     "diagram",
     "critical",
     "hertz",
-    "modal",
+    "modal", "modes",
     "margins", "tune", "report",
-    "sweep",
+    "sweep", "uncertainty",
     "emps",
     "reproduce_paper", "compensate",
     "diagnose", "gap_benchmark",
@@ -42,22 +44,32 @@ HEARTBEAT = ("report", "compensate", "reproduce-paper", "margins", "tune", "crit
 
 
 def plain(text):
-    """Help text without reStructuredText markup (``x`` and :func:`x` become x)."""
-    text = re.sub(r":[a-z]+:`~?([^`]*)`", r"\1", text)
-    return re.sub(r"``([^`]*)``", r"\1", text)
+    """Help text without reStructuredText markup (``code``, :func:`name`, :class:`~a.b.C`)."""
+    text = re.sub(r":[a-z]+:`~?([^`]+)`", lambda m: m.group(1).rpartition(".")[2] if m.group(0).count("~") else m.group(1), text)
+    return text.replace("``", "'").replace("`", "'")
+
+
+class _Formatter(argparse.HelpFormatter):
+    """Wraps the description paragraph by paragraph; strips reStructuredText markup from every help text."""
+
+    def _fill_text(self, text, width, indent):
+        paragraphs = [" ".join(p.split()) for p in plain(text).split("\n\n")]
+        return "\n\n".join(textwrap.fill(p, width, initial_indent=indent, subsequent_indent=indent)
+                             for p in paragraphs if p)
+
+    def _expand_help(self, action):
+        return plain(super()._expand_help(action))
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit code 2, and whose help is plain text."""
+    """ArgumentParser whose errors are one line and exit code 2; help without reStructuredText markup."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
-
-    def format_help(self):
-        return plain(super().format_help())
-
-    def format_usage(self):
-        return plain(super().format_usage())
 
 
 def _add_common(parser, suppress):
@@ -97,8 +109,6 @@ def _heartbeat(command):
 
 def build_parser():
     """Build the top-level parser with every registered subcommand."""
-    from drakecreep import __version__
-
     parser = _Parser(
         prog="drakecreep",
         description="Ball-screw feed drive in Drake: simulate creep, analyse servo loops, diagnose sim-to-real gaps.",

@@ -37,7 +37,7 @@ def add_params_options(parser, friction=True):
     group.add_argument("--preset", default="paper", choices=PRESETS, help="built-in parameter set (default: paper)")
     if friction:
         parser.add_argument(
-            "--friction", choices=("coulomb", "stribeck", "lugre"), help="friction law (default: from the parameters)"
+            "--friction", choices=("coulomb", "stribeck", "lugre", "gms"), help="friction law (default: from the parameters)"
         )
 
 

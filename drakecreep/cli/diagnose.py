@@ -1,7 +1,9 @@
 """``drakecreep diagnose``: where the sim-to-real gap of the rigid model lies, which effect explains it, how far it shrinks.
 
-DATA is an EMPS ``.mat`` file (``estimation`` / ``validation`` name the benchmark files) or a measured run
-(CSV, Parquet, HDF5 or .mat with its metadata YAML beside it or ``--meta``). A single-run file is split into out-and-back cycles; the
+DATA is an EMPS .mat file ('estimation' / 'validation' name the benchmark files) or a measured run: CSV,
+Parquet, HDF5 or .mat with a metadata YAML beside it or given with --meta; units in the column headers
+(t[ms], x_motor[mm], u[V]) are converted. The format is documented in docs/measured_format.md; an example
+ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split into out-and-back cycles; the
 training runs are fitted, the held-out runs only scored. ``--score FILE`` finally scores the finished
 diagnosis, with every parameter fixed, on another file (e.g. the EMPS validation set).
 """
@@ -14,26 +16,14 @@ from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run", "load_runs", "pick"]
 
-_EXAMPLE = "example"
-
 
 def add_parser(subparsers):
     """Register ``diagnose``."""
-    import argparse
-
-    p = subparsers.add_parser(
-        "diagnose", help="sim-to-real gap diagnosis of measured runs (where, which effect, shrink)",
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Where the sim-to-real gap of the rigid model lies, which effect explains it, how far it shrinks.",
-        epilog="Measured-run format (columns, units such as x_motor[mm] or t[ms], metadata YAML keys, column\n"
-               "mapping for Parquet/HDF5/.mat): docs/measured_format.md. The shipped example\n"
-               "(drakecreep/data/examples/measured_mm_ms.csv, mm and ms, with its .yaml):\n"
-               "  drakecreep diagnose " + _EXAMPLE)
-    p.add_argument("data", metavar="DATA",
-                   help="measured run: CSV, Parquet (.parquet), HDF5 (.h5) or MATLAB (.mat) with a metadata YAML; "
-                        "an EMPS .mat file; 'estimation' or 'validation' (the EMPS files); 'example' (the shipped "
-                        "example run)")
-    p.add_argument("--meta", metavar="FILE", help="metadata YAML of the data file (default: DATA with suffix .yaml)")
+    p = subparsers.add_parser("diagnose", help="sim-to-real gap diagnosis of measured runs (where, which effect, shrink)",
+                              description="\n\n".join(__doc__.split("\n\n")[:2]))
+    p.add_argument("data", metavar="DATA", help="EMPS .mat file (or 'estimation'), or a measured run "
+                   "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
+    p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
                    "(default: even indices)")
     p.add_argument("--test", metavar="RUNS", help="held-out runs (default: odd indices)")
@@ -51,19 +41,13 @@ def add_parser(subparsers):
 def load_runs(data, meta=None):
     """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles."""
     from drakecreep.gap.diagnosis import split_cycles
-    from drakecreep.data import example_path
-    from drakecreep.gap.measured import EMPS_FILES, default_meta_path, load_emps, load_measured
+    from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
-    if data == _EXAMPLE:
-        data = example_path("measured_mm_ms.csv")
-    if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None and default_meta_path(data) is None):
+    if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):
         md = load_emps(data)
     else:
         if not Path(data).exists():
             raise FileNotFoundError(2, "No such file or directory", str(data))
-        if meta is None and default_meta_path(data) is None:
-            raise InputError("--meta", None, f"a metadata YAML for {data} (none beside it: "
-                             f"{Path(data).with_suffix('.yaml')}); see docs/measured_format.md")
         md = load_measured(data, meta)
     runs = list(md.runs)
     if len(runs) == 1:

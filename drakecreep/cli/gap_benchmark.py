@@ -1,19 +1,39 @@
-"""``drakecreep gap-benchmark``: generate datasets with hidden effects, diagnose them blind, score the diagnosis."""
+"""``drakecreep gap-benchmark``: datasets from an independent, richer truth with withheld effects, diagnosed blind, scored."""
 
 import sys
 
-from drakecreep.cli._common import print_json, workers
+from drakecreep.cli._common import print_json
 
 __all__ = ["add_parser", "run"]
 
 
+def _count(text):
+    import argparse
+
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if n < 0:
+        raise argparse.ArgumentTypeError(f"{n} must be >= 0")
+    return n
+
+
 def add_parser(subparsers):
     """Register ``gap-benchmark``."""
-    p = subparsers.add_parser("gap-benchmark", help="withheld-effect benchmark of the gap diagnosis",
+    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS
+    from drakecreep.gap.truth import CONTROLLER_KINDS
+
+    p = subparsers.add_parser("gap-benchmark", help="withheld-effect benchmark of the gap diagnosis on realistic data",
                               description=__doc__)
-    p.add_argument("--n", type=workers, default=20, help="datasets (default 20)")
-    p.add_argument("--seed", type=int, default=0, help="first seed (datasets use seed .. seed+n-1)")
-    p.add_argument("--no-replay", action="store_true", help="skip the closed-loop replay (inverse dynamics only)")
+    p.add_argument("--seeds", choices=("heldout", "dev"), default="heldout",
+                   help=f"held-out seeds (from {HELDOUT_SEEDS}, reported) or development seeds (from {DEV_SEEDS})")
+    p.add_argument("--kinds", nargs="+", choices=CONTROLLER_KINDS, default=list(CONTROLLER_KINDS),
+                   help="controller kinds of the truth")
+    p.add_argument("--n-per-effect", type=_count, default=10, help="datasets per library effect with SNR >= 3 (default 10)")
+    p.add_argument("--n-null", type=_count, default=10, help="null datasets per controller kind (default 10)")
+    p.add_argument("--n-ool", type=_count, default=6, help="datasets per out-of-library effect and kind (default 6)")
+    p.add_argument("--samples", type=_count, default=3000, help="samples per run at 1 kHz (default 3000)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
@@ -21,9 +41,16 @@ def add_parser(subparsers):
 
 def run(args):
     """Run and print the scores."""
-    from drakecreep.gap.benchmark import run_benchmark
+    from drakecreep.errors import InputError
+    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
 
-    res = run_benchmark(n=args.n, seed=args.seed, replay=not args.no_replay, progress=not args.quiet)
+    if args.samples < 600:
+        raise InputError("--samples", args.samples, "at least 600 samples per run")
+    if args.n_per_effect + args.n_null + args.n_ool == 0:
+        raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
+    seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
+    res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
+                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples)
     if args.json:
         print_json(res)
         return 0
@@ -32,17 +59,18 @@ def run(args):
     def pct(d):
         return "-" if d["rate"] is None else f"{100 * d['rate']:.0f} % (n={d['n']})"
 
-    print(f"datasets: {s['n_datasets']} (seeds {args.seed}..{args.seed + args.n - 1})")
-    print(f"top-1 attribution: {pct(s['top1_all'])} all, {pct(s['top1_snr3'])} where SNR >= 3")
-    print(f"top-3 attribution: {pct(s['top3_all'])} all, {pct(s['top3_snr3'])} where SNR >= 3")
-    print(f"false claims on null datasets: {pct(s['false_claims_null'])}")
-    print(f"datasets with effects where a claimed effect is not hidden: {pct(s['wrong_claims_with_effects'])}")
-    ms = s["median_excess_shrink_snr3"]
-    print("median held-out gap shrink (excess over the noise floor, SNR >= 3): "
-          + ("-" if ms is None else f"{100 * ms:.0f} %"))
-    mr = s["median_raw_idim_shrink_snr3"]
-    print("median held-out inverse-dynamics RMS shrink (raw, SNR >= 3): " + ("-" if mr is None else f"{100 * mr:.0f} %"))
-    for k, v in s["parameter_recovery_median_rel_error"].items():
-        print(f"parameter recovery {k}: median relative error {100 * v:.1f} %")
+    print(f"datasets diagnosed: {s['n_datasets']} ({args.seeds} seeds from {seed}); skipped for SNR < 3: "
+          f"{sum(res['low_snr_skipped'].values())}")
+    print(f"top-1 where SNR >= 3: {pct(s['top1_snr3'])}")
+    print(f"claims on null datasets: {pct(s['claims_on_nulls'])}")
+    print(f"out-of-library answered unexplained: {pct(s['out_of_library_unexplained'])}")
+    m = s["median_relative_shrink_snr3"]
+    print("median audit replay shrink relative to the true effect's (SNR >= 3): " + ("-" if m is None else f"{100 * m:.0f} %"))
+    print(f"claims making the audit replay worse: {s['claims_making_audit_worse']} of {s['n_claims']}")
+    for k, b in s["per_kind"].items():
+        print(f"  {k}: top-1 {pct(b['top1_snr3'])}, nulls claimed {pct(b['claims_on_nulls'])}, "
+              f"out-of-library unexplained {pct(b['out_of_library_unexplained'])}")
+    for e, d in sorted(s["per_effect"].items()):
+        print(f"  {e}: right {pct(d['right'])}, median SNR {d['median_snr']:.1f}, claimed {', '.join(d['claimed']) or '-'}")
     print("", file=sys.stderr)
     return 0

@@ -29,6 +29,12 @@ def add_parser(subparsers):
     p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the text summary")
+    p.add_argument("--uncertainty", type=int, metavar="N",
+                   help="also run N plausible rigs (the preset's assumed values sampled over their ranges, "
+                        "drakecreep uncertainty) at this feed and load, and say in what share of them it creeps")
+    p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the --uncertainty rig sample (default 0)")
+    p.add_argument("--spec", metavar="FILE",
+                   help="uncertainty spec for --uncertainty (default: the preset's; needed with --params)")
     p.set_defaults(func=run)
     return p
 
@@ -50,6 +56,15 @@ def run(args):
             f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window",
         )
     scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
+    spec = None
+    if args.uncertainty is not None:
+        from drakecreep.cli.uncertainty import spec_from_args
+
+        if args.uncertainty < 1:
+            raise InputError("--uncertainty", args.uncertainty, "a number of rigs >= 1")
+        if args.seed < 0:
+            raise InputError("--seed", args.seed, "an integer >= 0")
+        spec = spec_from_args(args)
     result = simulate(params, scenario, backend=args.backend)
     paths = result.save(args.out)
     if not args.no_plot:
@@ -59,10 +74,28 @@ def run(args):
         plot_feed(result, paths["plot"])
     summary = result.summary()
     summary["out"] = str(paths["metrics"].parent)
+    study = None
+    if spec is not None:
+        from drakecreep.cli.uncertainty import run_study, share_line
+
+        study = run_study(params, spec, args.uncertainty, [feed], [args.load_case], seed=args.seed,
+                          duration=args.duration, out=str(paths["metrics"].parent / "uncertainty"),
+                          progress=not args.json)
+        row = study.summary.iloc[0]
+        summary["uncertainty"] = dict(
+            rigs=int(row["rigs"]), seed=args.seed, creep_percent=float(row["creep_percent"]),
+            creep_low_percent=float(row["creep_low_percent"]), creep_high_percent=float(row["creep_high_percent"]),
+            fluctuation_p50_mm_s=float(row["fluctuation_p50_mm_s"]), fluctuation_p95_mm_s=float(row["fluctuation_p95_mm_s"]),
+            deciding=[str(x) for x in study.sensitivity.dropna(subset=["rho_creep"])["parameter"].head(3)],
+        )
     if args.json:
         print_json(summary)
     else:
         _print_text(result, paths)
+        if study is not None:
+            row = study.summary.iloc[0]
+            print(f"plausible rigs ({spec.source}, seed {args.seed}): {share_line(row)}; "
+                  f"fluctuation p50/p95 {row['fluctuation_p50_mm_s']:.3g}/{row['fluctuation_p95_mm_s']:.3g} mm/s")
     if not result.ok:
         print(f"drakecreep simulate: error: {result.status} (results up to then saved in {args.out})", file=sys.stderr)
         return 1

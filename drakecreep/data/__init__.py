@@ -3,7 +3,7 @@
 - ``paper/``: the seed paper's Tables 1-9 as CSV (``#`` comment lines, then a header).
 - ``emps/``: the EMPS benchmark's two measured files (Janot, Gautier, Brunot, 2019; see ``emps/README.md``
   for the citation, the signals and the rule that ``DATA_EMPS_PULSES.mat`` is a held-out test set).
-- ``examples/``: small example inputs (a measured run in mm and ms with its metadata, a sweep spec).
+- ``examples/``: small example inputs (a measured run in ms, mm and V with its metadata YAML).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ def examples_dir() -> Path:
 
 
 def example_path(name: str) -> Path:
-    """Path of a shipped example file, e.g. ``example_path("measured_mm_ms.csv")``."""
+    """Path of a shipped example file, e.g. ``example_path("emps_segment.csv")``."""
     path = examples_dir() / name
     if not path.exists():
         from drakecreep.errors import InputError

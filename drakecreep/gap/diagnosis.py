@@ -8,14 +8,16 @@ Pipeline (:func:`diagnose`):
    (:func:`drakecreep.gap.effects.replay_with_effects`); speed, position and force residuals decomposed by
    time regime, by order against screw / motor angle and table position, by operating map
    (:mod:`drakecreep.gap.residuals`); whiteness of the inverse-dynamics residual.
-3. **Which**: every applicable effect of :data:`drakecreep.gap.effects.EFFECTS` is refitted with the nominal
-   friction (linear least squares on the inverse-dynamics residual, the nonlinear parameter on a grid)
-   on the training runs, then scored on the held-out runs with the parameters fixed. The score is a
-   penalized held-out log-likelihood ``n_eff ln(SSE_eff / SSE_nom) + k ln(n_train)`` with ``n_eff`` the
-   held-out sample count reduced for the residual's lag-1 autocorrelation; negative is evidence. An
-   effect is *claimed* when its score is below ``-claim_score`` and it removes at least ``min_gain`` of
-   the held-out residual energy. When the best claimed effect leaves a claimable remainder, a second
-   effect is added greedily (pairs).
+3. **Which**: every identifiable effect of :data:`drakecreep.gap.effects.EFFECTS` (one that adds a
+   regressor; quantization does not and is never ranked) is refitted with the nominal friction (linear
+   least squares on the inverse-dynamics residual, the nonlinear parameter on a grid) on the training
+   runs, then scored on the held-out runs with the parameters fixed and ranked by the penalized held-out
+   log-likelihood ``n_eff ln(SSE_eff / SSE_nom) + k ln(n_train)``. The best-ranked candidates are put to
+   the claim tests of :mod:`drakecreep.gap.claims` (held-out inverse-dynamics gain above a circular-shift
+   permutation null and better on most held-out runs, then a held-out closed-loop replay shrink above the
+   run-to-run variation of the nominal); the first that passes is claimed. Without a replay for the
+   runs' controller nothing is claimed and the candidates that pass the inverse-dynamics tests are
+   listed as provisional. What stays is located by :func:`locate` ("unexplained" and where).
 4. **Shrink**: RMS of the speed, position and force residuals of the closed-loop replay on the held-out
    runs, before and after adding the claimed effect(s), and of the inverse-dynamics force residual.
 """
@@ -40,8 +42,13 @@ from drakecreep.gap.effects import (
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, regressor
 from drakecreep.gap.replay import RigidModel
+from drakecreep.gap import claims as claims_mod
+from drakecreep.gap.claims import identifiable
 from drakecreep.gap.residuals import (
     classify_regimes,
+    frequency_bands,
+    independence,
+    motor_table_split,
     operating_map,
     order_spectrum,
     regime_shares,
@@ -59,6 +66,7 @@ __all__ = [
     "where",
     "diagnose",
     "score_fixed",
+    "locate",
 ]
 
 NOMINAL = ("M", "Fv", "Fc", "offset")
@@ -79,7 +87,10 @@ class DiagnosisConfig:
     min_gain : float
         ... and it removes at least this share of the held-out inverse-dynamics residual energy.
     max_effects : int
-        Effects combined at most (1: single effects, 2: pairs).
+        Unused since claims go through :mod:`drakecreep.gap.claims` (single effects only).
+    max_candidates : int
+        Best-ranked effects put to the claim tests (:func:`drakecreep.gap.claims.decide`), in ranking order;
+        the first that passes is claimed.
     effects : tuple of str or None
         Subset of the library to try (default: all).
     v_min_frac : float
@@ -96,6 +107,7 @@ class DiagnosisConfig:
     min_gain: float = 0.05
     max_effects: int = 2
     effects: tuple | None = None
+    max_candidates: int = 3
     v_min_frac: float = 0.01
     progress: bool = False
 
@@ -316,6 +328,7 @@ def replay_gap(fit, runs, ctx):
         _, v_meas, _ = filtered_derivatives(run.x_motor, run.dt)
         _, v_sim, _ = filtered_derivatives(sim["x"], run.dt)
         per.append({"t": run.t, "x": run.x_motor, "x_ref": run.x_ref, "v": v_meas, "force": run.force,
+                    "x_sim": sim["x"], "x_table": run.x_table,
                     "u": run.u, "e_speed": v_meas - v_sim, "e_position": run.x_motor - sim["x"],
                     "e_force": run.force - sim["force"]})
     cat = {k: np.concatenate([p[k] for p in per]) for k in ("e_speed", "e_position", "e_force")}
@@ -323,6 +336,9 @@ def replay_gap(fit, runs, ctx):
            "position_um": 1e6 * float(np.sqrt(np.mean(cat["e_position"] ** 2))),
            "force_N": float(np.sqrt(np.mean(cat["e_force"] ** 2)))}
     return {"rms": rms, "per_run": per}
+
+
+claims_mod.use(design=_design, fit_effect=fit_effect, replay=replay_gap)
 
 
 def where(gap, ctx, idim_residual=None, idim_input=None):
@@ -335,7 +351,7 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
         frequency per signal), ``map`` (per signal), ``whiteness`` (of the IDIM residual), ``sentences``.
     """
     per = gap["per_run"]
-    cat = {k: np.concatenate([p[k] for p in per]) for k in per[0] if k != "t"}
+    cat = {k: np.concatenate([p[k] for p in per]) for k in per[0] if k not in ("t", "x_table")}
     labels = np.concatenate([classify_regimes(p["t"], p["x_ref"], p["v"]) for p in per])
     dt = float(per[0]["t"][1] - per[0]["t"][0])
     signals = {"speed": "e_speed", "position": "e_position", "force": "e_force"}
@@ -369,6 +385,14 @@ def where(gap, ctx, idim_residual=None, idim_input=None):
         out["time"][name] = {"peak_hz": ts["peak_hz"]}
         out["spectra"][name]["time"] = (ts["freq"], ts["psd"])
         out["map"][name] = operating_map(cat[key], cat["v"], cat["x"], cat["force"])
+    out["bands"] = {name: frequency_bands([p[key] for p in per], dt) for name, key in signals.items()}
+    v_ref = np.concatenate([np.gradient(p["x_ref"], dt) for p in per])
+    try:
+        out["independence"] = independence(cat["e_force"], {"reference_speed": v_ref, "force": cat["force"]})
+    except InputError:
+        out["independence"] = {}
+    if all(p["x_table"] is not None for p in per):
+        out["motor_table"] = motor_table_split(cat["x"], np.concatenate([p["x_table"] for p in per]), cat["x_sim"])
     if idim_residual is not None:
         out["whiteness"] = whiteness(idim_residual, idim_input)
     out["sentences"] = _sentences(out)
@@ -396,6 +420,19 @@ def _sentences(w):
             order_txt = ", no sharp order against screw angle"
         lines.append(f"{100 * reg[top]['energy_share']:.0f} % of the {name} residual energy lies in "
                      f"{top.replace('_', '-')} phases ({100 * reg[top]['time_share']:.0f} % of the time){order_txt}.")
+    if "bands" in w:
+        b = w["bands"]["force"]["top"]
+        lines.append(f"{100 * b['share']:.0f} % of the force residual energy lies between {b['lo_Hz']:g} and "
+                     f"{b['hi_Hz']:g} Hz (peak at {w['bands']['force']['peak_hz']:.3g} Hz).")
+    if "motor_table" in w:
+        m = w["motor_table"]
+        lines.append(f"Position gap: {1e6 * m['motor_rms_m']:.3g} um RMS at the motor, {1e6 * m['transmission_rms_m']:.3g} "
+                     f"um RMS added by the transmission: {m['where']} ({100 * m['after_screw_share']:.0f} % after).")
+    if w.get("independence"):
+        dep = [f"{k} (max |r| {v['max_abs']:.2f} at lag {v['lag_of_max']} > band {v['band']:.2f})"
+               for k, v in w["independence"].items() if not v["independent"]]
+        lines.append("The replay force residual is " + ("correlated with " + "; ".join(dep) if dep else
+                     "independent of the reference speed and the force (99 % band)") + ".")
     if "whiteness" in w:
         wh = w["whiteness"]
         lines.append("The inverse-dynamics residual is " + ("white (noise)" if wh["white"] else
@@ -447,34 +484,42 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
     _log(cfg, f"nominal: " + ", ".join(f"{k}={v:.4g}" for k, v in nominal.items()))
     names = cfg.effects or tuple(e.name for e in EFFECTS)
     ranking = []
+    not_identifiable = []
     for name in names:
         eff = get_effect(name)
         if not eff.applicable(train):
+            continue
+        if not identifiable(name, train, ctx, nominal):
+            not_identifiable.append(name)  # nothing to fit: never ranked (no 0.0 score in a top-3)
             continue
         fit = fit_effect((name,), train, test, ctx, nominal, base=base, n_eff_ratio=ratio)
         _log(cfg, f"effect {name}: held-out score {fit.score:+.1f}, gain {100 * fit.gain:.1f} %")
         ranking.append(fit)
     ranking.sort(key=lambda f: (not f.physical, f.score))
 
-    def claimable(f, threshold=cfg.claim_score):
-        return f.physical and f.score < -threshold and f.gain >= cfg.min_gain
-
+    # claims (drakecreep.gap.claims): permutation null, run-to-run spread, held-out closed-loop replay
+    replay_nominal = None
+    if replay:
+        try:
+            replay_nominal = claims_mod.replay_energy(base, test_runs, ctx)
+        except InputError as err:
+            replay_nominal = err
+    rnull = {"ratios": [], "threshold": 0.0}
+    if replay and not isinstance(replay_nominal, Exception):
+        rnull = claims_mod.replay_null(train, test, test_runs, ctx, replay_nominal)
+        _log(cfg, f"replay threshold from run-to-run variation: {100 * rnull['threshold']:.1f} %")
+    decisions = {}
     claimed = []
-    if ranking and claimable(ranking[0]):
-        claimed = [ranking[0]]
-        if cfg.max_effects >= 2:
-            pairs = []
-            for other in ranking[1:]:
-                if other.effects[0] == "quantization":
-                    continue
-                pf = fit_effect(ranking[0].effects + other.effects, train, test, ctx, nominal,
-                                base=ranking[0], n_eff_ratio=ratio)
-                pairs.append(pf)
-            pairs.sort(key=lambda f: (not f.physical, f.score))
-            if pairs:
-                _log(cfg, f"best pair {pairs[0].label}: incremental score {pairs[0].score:+.1f}")
-            if pairs and claimable(pairs[0], cfg.pair_claim_score):
-                claimed.append(pairs[0])
+    for f in ranking[: cfg.max_candidates]:
+        if not f.physical or f.gain <= 0:
+            continue
+        d = claims_mod.decide(f, base, train, test, test_runs, ctx, replay_nominal=replay_nominal,
+                              replay_threshold=rnull["threshold"])
+        decisions[f.label] = d
+        _log(cfg, f"claim test {f.label}: {d['reason']}")
+        if d["claim"]:
+            claimed = [f]
+            break
     final = claimed[-1] if claimed else base
     idim_test_nom = math.sqrt(base.sse_test / test.n)
     idim_test_fin = math.sqrt(final.sse_test / test.n)
@@ -488,6 +533,17 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
         "idim_rms_N": {"before": idim_test_nom, "after": idim_test_fin},
         "idim_error_percent": {"before": _rel(base.sse_test, test), "after": _rel(final.sse_test, test)},
     }
+    result["claims"] = {
+        "rule": "permutation null + run-to-run spread on inverse dynamics, then the held-out closed-loop replay "
+                "(drakecreep.gap.claims)",
+        "replay_available": replay and not isinstance(replay_nominal, Exception),
+        "replay_error": str(replay_nominal) if isinstance(replay_nominal, Exception) else None,
+        "replay_null": rnull,
+        "decisions": _jsonable(decisions),
+        "provisional": [k for k, d in decisions.items() if d["provisional"]],
+        "not_identifiable": not_identifiable,
+    }
+    replay = replay and not isinstance(replay_nominal, Exception)
     if replay:
         _log(cfg, "closed-loop replay of the nominal on the held-out runs")
         gap0 = replay_gap(base, test_runs, ctx)
@@ -506,6 +562,13 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
             result["_gap_after"] = replay_gap(final, test_runs, ctx)
         result["shrink"] = {"before": gap0["rms"], "after": gaps.get(final.label, gap0["rms"]),
                             "model": final.label, "replays": gaps}
+        w_after = where(result["_gap_after"], ctx) if claimed else result["where"]
+        result["unexplained"] = locate(w_after, claimed=list(final.effects),
+                                       remaining_share=result["unexplained_share"])
+    else:
+        result["unexplained"] = {"verdict": "explained" if claimed else "unexplained", "where": None,
+                                 "sentence": "Where the gap lies needs the closed-loop replay "
+                                             f"({result['claims']['replay_error'] or 'not run'})."}
     for f in ranking:
         row = {"effect": f.label, "score": f.score, "gain": f.gain, "bic_delta": f.bic_delta,
                "physical": f.physical,
@@ -523,15 +586,84 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
     return result
 
 
+def locate(w, claimed=(), remaining_share=1.0):
+    """Where the gap no claimed effect explains lies, from a :func:`where` decomposition.
+
+    Parameters
+    ----------
+    w : dict
+        :func:`where` of the replay residual left by the claimed model (or the nominal).
+    claimed : sequence of str
+        Claimed effects (empty: the whole gap is unexplained).
+    remaining_share : float
+        Held-out inverse-dynamics residual energy left, relative to the nominal's.
+
+    Returns
+    -------
+    dict
+        ``verdict`` ("unexplained" or "partly explained by ..."), ``regime``, ``band``, ``order``,
+        ``operating_point``, ``dependent_on`` (inputs the force residual correlates with), ``sentence``.
+    """
+    reg = w["regimes"]["force"]
+    top_reg = max(reg, key=lambda r: reg[r]["energy_share"])
+    band = w["bands"]["force"]["top"] if "bands" in w else None
+    order = None
+    for axis in ("screw", "motor"):
+        o = w["orders"]["force"].get(axis, {})
+        if o.get("peak_order") is not None and o.get("peak_ratio", 0) >= 10 and not o.get("at_band_edge"):
+            order = {"axis": axis, "order": o["peak_order"], "share": o["peak_share"]}
+            break
+    op = None
+    for dim in ("speed", "position", "load"):
+        rows = w["map"]["force"][dim]
+        k = max(range(len(rows)), key=lambda i: rows[i]["energy_share"])
+        if op is None or rows[k]["energy_share"] > op["energy_share"]:
+            op = dict(rows[k], dimension=dim)
+    dep = [k for k, v in w.get("independence", {}).items() if not v["independent"]]
+    verdict = "unexplained" if not claimed else "partly explained by " + " + ".join(claimed)
+    unit = {"speed": (1e3, "mm/s"), "position": (1e3, "mm"), "load": (1.0, "N")}[op["dimension"]]
+    parts = [f"{100 * reg[top_reg]['energy_share']:.0f} % in {top_reg.replace('_', '-')} phases"]
+    if band is not None:
+        parts.append(f"{100 * band['share']:.0f} % between {band['lo_Hz']:g} and {band['hi_Hz']:.0f} Hz")
+    parts.append(f"{100 * op['energy_share']:.0f} % at {op['dimension']} {unit[0] * op['lo']:.3g}-"
+                 f"{unit[0] * op['hi']:.3g} {unit[1]}")
+    parts.append(f"a sharp {order['axis']} order {order['order']:.2f}" if order else "no sharp order")
+    if dep:
+        parts.append("correlated with " + " and ".join(d.replace("_", " ") for d in dep))
+    head = ("Unexplained gap, in the replay force residual" if not claimed else
+            f"Gap left after {' + '.join(claimed)} ({100 * remaining_share:.0f} % of the inverse-dynamics "
+            "residual remains), in the replay force residual")
+    return {"verdict": verdict, "regime": top_reg, "band": band, "order": order, "operating_point": op,
+            "dependent_on": dep, "sentence": f"{head}: " + "; ".join(parts) + "."}
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {k: _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return x
+
+
 def _summary(res):
     lines = list(res.get("where", {}).get("sentences", []))
     if res["claimed"]:
-        top = res["ranking"][0]
+        top = next(r for r in res["ranking"] if r["effect"] == "+".join(res["claimed"]))
         lines.append(f"Best explanation: {' + '.join(res['claimed'])} (held-out score {top['score']:+.1f}); "
                      f"it removes {100 * (1 - res['unexplained_share']):.0f} % of the held-out inverse-dynamics "
                      f"residual energy, {100 * res['unexplained_share']:.0f} % stays unexplained.")
     else:
-        lines.append("Unexplained: no effect of the library passes the held-out evidence threshold.")
+        lines.append("Unexplained: no effect of the library passes the claim tests (held-out inverse dynamics "
+                     "against a permutation null, and the held-out closed-loop replay against run-to-run variation).")
+        prov = res.get("claims", {}).get("provisional", [])
+        if prov:
+            lines.append("Provisional (inverse dynamics only, the replay is unavailable): " + ", ".join(prov) + ".")
+    if res.get("unexplained", {}).get("sentence"):
+        lines.append(res["unexplained"]["sentence"])
     if "shrink" in res:
         b, a = res["shrink"]["before"], res["shrink"]["after"]
         if "speed_mm_s" in a:

@@ -1,9 +1,7 @@
 """Measured runs of a real feed drive: validated arrays in SI units plus the metadata needed to replay them.
 
-A run is a table (CSV, Parquet, HDF5 or MATLAB ``.mat``, read by :mod:`drakecreep.gap.formats`) of these
-signals; a unit may follow a name in brackets, ``x_motor[mm]``, ``t[ms]``, and the values are converted to
-SI (``u`` stays in the unit of the metadata, ``u[mV]`` is converted to V). The format, with the metadata
-keys, is documented in ``docs/measured_format.md``:
+A run is a CSV with a header of SI signal names (a unit may follow a name in brackets, ``x_motor[m]``,
+and must then be the SI one; ``u`` must carry the unit of the metadata, ``u[V]``):
 
 ========== ======== ===================================================================
 column     unit     meaning
@@ -38,6 +36,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
+
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -46,6 +45,7 @@ import yaml
 
 from drakecreep.data import emps_data_dir
 from drakecreep.errors import InputError
+from drakecreep.gap.formats import read_signals
 
 __all__ = [
     "U_UNITS",
@@ -57,7 +57,6 @@ __all__ = [
     "MeasuredRun",
     "MeasuredData",
     "load_measured",
-    "default_meta_path",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -391,7 +390,7 @@ def _meta_from_dict(data, meta_path):
     where = str(meta_path)
     if not isinstance(data, dict):
         raise InputError(where, data, "a YAML mapping with at least u_units and u_gain")
-    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "columns"}
+    known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "file"}
     for key in data:
         if key not in known:
             raise InputError(f"{where}: {key}", data[key], "no such key; known: " + ", ".join(sorted(known)))
@@ -446,27 +445,37 @@ def _meta_to_dict(meta):
     return d
 
 
-# --------------------------------------------------------------------------- reading (drakecreep.gap.formats)
+# --------------------------------------------------------------------------- CSV
 
-def default_meta_path(data_path):
-    """The metadata YAML beside a data file (``<stem>.yaml`` or ``.yml``), or None."""
-    data_path = Path(data_path)
-    candidates = [data_path.with_suffix(".yaml"), data_path.with_suffix(".yml")]
-    return next((p for p in candidates if p.exists()), None)
+def _file_options(opts, meta_path):
+    """The metadata's ``file:`` mapping (``columns``, ``units``, ``key``) as keyword arguments of read_signals."""
+    if opts is None:
+        return {}
+    where = f"{meta_path}: file"
+    if not isinstance(opts, dict) or set(opts) - {"columns", "units", "key"}:
+        raise InputError(where, opts, "a mapping with columns (signal: file column), units (signal: unit), key (HDF5)")
+    for name in ("columns", "units"):
+        value = opts.get(name)
+        if value is not None and not (isinstance(value, dict) and all(isinstance(v, str) for v in value.values())):
+            raise InputError(f"{where}.{name}", value, "a mapping of signal names to strings")
+    key = opts.get("key")
+    if key is not None and not isinstance(key, str):
+        raise InputError(f"{where}.key", key, "a string (the HDF5 table's key)")
+    return dict(columns=opts.get("columns"), units=opts.get("units"), key=key)
 
 
 def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
-    """Load measured runs from a data file (CSV, Parquet, HDF5, MATLAB) and its metadata YAML.
+    """Load measured runs from a CSV and its metadata YAML.
 
     Parameters
     ----------
     csv_path : str or pathlib.Path
-        The data file; the format follows the suffix (:func:`drakecreep.gap.formats.read_table`):
-        ``.csv`` (header of column names with optional units, ``#`` comment lines ignored),
-        ``.parquet``, ``.h5``/``.hdf5`` or ``.mat``. Units in the names are converted to SI.
+        The data file: CSV (``#`` comment lines ignored), Parquet, HDF5 or MATLAB ``.mat``; column names
+        with units in brackets (``t[ms]``, ``x_motor[mm]``) are converted to SI, and the metadata's
+        ``file.columns`` / ``file.units`` map a file's own names (:mod:`drakecreep.gap.formats`,
+        ``docs/measured_format.md``).
     meta_path : str or pathlib.Path, optional
-        The metadata YAML; default: the data path with suffix ``.yaml`` (or ``.yml``). Its optional
-        ``columns`` key maps measured names to the file's names (``{x_motor[mm]: qm}``).
+        The metadata YAML; default: the CSV path with suffix ``.yaml`` (or ``.yml``).
     dt_rtol : float
         Allowed relative deviation of a time step from the median step of its run.
 
@@ -478,33 +487,55 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     Raises
     ------
     InputError
-        Missing or unknown column, unknown unit in a name, unknown ``u_units``, a row with the wrong
-        number of fields, a non-number, NaN, non-monotonic or non-uniform time, missing metadata.
+        Missing or unknown column, unknown unit, unknown ``u_units``, a non-number, NaN, non-monotonic or
+        non-uniform time, missing metadata.
     FileNotFoundError
-        If the data file does not exist.
+        If the CSV does not exist.
     """
-    from drakecreep.gap.formats import read_table
-    from drakecreep.params import load_yaml
-
     csv_path = Path(csv_path)
     if meta_path is None:
-        meta_path = default_meta_path(csv_path)
+        candidates = [csv_path.with_suffix(".yaml"), csv_path.with_suffix(".yml")]
+        meta_path = next((p for p in candidates if p.exists()), None)
         if meta_path is None:
-            raise InputError("metadata", str(csv_path.with_suffix(".yaml")),
-                             "a metadata YAML beside the data file (or name it: diagnose --meta FILE)")
+            raise InputError("metadata", str(candidates[0]),
+                             "a metadata YAML beside the CSV (or name it: diagnose --meta FILE)")
     meta_path = Path(meta_path)
-    meta_data = load_yaml(meta_path, "a YAML mapping with at least u_units and u_gain")
-    columns = meta_data.pop("columns", None) if isinstance(meta_data, dict) else None
+    from drakecreep.params import load_yaml
+
+    meta_data = load_yaml(meta_path, "a YAML mapping with at least u_units")
     meta = _meta_from_dict(meta_data, meta_path)
-    table = read_table(csv_path, meta.u_units, columns)
-    if "run" in table:
-        labels = table["run"].to_numpy()
-        groups = [(lab, np.flatnonzero(labels == lab)) for lab in dict.fromkeys(labels.tolist())]
+
+    file_opts = meta_data.get("file") if isinstance(meta_data, dict) else None
+    signals = read_signals(csv_path, meta.u_units, **_file_options(file_opts, meta_path))
+    unknown = [name for name in signals if name not in COLUMNS]
+    if unknown:
+        raise InputError(f"{csv_path}: header", unknown[0],
+                         "columns among " + ", ".join(COLUMNS) + " (or map the file's names in file.columns)")
+    missing = [c for c, (_, req) in COLUMNS.items() if req and c not in signals]
+    if missing:
+        raise InputError(f"{csv_path}: header", ",".join(signals), "the columns " + ", ".join(missing) + " as well")
+    n_rows = len(next(iter(signals.values())))
+    if n_rows < 1:
+        raise InputError(str(csv_path), "no data rows", "at least 3 rows")
+    arrays = {}
+    for name, values in signals.items():
+        if name == "run":
+            continue
+        arrays[name] = values
+        bad = np.flatnonzero(np.isnan(values))
+        if bad.size:
+            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN or empty)",
+                             "finite numbers")
+    cols = {"run": signals["run"]} if "run" in signals else {}
+    if "run" in cols:
+        labels = np.array(cols["run"], dtype=object)
+        order = list(dict.fromkeys(labels.tolist()))
+        groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
     else:
-        groups = [(csv_path.stem, np.arange(len(table)))]
+        groups = [(csv_path.stem, np.arange(n_rows))]
     runs = []
     for label, idx in groups:
-        kw = {name: (table[name].to_numpy()[idx] if name in table else None) for name in _ARRAYS}
+        kw = {name: (arrays[name][idx] if name in arrays else None) for name in _ARRAYS}
         try:
             runs.append(MeasuredRun(meta=meta, label=str(label), dt_rtol=dt_rtol, **kw))
         except InputError as err:

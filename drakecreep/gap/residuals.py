@@ -10,10 +10,16 @@ Inputs are plain arrays on a uniform time grid: the measured run and the closed-
   period: screw revolution, motor revolution, millimetre of table travel), so a periodic effect shows
   as a sharp order; :func:`time_spectrum` the same against time;
 * :func:`operating_map`: residual RMS binned by speed, position and load;
-* :func:`whiteness`: Ljung-Box test (SciPy chi-square) and the largest cross-correlation with the input.
+* :func:`whiteness`: Ljung-Box test (SciPy chi-square) and the largest cross-correlation with the input;
+* :func:`independence`: the residual-input independence test of system identification (cross-correlation
+  of the residual with each input over lags, with its confidence band);
+* :func:`frequency_bands`: share of the residual energy in frequency bands (Welch PSD);
+* :func:`motor_table_split`: for runs with a linear scale, is the gap before or after the screw?
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from scipy import signal, stats
@@ -28,7 +34,14 @@ __all__ = [
     "time_spectrum",
     "operating_map",
     "whiteness",
+    "BANDS_HZ",
+    "frequency_bands",
+    "independence",
+    "motor_table_split",
 ]
+
+#: Frequency bands [Hz] of :func:`frequency_bands` (the last one ends at the Nyquist frequency).
+BANDS_HZ = ((0.0, 2.0), (2.0, 10.0), (10.0, 50.0), (50.0, 150.0), (150.0, math.inf))
 
 #: Time regimes, in order of precedence.
 REGIMES = ("dwell", "stick", "reversal", "acceleration", "constant_speed")
@@ -242,3 +255,139 @@ def whiteness(residual, inputs=None, lags=10):
             xmax = float(np.max(np.abs(xc)))
     return {"ljung_box_q": q, "ljung_box_p": p, "acf": acf.tolist(), "max_abs_xcorr": xmax,
             "xcorr_bound": float(bound), "white": bool(p >= 0.05 and xmax <= bound)}
+
+
+def frequency_bands(residual, dt, bands=BANDS_HZ, nperseg=1024):
+    """Share of a residual's energy per frequency band (Welch PSD, :func:`scipy.signal.welch`).
+
+    Parameters
+    ----------
+    residual : array_like or sequence of array_like
+        One record or several (separate runs: their spectra are averaged, weighted by length).
+    dt : float
+        Sample time [s].
+    bands : sequence of (float, float)
+        Band edges [Hz]; ``inf`` means the Nyquist frequency.
+    nperseg : int
+        Welch segment length (shortened for short records).
+
+    Returns
+    -------
+    dict
+        ``bands`` (list of ``{"lo_Hz", "hi_Hz", "share", "rms"}``), ``peak_hz`` and ``top`` (the band
+        with the largest share).
+    """
+    recs = [np.asarray(residual, dtype=float)] if np.ndim(residual[0]) == 0 else \
+        [np.asarray(r, dtype=float) for r in residual]
+    if dt <= 0:
+        raise InputError("dt", dt, "a sample time > 0 s")
+    seg = int(min(nperseg, min(r.size for r in recs)))
+    if seg < 8:
+        raise InputError("residual", f"{seg} samples", "records of at least 8 samples")
+    psds, w = [], []
+    for r in recs:
+        f, p = signal.welch(r, fs=1.0 / dt, nperseg=seg, detrend="constant")
+        psds.append(p)
+        w.append(r.size)
+    psd = np.average(np.array(psds), axis=0, weights=w)
+    df = float(f[1] - f[0])
+    total = float(np.sum(psd) * df)
+    rows = []
+    for lo, hi in bands:
+        m = (f >= lo) & (f < (hi if math.isfinite(hi) else np.inf))
+        e = float(np.sum(psd[m]) * df)
+        rows.append({"lo_Hz": float(lo), "hi_Hz": float(min(hi, f[-1])), "share": e / total if total > 0 else 0.0,
+                     "rms": math.sqrt(max(e, 0.0))})
+    k = 1 + int(np.argmax(psd[1:]))
+    top = max(rows, key=lambda r: r["share"])
+    return {"bands": rows, "peak_hz": float(f[k]), "top": top}
+
+
+def _acf(x, lags):
+    x = x - x.mean()
+    d = float(x @ x)
+    return np.array([1.0] + [float(x[:-k] @ x[k:]) / d if d > 0 else 0.0 for k in range(1, lags + 1)])
+
+
+def independence(residual, inputs, lags=25, level=0.99):
+    """Cross-correlation of a residual with each input, with its confidence band (residual analysis).
+
+    As system-identification tools do (e.g. ``resid``), the normalised cross-correlation
+    ``r_eu(k) = corr(e[t], u[t - k])`` for ``k = -lags .. lags`` (positive lags: the residual follows the
+    input) is compared with a band that holds with probability ``level``
+    if residual and input are independent. The band uses Bartlett's variance of a cross-correlation of
+    two independent autocorrelated series, ``var r_eu(k) = (1/N) sum_j rho_e(j) rho_u(j)``, so slowly
+    varying residuals and inputs (filtered or closed-loop data) do not give false alarms.
+
+    Parameters
+    ----------
+    residual : array_like
+    inputs : dict
+        ``{name: array}`` on the same samples (e.g. the reference speed and the drive force).
+    lags : int
+        Largest lag (samples).
+    level : float
+        Family-wise coverage of the band over all lags (0.99; ``resid`` uses 0.99 pointwise).
+
+    Returns
+    -------
+    dict
+        Per input: ``xcorr`` (list), ``lags``, ``band``, ``max_abs``, ``lag_of_max``, ``independent``
+        (every lag inside the band).
+    """
+    e = np.asarray(residual, dtype=float)
+    e = e - e.mean()
+    n = e.size
+    if n < 4 * lags:
+        raise InputError("residual", f"{n} samples", f"at least {4 * lags} samples for {lags} lags")
+    # family-wise over the 2 lags + 1 values tested (Bonferroni): a pointwise band would flag about
+    # (2 lags + 1) (1 - level) lags of an independent pair by chance
+    z = float(stats.norm.ppf(1 - (1 - level) / (2 * (2 * lags + 1))))
+    rho_e = _acf(e, n // 4)
+    out = {}
+    for name, u in inputs.items():
+        u = np.asarray(u, dtype=float)
+        if u.size != n:
+            raise InputError(f"inputs.{name}", f"length {u.size}", f"length {n} like the residual")
+        u = u - u.mean()
+        den = math.sqrt(float(e @ e) * float(u @ u))
+        ks = np.arange(-lags, lags + 1)
+        if den == 0:
+            xc = np.zeros(ks.size)
+        else:
+            # xc[k] = corr(e[t], u[t - k]): a residual that follows the input by d samples peaks at k = +d
+            xc = np.array([float(e[max(0, k): n - max(0, -k)] @ u[max(0, -k): n - max(0, k)]) / den for k in ks])
+        rho_u = _acf(u, n // 4) if den > 0 else np.zeros(rho_e.size)
+        var = (1.0 + 2.0 * float(np.sum(rho_e[1:] * rho_u[1:]))) / n
+        band = z * math.sqrt(max(var, 1.0 / n))
+        i = int(np.argmax(np.abs(xc)))
+        out[name] = {"lags": ks.tolist(), "xcorr": xc.tolist(), "band": band, "max_abs": float(abs(xc[i])),
+                     "lag_of_max": int(ks[i]), "independent": bool(np.all(np.abs(xc) <= band))}
+    return out
+
+
+def motor_table_split(x_motor, x_table, x_motor_sim, x_table_sim=None):
+    """Is the position gap before or after the screw? (runs with a linear scale)
+
+    The motor-side gap is ``x_motor - x_motor_sim``; the part the transmission adds is the measured
+    deflection ``x_table - x_motor`` minus the simulated one (0 for a rigid model, when
+    ``x_table_sim`` is None).
+
+    Returns
+    -------
+    dict
+        ``motor_rms_m``, ``transmission_rms_m``, ``table_rms_m`` and ``after_screw_share``
+        (transmission energy / (motor + transmission energy)); ``where``: ``"before the screw"``,
+        ``"after the screw"`` or ``"both"``.
+    """
+    xm, xt, xs = (np.asarray(a, dtype=float) for a in (x_motor, x_table, x_motor_sim))
+    xts = xs if x_table_sim is None else np.asarray(x_table_sim, dtype=float)
+    em = xm - xs
+    et = (xt - xm) - (xts - xs)
+    et = et - et.mean()  # a constant scale offset is a mounting datum, not a gap
+    e_m, e_t = float(em @ em), float(et @ et)
+    share = e_t / (e_m + e_t) if e_m + e_t > 0 else 0.0
+    where = "after the screw" if share > 0.67 else ("before the screw" if share < 0.33 else "both")
+    return {"motor_rms_m": math.sqrt(e_m / em.size), "transmission_rms_m": math.sqrt(e_t / et.size),
+            "table_rms_m": float(np.sqrt(np.mean((xt - xts - np.mean(xt - xts)) ** 2))),
+            "after_screw_share": share, "where": where}

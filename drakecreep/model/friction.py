@@ -17,19 +17,26 @@ LuGreFriction
     friction", IEEE TAC 40(3), 1995: one bristle state (stored normalized, see the class),
     ``dz/dt = v - sigma0 |v| z / g(v)``, ``F = sigma0 z + sigma1 dz/dt + Fv v``,
     ``g(v) = Fc + (Fs - Fc) exp(-|v/vs|^delta)``. Its steady state is the Stribeck curve.
+GMSFriction
+    Generalized Maxwell-slip: Al-Bender, Lampaert, Swevers, "The generalized Maxwell-slip model: a
+    novel model for friction simulation and compensation", IEEE TAC 50(11), 2005. N elasto-slip
+    elements in parallel, each sticking (``dF_i/dt = k_i v``) until its force reaches its share
+    ``alpha_i g(v)`` of the Stribeck curve, then sliding with ``dF_i/dt = C (alpha_i sgn(v) - F_i/g(v))``;
+    presliding hysteresis with non-local memory, and the Stribeck curve in steady sliding.
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from drakecreep.model._scalar import exp, fabs, tanh
+from drakecreep.model._scalar import clip, exp, fabs, tanh, where
 
 __all__ = [
     "FrictionLaw",
     "CoulombFriction",
     "StribeckFriction",
     "LuGreFriction",
+    "GMSFriction",
     "FRICTION_LAWS",
     "make_friction_law",
     "stribeck_curve",
@@ -178,8 +185,118 @@ class LuGreFriction(FrictionLaw):
         return self.bristle_stiffness
 
 
+@dataclass(frozen=True)
+class GMSFriction(FrictionLaw):
+    """Generalized Maxwell-slip friction (Al-Bender, Lampaert, Swevers, IEEE TAC 50(11), 2005), N elements.
+
+    Element ``i`` is a spring ``k_i`` ending in a slip block. Its force ``F_i`` (state, stored as
+    ``w_i = F_i / Fc``)
+
+    * *sticks* -- ``dF_i/dt = k_i v`` -- while ``|F_i| < alpha_i g(v)`` or while the motion unloads it;
+    * *slides* once it reaches ``alpha_i g(v)`` and is pushed further:
+      ``dF_i/dt = C (alpha_i sgn(v) - F_i / g(v))`` (the paper's slip law, the sign taken with ``v``
+      as in its stated intent: ``F_i`` is attracted to ``alpha_i g(v) sgn(v)`` at the rate ``C``).
+
+    ``F = sum F_i + sigma1 sum(dF_i/dt) / sigma0 + Fv v``. In steady sliding every element sits at its
+    limit: ``F = g(v) sgn(v) + Fv v``, the Stribeck curve, as LuGre. Unlike LuGre, a stuck element
+    does not creep (LuGre's ``dz/dt = v - sigma0 |v| z / g`` lets the bristles slide at any load),
+    and the presliding force-displacement curve is a hysteresis loop with non-local memory
+    (Masing's rules: after a reversal the curve follows twice the virgin curve).
+
+    Element parameters: equal shares ``alpha_i = 1/N``, stiffnesses ``k_i = sigma0 / (i H_N)``
+    (``H_N`` the N-th harmonic number): their sum is LuGre's presliding stiffness ``sigma0`` and the
+    elements let go one after another at displacements ``i x1`` with ``x1 = Fs H_N / (N sigma0)``, the
+    last at ``H_N Fs / sigma0`` (about 2x LuGre's presliding range for N = 4). The switch from stick to
+    slip is blended over the last ``blend`` share of each element's limit (0.02: a continuous
+    right-hand side for the variable-step integrators; the steady state is exact).
+
+    Parameters
+    ----------
+    bristle_stiffness : float
+        ``sigma0 = sum k_i`` (N/m): initial presliding stiffness.
+    bristle_damping : float
+        ``sigma1`` (N s/m): micro-damping on the presliding rate ``sum(dF_i/dt) / sigma0``.
+    elements : int
+        N, the number of Maxwell-slip elements (>= 1).
+    attraction : float
+        ``C`` (N/s): how fast a sliding element's force follows ``alpha_i g(v)``; ``g / C`` is the
+        frictional memory time.
+    blend : float
+        Share of an element's limit over which stick turns into slip (numerical, 0 < blend < 1).
+    """
+
+    bristle_stiffness: float = 1e7
+    bristle_damping: float = 1e3
+    elements: int = 4
+    attraction: float = 1e4
+    blend: float = 0.02
+
+    name = "gms"
+
+    def __post_init__(self):
+        if isinstance(self.elements, bool) or not isinstance(self.elements, int) or self.elements < 1:
+            raise ValueError(f"GMSFriction.elements must be an integer >= 1, got {self.elements!r}")
+        if not 0.0 < self.blend < 1.0:
+            raise ValueError(f"GMSFriction.blend must be in (0, 1), got {self.blend!r}")
+
+    @property
+    def num_states(self):
+        """One state per element."""
+        return self.elements
+
+    @property
+    def shares(self):
+        """``alpha_i`` (sum 1)."""
+        return np.full(self.elements, 1.0 / self.elements)
+
+    @property
+    def stiffnesses(self):
+        """``k_i`` (N/m), summing to ``sigma0``."""
+        i = np.arange(1, self.elements + 1)
+        return self.bristle_stiffness / (i * np.sum(1.0 / i))
+
+    def _g(self, v, Fc, Fs):
+        return stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
+
+    def force_rates(self, v, w, Fc, Fs):
+        """``dF_i/dt`` (N/s) of the elements for the normalized states ``w``."""
+        if Fc <= 0.0:
+            return [0.0 * v for _ in range(self.elements)]
+        g = self._g(v, Fc, Fs)
+        rates = []
+        for alpha, k, wi in zip(self.shares, self.stiffnesses, w):
+            F = Fc * wi
+            limit = alpha * g
+            loaded = where(F * v > 0.0, 1.0, 0.0)  # the motion pushes the element further
+            phi = loaded * clip((fabs(F) / limit - (1.0 - self.blend)) / self.blend, 0.0, 1.0)
+            sign = where(F > 0.0, 1.0, -1.0)
+            slip = self.attraction * (alpha * sign - F / g)
+            rates.append((1.0 - phi) * (float(k) * v) + phi * slip)
+        return rates
+
+    def state_rates(self, v, w, Fc, Fs):
+        if Fc <= 0.0:
+            return [0.0 * v for _ in range(self.elements)]
+        return [r / Fc for r in self.force_rates(v, w, Fc, Fs)]
+
+    def force(self, v, w, Fc, Fs):
+        rates = self.force_rates(v, w, Fc, Fs)
+        total, rate = 0.0, 0.0
+        for wi, r in zip(w, rates):
+            total = total + Fc * wi
+            rate = rate + r
+        return total + self.bristle_damping * rate / self.bristle_stiffness + self.viscous * v
+
+    def steady_state_force(self, v, Fc, Fs):
+        v = np.asarray(v, dtype=float)
+        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous * v
+
+    def presliding_stiffness(self, Fc, Fs):
+        return self.bristle_stiffness
+
+
 #: selectable laws by name
-FRICTION_LAWS = {cls.name: cls for cls in (CoulombFriction, StribeckFriction, LuGreFriction)}
+FRICTION_LAWS = {cls.name: cls for cls in (CoulombFriction, StribeckFriction, LuGreFriction, GMSFriction)}
 
 
 def make_friction_law(params):
@@ -193,5 +310,10 @@ def make_friction_law(params):
     if params.law == "lugre":
         return LuGreFriction(
             **common, bristle_stiffness=params.bristle_stiffness, bristle_damping=params.bristle_damping
+        )
+    if params.law == "gms":
+        return GMSFriction(
+            **common, bristle_stiffness=params.bristle_stiffness, bristle_damping=params.bristle_damping,
+            elements=params.gms_elements, attraction=params.gms_attraction,
         )
     return FRICTION_LAWS[params.law](**common)

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 from drakecreep.model.friction import FrictionLaw, make_friction_law
 from drakecreep.model.nut_table import friction_levels, moving_mass
-from drakecreep.model.screw import axial_damping, axial_stiffness
+from drakecreep.model.screw import axial_damping, axial_stiffness, screw_inertia
 
-__all__ = ["LumpedDrive", "lumped"]
+__all__ = ["LumpedDrive", "lumped", "axial_mode_frequency"]
 
 
 @dataclass(frozen=True)
@@ -69,3 +69,19 @@ def lumped(params, load_case=0, x=0.0):
         law=make_friction_law(params.friction),
         load_case=int(load_case),
     )
+
+
+def axial_mode_frequency(params, x=0.0):
+    """Undamped axial mode (Hz) of the two-mass drive: motor side against the table on the chain.
+
+    ``omega^2 = K (1 / M + r^2 / J)`` with ``K`` the chain at table position ``x``, ``M`` the moving
+    mass, ``J`` the rotor, coupling and shaft inertia and ``r = Ph / 2 pi`` (the motor side reflected
+    as the mass ``J / r^2``). The frequency ``screw.damping_frequency`` should match for the
+    ``loss_factor`` damping model.
+    """
+    import math
+
+    r = params.screw.lead / (2.0 * math.pi)
+    inertia = params.motor.rotor_inertia + params.motor.coupling_inertia + screw_inertia(params.screw)
+    k = float(axial_stiffness(params.screw, params.nut, x))
+    return math.sqrt(k * (1.0 / moving_mass(params) + r * r / inertia)) / (2.0 * math.pi)

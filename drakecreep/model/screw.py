@@ -8,6 +8,23 @@ in series. The force acts on the table; its reaction, through the lead, loads th
 The series damping of the chain uses the light-damping combination of Kelvin-Voigt elements,
 ``C = K^2 sum(c_i / k_i^2)`` (each element's loss factor weighted by its share of the compliance);
 it is exact when every element has the same ``c_i / k_i``.
+
+The chain's elements (:func:`bearing_element`, :func:`nut_element`):
+
+* the thrust bearing, optionally in series with the fixed joints of its seat
+  (``screw.seat_joint_stiffness``: base-bearing seat, seat-outer ring, inner ring-shaft; seed paper
+  Tables 1-2, see :func:`drakecreep.paper.joints.axial_path_joints`);
+* the shaft (undamped);
+* the screw-nut contact, optionally in series with the nut seat joints (``nut.seat_joint_stiffness``).
+
+Damping model (``screw.chain_damping``): ``"viscous"`` uses the hammer-test coefficients as identified.
+``"loss_factor"`` reads them as hysteretic damping: each test gives a loss factor
+``eta_i = c_i omega_i / k_i = c_i / sqrt(k_i m_i)`` at its own test frequency ``omega_i = sqrt(k_i / m_i)``
+(half-power bandwidth method: ``eta = 2 zeta``; test masses ``nut.mass``, Table 3's M, and
+``screw.bearing_test_mass``), and the equivalent viscous coefficient at the mode the damping acts on,
+``c_i = eta_i k_i / (2 pi f)`` with ``f = screw.damping_frequency``, is what the chain uses (a
+frequency-independent loss factor cannot be simulated in the time domain; it is exact at ``f``).
+The fixed joints' coefficients are used as given.
 """
 
 import math
@@ -22,6 +39,8 @@ __all__ = [
     "shaft_axial_stiffness",
     "axial_stiffness",
     "axial_damping",
+    "bearing_element",
+    "nut_element",
     "screw_inertia",
 ]
 
@@ -45,15 +64,49 @@ def shaft_axial_stiffness(screw, x):
     return ea / a
 
 
+def _series(k, c, kj, cj):
+    """Element ``(k, c)`` in series with a joint ``(kj, cj)`` (``kj = 0``: rigid joint, no change)."""
+    if kj <= 0.0:
+        return k, c
+    ke = 1.0 / (1.0 / k + 1.0 / kj)
+    return ke, ke**2 * (c / k**2 + cj / kj**2)
+
+
+def _hysteretic(k, c, mass, frequency):
+    """Equivalent viscous coefficient at ``frequency`` (Hz) of the loss factor a test ``(k, c, mass)`` gives."""
+    eta = c / math.sqrt(k * mass)
+    return eta * k / (2.0 * math.pi * frequency)
+
+
+def bearing_element(screw):
+    """Thrust bearing (with its seat joints): axial ``(stiffness N/m, damping N s/m)`` of the chain's first element."""
+    k, c = screw.bearing_stiffness, screw.bearing_damping
+    if screw.chain_damping == "loss_factor":
+        c = _hysteretic(k, c, screw.bearing_test_mass, screw.damping_frequency)
+    return _series(k, c, screw.seat_joint_stiffness, screw.seat_joint_damping)
+
+
+def nut_element(screw, nut):
+    """Screw-nut contact (with its seat joints): axial ``(stiffness N/m, damping N s/m)``."""
+    k, c = nut.axial_stiffness, nut.axial_damping
+    if screw.chain_damping == "loss_factor":
+        c = _hysteretic(k, c, nut.mass, screw.damping_frequency)
+    return _series(k, c, nut.seat_joint_stiffness, nut.seat_joint_damping)
+
+
 def axial_stiffness(screw, nut, x=0.0):
     """Stiffness (N/m) of the whole chain, bearing + shaft + nut in series, with the table at ``x``."""
-    return 1.0 / (1.0 / screw.bearing_stiffness + 1.0 / shaft_axial_stiffness(screw, x) + 1.0 / nut.axial_stiffness)
+    kb, _ = bearing_element(screw)
+    kn, _ = nut_element(screw, nut)
+    return 1.0 / (1.0 / kb + 1.0 / shaft_axial_stiffness(screw, x) + 1.0 / kn)
 
 
 def axial_damping(screw, nut, x=0.0):
     """Damping (N s/m) of the chain: ``K^2 (c_bearing / k_bearing^2 + c_nut / k_nut^2)`` (shaft undamped)."""
     k = axial_stiffness(screw, nut, x)
-    return k**2 * (screw.bearing_damping / screw.bearing_stiffness**2 + nut.axial_damping / nut.axial_stiffness**2)
+    kb, cb = bearing_element(screw)
+    kn, cn = nut_element(screw, nut)
+    return k**2 * (cb / kb**2 + cn / kn**2)
 
 
 def screw_inertia(screw):

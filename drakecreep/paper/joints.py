@@ -44,6 +44,8 @@ __all__ = [
     "interference_fit_joint",
     "table1_ratios",
     "table2_ratios",
+    "AXIAL_PATH_JOINTS",
+    "axial_path_joints",
 ]
 
 
@@ -361,3 +363,51 @@ def table2_ratios(rows) -> dict:
     kr = np.array([r["Kr_1e10_N_per_m"] for r in rows]) * 1e10
     cr = np.array([r["Cr_1e8_Ns_per_m"] for r in rows]) * 1e8
     return {"ca_over_ka_s": ca / ka, "cr_over_kr_s": cr / kr, "kr_over_ka": kr / ka}
+
+
+#: the fixed joints the axial force passes through (Tables 1-2 row names), by element of the chain:
+#: the bearing's seat (base-seat bolted face, seat-outer ring and inner ring-shaft fits, axial = normal/"a")
+#: and the nut's seat (nut-seat and seat-workbench bolted faces). The guide and slider joints carry the
+#: table's weight, not the axial force.
+AXIAL_PATH_JOINTS = {
+    "bearing_seat": (("table1_bolted_fixed_joints", "base-bearing seat"),
+                     ("table2_interference_fit_joints", "bearing seat-outer ring"),
+                     ("table2_interference_fit_joints", "inner ring-screw shaft")),
+    "nut_seat": (("table1_bolted_fixed_joints", "workbench-nut seat"),
+                 ("table1_bolted_fixed_joints", "nut-nut seat")),
+}
+
+
+def axial_path_joints(data_dir=None) -> dict:
+    """Series stiffness and damping of the bearing-seat and nut-seat joints from the paper's Tables 1-2.
+
+    Each group of :data:`AXIAL_PATH_JOINTS` in series (normal / axial columns ``Kn, Cn`` or ``Ka, Ca``):
+    ``k = 1 / sum(1 / k_i)``, ``c = k^2 sum(c_i / k_i^2)`` (the chain's Kelvin-Voigt combination,
+    :mod:`drakecreep.model.screw`). The tables' column assignment is uncertain (see the CSV notes): the
+    values are what the printed columns say.
+
+    Returns
+    -------
+    dict
+        ``{"bearing_seat": (k N/m, c N s/m), "nut_seat": (k, c)}``; set them as
+        ``screw.seat_joint_stiffness/damping`` and ``nut.seat_joint_stiffness/damping``.
+    """
+    from drakecreep.paper.tables import read_paper_table
+
+    tables = {name: {r["joint"]: r for r in read_paper_table(name, data_dir)}
+              for name in ("table1_bolted_fixed_joints", "table2_interference_fit_joints")}
+    out = {}
+    for group, members in AXIAL_PATH_JOINTS.items():
+        ks, cs = [], []
+        for table, joint in members:
+            row = tables[table][joint]
+            if table.startswith("table1"):
+                ks.append(row["Kn_1e10_N_per_m"] * 1e10)
+                cs.append(row["Cn_1e8_Ns_per_m"] * 1e8)
+            else:
+                ks.append(row["Ka_1e10_N_per_m"] * 1e10)
+                cs.append(row["Ca_1e8_Ns_per_m"] * 1e8)
+        k = 1.0 / sum(1.0 / x for x in ks)
+        c = k**2 * sum(ci / ki**2 for ci, ki in zip(cs, ks))
+        out[group] = (float(k), float(c))
+    return out

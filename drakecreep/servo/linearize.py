@@ -136,8 +136,11 @@ def operating_point(params, scenario):
     ------
     InputError
         When no steady sliding exists: zero position gain without full feedforward, or a force
-        beyond the drive's limit.
+        beyond the drive's limit; for the GMS law (its elements switch between stick and slip: no
+        smooth steady state to linearize about).
     """
+    if params.friction.law == "gms":
+        raise InputError("friction.law", "gms", "coulomb, stribeck or lugre (linearization needs a smooth law)")
     g = params.controller
     v = scenario.feed
     load = params.load_case(scenario.load_case)

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from drakecreep.model.diagram import initial_conditions
+from drakecreep.model.screw import bearing_element, nut_element
 
 __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
 
@@ -27,9 +28,11 @@ __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
 def unsupported(params):
     """Why these plain-Python equations cannot run ``params``: ``(field, value, allowed)``, or None.
 
-    They cover the base drive: no disturbances, no friction compensation, nut friction on the table.
+    They cover the base drive (coulomb, stribeck or lugre friction): no disturbances, no friction compensation, nut friction on the table.
     """
     p = params
+    if p.friction.law not in ("coulomb", "stribeck", "lugre"):
+        return ("friction.law", p.friction.law, "coulomb, stribeck or lugre (the plain-Python equations)")
     if p.friction.nut_friction_on != "table":
         return ("friction.nut_friction_on", p.friction.nut_friction_on,
                 "table (the plain-Python equations lump the nut's friction on the table)")
@@ -80,8 +83,9 @@ class BaselineModel:
         sc, nut = self.p.screw, self.p.nut
         a = sc.nut_start_distance + x
         ks = self.ea * sc.length / (a * (sc.length - a)) if sc.mounting == "fixed-fixed" else self.ea / a
-        k = 1.0 / (1.0 / sc.bearing_stiffness + 1.0 / ks + 1.0 / nut.axial_stiffness)
-        c = k * k * (sc.bearing_damping / sc.bearing_stiffness**2 + nut.axial_damping / nut.axial_stiffness**2)
+        (kb, cb), (kn, cn) = bearing_element(sc), nut_element(sc, nut)
+        k = 1.0 / (1.0 / kb + 1.0 / ks + 1.0 / kn)
+        c = k * k * (cb / kb**2 + cn / kn**2)
         return k, c
 
     def g(self, v):

@@ -21,6 +21,7 @@ import numpy as np
 from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem
 from pydrake.systems.primitives import VectorLogSink
 
+from drakecreep.model.screw import bearing_element, nut_element
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
@@ -71,10 +72,8 @@ class _Columns:
         self.tc = col(lambda m: m.lag if m.lag > 0 else 1.0)
         self.peak = np.array([q.motor.peak_torque for q in p])
         self.bm = np.array([q.motor.viscous_damping for q in p])
-        self.kb = np.array([q.screw.bearing_stiffness for q in p])
-        self.cb = np.array([q.screw.bearing_damping for q in p])
-        self.kn = np.array([q.nut.axial_stiffness for q in p])
-        self.cn = np.array([q.nut.axial_damping for q in p])
+        self.kb, self.cb = np.array([bearing_element(q.screw) for q in p]).T
+        self.kn, self.cn = np.array([nut_element(q.screw, q.nut) for q in p]).T
         self.a0 = np.array([q.screw.nut_start_distance for q in p])
         self.length = np.array([q.screw.length for q in p])
         self.vs = np.array([q.friction.stribeck_velocity for q in p])

@@ -5,18 +5,27 @@ import pytest
 from drakecreep import cli
 
 
-def test_gap_benchmark_json(capsys):
-    assert cli.main(["gap-benchmark", "--n", "1", "--seed", "4", "--no-replay", "--json"]) == 0
+def test_gap_benchmark_json_on_one_short_null(capsys):
+    assert cli.main(["gap-benchmark", "--seeds", "dev", "--kinds", "drakecreep", "--n-per-effect", "0",
+                     "--n-null", "1", "--n-ool", "0", "--samples", "900", "--json"]) == 0
     captured = capsys.readouterr()
     data = json.loads(captured.out)
     assert data["scores"]["n_datasets"] == 1
     row = data["datasets"][0]
-    assert row["seed"] == 4 and "hidden" in row and "claimed" in row
-    assert "[gap-benchmark] 1/1" in captured.err
+    assert row["category"] == "null" and row["kind"] == "drakecreep" and row["claimed"] == []
+    assert "[gap-benchmark] 1 seed" in captured.err
 
 
-def test_gap_benchmark_rejects_zero(capsys):
+@pytest.mark.parametrize("argv, needle", [(["--n-null", "-1"], "must be >= 0"),
+                                          (["--kinds", "pid"], "invalid choice")])
+def test_gap_benchmark_rejects_bad_arguments(capsys, argv, needle):
     with pytest.raises(SystemExit) as exc:
-        cli.main(["gap-benchmark", "--n", "0"])
+        cli.main(["gap-benchmark"] + argv)
     assert exc.value.code == 2
-    assert "must be >= 1" in capsys.readouterr().err
+    assert needle in capsys.readouterr().err
+
+
+def test_gap_benchmark_rejects_short_runs_before_work(capsys):
+    assert cli.main(["gap-benchmark", "--samples", "10"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--samples" in err

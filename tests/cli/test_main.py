@@ -32,7 +32,7 @@ def test_simulate_text(tmp_path, capsys):
     (["simulate", "--feed", "0"], "--feed"),
     (["simulate", "--load-case", "9"], "--load-case"),
     (["simulate", "--duration", "0.5"], "--duration"),
-    (["simulate", "--friction", "gms"], "--friction"),
+    (["simulate", "--friction", "maxwell"], "--friction"),
     (["simulate", "--params", "/no/such/file.yaml"], "No such file"),
     (["diagram", "--out", "x.jpg"], "--out"),
     (["nonsense"], "invalid choice"),

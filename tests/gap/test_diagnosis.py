@@ -82,5 +82,10 @@ def test_emps_estimation_points_at_asymmetric_friction():
     """The benchmark authors' finding (asymmetric friction), found blind on the estimation file only."""
     parts = split_cycles(load_emps("estimation").run())
     res = diagnose(parts[0::2], parts[1::2], DiagnosisConfig(screw_lead=2.5e-3), replay=False)
-    assert res["claimed"][0] == "asymmetric_friction"
-    assert res["idim_error_percent"]["after"] < 0.8 * res["idim_error_percent"]["before"]
+    # without the closed-loop replay nothing is claimed (drakecreep.gap.claims); the inverse-dynamics
+    # tests (permutation null, held-out runs) already single it out
+    assert res["claimed"] == []
+    assert res["claims"]["provisional"][0] == "asymmetric_friction"
+    top = res["ranking"][0]
+    assert top["effect"] == "asymmetric_friction"
+    assert top["idim_rms_N"]["after"] < 0.8 * top["idim_rms_N"]["before"]

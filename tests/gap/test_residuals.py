@@ -77,3 +77,44 @@ def test_operating_map_bins_cover_the_energy():
     m = operating_map(r, V, X_REF, V * 100, bins=4)
     assert sum(b["energy_share"] for b in m["speed"]) == pytest.approx(1.0)
     assert m["speed"][-1]["rms"] > m["speed"][0]["rms"]
+
+
+def test_frequency_bands_find_a_30_hz_residual():
+    from drakecreep.gap.residuals import frequency_bands
+
+    rng = np.random.default_rng(0)
+    t = np.arange(4000) * 1e-3
+    r = np.sin(2 * np.pi * 30 * t) + 0.05 * rng.normal(size=t.size)
+    out = frequency_bands([r[:2000], r[2000:]], 1e-3)
+    assert out["top"]["lo_Hz"] == 10.0 and out["top"]["share"] > 0.9
+    assert abs(out["peak_hz"] - 30.0) < 1.5
+    assert abs(sum(b["share"] for b in out["bands"]) - 1.0) < 1e-9
+
+
+def test_independence_band_and_lag():
+    from drakecreep.gap.residuals import independence
+
+    rng = np.random.default_rng(1)
+    u = np.convolve(rng.normal(size=5000), np.ones(5) / 5, mode="same")  # coloured input
+    e_ind = np.convolve(rng.normal(size=5000), np.ones(5) / 5, mode="same")
+    e_dep = 0.3 * np.roll(u, 3) + e_ind  # follows the input by 3 samples
+    ind = independence(e_ind, {"u": u})["u"]
+    dep = independence(e_dep, {"u": u})["u"]
+    assert ind["independent"] and not dep["independent"]
+    assert dep["lag_of_max"] == 3 and dep["max_abs"] > dep["band"]
+    # Bartlett's band is wider than 2.58/sqrt(N) for coloured series
+    assert ind["band"] > 2.58 / np.sqrt(5000)
+    with pytest.raises(InputError):
+        independence(e_ind[:50], {"u": u[:50]})
+
+
+def test_motor_table_split():
+    from drakecreep.gap.residuals import motor_table_split
+
+    t = np.arange(3000) * 1e-3
+    x = 0.01 * t
+    sim = x.copy()
+    after = motor_table_split(x, x + 2e-6 * np.sin(2 * np.pi * 3 * t), sim)
+    before = motor_table_split(x + 2e-6 * np.sin(2 * np.pi * 3 * t), x + 2e-6 * np.sin(2 * np.pi * 3 * t), sim)
+    assert after["where"] == "after the screw" and after["after_screw_share"] > 0.99
+    assert before["where"] == "before the screw" and before["after_screw_share"] < 0.01

@@ -79,3 +79,69 @@ def test_two_mass_natural_frequency_without_friction(paper):
     m2 = p.table.mass + p.nut.mass
     f_expected = math.sqrt(axial_stiffness(p.screw, p.nut, 0.0) * (1 / m1 + 1 / m2)) / (2 * math.pi)
     assert f_sim == pytest.approx(f_expected, rel=5e-3)
+
+
+# --------------------------------------------------------------------------- issue 15: defects 6 and 7
+
+def _chain(p, x=0.0):
+    return axial_stiffness(p.screw, p.nut, x), axial_damping(p.screw, p.nut, x)
+
+
+def test_loss_factor_damping_equals_the_identified_one_at_the_test_frequency(paper):
+    """A loss factor eta = c / sqrt(k m) from a half-power test at omega = sqrt(k/m) gives back c at that omega,
+    and c x (omega_test / omega) at another frequency."""
+    from drakecreep.model.screw import nut_element
+
+    n = paper.nut
+    f_test = math.sqrt(n.axial_stiffness / n.mass) / (2 * math.pi)  # ~1975 Hz (paper Table 3: Hertz 1917 Hz)
+    at_test = with_value(with_value(paper, "screw.chain_damping", "loss_factor"), "screw.damping_frequency", f_test)
+    assert nut_element(at_test.screw, at_test.nut)[1] == pytest.approx(n.axial_damping)
+    at_mode = with_value(paper, "screw.chain_damping", "loss_factor")
+    assert nut_element(at_mode.screw, at_mode.nut)[1] == pytest.approx(
+        n.axial_damping * f_test / at_mode.screw.damping_frequency)
+    # the stiffness does not change
+    assert _chain(at_mode)[0] == pytest.approx(_chain(paper)[0])
+
+
+def test_loss_factor_raises_the_structural_damping_ratio_of_the_paper_rig_tenfold(paper):
+    from drakecreep.model.lumped import lumped
+
+    def zeta(p):
+        d = lumped(p, 3)
+        return d.damping / (2 * math.sqrt(d.stiffness * d.mass))
+
+    viscous = zeta(paper)
+    hysteretic = zeta(with_value(paper, "screw.chain_damping", "loss_factor"))
+    assert 0.001 < viscous < 0.003
+    assert 0.015 < hysteretic < 0.03
+
+
+def test_default_damping_frequency_is_the_paper_rigs_axial_mode(paper):
+    from drakecreep.model.lumped import axial_mode_frequency
+
+    assert paper.screw.damping_frequency == pytest.approx(axial_mode_frequency(paper), rel=0.005)
+
+
+def test_seat_joints_in_series_by_hand(paper):
+    from drakecreep.paper.joints import axial_path_joints
+
+    j = axial_path_joints()
+    (kbs, cbs), (kns, cns) = j["bearing_seat"], j["nut_seat"]
+    # Table 2 inner ring-shaft fit (2.2e9 N/m) is the softest joint of the bearing seat
+    assert 1.0e9 < kbs < 2.2e9 and kns > 1e10
+    p = paper
+    for path, value in (("screw.seat_joint_stiffness", kbs), ("screw.seat_joint_damping", cbs),
+                        ("nut.seat_joint_stiffness", kns), ("nut.seat_joint_damping", cns)):
+        p = with_value(p, path, value)
+    s, n = p.screw, p.nut
+    ks = shaft_axial_stiffness(s, 0.0)
+    k = 1 / (1 / s.bearing_stiffness + 1 / kbs + 1 / ks + 1 / n.axial_stiffness + 1 / kns)
+    c = k**2 * (s.bearing_damping / s.bearing_stiffness**2 + cbs / kbs**2
+                + n.axial_damping / n.axial_stiffness**2 + cns / kns**2)
+    assert _chain(p) == pytest.approx((k, c))
+    assert _chain(p)[0] < _chain(paper)[0]
+    # the plain-Python equations (batch and baseline paths) use the same elements
+    from drakecreep.scenario import Scenario
+    from drakecreep.sim.baseline import BaselineModel
+
+    assert BaselineModel(p, Scenario(feed=1e-3)).stiffness(0.0) == pytest.approx((k, c))

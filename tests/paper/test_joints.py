@@ -64,3 +64,15 @@ def test_bad_face_raises_input_error():
         BoltedFace(area=-1.0, bolts=4, preload=1e3)
     with pytest.raises(InputError):
         bolted_joint(BoltedFace(area=0.05, bolts=4, preload=1e3), distribution="parabolic")
+
+
+def test_axial_path_joints_from_tables_1_and_2():
+    from drakecreep.paper.joints import axial_path_joints
+
+    j = axial_path_joints()
+    kbs, cbs = j["bearing_seat"]
+    # 12.15e10 (base-seat), 0.643e10 (seat-outer ring), 0.22e10 (inner ring-shaft) N/m in series
+    assert kbs == pytest.approx(1 / (1 / 12.15e10 + 1 / 0.643e10 + 1 / 0.22e10))
+    kns, _ = j["nut_seat"]
+    assert kns == pytest.approx(1 / (1 / 11.07e10 + 1 / 7.83e10))
+    assert cbs > 0

@@ -90,6 +90,19 @@ def test_steady_window_must_fit(paper):
         simulate(paper, Scenario(duration=0.5))
 
 
+def test_gms_friction_runs_in_the_drake_diagram_and_sticks_at_low_feed():
+    """friction.law: gms plugs into NutTable like LuGre (N states); the compiled path runs it."""
+    from drakecreep.params import preset, with_value
+    from drakecreep.scenario import Scenario
+    from drakecreep.sim.simulation import simulate
+
+    p = with_value(preset("paper"), "friction.law", "gms")
+    r = simulate(p, Scenario(feed=0.1e-3, load_case=3, duration=1.3))
+    assert r.ok
+    assert r.metrics.creep and r.metrics.stick_slip_cycles >= 10
+    assert r.metrics.mean_speed == pytest.approx(0.1e-3, rel=0.05)
+
+
 def test_to_dataframe_has_si_columns_and_matches_the_saved_csv(low_feed, tmp_path):
     import pandas as pd
 

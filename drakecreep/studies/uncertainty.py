@@ -1,0 +1,384 @@
+"""Conclusions that survive the unknowns: creep over every plausible rig, not one guessed one.
+
+The paper gives the stiffness chain, the loads and the screw geometry; the other values of a preset are
+assumptions (``[assumed]`` in ``presets/<name>.yaml``). The *uncertainty spec*
+(``presets/<name>_uncertainty.yaml``) gives each sampled assumption a distribution over its plausible
+range with the source of that range, and names every assumption held fixed and why.
+:func:`run_uncertainty` draws ``n`` rigs from it (a seeded Latin hypercube, :class:`scipy.stats.qmc.LatinHypercube`,
+mapped to uniform or log-uniform marginals), runs every rig at every feed and load case through the sweep
+engine (:func:`drakecreep.sim.sweep.run_sweep`: batched, local processes or a Dask cluster) and reports
+
+* per feed and load case (:func:`summarize`): the share of plausible rigs that creep (stick-slip in the
+  steady window, :attr:`drakecreep.sim.metrics.FeedMetrics.creep`) with a 95 % Wilson interval, and
+  percentiles of the maximum speed fluctuation;
+* per sampled parameter (:func:`sensitivity`): Spearman's rank correlation with the creep verdict and
+  with the fluctuation, and the creep share of the rigs in the lower and the upper half of the
+  parameter's range (log-scale halves for log-uniform ones): which unknown decides the answer.
+
+Every rig runs at every feed and load (common random numbers), so differences between feeds are not
+sampling noise of different rigs.
+"""
+
+import math
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from drakecreep.errors import InputError
+from drakecreep.params import get_value, with_value
+
+__all__ = [
+    "DISTRIBUTIONS",
+    "Distribution",
+    "UncertaintySpec",
+    "UncertaintyResult",
+    "load_uncertainty",
+    "uncertainty_spec",
+    "sample_rigs",
+    "run_uncertainty",
+    "summarize",
+    "sensitivity",
+]
+
+DISTRIBUTIONS = ("uniform", "log-uniform")
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """Distribution of one assumed parameter over its plausible range (SI).
+
+    Parameters
+    ----------
+    path : str
+        Dotted parameter path (``"friction.bristle_stiffness"``).
+    dist : {"uniform", "log-uniform"}
+    low, high : float
+        The plausible range, ``low < high`` (``low > 0`` for log-uniform).
+    source : str
+        Where the range comes from.
+    """
+
+    path: str
+    dist: str
+    low: float
+    high: float
+    source: str
+
+    def __post_init__(self):
+        where = f"sample.{self.path}"
+        if self.dist not in DISTRIBUTIONS:
+            raise InputError(f"{where}.dist", self.dist, "one of " + ", ".join(DISTRIBUTIONS))
+        for name in ("low", "high"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise InputError(f"{where}.{name}", value, "a finite number")
+            object.__setattr__(self, name, float(value))
+        if not self.low < self.high:
+            raise InputError(f"{where}.high", self.high, f"> low ({self.low})")
+        if self.dist == "log-uniform" and self.low <= 0:
+            raise InputError(f"{where}.low", self.low, "> 0 for a log-uniform distribution")
+        if not isinstance(self.source, str) or not self.source.strip():
+            raise InputError(f"{where}.source", self.source, "a non-empty text naming the source of the range")
+
+    def ppf(self, u):
+        """Values at quantiles ``u`` in [0, 1] (inverse CDF)."""
+        u = np.asarray(u, dtype=float)
+        if self.dist == "log-uniform":
+            return np.exp(math.log(self.low) + u * (math.log(self.high) - math.log(self.low)))
+        return self.low + u * (self.high - self.low)
+
+    def unit(self, value):
+        """Position of ``value`` in the range, 0-1 (on a log scale for log-uniform)."""
+        value = np.asarray(value, dtype=float)
+        if self.dist == "log-uniform":
+            return (np.log(value) - math.log(self.low)) / (math.log(self.high) - math.log(self.low))
+        return (value - self.low) / (self.high - self.low)
+
+
+@dataclass(frozen=True)
+class UncertaintySpec:
+    """The distributions of a preset's sampled assumptions and the assumptions held fixed.
+
+    ``preset`` is the preset the spec was read for (a spec file may name several presets that share
+    their assumptions, e.g. ``paper`` and ``paper_catalogue``).
+    """
+
+    preset: str
+    distributions: tuple
+    fixed: dict = field(default_factory=dict)
+    source: str = ""
+
+    @property
+    def paths(self):
+        """Sampled parameter paths, in the spec's order."""
+        return [d.path for d in self.distributions]
+
+
+def load_uncertainty(path):
+    """Read an uncertainty spec (YAML; see ``presets/paper_uncertainty.yaml``).
+
+    Raises
+    ------
+    InputError
+        For bad YAML, an unknown key, a bad distribution or an unknown parameter path.
+    """
+    path = Path(path)
+    return _spec_from_text(path.read_text(), str(path))
+
+
+def uncertainty_spec(name="paper"):
+    """The packaged uncertainty spec of preset ``name``: the ``presets/*_uncertainty.yaml`` whose ``preset`` names it."""
+    from drakecreep.params import PRESETS, _yaml_load
+
+    folder = resources.files("drakecreep").joinpath("presets")
+    files = sorted((f for f in folder.iterdir() if f.name.endswith("_uncertainty.yaml")), key=lambda f: f.name)
+    have = []
+    for file in files:
+        names = _yaml_load(file.read_text()).get("preset", "paper")
+        names = [names] if isinstance(names, str) else list(names)
+        if name in PRESETS and name in names:
+            return _spec_from_text(file.read_text(), f"presets/{file.name}", name)
+        have += names
+    raise InputError("preset", name, "a preset with an uncertainty spec: " + ", ".join(have))
+
+
+def _spec_from_text(text, where, name=None):
+    from drakecreep.params import PRESETS, _yaml_load, preset
+
+    try:
+        data = _yaml_load(text)  # the parameter files' reader: 2.0e11 is a number, as in the presets
+    except yaml.YAMLError:
+        raise InputError(where, "invalid YAML", "a YAML uncertainty spec") from None
+    if not isinstance(data, dict) or set(data) - {"preset", "sample", "fixed"} or "sample" not in data:
+        raise InputError(where, data if not isinstance(data, dict) else sorted(data),
+                         "a mapping with preset, sample and (optional) fixed")
+    names = data.get("preset", "paper")
+    names = [names] if isinstance(names, str) else names
+    if not isinstance(names, list) or not names or any(n not in PRESETS for n in names):
+        raise InputError("preset", names, "a preset name or a list of them: " + ", ".join(PRESETS))
+    name = name or names[0]
+    sample = data["sample"]
+    if not isinstance(sample, dict) or not sample:
+        raise InputError("sample", sample, "a mapping path -> {dist, low, high, source}")
+    base = preset(name)
+    dists = []
+    for path, spec in sample.items():
+        if not isinstance(spec, dict) or set(spec) != {"dist", "low", "high", "source"}:
+            raise InputError(f"sample.{path}", spec, "a mapping with dist, low, high, source")
+        dist = Distribution(path=str(path), **spec)
+        current = get_value(base, dist.path)  # raises for an unknown path
+        if isinstance(current, (bool, str)):
+            raise InputError(f"sample.{path}", current, "a numeric parameter")
+        for bound in (dist.low, dist.high):
+            with_value(base, dist.path, bound)  # each bound is a valid value of the field
+        dists.append(dist)
+    fixed = data.get("fixed") or {}
+    if not isinstance(fixed, dict):
+        raise InputError("fixed", fixed, "a mapping path -> reason")
+    for path in fixed:
+        get_value(base, path)
+    both = sorted(set(fixed) & set(sample))
+    if both:
+        raise InputError(f"fixed.{both[0]}", fixed[both[0]], "a path not also sampled")
+    return UncertaintySpec(preset=name, distributions=tuple(dists), fixed=dict(fixed), source=where)
+
+
+def sample_rigs(spec, n, seed=0):
+    """``n`` plausible rigs: a Latin hypercube over the spec's distributions.
+
+    Parameters
+    ----------
+    spec : UncertaintySpec
+    n : int
+        Number of rigs (>= 1).
+    seed : int
+        Seed of :class:`scipy.stats.qmc.LatinHypercube`; the same seed gives the same rigs.
+
+    Returns
+    -------
+    list of dict
+        One ``{path: value}`` per rig (SI), ready as sweep points.
+    """
+    from scipy.stats import qmc
+
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise InputError("samples", n, "an integer >= 1")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError("seed", seed, "an integer >= 0")
+    u = qmc.LatinHypercube(d=len(spec.distributions), seed=seed).random(n)
+    columns = [d.ppf(u[:, j]) for j, d in enumerate(spec.distributions)]
+    return [{d.path: float(columns[j][i]) for j, d in enumerate(spec.distributions)} for i in range(n)]
+
+
+@dataclass
+class UncertaintyResult:
+    """What :func:`run_uncertainty` produced.
+
+    Attributes
+    ----------
+    table : pandas.DataFrame
+        One row per rig, feed and load case: ``rig``, the sampled paths (SI), ``feed`` (m/s),
+        ``load_case`` and the sweep's metric columns (``creep``, ``max_fluctuation_mm_s``, ...).
+    summary : pandas.DataFrame
+        :func:`summarize` of the table.
+    sensitivity : pandas.DataFrame
+        :func:`sensitivity` of the table.
+    spec : UncertaintySpec
+    samples, seed : int
+    wall_time : float
+        Seconds for the simulations (the sweep).
+    failed : int
+        Cases that failed in the sweep (excluded from the shares).
+    """
+
+    table: object
+    summary: object
+    sensitivity: object
+    spec: UncertaintySpec
+    samples: int
+    seed: int
+    wall_time: float
+    failed: int
+
+
+def run_uncertainty(base, spec, samples, feeds, load_cases=(3,), *, seed=0, duration=3.0, executor="processes",
+                    workers=None, scheduler=None, batch_size=200, out_dir=None, progress=True):
+    """Run every plausible rig at every feed and load case; summarize creep and fluctuation.
+
+    Parameters
+    ----------
+    base : drakecreep.params.DriveParams
+        The preset the spec belongs to (its non-sampled values are used as they are).
+    spec : UncertaintySpec
+    samples : int
+        Number of rigs.
+    feeds : sequence of float
+        Feeds (m/s).
+    load_cases : sequence of int
+        Load cases of ``base``.
+    seed : int
+        Seed of the rig sample.
+    duration : float
+        Simulated time per case (s); the metrics window is ``simulation.steady_start`` to the end.
+    executor, workers, scheduler, batch_size, out_dir, progress
+        As :func:`drakecreep.sim.sweep.run_sweep` (``out_dir`` caches finished cases).
+
+    Returns
+    -------
+    UncertaintyResult
+    """
+    from drakecreep.sim.sweep import run_sweep
+
+    feeds = [float(f) for f in feeds]
+    if not feeds:
+        raise InputError("feeds", feeds, "at least one feed")
+    load_cases = [int(c) for c in load_cases]
+    if not load_cases:
+        raise InputError("load_cases", load_cases, "at least one load case")
+    for case in load_cases:
+        base.load_case(case)
+    rigs = sample_rigs(spec, samples, seed)
+    points = [dict(rig, feed=f, load_case=c) for rig in rigs for c in load_cases for f in feeds]
+    result = run_sweep(base, points, scenario=dict(duration=duration), executor=executor, workers=workers,
+                       scheduler=scheduler, out_dir=out_dir, progress=progress, batch_size=batch_size)
+    table = result.table
+    per_rig = len(load_cases) * len(feeds)
+    table.insert(1, "rig", table["case"] // per_rig)
+    return UncertaintyResult(table=table, summary=summarize(table), sensitivity=sensitivity(table, spec),
+                             spec=spec, samples=samples, seed=seed, wall_time=result.wall_time, failed=result.failed)
+
+
+def _wilson(k, n, z=1.96):
+    if n == 0:
+        return float("nan"), float("nan")
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _ok(table):
+    if "status" not in table:
+        return table.iloc[0:0]
+    return table[table["status"] == "ok"]
+
+
+def summarize(table, percentiles=(5, 50, 95)):
+    """Per feed and load case: the share of rigs that creep and the spread of the fluctuation.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        :attr:`UncertaintyResult.table` (columns ``feed``, ``load_case``, ``status``, ``creep``,
+        ``max_fluctuation_mm_s``, ``fluctuation_rate_percent``).
+    percentiles : sequence of float
+        Percentiles of the fluctuation to report.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``feed_mm_s``, ``load_case``, ``rigs`` (ok cases), ``failed``, ``creep_percent`` and its 95 %
+        Wilson interval ``creep_low_percent``/``creep_high_percent``, ``fluctuation_p<q>_mm_s``,
+        ``rate_p<q>_percent``.
+    """
+    import pandas as pd
+
+    rows = []
+    for (feed, case), group in table.groupby(["feed", "load_case"], sort=True):
+        ok = _ok(group)
+        n = len(ok)
+        k = int(ok["creep"].astype(bool).sum()) if n else 0
+        low, high = _wilson(k, n)
+        row = dict(feed_mm_s=feed * 1e3, load_case=int(case), rigs=n, failed=len(group) - n,
+                   creep_percent=100.0 * k / n if n else float("nan"),
+                   creep_low_percent=100.0 * low, creep_high_percent=100.0 * high)
+        for q in percentiles:
+            row[f"fluctuation_p{q:g}_mm_s"] = float(np.percentile(ok["max_fluctuation_mm_s"], q)) if n else float("nan")
+        for q in percentiles:
+            row[f"rate_p{q:g}_percent"] = float(np.percentile(ok["fluctuation_rate_percent"], q)) if n else float("nan")
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def sensitivity(table, spec):
+    """Which sampled assumption decides creep: rank correlations and half-range creep shares.
+
+    Over all ok cases of ``table`` (every feed and load case pooled; run it on a sub-table for one
+    feed), per sampled parameter:
+
+    * ``rho_creep``: Spearman's rank correlation of the parameter with the creep verdict (0/1);
+    * ``rho_fluctuation``: with ``max_fluctuation_mm_s``;
+    * ``creep_low_half_percent`` / ``creep_high_half_percent``: creep share of the rigs whose value lies
+      in the lower / upper half of the range (log scale for log-uniform).
+
+    Rows are sorted by ``|rho_creep|``, largest first. A correlation is ``nan`` when the verdict
+    does not vary (every rig creeps, or none).
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    import pandas as pd
+    from scipy.stats import spearmanr
+
+    ok = _ok(table)
+    creep = ok["creep"].astype(bool).to_numpy() if len(ok) else np.zeros(0, dtype=bool)
+    fluct = ok["max_fluctuation_mm_s"].to_numpy(dtype=float) if len(ok) else np.zeros(0)
+    rows = []
+    for d in spec.distributions:
+        x = ok[d.path].to_numpy(dtype=float) if len(ok) else np.zeros(0)
+        varies = len(x) > 2 and np.ptp(x) > 0
+        rho_c = float(spearmanr(x, creep).statistic) if varies and 0 < creep.sum() < len(creep) else float("nan")
+        rho_f = float(spearmanr(x, fluct).statistic) if varies and np.ptp(fluct) > 0 else float("nan")
+        lower = d.unit(x) < 0.5
+        rows.append(dict(
+            parameter=d.path, dist=d.dist, low=d.low, high=d.high, rho_creep=rho_c, rho_fluctuation=rho_f,
+            creep_low_half_percent=100.0 * creep[lower].mean() if lower.any() else float("nan"),
+            creep_high_half_percent=100.0 * creep[~lower].mean() if (~lower).any() else float("nan"),
+        ))
+    frame = pd.DataFrame(rows)
+    order = np.argsort(-np.nan_to_num(np.abs(frame["rho_creep"].to_numpy()), nan=-1.0), kind="stable")
+    return frame.iloc[order].reset_index(drop=True)
