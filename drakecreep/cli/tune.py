@@ -36,6 +36,10 @@ def run(args):
     from drakecreep.cli.margins import print_margins, scenario_from_args
     from drakecreep.servo.tuning import tune
 
+    if not args.bandwidth > 0:  # refused before the linearization, not after it
+        raise InputError("--bandwidth", args.bandwidth, "a bandwidth > 0 Hz")
+    if not 0 < args.phase_margin < 90:
+        raise InputError("--phase-margin", args.phase_margin, "a phase margin in (0, 90) deg")
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     try:

@@ -64,3 +64,14 @@ def test_every_command_documents_quiet_and_verbose():
     for name, sub in [("drakecreep", parser), *commands.items()]:
         text = sub.format_help()
         assert "-q, --quiet" in text and "-v, --verbose" in text, name
+
+
+@pytest.mark.parametrize("args, option", [(["--bandwidth", "-5"], "--bandwidth"), (["--phase-margin", "95"], "--phase-margin")])
+def test_tune_refuses_bad_targets_before_any_work(args, option, capsys):
+    import time
+
+    start = time.perf_counter()
+    assert cli.main(["tune", *args]) == 2
+    assert time.perf_counter() - start < 5.0  # the tuning itself takes > 10 s
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"error: {option}: got" in err[0]
