@@ -33,13 +33,13 @@ def add_parser(subparsers):
 
 def run(args):
     """Tune and print."""
-    from drakecreep.cli.margins import print_margins, scenario_from_args
-    from drakecreep.servo.tuning import tune
-
-    if not args.bandwidth > 0:  # refused before the linearization, not after it
+    if not args.bandwidth > 0:  # refused before any import or linearization
         raise InputError("--bandwidth", args.bandwidth, "a bandwidth > 0 Hz")
     if not 0 < args.phase_margin < 90:
         raise InputError("--phase-margin", args.phase_margin, "a phase margin in (0, 90) deg")
+    from drakecreep.cli.margins import print_margins, scenario_from_args
+    from drakecreep.servo.tuning import tune
+
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     try:
