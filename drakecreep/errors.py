@@ -1,6 +1,25 @@
 """Errors a user can act on: one line naming the field, the value and what is allowed."""
 
-__all__ = ["DrakecreepError", "InputError"]
+import reprlib
+
+__all__ = ["DrakecreepError", "InputError", "short_repr"]
+
+#: longest value shown in a message: a value from a file may be huge (a YAML alias bomb expands to
+#: billions of items) and its whole ``repr()`` would hang the program before it could print one line
+MAX_VALUE_CHARS = 120
+
+_REPR = reprlib.Repr()
+_REPR.maxlevel, _REPR.maxdict, _REPR.maxlist, _REPR.maxtuple, _REPR.maxset = 3, 4, 6, 6, 6
+_REPR.maxstring, _REPR.maxother, _REPR.maxlong = MAX_VALUE_CHARS, MAX_VALUE_CHARS, 40
+
+
+def short_repr(value, limit=MAX_VALUE_CHARS):
+    """``repr(value)`` bounded in work and length (at most ``limit`` characters, ``...`` marks a cut)."""
+    try:
+        text = _REPR.repr(value)
+    except Exception:  # noqa: BLE001 - a value whose repr fails still gets a message
+        text = f"<{type(value).__name__}>"
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 class DrakecreepError(Exception):
@@ -18,10 +37,13 @@ class InputError(DrakecreepError, ValueError):
         The value that was given.
     allowed : str
         What would have been accepted (e.g. ``"> 0"``, ``"one of coulomb, stribeck, lugre"``).
+
+    The message shows at most :data:`MAX_VALUE_CHARS` characters of the value (:func:`short_repr`).
     """
 
     def __init__(self, field, value, allowed):
         self.field = field
         self.value = value
         self.allowed = allowed
-        super().__init__(f"{field}: got {value!r}; allowed: {allowed}")
+        super().__init__(f"{short_repr(field, 200) if not isinstance(field, str) else field[:200]}: "
+                         f"got {short_repr(value)}; allowed: {str(allowed)[:600]}")

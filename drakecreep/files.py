@@ -1,4 +1,13 @@
-"""Writing results: atomic files and one JSON form for every output (base layer: imports nothing of the package).
+"""Reading inputs and writing results safely (base layer: imports only :mod:`drakecreep.errors`).
+
+Inputs: :func:`read_input_text` reads a user's text file only if it is a regular file of bounded size
+(``/dev/zero``, a FIFO or a directory are refused before anything is read) and decodes it as UTF-8, turning
+every failure into an :class:`~drakecreep.errors.InputError` naming the file; :func:`resolve_reference` reads
+a file named *inside* another file relative to that file. Neither ever echoes a file's content.
+
+Outputs: :func:`write_atomic` replaces one file atomically; :class:`OutputSet` writes a set of files that
+belong to one run, the manifest last (see there); :func:`check_output_dir` validates an output folder
+before a long computation starts.
 
 Every JSON the project writes or prints goes through :func:`to_jsonable`: NumPy scalars and arrays become
 Python numbers and lists, NaN becomes ``null`` and an infinite value the string ``"inf"`` / ``"-inf"``
@@ -8,13 +17,39 @@ Python numbers and lists, NaN becomes ``null`` and an infinite value the string 
 from __future__ import annotations
 
 import dataclasses
+import datetime
+import errno
+import hashlib
 import json
 import math
 import os
+import stat
 import tempfile
+import uuid
 from pathlib import Path
 
-__all__ = ["to_jsonable", "write_atomic", "write_json", "write_text"]
+from drakecreep.errors import InputError
+
+__all__ = [
+    "MAX_INPUT_BYTES",
+    "MAX_DATA_BYTES",
+    "to_jsonable",
+    "write_atomic",
+    "write_json",
+    "write_text",
+    "read_input_text",
+    "check_input_file",
+    "resolve_reference",
+    "check_output_dir",
+    "OutputSet",
+    "read_manifest",
+]
+
+#: largest parameter, metadata or spec file read (bytes): such files are a few kB; the bound keeps
+#: ``/dev/zero``-like inputs and accidental multi-GB files from exhausting memory
+MAX_INPUT_BYTES = 4 * 1024 * 1024
+#: largest measured data file read (bytes): the EMPS files are 1-2 MB; 2 GB is far beyond any rig log
+MAX_DATA_BYTES = 2 * 1024 ** 3
 
 
 def to_jsonable(obj):
@@ -46,12 +81,15 @@ def to_jsonable(obj):
 def write_atomic(path, write):
     """Write a file atomically: ``write(tmp_path)`` then ``os.replace(tmp_path, path)``.
 
-    A reader (or a resumed sweep) sees the old file or the whole new one, never a partial one. The file is
-    readable by the group and others (0644 less the umask), like any file a program writes.
+    A reader (or a resumed sweep) sees the old file or the whole new one, never a partial one; a failure
+    (a full disk, a kill) leaves the old file and no temporary file behind (a SIGKILL may leave a hidden
+    ``.<stem>.*.tmp<suffix>``, never a partial ``path``). The temporary file keeps the suffix of ``path``,
+    so writers that pick a format by extension (``savefig``) work. The file is readable by the group and
+    others (0666 less the umask), like any file a program writes.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}")
     os.close(fd)
     try:
         write(tmp)
@@ -79,3 +117,222 @@ def write_text(path, text):
 def write_json(path, obj, indent=None):
     """Write ``to_jsonable(obj)`` as JSON to ``path`` atomically."""
     return write_text(path, json.dumps(to_jsonable(obj), indent=indent) + ("\n" if indent else ""))
+
+
+# --------------------------------------------------------------------------- inputs
+
+def check_input_file(path, field, max_bytes=MAX_INPUT_BYTES):
+    """``path`` as a :class:`~pathlib.Path` if it is a regular file of at most ``max_bytes``.
+
+    Raises
+    ------
+    FileNotFoundError
+        If it does not exist (the CLI prints it in one line).
+    InputError
+        Naming ``field`` if it is not a regular file (a directory, ``/dev/zero``, a FIFO) or too large.
+    """
+    path = Path(path)
+    try:
+        info = os.stat(path)
+    except FileNotFoundError:
+        raise FileNotFoundError(errno.ENOENT, "No such file or directory", str(path)) from None
+    except OSError as err:
+        raise InputError(field, str(path), f"a readable file ({err.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = "a directory" if stat.S_ISDIR(info.st_mode) else "not a regular file"
+        raise InputError(field, f"{path} ({kind})", "a regular file")
+    if info.st_size > max_bytes:
+        raise InputError(field, f"{path} ({info.st_size} bytes)", f"a file of at most {max_bytes} bytes")
+    return path
+
+
+def read_input_text(path, field=None, max_bytes=MAX_INPUT_BYTES):
+    """The text of a user's input file: a regular file of at most ``max_bytes``, UTF-8 (a BOM is skipped).
+
+    Parameters
+    ----------
+    path : path-like
+    field : str, optional
+        What the file is, for messages (default: the path).
+    max_bytes : int
+
+    Raises
+    ------
+    InputError
+        Not a regular file, too large, not UTF-8 text (binary, UTF-16) or unreadable; the content is never
+        quoted.
+    FileNotFoundError
+        If it does not exist.
+    """
+    field = field or str(path)
+    path = check_input_file(path, field, max_bytes)
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(max_bytes + 1)
+    except IsADirectoryError:  # pragma: no cover - caught by check_input_file
+        raise InputError(field, str(path), "a regular file") from None
+    except PermissionError:
+        raise
+    except OSError as err:
+        raise InputError(field, str(path), f"a readable file ({err.strerror})") from None
+    if len(raw) > max_bytes:  # grew while we read it
+        raise InputError(field, f"{path} (more than {max_bytes} bytes)", f"a file of at most {max_bytes} bytes")
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise InputError(field, f"{path}: byte 0x{raw[err.start]:02x} at offset {err.start} is not UTF-8",
+                         "a UTF-8 text file (not binary, not UTF-16)") from None
+    if "\x00" in text:
+        raise InputError(field, f"{path}: NUL byte at offset {text.index(chr(0))}", "a UTF-8 text file (not binary)")
+    return text
+
+
+def resolve_reference(value, referring_file, field, max_bytes=MAX_INPUT_BYTES):
+    """The path of a file named inside ``referring_file`` (relative paths are relative to that file's folder).
+
+    The file must be a regular file; its content is never echoed in a message.
+
+    Raises
+    ------
+    InputError
+        ``value`` not a non-empty string, the file missing, not a regular file or too large.
+    """
+    if not isinstance(value, (str, os.PathLike)) or not str(value).strip():
+        raise InputError(field, value, "a file path (relative to the file that names it)")
+    ref = Path(value)
+    if not ref.is_absolute():
+        ref = Path(referring_file).parent / ref
+    try:
+        return check_input_file(ref, field, max_bytes)
+    except FileNotFoundError:
+        raise InputError(field, str(value), f"an existing file (looked for {ref})") from None
+
+
+# --------------------------------------------------------------------------- output sets
+
+def check_output_dir(path, field="--out"):
+    """Create the output folder ``path`` if needed and check it is a writable folder, before any work.
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` if ``path`` (or one of its parents) is a file, or the folder cannot be created or
+        written.
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(field, str(path), "a folder (this is an existing file)")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise InputError(field, str(path), "a folder (a parent is an existing file)") from None
+    except OSError as err:
+        raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
+    if not os.access(path, os.W_OK | os.X_OK):
+        raise InputError(field, str(path), "a writable folder")
+    return path
+
+
+def _sha256(path):
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+class OutputSet:
+    """Files of one run written to a folder so that a reader never mixes two runs.
+
+    The protocol: (1) the previous manifest is removed first, so from then on the folder claims no complete
+    run; (2) every file is written atomically (:func:`write_atomic`); (3) the manifest is written last,
+    atomically, naming each file of this run with its size and SHA-256 and a fresh ``run_id``. A folder with
+    a manifest holds a complete run; files the manifest does not name (left from an earlier run) are not part
+    of it. A kill at any moment leaves either the new manifest with all its files, or no manifest.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The folder (created if needed; see :func:`check_output_dir`).
+    manifest : str
+        File name of the manifest (JSON), e.g. ``"metrics.json"`` or ``"manifest.json"``.
+    field : str
+        Option name for messages.
+
+    Examples
+    --------
+    >>> with OutputSet(tmp, "manifest.json") as out:           # doctest: +SKIP
+    ...     out.write_text("a.txt", "hello")
+    ...     out.commit({"status": "ok"})
+    """
+
+    def __init__(self, out_dir, manifest="manifest.json", field="--out"):
+        self.dir = check_output_dir(out_dir, field)
+        self.manifest = self.dir / manifest
+        self.run_id = uuid.uuid4().hex
+        self.files = {}
+        self.committed = False
+
+    def start(self):
+        """Remove the previous manifest (step 1); ``with OutputSet(...)`` does it on entry. Returns ``self``."""
+        try:
+            self.manifest.unlink()
+        except FileNotFoundError:
+            pass
+        return self
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc):
+        return False
+
+    def path(self, name):
+        """Final path of file ``name`` in the set."""
+        return self.dir / name
+
+    def write(self, name, write):
+        """Write file ``name`` atomically with ``write(tmp_path)`` and record it; returns its path."""
+        path = write_atomic(self.dir / name, write)
+        self.files[name] = dict(bytes=path.stat().st_size, sha256=_sha256(path))
+        return path
+
+    def write_text(self, name, text):
+        """Write text file ``name`` (UTF-8) in the set."""
+        def write(tmp):
+            with open(tmp, "w", encoding="utf-8") as fh:
+                fh.write(text)
+        return self.write(name, write)
+
+    def commit(self, payload=None):
+        """Write the manifest: ``payload`` plus ``run_id``, ``written`` (UTC) and ``files``; returns its path."""
+        body = dict(to_jsonable(payload or {}))
+        body["run_id"] = self.run_id
+        body["written"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+        body["files"] = self.files
+        write_text(self.manifest, json.dumps(to_jsonable(body), indent=2) + "\n")
+        self.committed = True
+        return self.manifest
+
+
+def read_manifest(path, verify=True):
+    """The manifest of an :class:`OutputSet`, or None when the set is incomplete.
+
+    With ``verify``, every file it names must exist with the recorded size and SHA-256 (else None).
+    """
+    try:
+        body = json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(body, dict) or not isinstance(body.get("files"), dict):
+        return None
+    if verify:
+        folder = Path(path).parent
+        for name, info in body["files"].items():
+            f = folder / name
+            try:
+                if f.stat().st_size != info["bytes"] or _sha256(f) != info["sha256"]:
+                    return None
+            except (OSError, KeyError, TypeError):
+                return None
+    return body

@@ -19,7 +19,8 @@ from pathlib import Path
 
 import yaml
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, short_repr
+from drakecreep.files import MAX_INPUT_BYTES, read_input_text
 
 __all__ = [
     "MotorParams",
@@ -40,16 +41,51 @@ __all__ = [
     "preset",
     "preset_text",
     "load_params",
+    "load_yaml_file",
     "save_params",
     "params_from_dict",
     "params_to_dict",
     "with_value",
     "get_value",
-    "load_yaml",
 ]
 
+#: most YAML aliases (``*name``) one file may use: parameter files need none; a few hundred is generous,
+#: and the bound stops an "alias bomb" (nested aliases that expand to billions of items) at the parser
+MAX_YAML_ALIASES = 100
+
+
 class _Loader(yaml.SafeLoader):
-    """SafeLoader that also reads ``9.38e6`` (no exponent sign) as a float, as users write it."""
+    """SafeLoader that also reads ``9.38e6`` (no exponent sign) as a float, as users write it.
+
+    It refuses what SafeLoader silently accepts: a key given twice in one mapping (SafeLoader keeps the
+    last one) and more than :data:`MAX_YAML_ALIASES` aliases.
+    """
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            self._aliases = getattr(self, "_aliases", 0) + 1
+            if self._aliases > MAX_YAML_ALIASES:
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(
+                    None, None, f"more than {MAX_YAML_ALIASES} aliases (*name)", event.start_mark)
+        return super().compose_node(parent, index)
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = self.construct_object(key_node, deep=True)
+                try:
+                    duplicate = key in seen
+                    seen.add(key)
+                except TypeError:
+                    continue  # unhashable key: SafeLoader reports it
+                if duplicate:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key {short_repr(key, 40)}", key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
 
 
 _Loader.add_implicit_resolver(
@@ -70,30 +106,40 @@ def _yaml_load(text):
     return yaml.load(text, Loader=_Loader)
 
 
-def load_yaml(path, what):
-    """Read a YAML file the way every drakecreep file is read (``5.0e6`` is a float, as in YAML 1.2).
+def load_yaml_file(path, field=None, what="a YAML mapping", max_bytes=MAX_INPUT_BYTES):
+    """Read a user's YAML file with the hardened loader; every failure is an :class:`InputError`.
+
+    The file must be a regular UTF-8 file of at most ``max_bytes`` (:func:`drakecreep.files.read_input_text`);
+    duplicate keys and alias bombs are refused; an empty or comment-only file is refused (it would silently
+    mean "all defaults"). Messages name the file and the line, never the content.
 
     Parameters
     ----------
-    path : str or pathlib.Path
-        The file.
+    path : path-like
+    field : str, optional
+        Name for messages (default: the path).
     what : str
-        What the file should hold, for the error message (e.g. ``"a YAML sweep spec"``).
+        What the file should hold, for messages.
 
-    Raises
-    ------
-    InputError
-        Naming the file and the line of a YAML syntax error.
-    FileNotFoundError
-        If ``path`` does not exist.
+    Returns
+    -------
+    object
+        The loaded document (not None).
     """
-    text = Path(path).read_text()
+    field = field or str(path)
+    text = read_input_text(path, field, max_bytes)
     try:
-        return _yaml_load(text)
+        data = _yaml_load(text)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(str(path), "invalid YAML" + where, what) from None
+        where = f" (line {mark.line + 1}, column {mark.column + 1})" if mark is not None else ""
+        problem = getattr(err, "problem", None) or "syntax error"
+        raise InputError(field, f"invalid YAML{where}: {str(problem)[:80]}", what) from None
+    except RecursionError:
+        raise InputError(field, "YAML nested too deeply", what) from None
+    if data is None:
+        raise InputError(field, "empty (no values, only comments or blank lines)", what)
+    return data
 
 
 INTEGRATORS = ("runge_kutta2", "runge_kutta3", "runge_kutta5", "bogacki_shampine3", "radau3", "implicit_euler")
@@ -118,6 +164,15 @@ def _allowed(meta):
     if lo is not None:
         return f"a finite number {'>' if meta.get('lo_open') else '>='} {lo}{unit}"
     return f"a finite number{unit}"
+
+
+#: largest magnitude of a float field without a stated upper bound, in its SI unit: 1e8 times the largest
+#: real quantity of a feed drive (Young's modulus, ~2e11 Pa), so "rigid" idealisations (a 2e19 Pa shaft)
+#: stay possible, while products and squares of fields stay far from float overflow (1e300 kg gave
+#: nonsense or runs that never end)
+ABSURD = 1e20
+#: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
+MAX_INT = 2**40
 
 
 class _Params:
@@ -148,11 +203,18 @@ class _Params:
                 else:
                     raise InputError(f.name, value, "an integer")
             if kind is float:
-                value = float(value)
+                try:
+                    value = float(value)
+                except OverflowError:  # an integer of hundreds of digits
+                    raise InputError(f.name, value, _allowed(meta)) from None
                 object.__setattr__(self, f.name, value)
+            if kind is int and abs(value) > MAX_INT:
+                raise InputError(f.name, value, f"an integer of magnitude <= {MAX_INT}")
             if not math.isfinite(value):
                 raise InputError(f.name, value, _allowed(meta))
             lo, hi = meta.get("lo"), meta.get("hi")
+            if hi is None and abs(value) > ABSURD:
+                raise InputError(f.name, value, _allowed(meta) + f" of magnitude <= {ABSURD:g} (larger is no feed drive)")
             if lo is not None and (value < lo or (meta.get("lo_open") and value == lo)):
                 raise InputError(f.name, value, _allowed(meta))
             if hi is not None and value > hi:
@@ -163,14 +225,19 @@ class _Params:
         """Cross-field checks; overridden where needed."""
 
 
+# Upper bounds that are not physics limits but sanity limits, stated once: masses and inertias at most
+# 100 t (table), 1 t (nut), 10 kg m^2 (rotor, coupling: servo motors of feed drives are below 0.1 kg m^2),
+# torque 1e5 N m; any other unbounded field at most ABSURD in its SI unit.
+
+
 @dataclass(frozen=True)
 class MotorParams(_Params):
     """Servo motor: rotor, torque limit and the closed current loop seen as a first-order lag."""
 
-    rotor_inertia: float = _q(1.3e-4, "kg m^2", 0.0, lo_open=True, doc="rotor inertia")
-    coupling_inertia: float = _q(2.0e-5, "kg m^2", 0.0, doc="coupling inertia (motor side)")
+    rotor_inertia: float = _q(1.3e-4, "kg m^2", 0.0, 10.0, lo_open=True, doc="rotor inertia")
+    coupling_inertia: float = _q(2.0e-5, "kg m^2", 0.0, 10.0, doc="coupling inertia (motor side)")
     torque_constant: float = _q(0.9, "N m/A", 0.0, lo_open=True, doc="torque constant (reports current)")
-    peak_torque: float = _q(7.1, "N m", 0.0, lo_open=True, doc="torque limit of the drive")
+    peak_torque: float = _q(7.1, "N m", 0.0, 1e5, lo_open=True, doc="torque limit of the drive")
     current_loop_time_constant: float = _q(
         2.0e-4, "s", 0.0, 0.1, doc="closed current loop as a first-order lag; 0 = ideal"
     )
@@ -221,7 +288,7 @@ class NutParams(_Params):
 
     axial_stiffness: float = _q(51.6e6, "N/m", 0.0, lo_open=True, doc="screw-nut axial stiffness (Table 4)")
     axial_damping: float = _q(898.88, "N s/m", 0.0, doc="screw-nut axial damping (Table 4)")
-    mass: float = _q(0.335, "kg", 0.0, doc="nut mass (Table 3), lumped into the table")
+    mass: float = _q(0.335, "kg", 0.0, 1e3, doc="nut mass (Table 3), lumped into the table")
     preload_torque: float = _q(0.03, "N m", 0.0, doc="preload drag torque of the nut")
     load_friction_coefficient: float = _q(0.01, "-", 0.0, 1.0, doc="nut friction per N of axial load")
     seat_joint_stiffness: float = _q(
@@ -234,7 +301,7 @@ class NutParams(_Params):
 class TableParams(_Params):
     """Table (workbench) on rolling guides."""
 
-    mass: float = _q(40.0, "kg", 0.0, lo_open=True, doc="table, nut seat and sliders")
+    mass: float = _q(40.0, "kg", 0.0, 1e5, lo_open=True, doc="table, nut seat and sliders")
     guide_friction_coefficient: float = _q(0.003, "-", 0.0, 1.0, doc="rolling guides, per N of normal load")
     seal_force: float = _q(4.0, "N", 0.0, doc="seal and wiper drag of the slider blocks")
 
@@ -426,14 +493,15 @@ class DriveParams(_Params):
 
 def _from_dict(cls, data, path):
     if not isinstance(data, dict):
-        raise InputError(path or "params", data, f"a mapping of {cls.__name__} fields")
+        # the type, not the value: a file that is no parameter file (a path typo) is never echoed
+        raise InputError(path or "params", f"a YAML {type(data).__name__}", f"a mapping of {cls.__name__} fields")
     hints = typing.get_type_hints(cls)
     names = {f.name for f in dataclasses.fields(cls)}
     kwargs = {}
     for key, value in data.items():
         dotted = f"{path}.{key}" if path else str(key)
         if key not in names:
-            raise InputError(dotted, value, "no such field; known: " + ", ".join(sorted(names)))
+            raise InputError(dotted[:80], f"a {type(value).__name__}", "no such field; known: " + ", ".join(sorted(names)))
         kind = hints[key]
         if dataclasses.is_dataclass(kind):
             kwargs[key] = _from_dict(kind, value, dotted)
@@ -466,11 +534,13 @@ def load_params(path):
     Raises
     ------
     InputError
-        For a YAML syntax error, an unknown key, a wrong type or a value out of range.
+        For a YAML syntax error, a duplicate key, an empty file, a file that is not regular UTF-8 text,
+        an unknown key, a wrong type or a value out of range.
     FileNotFoundError
         If ``path`` does not exist.
     """
-    return params_from_dict(load_yaml(path, "a YAML mapping of parameter groups"))
+    data = load_yaml_file(path, str(path), "a YAML mapping of parameter groups")
+    return params_from_dict(data)
 
 
 def save_params(params, path):
@@ -501,15 +571,33 @@ def preset(name="paper"):
 
 def get_value(params, path):
     """Value at a dotted path such as ``"screw.lead"`` or ``"loads.cases[2].fx"``."""
+    _check_path(path)
     obj = params
     for part in path.split("."):
-        name, index = _split_index(part)
+        name, index = _split_index(part, path)
         if not dataclasses.is_dataclass(obj) or name not in {f.name for f in dataclasses.fields(obj)}:
             raise InputError(path, part, "a dotted path of existing parameter fields")
         obj = getattr(obj, name)
         if index is not None:
-            obj = obj[index]
+            if not isinstance(obj, tuple):
+                raise InputError(path, part, "an index only on a list field (loads.cases)")
+            obj = _item(obj, index, path, part)
     return obj
+
+
+def field_unit(params, path):
+    """SI unit of the field at dotted ``path`` (``"N/m"``, ``"-"`` for dimensionless; ``""`` when unknown)."""
+    obj, unit = params, ""
+    for part in path.split("."):
+        name, index = _split_index(part)
+        fields = {f.name: f for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else {}
+        if name not in fields:
+            raise InputError(path, part, "a dotted path of existing parameter fields")
+        unit = fields[name].metadata.get("unit", "") or ""
+        obj = getattr(obj, name)
+        if index is not None:
+            obj = obj[index]
+    return unit
 
 
 def with_value(params, path, value):
@@ -517,10 +605,16 @@ def with_value(params, path, value):
 
     ``path`` may index load cases: ``"loads.cases[2].fx"``. Errors name the full dotted field.
     """
+    _check_path(path)
     head, _, rest = path.partition(".")
-    name, index = _split_index(head)
+    name, index = _split_index(head, path)
     if not dataclasses.is_dataclass(params) or name not in {f.name for f in dataclasses.fields(params)}:
         raise InputError(path, value, "a dotted path of existing parameter fields")
+    if index is not None:
+        child = getattr(params, name)
+        if not isinstance(child, tuple):
+            raise InputError(path, value, "an index only on a list field (loads.cases)")
+        _item(child, index, path, value)
     try:
         if not rest:
             if index is not None:
@@ -539,8 +633,26 @@ def with_value(params, path, value):
         raise InputError(f"{head}.{err.field}", err.value, err.allowed) from None
 
 
-def _split_index(part):
-    if part.endswith("]") and "[" in part:
-        name, idx = part[:-1].split("[", 1)
-        return name, int(idx)
-    return part, None
+_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[([0-9]{1,6})\])?$")
+
+
+def _split_index(part, path=None):
+    """``"cases[2]"`` -> ``("cases", 2)``; ``"lead"`` -> ``("lead", None)``; anything else an InputError."""
+    match = _PART.match(part)
+    if match is None:
+        raise InputError(path or part, part, "a dotted path of field names, a list item as name[INDEX] with INDEX >= 0")
+    name, idx = match.groups()
+    return name, None if idx is None else int(idx)
+
+
+def _check_path(path):
+    if not isinstance(path, str) or not path:
+        raise InputError("path", path, "a dotted path of parameter fields such as screw.lead or loads.cases[0].fx")
+    if len(path) > 200:
+        raise InputError("path", path, "a dotted path of at most 200 characters")
+
+
+def _item(seq, index, path, value):
+    if not 0 <= index < len(seq):
+        raise InputError(path, value, f"an index in 0..{len(seq) - 1}" if seq else "an index of an existing item (the list is empty)")
+    return seq[index]

@@ -6,10 +6,12 @@ Each subcommand lives in its own module of this package and exposes
 * ``run(args) -> int`` -- calls the library and prints; returns the exit code.
 
 User errors (:class:`drakecreep.errors.DrakecreepError`, bad files, bad options) print one line on stderr
-and exit with code 2, never a traceback.
+and exit with code 2, never a traceback. Anything unexpected (a bug, a full disk) prints one line naming
+the error and pointing to ``--debug`` (which shows the traceback) and exits with code 1; Ctrl-C exits 130.
 """
 
 import argparse
+import errno
 import importlib
 import re
 import textwrap
@@ -17,6 +19,7 @@ import os
 import sys
 import threading
 import time
+import traceback
 
 from drakecreep import __version__
 from drakecreep.errors import DrakecreepError
@@ -39,7 +42,8 @@ COMMANDS = [
 ]
 
 
-#: Commands that can take more than ~2 s and report no progress of their own: an elapsed-time bar on stderr.
+#: Commands that can take more than ~2 s and report no progress of their own: an elapsed-time bar on stderr
+#: (on a terminal, or with DRAKECREEP_PROGRESS=1).
 HEARTBEAT = ("report", "compensate", "reproduce-paper", "margins", "tune", "critical", "modal", "emps", "simulate")
 
 
@@ -78,7 +82,7 @@ def _add_common(parser, suppress):
     parser.add_argument("-q", "--quiet", action="store_true", default=default or False,
                         help="no progress on stderr (results and errors only)")
     parser.add_argument("-v", "--verbose", action="count", default=default or 0,
-                        help="more detail on stderr: INFO logging, -vv DEBUG and a traceback with errors")
+                        help="more detail on stderr: INFO logging; -vv DEBUG logging and tracebacks (as --debug)")
 
 
 def _heartbeat(command):
@@ -115,6 +119,7 @@ def build_parser():
     )
     parser.add_argument("--version", action="version", version=f"drakecreep {__version__}")
     _add_common(parser, suppress=False)
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an unexpected error")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
@@ -135,22 +140,39 @@ def main(argv=None):
     saved = os.environ.get("TQDM_DISABLE")
     if args.quiet:
         os.environ["TQDM_DISABLE"] = "1"  # every tqdm bar of the library (tqdm >= 4.66), also in worker processes
-    stop = _heartbeat(args.command) if args.command in HEARTBEAT and not args.quiet else None
+    # the elapsed-time bar only on a terminal (logs and pipes keep one line per message), or when forced
+    show = sys.stderr.isatty() or os.environ.get("DRAKECREEP_PROGRESS") == "1"
+    stop = _heartbeat(args.command) if args.command in HEARTBEAT and show and not args.quiet else None
+    debug = getattr(args, "debug", False) or args.verbose > 1
+    prefix = f"drakecreep {args.command}"
     try:
         return int(args.func(args) or 0)
     except DrakecreepError as err:
-        if args.verbose > 1:
-            import traceback
-
-            traceback.print_exc()
-        print(f"drakecreep {args.command}: error: {err}", file=sys.stderr)
+        _debug_traceback(debug)
+        print(f"{prefix}: error: {_one_line(err)}", file=sys.stderr)
         return 2
-    except (FileNotFoundError, IsADirectoryError, PermissionError) as err:
-        print(f"drakecreep {args.command}: error: {err.strerror}: {err.filename}", file=sys.stderr)
+    except (FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError) as err:
+        _debug_traceback(debug)
+        print(f"{prefix}: error: {err.strerror}: {_one_line(err.filename)}", file=sys.stderr)
         return 2
+    except OSError as err:
+        _debug_traceback(debug)
+        if err.filename is not None and err.errno in _PATH_ERRNOS:  # a bad path the user gave
+            print(f"{prefix}: error: {err.strerror}: {_one_line(err.filename)}", file=sys.stderr)
+            return 2
+        hint = "" if debug else " (run again with --debug for the traceback)"
+        print(f"{prefix}: internal error: {type(err).__name__}: {_one_line(err.strerror or err)}"
+              f"{': ' + _one_line(err.filename) if err.filename else ''}{hint}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
-        print(f"drakecreep {args.command}: interrupted", file=sys.stderr)
+        print(f"{prefix}: interrupted", file=sys.stderr)
         return 130
+    except Exception as err:  # noqa: BLE001 - the one top-level guard: one line, the traceback on --debug
+        _debug_traceback(debug)
+        what = _one_line(err)
+        hint = "" if debug else " (run again with --debug for the traceback)"
+        print(f"{prefix}: internal error: {type(err).__name__}: {what}{hint}", file=sys.stderr)
+        return 1
     finally:
         if stop is not None:
             stop()
@@ -159,6 +181,26 @@ def main(argv=None):
                 os.environ.pop("TQDM_DISABLE", None)
             else:
                 os.environ["TQDM_DISABLE"] = saved
+
+
+#: errors of a path given by the user (exit 2); other OSErrors (a full disk, I/O errors) exit 1
+_PATH_ERRNOS = {errno.ENAMETOOLONG, errno.ELOOP, errno.ENOTDIR, errno.EISDIR, errno.ENOENT, errno.EACCES,
+                errno.EROFS, errno.EEXIST}
+
+
+def _one_line(obj, limit=400):
+    """``str(obj)`` on one line of at most ``limit`` characters."""
+    try:
+        text = str(obj)
+    except Exception:  # noqa: BLE001
+        text = f"<{type(obj).__name__}>"
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _debug_traceback(debug):
+    if debug:
+        traceback.print_exc(file=sys.stderr)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -69,6 +69,8 @@ def feed_from_mm_s(value, option="--feed"):
     """m/s from a CLI value in mm/s, or an InputError naming the option."""
     from drakecreep.scenario import MAX_FEED
 
-    if not math.isfinite(value) or value == 0 or abs(value) > MAX_FEED * 1e3:
-        raise InputError(option, value, f"a non-zero feed within +-{MAX_FEED * 1e3:g} mm/s")
+    # below 1e-4 mm/s (0.1 um/s) a run of seconds moves a few scale counts: nothing left to measure, and
+    # the analyses' 1/v terms overflow (1e-300 mm/s ran forever)
+    if not math.isfinite(value) or not 1e-4 <= abs(value) <= MAX_FEED * 1e3:
+        raise InputError(option, value, f"a feed of magnitude in [1e-4, {MAX_FEED * 1e3:g}] mm/s")
     return value * 1e-3

@@ -52,12 +52,17 @@ def run(args):
     from drakecreep.scenario import MAX_FEED
 
     params = params_from_args(args)
-    feeds = _list(args.feeds, "--feeds", float, lambda v: 0 < v <= MAX_FEED * 1e3,
-                  f"comma-separated feeds in (0, {MAX_FEED * 1e3:g}] mm/s")
+    from drakecreep.files import check_output_dir
+
+    feeds = _list(args.feeds, "--feeds", float, lambda v: 1e-4 <= v <= MAX_FEED * 1e3,
+                  f"comma-separated feeds in [1e-4, {MAX_FEED * 1e3:g}] mm/s")
+    if not args.duration <= 3600:
+        raise InputError("--duration", args.duration, "in (0, 3600] s")
     n = len(params.loads.cases)
     loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
-    if args.workers < 1:
-        raise InputError("--workers", args.workers, "an integer >= 1")
+    if not 1 <= args.workers <= 256:
+        raise InputError("--workers", args.workers, "an integer in [1, 256]")
+    check_output_dir(args.out)  # before the study, not after it
     methods = ["none"] + list(dict.fromkeys(args.method or COMPENSATION_STUDY_METHODS[1:]))
     rows = evaluate(params, methods, feeds, loads, duration=args.duration, workers=args.workers)
     crit = creep_boundaries(params, methods, loads) if args.critical else None

@@ -65,7 +65,7 @@ def pick(runs, spec, default_parity, option="--train"):
         item = item.strip()
         if item in labels:
             out.append(runs[labels.index(item)])
-        elif item.isdigit() and int(item) < len(runs):
+        elif item.isascii() and item.isdigit() and len(item) < 10 and int(item) < len(runs):
             out.append(runs[int(item)])
         else:
             raise InputError(option, item, "a run label or index among " + ", ".join(labels))
@@ -74,6 +74,7 @@ def pick(runs, spec, default_parity, option="--train"):
 
 def run(args):
     """Diagnose, print the answer, write the report."""
+    from drakecreep.files import check_output_dir
     from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
     from drakecreep.report.gap_report import to_json_dict, write_report
 
@@ -81,6 +82,10 @@ def run(args):
     train, test = pick(runs, args.train, 0, "--train"), pick(runs, args.test, 1, "--test")
     if set(r.label for r in train) & set(r.label for r in test):
         raise InputError("--test", args.test, "runs disjoint from the training runs")
+    # everything the end of the run needs is checked before the diagnosis starts
+    if args.out:
+        check_output_dir(args.out)
+    score_runs = load_runs(args.score, None) if args.score else None
     cfg = DiagnosisConfig(screw_lead=args.screw_lead * 1e-3,
                           motor_period=None if args.motor_period is None else args.motor_period * 1e-3,
                           progress=not args.quiet)
@@ -91,7 +96,7 @@ def run(args):
     if args.score:
         if not args.quiet:
             print(f"[diagnose] scoring the fixed diagnosis on {args.score}", file=sys.stderr, flush=True)
-        result["scored"] = score_fixed(result, load_runs(args.score, None))
+        result["scored"] = score_fixed(result, score_runs)
         result["scored"]["data"] = str(args.score)
     if args.out:
         html_path, json_path = write_report(result, args.out)

@@ -38,8 +38,16 @@ def run(args):
     """Compute and print the Hertz stiffness."""
     from drakecreep.errors import InputError
 
-    if not (math.isfinite(args.youngs_modulus) and args.youngs_modulus > 0):
-        raise InputError("--youngs-modulus", args.youngs_modulus, "> 0 GPa")
+    # sanity bounds (no ball screw is outside them; beyond them the contact arithmetic under- or overflows)
+    if not (math.isfinite(args.youngs_modulus) and 1.0 <= args.youngs_modulus <= 2000.0):
+        raise InputError("--youngs-modulus", args.youngs_modulus, "in [1, 2000] GPa")
+    if not 1 <= args.balls <= 10000:
+        raise InputError("--balls", args.balls, "an integer in [1, 10000]")
+    for option, value, hi in (("--ball-diameter", args.ball_diameter, 1e3), ("--diameter", args.diameter, 1e4),
+                              ("--lead", args.lead, 1e3), ("--preload", args.preload, 1e7),
+                              ("--mass", args.mass, 1e5), ("--conformity", args.conformity, 10.0)):
+        if not (math.isfinite(value) and 0 < value <= hi):
+            raise InputError(option, value, f"a finite number in (0, {hi:g}]")
     if not (math.isfinite(args.poisson) and 0.0 <= args.poisson < 0.5):
         raise InputError("--poisson", args.poisson, "in [0, 0.5)")
     steel = Material(args.youngs_modulus * 1e9, args.poisson)

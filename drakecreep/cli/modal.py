@@ -43,8 +43,10 @@ def add_parser(subparsers):
 
 
 def _read_csv(path):
-    with open(path, newline="") as fh:
-        lines = [ln for ln in fh if ln.strip() and not ln.lstrip().startswith("#")]
+    from drakecreep.files import MAX_DATA_BYTES, read_input_text
+
+    text = read_input_text(path, str(path), MAX_DATA_BYTES)  # regular UTF-8 file, bounded
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(str(path), "empty", "a CSV with header f_Hz,re,im or t,force,response")
     header = tuple(h.strip() for h in lines[0].split(","))

@@ -27,11 +27,13 @@ def run(args):
     """Build the report and print where it is."""
     from drakecreep.cli._common import feed_from_mm_s
     from drakecreep.cli.margins import scenario_from_args
+    from drakecreep.files import check_output_dir
     from drakecreep.report.loop_report import build_report
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     low = feed_from_mm_s(args.low_feed, "--low-feed")
+    check_output_dir(args.out)  # before the computation, not after it
     source = args.params if args.params else f"preset {args.preset}"
     if getattr(args, "friction", None):
         source += f", friction law {args.friction}"

@@ -27,6 +27,8 @@ def add_parser(subparsers):
     p.add_argument("--controller", choices=("sampled", "continuous"), help="controller variant (default: parameters)")
     p.add_argument("--backend", choices=("compiled", "leaf"), help="compiled symbolic fast path or Python leaf systems")
     p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
+    p.add_argument("--max-wall", type=positive_float, metavar="S",
+                   help="stop the run after S seconds of computing (what was computed is saved)")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the text summary")
     p.add_argument("--uncertainty", type=int, metavar="N",
@@ -40,6 +42,7 @@ def add_parser(subparsers):
 
 
 def run(args):
+    from drakecreep.files import check_output_dir
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
     from drakecreep.sim.simulation import simulate
@@ -65,13 +68,16 @@ def run(args):
         if args.seed < 0:
             raise InputError("--seed", args.seed, "an integer >= 0")
         spec = spec_from_args(args)
-    result = simulate(params, scenario, backend=args.backend)
-    paths = result.save(args.out)
-    if not args.no_plot:
+    check_output_dir(args.out)  # before the run, not after it
+    result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall)
+    extra = {}
+    if not args.no_plot and len(result.time) > 1:
         from drakecreep.report.plots import plot_feed
 
-        paths["plot"] = paths["metrics"].parent / "speed.png"
-        plot_feed(result, paths["plot"])
+        extra["speed.png"] = lambda path: plot_feed(result, path)
+    paths = result.save(args.out, extra=extra)  # one set, metrics.json last (also after a stop or Ctrl-C)
+    if "speed" in paths:
+        paths["plot"] = paths.pop("speed")
     summary = result.summary()
     summary["out"] = str(paths["metrics"].parent)
     study = None
@@ -98,7 +104,7 @@ def run(args):
                   f"fluctuation p50/p95 {row['fluctuation_p50_mm_s']:.3g}/{row['fluctuation_p95_mm_s']:.3g} mm/s")
     if not result.ok:
         print(f"drakecreep simulate: error: {result.status} (results up to then saved in {args.out})", file=sys.stderr)
-        return 1
+        return 130 if result.status.startswith("interrupted") else 1
     return 0
 
 

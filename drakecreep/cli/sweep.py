@@ -28,41 +28,54 @@ def add_parser(subparsers):
     p.add_argument("--batch", type=int, default=200, metavar="N",
                    help="simulate up to N compatible cases together in one Drake system (default 200; "
                         "1 = one case at a time)")
+    p.add_argument("--max-cases", type=int, default=None, metavar="N",
+                   help="refuse sweeps of more cases than N (default 100000; raise it deliberately)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=run)
     return p
 
 
 def run(args):
+    from drakecreep.files import check_output_dir
     from drakecreep.report.plots import plot_stability_map
-    from drakecreep.sim.sweep import load_spec, run_sweep
+    from drakecreep.sim.sweep import MAX_CASES, connect_dask, load_spec, run_sweep
 
-    if args.scheduler and args.workers:
+    if args.scheduler is not None and args.workers:
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")
     if args.retries < 0:
         raise InputError("--retries", args.retries, "an integer >= 0")
     if args.batch is not None and args.batch < 1:
         raise InputError("--batch", args.batch, "an integer >= 1")
-    spec = load_spec(args.spec)
-    if args.scheduler:
+    if args.max_cases is not None and args.max_cases < 1:
+        raise InputError("--max-cases", args.max_cases, "an integer >= 1")
+    # everything is checked before the first case runs: the spec, the output folder, the scheduler
+    spec = load_spec(args.spec, max_cases=args.max_cases or MAX_CASES)
+    check_output_dir(args.out)
+    scheduler = connect_dask(args.scheduler) if args.scheduler is not None else None
+    if scheduler is not None:
         executor = "dask"
     elif args.workers == 1:
         executor = "serial"
     else:
         executor = "processes"
-    result = run_sweep(
-        spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
-        scheduler=args.scheduler, out_dir=args.out, progress=not (args.no_progress or args.quiet), retries=args.retries,
-        columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None,
-    )
-    paths = {k: str(v) for k, v in result.paths.items()}
+    extra = {}
     if spec.plot:
         color = spec.plot.get("color", "fluctuation_rate_percent")
-        if color in result.table.columns:
-            paths["map"] = str(plot_stability_map(
-                result.table, spec.plot["x"], os.path.join(args.out, "map.png"), y=spec.plot.get("y", "feed"),
-                color=color, base=spec.base,
-            ))
+        if spec.metrics is None or color in spec.metrics:
+            def write_map(table, path):
+                plot_stability_map(table, spec.plot["x"], path, y=spec.plot.get("y", "feed"), color=color,
+                                   base=spec.base)
+            extra["map.png"] = write_map
+    try:
+        result = run_sweep(
+            spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
+            scheduler=scheduler, out_dir=args.out, progress=not (args.no_progress or args.quiet), retries=args.retries,
+            columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None, extra_outputs=extra,
+        )
+    finally:
+        if scheduler is not None:
+            scheduler.close()
+    paths = {k: str(v) for k, v in result.paths.items()}
     print_json(dict(cases=len(result.table), computed=result.computed, cached=result.cached, failed=result.failed,
                     retried=result.retried, wall_time_s=round(result.wall_time, 3), executor=executor, **paths))
     return 0 if result.failed == 0 else 1

@@ -385,6 +385,7 @@ class MeasuredData:
 # --------------------------------------------------------------------------- metadata YAML
 
 def _meta_from_dict(data, meta_path):
+    from drakecreep.files import resolve_reference
     from drakecreep.params import load_params, params_from_dict
 
     where = str(meta_path)
@@ -398,10 +399,8 @@ def _meta_from_dict(data, meta_path):
         raise InputError(f"{where}: u_units", None, "one of " + ", ".join(U_UNITS) + " (required)")
     params = data.get("params")
     if isinstance(params, str):
-        ppath = Path(params)
-        if not ppath.is_absolute():
-            ppath = Path(meta_path).parent / ppath
-        params = load_params(ppath)
+        # relative to the metadata file; a regular file only; its content is never echoed
+        params = load_params(resolve_reference(params, meta_path, f"{where}: params"))
     elif isinstance(params, dict):
         params = params_from_dict(params)
     elif params is not None:
@@ -499,12 +498,14 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
         if meta_path is None:
             raise InputError("metadata", str(candidates[0]),
                              "a metadata YAML beside the CSV (or name it: diagnose --meta FILE)")
-    meta_path = Path(meta_path)
-    from drakecreep.params import load_yaml
+    from drakecreep.files import MAX_DATA_BYTES, check_input_file
+    from drakecreep.params import load_yaml_file
 
-    meta_data = load_yaml(meta_path, "a YAML mapping with at least u_units")
+    meta_path = Path(meta_path)
+    meta_data = load_yaml_file(meta_path, str(meta_path), "a YAML mapping with at least u_units and u_gain")
     meta = _meta_from_dict(meta_data, meta_path)
 
+    check_input_file(csv_path, str(csv_path), MAX_DATA_BYTES)  # a regular file of bounded size, before reading
     file_opts = meta_data.get("file") if isinstance(meta_data, dict) else None
     signals = read_signals(csv_path, meta.u_units, **_file_options(file_opts, meta_path))
     unknown = [name for name in signals if name not in COLUMNS]
@@ -640,27 +641,40 @@ def load_emps(path=None):
         path = "estimation"
     if isinstance(path, str) and path in EMPS_FILES:
         path = emps_path(path)
-    path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(2, "No such file or directory", str(path))
-    mat = scipy.io.loadmat(str(path))
+    from drakecreep.files import MAX_DATA_BYTES, check_input_file
+
+    path = check_input_file(path, str(path), MAX_DATA_BYTES)
+    try:
+        mat = scipy.io.loadmat(str(path))
+    except MemoryError:
+        raise
+    except Exception as err:  # noqa: BLE001 - empty, truncated, corrupt: OSError, IndexError, MatReadError, zlib.error...
+        raise InputError(str(path), f"not a readable MATLAB file ({type(err).__name__})",
+                         "a MATLAB .mat file (v4-v7.2) with the EMPS variables") from None
     missing = [k for k in ("t", "qm", "qg", "vir", "gtau", "kp", "kv") if k not in mat]
     if missing:
         raise InputError(f"{path}: variables", ",".join(sorted(k for k in mat if not k.startswith("__"))),
                          "the EMPS variables t, qm, qg, vir, gtau, kp, kv")
 
+    def array(name):
+        try:
+            return np.asarray(mat[name], dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{path}: {name}", f"{type(mat[name]).__name__} {getattr(mat[name], 'dtype', '')}",
+                             "a numeric array") from None
+
     def scalar(name):
-        a = np.asarray(mat[name], dtype=float)
+        a = array(name)
         if a.size != 1:
             raise InputError(f"{path}: {name}", f"shape {a.shape}", "a scalar")
         return float(a.item())
 
     gtau = scalar("gtau")
     controller = dataclasses.replace(EMPS_CONTROLLER, kp=scalar("kp"), kv=scalar("kv"))
-    vir = np.asarray(mat["vir"], dtype=float).ravel()
+    vir = array("vir").ravel()
     u, f_ext = vir, None
     if "pulses_N" in mat:
-        pulses = np.asarray(mat["pulses_N"], dtype=float).ravel()
+        pulses = array("pulses_N").ravel()
         if pulses.size != vir.size:
             raise InputError(f"{path}: pulses_N", f"length {pulses.size}", f"length {vir.size} like vir")
         u = vir - pulses
@@ -669,6 +683,6 @@ def load_emps(path=None):
                         sensors=SensorMeta(encoder_resolution=EMPS_ENCODER_RESOLUTION, scale_resolution=0.0),
                         source=f"EMPS benchmark (Janot, Gautier, Brunot 2019): {path.name}",
                         notes=_EMPS_NOTES)
-    run = MeasuredRun(t=mat["t"], x_ref=mat["qg"], x_motor=mat["qm"], u=u, f_ext=f_ext, meta=meta,
+    run = MeasuredRun(t=array("t"), x_ref=array("qg"), x_motor=array("qm"), u=u, f_ext=f_ext, meta=meta,
                       label=path.stem)
     return MeasuredData(runs=(run,), meta=meta)

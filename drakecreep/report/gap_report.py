@@ -139,11 +139,12 @@ def write_report(result, out_dir, title="Sim-to-real gap diagnosis"):
     """
     from pathlib import Path
 
+    from drakecreep.files import OutputSet
+
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    outset = OutputSet(out, "manifest.json").start()  # one set: manifest.json written last names its files
     data = to_json_dict(result)
-    json_path = out / "diagnosis.json"
-    json_path.write_text(json.dumps(data, indent=1))
+    json_path = outset.write_text("diagnosis.json", json.dumps(data, indent=1))
     parts = [f"<h1>{html.escape(title)}</h1>", "<h2>Answer</h2><ul>"]
     parts += [f"<li>{html.escape(s)}</li>" for s in result.get("summary", [])]
     parts.append("</ul>")
@@ -196,6 +197,6 @@ def write_report(result, out_dir, title="Sim-to-real gap diagnosis"):
            "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:collapse}"
            "td,th{border:1px solid #ccc;padding:2px 6px;font-size:12px}</style></head><body>"
            + "\n".join(parts) + "</body></html>")
-    html_path = out / "diagnosis.html"
-    html_path.write_text(doc)
+    html_path = outset.write_text("diagnosis.html", doc)
+    outset.commit(dict(report=title, html="diagnosis.html", json="diagnosis.json"))
     return html_path, json_path

@@ -25,112 +25,204 @@ _STYLE = {"continuous": dict(ls="--", lw=1.0), "sampled": dict(ls="-", lw=1.3)}
 _COLOR = {"velocity": "C0", "position": "C3"}
 
 
-def _grid(L, lo=0.1):
+def _grid(L, lo=0.1, dense_at=(), n=3000):
+    """Log frequency grid (Hz) up to Nyquist (sampled) or 5 kHz, refined around ``dense_at`` (resonances,
+    crossovers) so that sharp features are drawn as smooth curves."""
     top = 0.5 / L.dt if L.isdtime(strict=True) else 5e3
-    return np.logspace(math.log10(lo), math.log10(top * 0.999), 2000)
+    f = np.logspace(math.log10(lo), math.log10(top * 0.999), n)
+    extra = [fc * (1.0 + np.linspace(-0.1, 0.1, 4001)) for fc in dense_at if math.isfinite(fc) and lo < fc < top]
+    return np.unique(np.concatenate([f, *extra])) if extra else f
 
 
 def _resp(L, f):
     return np.asarray(control.frequency_response(L, 2 * np.pi * f).complex).reshape(-1)
 
 
+def _phase_deg(r):
+    """Unwrapped phase (deg), shifted by a multiple of 360 so that it starts in (-360, 0]."""
+    p = np.degrees(np.unwrap(np.angle(r)))
+    return p - 360.0 * math.ceil(p[0] / 360.0)
+
+
+def _fmt(value, unit, digits=3):
+    if isinstance(value, str) or value is None or not math.isfinite(value):
+        return "inf" if value in ("inf", math.inf) else "n/a"
+    return f"{value:.{digits}g} {unit}"
+
+
 def plot_bode(analysis, path):
-    """Bode plot of both loop gains, continuous (dashed) and sampled (solid), crossovers marked."""
-    fig, (axm, axp) = plt.subplots(2, 1, figsize=(9, 7), sharex=True, constrained_layout=True)
+    """Bode plot of both loop gains, continuous (dashed) and sampled (solid).
+
+    The margins of the configured controller are drawn where they are read: the phase margin as an arrow
+    from -180 deg at the gain crossover, the gain margin as an arrow from 0 dB at the phase crossover, each
+    labelled with its value; the crossovers are labelled in Hz.
+    """
+    fig, (axm, axp) = plt.subplots(2, 1, figsize=(10, 7.5), sharex=True, constrained_layout=True)
+    main = "sampled" if analysis.sampled else "continuous"
+    res = analysis.resonance_Hz
+    phase_lo = -200.0
     for variant, loops in analysis.loops.items():
         for loop in LOOPS:
             L = loops[loop]
-            f = _grid(L)
+            m = analysis.margins[variant][loop]
+            f = _grid(L, dense_at=(res, m["crossover_Hz"]))
             r = _resp(L, f)
             label = f"{loop} loop, {variant}"
             axm.semilogx(f, 20 * np.log10(np.abs(r)), color=_COLOR[loop], label=label, **_STYLE[variant])
-            axp.semilogx(f, np.degrees(np.unwrap(np.angle(r))), color=_COLOR[loop], **_STYLE[variant])
-            m = analysis.margins[variant][loop]
-            if variant == ("sampled" if analysis.sampled else "continuous") and math.isfinite(m["crossover_Hz"]):
-                axm.axvline(m["crossover_Hz"], color=_COLOR[loop], lw=0.6, alpha=0.5)
-                axp.axvline(m["crossover_Hz"], color=_COLOR[loop], lw=0.6, alpha=0.5)
+            ph = _phase_deg(r)
+            axp.semilogx(f, ph, color=_COLOR[loop], **_STYLE[variant])
+            phase_lo = min(phase_lo, float(np.min(ph)))
+            if variant != main:
+                continue
+            fc, pm = m["crossover_Hz"], m["phase_margin_deg"]
+            if math.isfinite(fc):
+                for ax in (axm, axp):
+                    ax.axvline(fc, color=_COLOR[loop], lw=0.6, alpha=0.5)
+                axm.annotate(f"{loop}: crossover {fc:.3g} Hz", (fc, 0), xytext=(4, 8 if loop == "velocity" else -14),
+                             textcoords="offset points", color=_COLOR[loop], fontsize=8)
+                if math.isfinite(pm):
+                    axp.annotate("", xy=(fc, -180.0 + pm), xytext=(fc, -180.0),
+                                 arrowprops=dict(arrowstyle="->", color=_COLOR[loop], lw=1.5))
+                    axp.annotate(f"PM {pm:.1f} deg", (fc, -180.0 + pm / 2), xytext=(5, 0), textcoords="offset points",
+                                 color=_COLOR[loop], fontsize=8, va="center")
+            fp, gm = m["phase_crossover_Hz"], m["gain_margin_dB"]
+            if fp is not None and math.isfinite(fp) and not isinstance(gm, str) and math.isfinite(gm):
+                axm.annotate("", xy=(fp, 0.0), xytext=(fp, -gm),
+                             arrowprops=dict(arrowstyle="->", color=_COLOR[loop], lw=1.5))
+                axm.annotate(f"GM {gm:.1f} dB\nat {fp:.3g} Hz", (fp, -gm / 2), xytext=(5, 0),
+                             textcoords="offset points", color=_COLOR[loop], fontsize=8, va="center")
+                axp.axvline(fp, color=_COLOR[loop], lw=0.6, ls=":", alpha=0.6)
     axm.axhline(0, color="k", lw=0.6)
-    for k in (-180, -540):
-        axp.axhline(k, color="k", lw=0.6)
-    if math.isfinite(analysis.resonance_Hz):
+    axp.axhline(-180, color="k", lw=0.6)
+    axp.set_ylim(max(phase_lo, -400.0) - 10.0, 60.0)
+    axp.set_yticks(np.arange(-360, 61, 45))
+    if math.isfinite(res):
         for ax in (axm, axp):
-            ax.axvline(analysis.resonance_Hz, color="C2", ls=":", lw=1)
-        axm.text(analysis.resonance_Hz, axm.get_ylim()[1], " screw resonance", color="C2", va="top", fontsize=8)
+            ax.axvline(res, color="C2", ls=":", lw=1)
+        axm.text(res, axm.get_ylim()[1], f" screw axial mode {res:.3g} Hz", color="C2", va="top", fontsize=8)
     axm.set_ylabel("|L| (dB)")
     axp.set_ylabel("phase of L (deg)")
     axp.set_xlabel("frequency (Hz)")
     axm.legend(fontsize=8, loc="lower left")
-    axm.set_title("loop gains broken at the speed feedback (velocity) and the position feedback (position)",
-                  fontsize=9)
+    axm.set_title(f"loop gains broken at the speed feedback (velocity) and the position feedback (position); "
+                  f"margins of the {main} controller", fontsize=9)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
 def plot_nyquist(analysis, path):
-    """Nyquist curves of both loops near -1, with the ``Ms`` circle of each loop."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
+    """Nyquist curves of both loops near -1: the ``1/Ms`` circle, the gain-margin point on the negative real
+    axis and the phase-margin point on the unit circle; a grid refined at the resonance and the crossover."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6), constrained_layout=True)
     main = "sampled" if analysis.sampled else "continuous"
+    t = np.linspace(0, 2 * np.pi, 400)
     for ax, loop in zip(axes, LOOPS):
+        m = analysis.margins[main][loop]
         for variant, loops in analysis.loops.items():
             L = loops[loop]
-            f = _grid(L, lo=0.01)
+            f = _grid(L, lo=0.01, dense_at=(analysis.resonance_Hz, m["crossover_Hz"], m["phase_crossover_Hz"] or math.nan),
+                      n=6000)
             r = _resp(L, f)
             ax.plot(r.real, r.imag, color=_COLOR[loop], label=f"{variant}, f > 0", **_STYLE[variant])
-            ax.plot(r.real, -r.imag, color=_COLOR[loop], alpha=0.35, **_STYLE[variant])
-        ms = analysis.margins[main][loop]["ms_peak"]
-        t = np.linspace(0, 2 * np.pi, 200)
+            ax.plot(r.real, -r.imag, color=_COLOR[loop], alpha=0.3, **_STYLE[variant])
+        ms = m["ms_peak"]
         ax.plot(-1 + np.cos(t) / ms, np.sin(t) / ms, color="0.5", lw=0.8, label=f"1/Ms circle (Ms = {ms:.2f})")
-        ax.plot(np.cos(t), np.sin(t), color="0.8", lw=0.6)
+        ax.plot(np.cos(t), np.sin(t), color="0.8", lw=0.6, label="unit circle")
         ax.plot([-1], [0], "k+", ms=12, mew=2)
-        ax.set_xlim(-3, 1.5)
-        ax.set_ylim(-2.5, 2.5)
+        ax.annotate("-1", (-1, 0), xytext=(-12, 6), textcoords="offset points", fontsize=9)
+        gm = m["gain_margin_dB"]
+        if not isinstance(gm, str) and math.isfinite(gm):
+            x = -10 ** (-gm / 20)
+            ax.plot([x], [0], "o", color=_COLOR[loop], mfc="none", ms=7, label=f"GM {gm:.1f} dB: -1/GM = {x:.3f}")
+        pm = m["phase_margin_deg"]
+        if math.isfinite(pm):
+            ang = np.radians(-180.0 + pm)
+            ax.plot([0, np.cos(ang)], [0, np.sin(ang)], color=_COLOR[loop], lw=0.8, ls=":")
+            ax.plot([np.cos(ang)], [np.sin(ang)], "s", color=_COLOR[loop], mfc="none", ms=7, label=f"PM {pm:.1f} deg")
+        ax.set_xlim(-2.5, 1.5)
+        ax.set_ylim(-2.0, 2.0)
         ax.set_aspect("equal")
         ax.axhline(0, color="k", lw=0.4)
         ax.axvline(0, color="k", lw=0.4)
-        ax.set_title(f"{loop} loop (zoom on -1)", fontsize=9)
+        ax.set_title(f"{loop} loop, zoom on -1 (margins of the {main} controller)", fontsize=9)
         ax.set_xlabel("Re L")
         ax.set_ylabel("Im L")
-        ax.legend(fontsize=8, loc="lower right")
+        ax.legend(fontsize=7.5, loc="lower right")
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
+def _dominant_box(poles, dt, f_max):
+    """Axis limits around the closed-loop poles slower than ``f_max`` (Hz), with a margin; the s-plane box keeps
+    the imaginary axis in view, the z-plane box the point z = 1."""
+    s = np.log(poles.astype(complex)) / dt if dt else poles.astype(complex)
+    keep = poles[np.abs(s) <= 2 * np.pi * f_max]
+    if keep.size == 0:
+        keep = poles
+    anchor = 1.0 + 0j if dt else 0j
+    pts = np.concatenate([keep, [anchor]])
+    x0, x1 = pts.real.min(), pts.real.max()
+    yabs = max(np.abs(pts.imag).max(), 0.25 * (x1 - x0), 1e-3)
+    pad = 0.25 * max(x1 - x0, yabs)
+    return (x0 - pad, x1 + pad), (-yabs - pad, yabs + pad)
+
+
 def plot_gain_locus(analysis, path, factors=None):
-    """Root locus of the velocity loop versus a factor on its PI gains (continuous s-plane, sampled z-plane)."""
+    """Root locus of the velocity loop versus a factor on its PI gains (continuous s-plane, sampled z-plane).
+
+    Each panel is zoomed to the dominant closed-loop poles (slower than twice the higher of the crossover and
+    the screw's axial mode); an inset shows the full range.
+    """
     factors = np.geomspace(0.05, 20, 240) if factors is None else np.asarray(factors)
     variants = list(analysis.loops)
-    fig, axes = plt.subplots(1, len(variants), figsize=(6 * len(variants), 5.2), constrained_layout=True,
+    fig, axes = plt.subplots(1, len(variants), figsize=(6.5 * len(variants), 5.6), constrained_layout=True,
                              squeeze=False)
     for ax, variant in zip(axes[0], variants):
         L = analysis.loops[variant]["velocity"]
+        m = analysis.margins[variant]["velocity"]
         pts = np.array([control.feedback(k * L, 1).poles() for k in factors])
         discrete = L.isdtime(strict=True)
         kk = np.repeat(factors, pts.shape[1])
-        sc = ax.scatter(pts.real.ravel(), pts.imag.ravel(), c=np.log10(kk), s=4, cmap="viridis")
         nominal = control.feedback(L, 1).poles()
-        ax.plot(nominal.real, nominal.imag, "r^", ms=7, mfc="none", label="nominal gains")
-        ol = L.poles()
-        ax.plot(ol.real, ol.imag, "kx", label="open-loop poles")
-        z = L.zeros()
-        ax.plot(z.real, z.imag, "ko", mfc="none", label="zeros")
+        ol, z = L.poles(), L.zeros()
+        inset = ax.inset_axes([0.08, 0.62, 0.32, 0.34])
+        for target, small in ((ax, False), (inset, True)):
+            sc = target.scatter(pts.real.ravel(), pts.imag.ravel(), c=np.log10(kk), s=2 if small else 5,
+                                cmap="viridis", vmin=np.log10(factors[0]), vmax=np.log10(factors[-1]))
+            target.plot(nominal.real, nominal.imag, "r^", ms=4 if small else 8, mfc="none",
+                        label="closed loop, nominal gains")
+            target.plot(ol.real, ol.imag, "kx", ms=4 if small else 7, label="open-loop poles")
+            target.plot(z.real, z.imag, "ko", ms=3 if small else 6, mfc="none", label="zeros")
+            if discrete:
+                t = np.linspace(0, 2 * np.pi, 400)
+                target.plot(np.cos(t), np.sin(t), color="0.5", lw=0.8)
+            else:
+                target.axvline(0, color="k", lw=0.6)
+            if small:
+                colorbar_source = sc
         if discrete:
-            t = np.linspace(0, 2 * np.pi, 300)
-            ax.plot(np.cos(t), np.sin(t), color="0.5", lw=0.8)
-            ax.set_xlim(-1.2, 1.2)
-            ax.set_ylim(-1.2, 1.2)
-            ax.set_aspect("equal")
+            inset.set_xlim(-1.15, 1.15)
+            inset.set_ylim(-1.15, 1.15)
+            inset.set_aspect("equal")
             ax.set_xlabel("Re z")
             ax.set_ylabel("Im z")
         else:
-            ax.axvline(0, color="k", lw=0.6)
-            ax.set_xlim(-1200, 200)
-            ax.set_ylim(-800, 800)
+            inset.set_xlim(-1500, 300)
+            inset.set_ylim(-900, 900)
             ax.set_xlabel("Re s (1/s)")
             ax.set_ylabel("Im s (rad/s)")
-        fig.colorbar(sc, ax=ax, label="log10(gain factor on kv, ki)")
-        ax.set_title(f"velocity loop, {variant} ({'z-plane' if discrete else 's-plane'})", fontsize=9)
+        inset.set_title("full range", fontsize=7)
+        inset.tick_params(labelsize=6)
+        f_max = 2 * max(m["crossover_Hz"] if math.isfinite(m["crossover_Hz"]) else 0.0,
+                        analysis.resonance_Hz if math.isfinite(analysis.resonance_Hz) else 0.0, 1.0)
+        xlim, ylim = _dominant_box(nominal, L.dt if discrete else 0.0, f_max)
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
+        fig.colorbar(colorbar_source, ax=ax, label="log10(gain factor on kv, ki)")
+        ax.set_title(f"velocity loop, {variant} ({'z-plane' if discrete else 's-plane'}): zoom on the poles "
+                     f"below {f_max:.3g} Hz", fontsize=9)
         ax.legend(fontsize=7, loc="lower left")
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -6,7 +6,6 @@ simulation runs (:mod:`drakecreep.servo.linearize`, :mod:`drakecreep.servo.loops
 :func:`drakecreep.sim.simulation.simulate`, :mod:`drakecreep.paper.creep`).
 """
 
-import base64
 import datetime
 import html
 import json
@@ -20,7 +19,8 @@ from drakecreep.paper import creep
 
 from drakecreep.report import loop_plots
 from drakecreep.errors import InputError
-from drakecreep.files import to_jsonable
+from drakecreep.files import OutputSet, to_jsonable
+from drakecreep.report.html import figure, page, table
 from drakecreep.servo.loops import LOOPS, analyze_loops
 from drakecreep.model.motor import motor_inertia
 from drakecreep.params import params_to_dict, with_value
@@ -45,19 +45,8 @@ MARGIN_ROWS = (
     ("open_loop_unstable_poles", "open-loop unstable poles", None),
 )
 
-_CSS = """
-body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
-h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.8em}
-table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right}
-th{background:#f3f3f3}td:first-child,th:first-child{text-align:left}img{max-width:100%;border:1px solid #eee}
-.note{background:#f7f7ee;border-left:4px solid #cc9;padding:.5em 1em}pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
-.bad{color:#b00;font-weight:bold}
-"""
-
-
 def _img(path):
-    data = base64.b64encode(Path(path).read_bytes()).decode("ascii")
-    return f'<img alt="{html.escape(Path(path).stem)}" src="data:image/png;base64,{data}">'
+    return figure(path)
 
 
 def _fmt(value, fmt):
@@ -73,10 +62,7 @@ def _fmt(value, fmt):
 
 
 def _table(header, rows):
-    out = ["<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>"]
-    for row in rows:
-        out.append("<tr>" + "".join(f"<td>{c}</td>" for c in row) + "</tr>")
-    return "\n".join(out) + "</table>"
+    return table(header, rows, raw=True)
 
 
 def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step_feed=10e-3,
@@ -162,17 +148,20 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
 
     fmt_cross = ", ".join(f"{v * 1e3:.3g}" for v in crossings["closed_loop"]["pole"]) or "none"
     th_cross = ", ".join(f"{v * 1e3:.3g}" for v in crossings["closed_loop"]["theory"]) or "none"
+    # the files form one output set: the old manifest goes first, every file is replaced atomically, and
+    # manifest.json, written last, names the files of this run (a kill part way leaves no manifest)
+    outset = OutputSet(out, "manifest.json").start()
     png = {}
-    png["bode"] = loop_plots.plot_bode(analysis, out / "bode.png")
-    png["nyquist"] = loop_plots.plot_nyquist(analysis, out / "nyquist.png")
-    png["gain_locus"] = loop_plots.plot_gain_locus(analysis, out / "root_locus_gain.png")
-    png["loci"] = loop_plots.plot_parameter_loci(
-        loci, out / "root_locus_parameters.png",
+    png["bode"] = outset.write("bode.png", lambda p: loop_plots.plot_bode(analysis, p))
+    png["nyquist"] = outset.write("nyquist.png", lambda p: loop_plots.plot_nyquist(analysis, p))
+    png["gain_locus"] = outset.write("root_locus_gain.png", lambda p: loop_plots.plot_gain_locus(analysis, p))
+    png["loci"] = outset.write("root_locus_parameters.png", lambda p: loop_plots.plot_parameter_loci(
+        loci, p,
         labels={"stiffness": "stiffness factor", "feed": "feed, mm/s", "mass": "table mass, kg"},
         crossings=f"axis crossings at {fmt_cross} mm/s; C + C1 = 0 at {th_cross} mm/s",
-    )
-    png["pole_map"] = loop_plots.plot_pole_map(pm, out / "pole_map.png")
-    png["sims"] = loop_plots.plot_step_and_feed(step, low_run, out / "simulations.png")
+    ))
+    png["pole_map"] = outset.write("pole_map.png", lambda p: loop_plots.plot_pole_map(pm, p))
+    png["sims"] = outset.write("simulations.png", lambda p: loop_plots.plot_step_and_feed(step, low_run, p))
     t = lap("plots", t)
 
     payload = to_jsonable(dict(
@@ -183,15 +172,14 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
         low_feed=low_run.summary(), step=step.summary(),
         pole_map_agreement=pm.agreement() if len(pm.sim_creep) else None,
     ))
-    json_path = out / "margins.json"
-    json_path.write_text(json.dumps(payload, indent=2) + "\n")
+    json_path = outset.write_text("margins.json", json.dumps(payload, indent=2) + "\n")
 
     html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v0, v0_sc, png, low_feed,
                       timings)
     timings["total"] = time.perf_counter() - t_start
     html_text = html_text.replace("@@TOTAL@@", f"{timings['total']:.1f}")
-    html_path = out / "index.html"
-    html_path.write_text(html_text)
+    html_path = outset.write_text("index.html", html_text)
+    outset.commit(dict(report="servo-loop report", source=source, html="index.html", json="margins.json"))
     return dict(html=html_path, json=json_path, timings=timings, pngs=png)
 
 
@@ -248,8 +236,6 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v
     yaml_text = yaml.safe_dump(params_to_dict(params), sort_keys=False)
     now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
     parts = [
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>drakecreep servo-loop report</title>"
-        f"<style>{_CSS}</style></head><body>",
         "<h1>Feed-drive servo loops: margins, loci and creep</h1>",
         f"<p>Parameters: <b>{html.escape(source)}</b>. Operating point: feed <b>{op.feed * 1e3:g} mm/s</b>, "
         f"load case <b>{analysis.scenario.load_case}</b>. Generated {now} by <code>drakecreep report</code> in "
@@ -330,11 +316,8 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v
         "<p>Equation 11 puts the onset of creep where the paper's large-signal condition is met; the linearized "
         "loop only says where steady sliding stops being stable to small deviations. A drive can slide steadily "
         "below v0 when the servo loop damps the motor side (compare the pole map's simulated markers).</p>",
-        "<h2>Build time</h2>",
-        _table(["stage", "s"], [(k, f"{v:.2f}") for k, v in timings.items()]),
-        "</body></html>",
     ]
-    return "\n".join(parts)
+    return page("drakecreep servo-loop report", parts)
 
 
 def _metric_cells(m):

@@ -8,11 +8,11 @@ import numpy as np  # noqa: E402
 from drakecreep.errors import InputError
 from drakecreep.model.lumped import lumped
 from drakecreep.paper.creep import critical_speed_of
-from drakecreep.params import with_value
+from drakecreep.params import field_unit, preset, with_value
 from drakecreep.files import write_atomic
 from drakecreep.sim.sweep import SCENARIO_FIELDS
 
-__all__ = ["plot_feed", "zoom_window", "plot_stability_map"]
+__all__ = ["plot_feed", "zoom_window", "plot_stability_map", "axis_label", "column_label"]
 
 
 def zoom_window(result, span=None):
@@ -95,6 +95,29 @@ def plot_feed(result, path):
     return path
 
 
+#: metric column suffix -> unit shown on a plot
+_SUFFIX_UNITS = {"_percent": "%", "_mm_s": "mm/s", "_um": "um", "_Hz": "Hz", "_N": "N", "_s": "s"}
+
+
+def column_label(column):
+    """A table column as an axis label: ``fluctuation_rate_percent`` -> ``fluctuation rate (%)``."""
+    for suffix, unit in _SUFFIX_UNITS.items():
+        if column.endswith(suffix):
+            return f"{column[:-len(suffix)].replace('_', ' ')} ({unit})"
+    return column.replace("_", " ")
+
+
+def axis_label(params, path):
+    """A swept parameter as an axis label with its SI unit: ``nut.axial_stiffness (N/m)``."""
+    if path in SCENARIO_FIELDS:
+        return {"feed": "feed (m/s)", "load_case": "load case", "duration": "duration (s)"}.get(path, path)
+    try:
+        unit = field_unit(params, path)
+    except InputError:
+        return path
+    return f"{path} ({unit})" if unit not in ("", "-") else path
+
+
 def plot_stability_map(table, x, path, *, y="feed", color="fluctuation_rate_percent", base=None, load_case=None,
                        log_x=True, log_y=True, title=None):
     """Scatter map of a sweep (``x`` x ``y``, colour = ``color``) with the analytic ``v0`` curve.
@@ -131,7 +154,7 @@ def plot_stability_map(table, x, path, *, y="feed", color="fluctuation_rate_perc
         norm = LogNorm(vmin=max(positive.min(), positive.max() * 1e-6), vmax=positive.max())
         values = values.clip(lower=norm.vmin)
     sc = ax.scatter(table[x], table[y] * scale_y, c=values, cmap="viridis", norm=norm, s=36, marker="s")
-    fig.colorbar(sc, ax=ax, label=color)
+    fig.colorbar(sc, ax=ax, label=column_label(color))
     if "creep" in table.columns:
         creeping = table[table["creep"].fillna(False).astype(bool)]
         ax.scatter(creeping[x], creeping[y] * scale_y, facecolors="none", edgecolors="red", s=80,
@@ -152,8 +175,9 @@ def plot_stability_map(table, x, path, *, y="feed", color="fluctuation_rate_perc
         ax.set_xscale("log")
     if log_y:
         ax.set_yscale("log")
-    ax.set_xlabel(x)
-    ax.set_ylabel("feed (mm/s)" if y == "feed" else y)
+    reference = base if base is not None else preset("paper")
+    ax.set_xlabel(axis_label(reference, x))
+    ax.set_ylabel("feed (mm/s)" if y == "feed" else axis_label(reference, y))
     ax.set_title(title or f"stability map: {color}")
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="best", fontsize=8)

@@ -21,11 +21,30 @@ from drakecreep.model.diagram import build_diagram
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
 from drakecreep.params import save_params
+from drakecreep.scenario import MAX_FEED
 
-__all__ = ["SimulationResult", "simulate", "make_simulator", "FIXED_STEP"]
+__all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "FIXED_STEP", "MAX_SAMPLES",
+           "MAX_TABLE_SPEED", "MIN_STEP"]
 
 #: integrators without error control: they step at ``max_step``
 FIXED_STEP = ("runge_kutta2",)
+#: most recorded samples of one run: 2e6 samples of the ~20 signals are ~0.3 GB in memory and a 0.5 GB CSV;
+#: a finer log (``log_period: 1e-8`` over seconds) would take minutes and gigabytes and show nothing more
+MAX_SAMPLES = 2_000_000
+#: divergence guard: largest table speed (m/s). Feed drives of this class traverse at 0.5-1 m/s
+#: (:data:`drakecreep.scenario.MAX_FEED`); a table ten times faster has left the physics of a feed drive
+#: (an unstable loop, a raised torque limit) and its results mean nothing
+MAX_TABLE_SPEED = 10.0 * MAX_FEED
+#: divergence guard: smallest step (s) an error-controlled integrator may take. The stiffest mode of the
+#: drive (screw-nut contact, ~1e4 rad/s) needs steps of ~1e-6 s; steps a thousand times smaller mean the
+#: integrator is chasing a divergence (2 M steps of 1e-11 s were seen) and would never finish
+MIN_STEP = 1e-9
+#: the guard looks at the signals every this many integrator steps (a Python call per step costs ~1 us)
+GUARD_EVERY = 64
+
+
+class Diverged(RuntimeError):
+    """The divergence guard stopped a run (``status`` of the result says why)."""
 
 
 @dataclass
@@ -93,30 +112,50 @@ class SimulationResult:
             cols[f"{name}_{_unit_tag(self.units[name])}"] = np.asarray(values, dtype=float)
         return pd.DataFrame(cols)
 
-    def save(self, out_dir):
-        """Write ``timeseries.csv``, ``metrics.json`` and ``params.yaml`` to ``out_dir``.
+    def save(self, out_dir, extra=None):
+        """Write ``timeseries.csv``, ``params.yaml`` and, last, ``metrics.json`` to ``out_dir`` as one set.
 
-        The speed plot is :func:`drakecreep.report.plots.plot_feed` (reports read results, not the reverse).
+        The files form a :class:`drakecreep.files.OutputSet` with ``metrics.json`` as its manifest: the old
+        ``metrics.json`` is removed first, each file is written atomically, and ``metrics.json`` is written
+        last naming the files of this run (sizes, SHA-256, ``run_id``). A kill or a full disk part way
+        leaves no ``metrics.json``, never one beside files of another run.
+
+        Parameters
+        ----------
+        out_dir : path-like
+        extra : dict, optional
+            ``file name -> write(path)`` of further files of the set, e.g. the speed plot of
+            :func:`drakecreep.report.plots.plot_feed` (reports read results, not the reverse).
 
         Returns
         -------
         dict
-            name -> path of each written file.
+            name -> path of each written file (the keys of ``extra`` are the file stems).
         """
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
+        from drakecreep.files import OutputSet
+
         paths = {}
         names = list(self.signals)
         header = ",".join(["t_s"] + [f"{n}_{_unit_tag(self.units[n])}" for n in names])
         data = np.column_stack([self.time] + [self.signals[n] for n in names])
-        paths["timeseries"] = out / "timeseries.csv"
-        np.savetxt(paths["timeseries"], data, delimiter=",", header=header, comments="", fmt="%.10g")
-        paths["metrics"] = out / "metrics.json"
-        payload = dict(summary=self.summary(), scenario=asdict(self.scenario), units=self.units)
-        paths["metrics"].write_text(json.dumps(payload, indent=2) + "\n")
-        paths["params"] = out / "params.yaml"
-        save_params(self.params, paths["params"])
+        with OutputSet(out_dir, "metrics.json") as out:
+            paths["timeseries"] = out.write(
+                "timeseries.csv",
+                lambda tmp: np.savetxt(tmp, data, delimiter=",", header=header, comments="", fmt="%.10g"))
+            paths["params"] = out.write("params.yaml", lambda tmp: save_params(self.params, tmp))
+            for name, write in (extra or {}).items():
+                paths[Path(name).stem] = out.write(name, write)
+            payload = dict(summary=self.summary(), scenario=asdict(self.scenario), units=self.units)
+            paths["metrics"] = out.commit(payload)
         return paths
+
+
+def check_log_period(log_period, duration):
+    """Refuse a log period that records more than :data:`MAX_SAMPLES` samples over ``duration``."""
+    if duration / log_period > MAX_SAMPLES:
+        raise InputError("simulation.log_period", log_period,
+                         f">= {duration / MAX_SAMPLES:.3g} s for a {duration:g} s run (at most {MAX_SAMPLES} "
+                         "recorded samples per run)")
 
 
 def _unit_tag(unit):
@@ -130,11 +169,48 @@ def make_simulator(system, context, sim):
     integrator.set_maximum_step_size(sim.max_step)
     if sim.integrator not in FIXED_STEP:
         integrator.set_target_accuracy(sim.accuracy)
+        integrator.set_requested_minimum_step_size(min(MIN_STEP, sim.max_step))
+        integrator.set_throw_on_minimum_step_size_violation(True)
     simulator.Initialize()
     return simulator
 
 
-def simulate(params, scenario, *, backend=None):
+def _guard(simulator, root, read_speeds, bounds, wall_limit):
+    """Install the divergence guard as the simulator's monitor; returns the dict it reports into."""
+    from pydrake.systems.framework import EventStatus
+
+    report = dict(reason=None)
+    start = time.perf_counter()
+    calls = [0]
+    v_max, w_max = bounds
+
+    def monitor(context):
+        calls[0] += 1
+        if calls[0] % GUARD_EVERY:
+            return EventStatus.Succeeded()
+        t = context.get_time()
+        v, w = read_speeds(context)
+        reason = None
+        if not (math.isfinite(v) and math.isfinite(w)):
+            reason = f"diverged at t = {t:.6g} s: non-finite state"
+        elif abs(v) > v_max:
+            reason = (f"diverged at t = {t:.6g} s: table speed {v:.3g} m/s beyond +-{v_max:g} m/s "
+                      "(an unstable loop or a raised torque limit)")
+        elif abs(w) > w_max:
+            reason = (f"diverged at t = {t:.6g} s: motor speed {w:.3g} rad/s beyond +-{w_max:.3g} rad/s "
+                      f"(the table speed limit {v_max:g} m/s through the lead)")
+        elif wall_limit is not None and time.perf_counter() - start > wall_limit:
+            reason = f"stopped at t = {t:.6g} s: wall-clock limit of {wall_limit:g} s reached"
+        if reason is None:
+            return EventStatus.Succeeded()
+        report["reason"] = reason
+        return EventStatus.ReachedTermination(None, reason)
+
+    simulator.set_monitor(monitor)
+    return report
+
+
+def simulate(params, scenario, *, backend=None, wall_limit=None):
     """Simulate ``scenario`` on the drive described by ``params``.
 
     Parameters
@@ -143,19 +219,28 @@ def simulate(params, scenario, *, backend=None):
     scenario : drakecreep.scenario.Scenario
     backend : {"compiled", "leaf"}, optional
         Default ``params.simulation.backend``.
+    wall_limit : float, optional
+        Stop after this many seconds of computing (the result says so in ``status``).
 
     Returns
     -------
     SimulationResult
-        If the integrator fails part way, the result holds everything up to that point and
-        ``status`` says why; metrics are computed when the steady window was reached.
+        If the run stops part way, the result holds everything up to that point and ``status`` says
+        why: the integrator failed, the divergence guard stopped it (table speed beyond
+        :data:`MAX_TABLE_SPEED`, motor speed beyond its equivalent, non-finite state, a step below
+        :data:`MIN_STEP`), the wall-clock limit, or Ctrl-C (``status`` starts with ``"interrupted"``);
+        metrics are computed when the steady window was reached.
     """
+    if wall_limit is not None and (isinstance(wall_limit, bool) or not isinstance(wall_limit, (int, float))
+                                   or not wall_limit > 0):
+        raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
     sim = params.simulation
     backend = backend or sim.backend
     if backend not in ("compiled", "leaf"):
         raise InputError("backend", backend, "compiled or leaf")
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
+    check_log_period(sim.log_period, scenario.duration)
     feed_drive = build_diagram(params, scenario)
     units = feed_drive.signal_units()
 
@@ -183,13 +268,41 @@ def simulate(params, scenario, *, backend=None):
     if backend == "compiled":
         compiled.set_initial_state(root.GetMutableSubsystemContext(system, context))
 
+    names = feed_drive.signal_names
+    if backend == "compiled":
+        sub = root.GetSubsystemContext(system, context)
+        i_v, i_w = names.index("table_speed"), names.index("motor_speed")
+
+        def read_speeds(ctx):
+            y = port.Eval(sub)
+            return float(y[i_v]), float(y[i_w])
+    else:
+        table, motor = feed_drive.diagram.GetSubsystemByName("table"), feed_drive.diagram.GetSubsystemByName("motor")
+        diagram_context = root.GetSubsystemContext(system, context)
+        t_ctx = feed_drive.diagram.GetSubsystemContext(table, diagram_context)
+        m_ctx = feed_drive.diagram.GetSubsystemContext(motor, diagram_context)
+
+        def read_speeds(ctx):
+            return (float(table.GetOutputPort("table_state").Eval(t_ctx)[1]),
+                    float(motor.GetOutputPort("motor_state").Eval(m_ctx)[1]))
+    v_max = MAX_TABLE_SPEED
+    bounds = (v_max, v_max * 2.0 * math.pi / params.screw.lead)
+
     start = time.perf_counter()
     simulator = make_simulator(root, context, sim)
+    guard = _guard(simulator, root, read_speeds, bounds, wall_limit)
     status = "ok"
     try:
         simulator.AdvanceTo(scenario.duration)  # the log's periodic publish lands on `duration` too
     except RuntimeError as err:
-        status = f"integration stopped at t = {context.get_time():.6g} s: {str(err).splitlines()[0]}"
+        first = str(err).splitlines()[0] if str(err) else type(err).__name__
+        if "minimum" in first.lower() and "step" in first.lower():
+            first = f"diverged: the integrator needed a step below {MIN_STEP:g} s ({first[:120]})"
+        status = f"integration stopped at t = {context.get_time():.6g} s: {first}"
+    except KeyboardInterrupt:
+        status = f"interrupted (Ctrl-C) at t = {context.get_time():.6g} s"
+    if guard["reason"] is not None:
+        status = guard["reason"]
     wall = time.perf_counter() - start
 
     columns = [None] * len(feed_drive.signals)
@@ -212,7 +325,8 @@ def simulate(params, scenario, *, backend=None):
     t = np.asarray(t)
 
     metrics = None
-    if len(t) and t[-1] > sim.steady_start + 2 * sim.log_period:
+    diverged = "diverged" in status
+    if len(t) and t[-1] > sim.steady_start + 2 * sim.log_period and not diverged:
         # travel error: reference travel minus table travel (the reference starts where the position
         # feedback reads at rest, which for the encoder includes the screw's static stretch)
         metrics = feed_metrics(

@@ -39,7 +39,7 @@ import numpy as np
 
 from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.errors import InputError
-from drakecreep.files import write_atomic, write_json
+from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.scenario import Scenario
 
@@ -59,6 +59,8 @@ __all__ = [
     "SweepSpec",
     "load_spec",
     "metric_columns",
+    "connect_dask",
+    "MAX_CASES",
 ]
 
 #: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter (``drive``:
@@ -67,12 +69,24 @@ SCENARIO_FIELDS = ("feed", "load_case", "duration", "drive")
 EXECUTORS = ("serial", "processes", "dask")
 #: bump when the meaning of a cached row changes (simulation semantics, report keys)
 CACHE_VERSION = 1
+#: default largest number of cases of one sweep (``max_cases`` / ``--max-cases`` raise it): 100 000 cases
+#: of a few seconds each are days of computing, and the case list alone must fit in memory
+MAX_CASES = 100_000
+
+
+def _check_size(n, max_cases, what="the sweep"):
+    if n > max_cases:
+        digits = len(str(int(n))) if n < 10**4000 else 4000
+        raise InputError("axes", f"about 10^{digits - 1} cases" if n >= 10**6 else f"{n} cases",
+                         f"at most {max_cases} cases in {what} (raise the cap with --max-cases / max_cases)")
 
 
 # --------------------------------------------------------------------------- points
 
 def _axis_values(path, values):
-    if isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+    if not isinstance(path, str):
+        raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
+    if isinstance(values, dict) or isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
         raise InputError(f"axes.{path}", values, "a list of values")
     values = list(values)
     if not values:
@@ -80,13 +94,16 @@ def _axis_values(path, values):
     return [v.item() if isinstance(v, np.generic) else v for v in values]
 
 
-def grid(axes):
+def grid(axes, max_cases=MAX_CASES):
     """Every combination of the axes' values (the first axis varies slowest).
 
     Parameters
     ----------
     axes : mapping
         ``path -> list of values``; paths are parameter paths or scenario fields.
+
+    max_cases : int
+        Refuse grids of more points (an :class:`InputError` before any is made).
 
     Returns
     -------
@@ -97,10 +114,11 @@ def grid(axes):
         return [{}]
     names = list(axes)
     lists = [_axis_values(n, axes[n]) for n in names]
+    _check_size(math.prod(len(v) for v in lists), max_cases, "the grid")
     return [dict(zip(names, combo)) for combo in itertools.product(*lists)]
 
 
-def random_sample(axes, n, seed=0):
+def random_sample(axes, n, seed=0, max_cases=MAX_CASES):
     """``n`` random points.
 
     Parameters
@@ -120,16 +138,22 @@ def random_sample(axes, n, seed=0):
     """
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InputError("n", n, "an integer >= 1")
+    _check_size(n, max_cases, "the sample")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
+        raise InputError("seed", seed, "an integer in [0, 2^63)")
     rng = np.random.default_rng(seed)
     columns = {}
     for path, spec in axes.items():
+        if not isinstance(path, str):
+            raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
         if isinstance(spec, dict):
             low, high = spec.get("low"), spec.get("high")
             scale = spec.get("scale", "linear")
             if set(spec) - {"low", "high", "scale"}:
                 raise InputError(f"axes.{path}", spec, "a mapping with keys low, high, scale")
-            if not all(isinstance(b, (int, float)) and not isinstance(b, bool) for b in (low, high)) or not low <= high:
-                raise InputError(f"axes.{path}", spec, "low <= high, both numbers")
+            if not all(isinstance(b, (int, float)) and not isinstance(b, bool) and abs(b) < 1e300 and math.isfinite(b)
+                       for b in (low, high)) or not low <= high:
+                raise InputError(f"axes.{path}", spec, "low <= high, both finite numbers")
             if scale == "log":
                 if low <= 0:
                     raise InputError(f"axes.{path}.low", low, "> 0 for a log scale")
@@ -306,11 +330,24 @@ def _plain(value):
 
 # --------------------------------------------------------------------------- files
 
-def _read_cache(path):
+def _read_cache(path, key, batch=None):
+    """The cached row of case ``key``, or None when absent, unreadable, not a well-formed row of that case, or
+    computed in another batch than ``batch`` (a batched row depends on its batch: it steps as finely as the
+    batch's most demanding member)."""
     try:
-        return json.loads(Path(path).read_text())
+        if not path.is_file() or path.stat().st_size > 1_000_000:
+            return None
+        entry = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return None
+    if not isinstance(entry, dict) or entry.get("key") != key or entry.get("batch") != batch:
+        return None
+    row = entry.get("row")
+    if not isinstance(row, dict) or not isinstance(row.get("status"), str):
+        return None
+    if not all(isinstance(k, str) and (v is None or isinstance(v, (bool, int, float, str))) for k, v in row.items()):
+        return None
+    return row
 
 
 # --------------------------------------------------------------------------- running
@@ -371,37 +408,112 @@ def _run_serial(todo, metric, retries, done):
             done(case, None, error)
 
 
+def _watch_parent(parent_pid, period=1.0):
+    """Pool worker initializer: exit as soon as the sweep's process is gone (SIGKILL leaves no one to stop us)."""
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(period)
+            if os.getppid() != parent_pid:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="drakecreep-parent-watch", daemon=True).start()
+
+
+def _stop_pool(pool):
+    """Cancel queued work and end the running workers now (Ctrl-C must not wait for every case)."""
+    processes = list(getattr(pool, "_processes", {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        try:
+            proc.terminate()
+        except Exception:  # noqa: BLE001 - already gone
+            pass
+    for proc in processes:
+        proc.join(timeout=5)
+
+
 def _run_processes(todo, metric, retries, done, workers):
-    attempts = {c.key: 0 for c in todo}
+    attempts = {_unit_key(c): 0 for c in todo}
     pending = list(todo)
     context = multiprocessing.get_context("spawn")
     retried = 0
     while pending:
         broken = []
-        with cf.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_watch_parent,
+                                      initargs=(os.getpid(),))
+        try:
             futures = {pool.submit(_work, case, metric): case for case in pending}
             for future in cf.as_completed(futures):
                 case = futures[future]
                 try:
                     row = future.result()
                 except Exception as err:  # noqa: BLE001 - BrokenProcessPool (a worker died) or the case raised
-                    attempts[case.key] += 1
-                    if attempts[case.key] <= retries:
+                    attempts[_unit_key(case)] += 1
+                    if attempts[_unit_key(case)] <= retries:
                         broken.append(case)
                     else:
                         done(case, None, err)
                     continue
                 done(case, row, None)
+        except BaseException:
+            _stop_pool(pool)
+            raise
+        pool.shutdown(wait=True)
         retried += len(broken)
         pending = broken
     return retried
 
 
+def _unit_key(unit):
+    return unit.key
+
+
+def _members(unit):
+    return unit.cases if isinstance(unit, _Batch) else (unit,)
+
+
+#: seconds to wait for a Dask scheduler to answer, and for its first worker
+DASK_TIMEOUT = 10.0
+
+
+def connect_dask(scheduler, timeout=None):
+    """A ``distributed.Client`` of ``scheduler`` that has at least one worker, within ``timeout`` seconds each.
+
+    ``timeout`` defaults to :data:`DASK_TIMEOUT`.
+
+    Raises
+    ------
+    InputError
+        Naming ``--scheduler``: a malformed address, no scheduler answering, or no worker joining in time.
+    """
+    from distributed import Client
+
+    timeout = DASK_TIMEOUT if timeout is None else timeout
+    if not isinstance(scheduler, str) or not scheduler.strip():
+        raise InputError("--scheduler", scheduler, "a Dask scheduler address such as tcp://host:8786")
+    try:
+        client = Client(scheduler, timeout=f"{timeout}s")
+    except Exception as err:  # noqa: BLE001 - OSError, TimeoutError, a bad address, a non-Dask server's reply
+        reason = "malformed address" if isinstance(err, (ValueError, TypeError)) else type(err).__name__
+        raise InputError("--scheduler", scheduler,
+                         f"a reachable Dask scheduler address such as tcp://host:8786 (none answered within "
+                         f"{timeout:g} s: {reason})") from None
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except Exception:  # noqa: BLE001 - TimeoutError (no worker), a lost connection
+        client.close()
+        raise InputError("--scheduler", scheduler,
+                         f"a scheduler with at least one worker (none joined within {timeout:g} s)") from None
+    return client
+
+
 def _run_dask(todo, metric, retries, done, scheduler):
-    from distributed import Client, as_completed
+    from distributed import as_completed
 
     own = not hasattr(scheduler, "submit")
-    client = Client(scheduler) if own else scheduler
+    client = connect_dask(scheduler) if own else scheduler
     retried = 0
     try:
         attempts = {c.key: 0 for c in todo}
@@ -437,7 +549,7 @@ def _run_dask(todo, metric, retries, done, scheduler):
 
 
 def run_sweep(base, points, *, scenario=None, metric=None, executor="processes", workers=None, scheduler=None,
-              out_dir=None, progress=True, retries=2, columns=None, batch_size=None):
+              out_dir=None, progress=True, retries=2, columns=None, batch_size=None, extra_outputs=None):
     """Run a sweep and collect one row per case.
 
     Parameters
@@ -466,16 +578,27 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         Extra attempts for a case whose worker died or that raised.
     columns : list of str, optional
         Metric columns to keep (default: all the metric returns).
+    extra_outputs : dict, optional
+        ``file name -> write(table, path)`` of further files of the output set (e.g. a map).
     batch_size : int, optional
         Simulate up to this many compatible cases together in one Drake system
         (:mod:`drakecreep.sim.batch`; several times the throughput for large sweeps). Only with the
         default metric; cases the batch path cannot run (constant-speed drive, continuous
         controller, disturbances, compensation, nut friction on the screw: see
-        :func:`drakecreep.sim.baseline.unsupported`) run one by one. The batches are the executors' units of work.
+        :func:`drakecreep.sim.baseline.unsupported`) run one by one. The batches are the executors' units of
+        work; they are made no larger than needed to give every worker one (a kill or Ctrl-C loses at most
+        the batches under way: every finished batch is cached at once).
 
     Returns
     -------
     SweepResult
+
+    Notes
+    -----
+    The tables (and ``extra_outputs``) are one :class:`drakecreep.files.OutputSet` whose ``manifest.json``
+    is written last. On Ctrl-C the queued cases are cancelled, the running workers stopped, the tables
+    written with the finished cases (the others ``status: "not run (interrupted)"``) and
+    ``KeyboardInterrupt`` raised again. Pool workers exit by themselves when the sweep's process dies.
     """
     if executor not in EXECUTORS:
         raise InputError("executor", executor, "one of " + ", ".join(EXECUTORS))
@@ -489,16 +612,32 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     metric = metric or feed_report
     cases = make_cases(base, points, scenario, metric)
     cache_dir = Path(out_dir) / "cache" if out_dir is not None else None
+    n_workers = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
+    if executor == "dask" and hasattr(scheduler, "scheduler_info"):
+        n_workers = max(1, len(scheduler.scheduler_info().get("workers", {})))
+    if batch_size and cases:
+        # no larger than needed to give every worker a batch: a kill loses at most the batches under way
+        batch_size = max(1, min(batch_size, math.ceil(len(cases) / n_workers)))
+    # batches are formed from the whole sweep, so a case always shares its batch with the same cases; the
+    # batch is part of what a cached row is valid for, and a batch is run (and cached) whole or not at all
+    all_units = _batches(cases, batch_size, metric)
+    batch_of = {}
+    for unit in all_units:
+        for case in _members(unit):
+            batch_of[case.key] = unit.key if isinstance(unit, _Batch) else None
     rows = {}
-    todo = []
-    for case in cases:
-        cached = _read_cache(cache_dir / f"{case.key}.json") if cache_dir is not None else None
-        if cached is not None and cached.get("key") == case.key:
-            rows[case.key] = cached["row"]
+    units = []
+    for unit in all_units:
+        got = {}
+        if cache_dir is not None:
+            got = {c.key: _read_cache(cache_dir / f"{c.key}.json", c.key, batch_of[c.key]) for c in _members(unit)}
+        if got and all(row is not None for row in got.values()):
+            rows.update(got)
         else:
-            todo.append(case)
+            units.append(unit)
+    todo = [case for unit in units for case in _members(unit)]
     n_cached = len(cases) - len(todo)
-    failed = 0
+    failed = computed = 0
     bar = _Progress(len(cases), progress, "sweep")
     bar.update(n_cached)
 
@@ -510,40 +649,59 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
             done_case(unit, result, error)
 
     def done_case(case, row, error):
-        nonlocal failed
+        nonlocal failed, computed
+        if row is not None:
+            computed += 1
         if row is None:
             failed += 1
             row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
+            rows[case.key] = row
         elif cache_dir is not None:
-            write_json(cache_dir / f"{case.key}.json", dict(key=case.key, point=case.point, row=row))
+            rows[case.key] = row  # kept even if Ctrl-C lands while the cache file is written
+            write_json(cache_dir / f"{case.key}.json",
+                       dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row))
         rows[case.key] = row
         bar.update()
 
     retried = 0
-    units = _batches(todo, batch_size, metric)
+    interrupted = False
     try:
         if units:
             if executor == "serial":
                 _run_serial(units, metric, retries, done)
             elif executor == "processes":
-                retried = _run_processes(units, metric, retries, done, workers or os.cpu_count() or 1)
+                retried = _run_processes(units, metric, retries, done, n_workers)
             else:
                 retried = _run_dask(units, metric, retries, done, scheduler)
+    except KeyboardInterrupt:
+        interrupted = True
     finally:
         bar.close()
 
+    for case in cases:
+        if interrupted and case.key not in rows:
+            rows[case.key] = dict(status="not run (interrupted)")
     table = _table(cases, rows, columns)
     paths = {}
     if out_dir is not None:
-        out = Path(out_dir)
-        paths["results_csv"] = write_atomic(out / "results.csv", lambda tmp: table.to_csv(tmp, index=False))
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
-            pass
-        else:
-            paths["results_parquet"] = write_atomic(out / "results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
-    return SweepResult(table=table, computed=len(todo) - failed, cached=n_cached, failed=failed, retried=retried,
+        from drakecreep.files import OutputSet
+
+        with OutputSet(out_dir, "manifest.json") as out:
+            paths["results_csv"] = out.write("results.csv", lambda tmp: table.to_csv(tmp, index=False))
+            try:
+                import pyarrow  # noqa: F401
+            except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
+                pass
+            else:
+                paths["results_parquet"] = out.write("results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
+            if not interrupted:
+                for name, write in (extra_outputs or {}).items():
+                    paths[Path(name).stem] = out.write(name, lambda tmp, w=write: w(table, tmp))
+            paths["manifest"] = out.commit(dict(cases=len(cases), interrupted=interrupted,
+                                                computed=computed, cached=n_cached, failed=failed))
+    if interrupted:
+        raise KeyboardInterrupt
+    return SweepResult(table=table, computed=computed, cached=n_cached, failed=failed, retried=retried,
                        paths=paths, wall_time=time.perf_counter() - start)
 
 
@@ -588,14 +746,18 @@ class SweepSpec:
     source: str = ""
 
 
-def _range(path, spec):
+def _range(path, spec, max_cases=MAX_CASES):
+    if not isinstance(path, str):
+        raise InputError("axes", path, "a parameter path (text such as nut.axial_stiffness) or a scenario field")
     keys = set(spec)
     if keys <= {"start", "stop", "num", "scale"} and {"start", "stop", "num"} <= keys:
         start, stop, num, scale = spec["start"], spec["stop"], spec["num"], spec.get("scale", "linear")
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             raise InputError(f"axes.{path}.num", num, "an integer >= 1")
-        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop)):
-            raise InputError(f"axes.{path}", spec, "numbers start and stop")
+        _check_size(num, max_cases, f"axes.{path}")
+        if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and abs(v) < 1e300 and math.isfinite(v)
+                   for v in (start, stop)):
+            raise InputError(f"axes.{path}", spec, "finite numbers start and stop")
         if scale == "log":
             if start <= 0 or stop <= 0:
                 raise InputError(f"axes.{path}", spec, "start, stop > 0 for a log scale")
@@ -606,7 +768,7 @@ def _range(path, spec):
     raise InputError(f"axes.{path}", spec, "a list of values or {start, stop, num[, scale: linear|log]}")
 
 
-def load_spec(path):
+def load_spec(path, max_cases=MAX_CASES):
     """Read a sweep spec (YAML).
 
     ::
@@ -620,15 +782,18 @@ def load_spec(path):
         metrics: [fluctuation_rate_percent, creep]      # columns to keep (default: all)
         plot: {x: nut.axial_stiffness, y: feed, color: fluctuation_rate_percent}   # optional stability map
 
+    ``max_cases`` caps the number of cases (:data:`MAX_CASES` by default).
+
     Raises
     ------
     InputError
         Naming the key of the first problem.
     """
-    from drakecreep.params import load_params, load_yaml, preset
+    from drakecreep.files import resolve_reference
+    from drakecreep.params import load_params, load_yaml_file, preset
 
     path = Path(path)
-    data = load_yaml(path, "a YAML sweep spec")
+    data = load_yaml_file(path, str(path), "a YAML sweep spec (a mapping with axes)")
     if not isinstance(data, dict):
         raise InputError(str(path), data, "a mapping with base, scenario, axes, sample, metrics, plot")
     known = {"base", "scenario", "axes", "sample", "metrics", "plot"}
@@ -640,14 +805,15 @@ def load_spec(path):
             or ("preset" in base_spec and "file" in base_spec):
         raise InputError("base", base_spec, "{preset: NAME} or {file: PATH}, optionally with set: {path: value}")
     if "file" in base_spec:
-        file = Path(base_spec["file"])
-        base = load_params(file if file.is_absolute() else path.parent / file)
+        base = load_params(resolve_reference(base_spec["file"], path, "base.file"))
     else:
         base = preset(base_spec.get("preset", "paper"))
     overrides = base_spec.get("set") or {}
     if not isinstance(overrides, dict):
         raise InputError("base.set", overrides, "a mapping path -> value")
     for key, value in overrides.items():
+        if not isinstance(key, str):
+            raise InputError("base.set", key, "parameter paths (text such as table.mass)")
         base = with_value(base, key, value)
     scenario = data.get("scenario") or {}
     if not isinstance(scenario, dict):
@@ -660,10 +826,10 @@ def load_spec(path):
             or set(sample) - {"mode", "n", "seed"}:
         raise InputError("sample", sample, "{mode: grid} or {mode: random, n: N, seed: S}")
     if sample.get("mode", "grid") == "grid":
-        expanded = {p: (_range(p, v) if isinstance(v, dict) else v) for p, v in axes.items()}
-        points = grid(expanded)
+        expanded = {p: (_range(p, v, max_cases) if isinstance(v, dict) else v) for p, v in axes.items()}
+        points = grid(expanded, max_cases)
     else:
-        points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0))
+        points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0), max_cases=max_cases)
     metrics = data.get("metrics")
     known_metrics = metric_columns()
     if metrics is not None:
@@ -675,6 +841,13 @@ def load_spec(path):
     plot = data.get("plot") or {}
     if not isinstance(plot, dict) or set(plot) - {"x", "y", "color"} or (plot and "x" not in plot):
         raise InputError("plot", plot, "{x: PATH[, y: PATH, color: METRIC]}")
+    # the map is drawn after the whole sweep: its axes are checked now, not after hours of computing
+    swept = list(axes) + [f for f in SCENARIO_FIELDS if f not in axes]
+    for key in ("x", "y"):
+        if key in plot and plot[key] not in swept:
+            raise InputError(f"plot.{key}", plot[key], "a swept path or scenario field: " + ", ".join(map(str, swept)))
+    if "color" in plot and plot["color"] not in known_metrics:
+        raise InputError("plot.color", plot["color"], "one of " + ", ".join(known_metrics))
     make_cases(base, points, scenario)  # validates every path and value before anything runs
     return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))
 

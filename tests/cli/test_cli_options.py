@@ -30,12 +30,16 @@ def test_heartbeat_appears_on_stderr_for_a_long_job_and_not_with_quiet(monkeypat
         return 0
 
     monkeypatch.setattr(cli, "HEARTBEAT", ("hertz",))
+    monkeypatch.setenv("DRAKECREEP_PROGRESS", "1")  # stderr is not a terminal under pytest: force it
     monkeypatch.setattr(hertz, "run", slow)
     assert cli.main(["hertz"]) == 0
     err = capsys.readouterr().err
     assert "drakecreep hertz: 00:0" in err and "elapsed" in err
     assert cli.main(["-q", "hertz"]) == 0
     assert "elapsed" not in capsys.readouterr().err
+    monkeypatch.delenv("DRAKECREEP_PROGRESS")
+    assert cli.main(["hertz"]) == 0
+    assert "elapsed" not in capsys.readouterr().err  # not a terminal: one line per message in logs
 
 
 def test_tune_write_gives_a_file_simulate_accepts(tmp_path, capsys):

@@ -67,6 +67,9 @@ def test_a_failing_run_keeps_what_was_computed(short_paper, monkeypatch):
             def get_integrator(self):
                 return simulator.get_integrator()
 
+            def set_monitor(self, monitor):
+                simulator.set_monitor(monitor)
+
         return Breaks()
 
     monkeypatch.setattr(simulation, "make_simulator", failing)

@@ -1,0 +1,60 @@
+"""One look for every HTML report: the page skeleton, the style, tables and embedded figures.
+
+Reports are self-contained files (figures embedded as base64 PNG), so they can be mailed or archived alone.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+from pathlib import Path
+
+__all__ = ["CSS", "page", "table", "figure", "png_data", "escape"]
+
+CSS = """
+body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222;line-height:1.45}
+h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.8em}
+table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right}
+th{background:#f3f3f3}td:first-child,th:first-child{text-align:left}img{max-width:100%;border:1px solid #eee}
+figure{margin:1em 0}figcaption{font-size:.9em;color:#555}
+.note{background:#f7f7ee;border-left:4px solid #cc9;padding:.5em 1em}pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
+.bad{color:#b00;font-weight:bold}.good{color:#070}
+"""
+
+escape = html.escape
+
+
+def page(title, body):
+    """A complete HTML document: ``title`` (plain text) and ``body`` (HTML parts, a string or a list)."""
+    if not isinstance(body, str):
+        body = "\n".join(body)
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{escape(title)}</title>"
+            f"<style>{CSS}</style></head><body>\n{body}\n</body></html>\n")
+
+
+def table(header, rows, *, raw=False):
+    """An HTML table; cells are escaped unless ``raw`` (cells already HTML). ``""`` when there are no rows,
+    so a report never shows an empty table."""
+    rows = list(rows)
+    if not rows:
+        return ""
+    cell = (lambda c: str(c)) if raw else (lambda c: escape(str(c)))
+    out = ["<table><tr>" + "".join(f"<th>{escape(str(h))}</th>" for h in header) + "</tr>"]
+    for row in rows:
+        out.append("<tr>" + "".join(f"<td>{cell(c)}</td>" for c in row) + "</tr>")
+    return "\n".join(out) + "</table>"
+
+
+def png_data(source):
+    """Base64 text of a PNG: ``source`` is a path or the PNG's bytes."""
+    data = source if isinstance(source, (bytes, bytearray)) else Path(source).read_bytes()
+    return base64.b64encode(bytes(data)).decode("ascii")
+
+
+def figure(source, caption="", alt=None):
+    """An embedded PNG (path or bytes) with an optional caption."""
+    alt = alt if alt is not None else (Path(source).stem if not isinstance(source, (bytes, bytearray)) else caption)
+    img = f'<img alt="{escape(str(alt))}" src="data:image/png;base64,{png_data(source)}">'
+    if not caption:
+        return img
+    return f"<figure>{img}<figcaption>{escape(caption)}</figcaption></figure>"

@@ -1,0 +1,364 @@
+"""Hostile input to the command line: every bad input is one line on stderr and exit code 2, before any work.
+
+One test per class of bad input (parameter files, sweep specs, measured CSV + metadata, ``.mat`` files, output
+folders, options), each parametrized over many malformed files. None of these may start a simulation: they
+all fail while the input is checked, so the whole module takes a few seconds.
+"""
+
+import time
+
+import pytest
+
+from drakecreep.cli import main
+
+PASSWD_LIKE = "root:x:0:0:root:/root:/bin/bash\nsecret_token: s3cr3t-VALUE-never-echo\n"
+
+
+def _bomb(levels=14):
+    lines = ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
+    for i in range(1, levels):
+        lines.append(f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * 9) + "]")
+    return "\n".join(lines) + "\n"
+
+
+def _bomb_in_value():
+    # the bomb sits where a value goes: the error message must not repr() it whole
+    lines = ["x0: &x0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]"]
+    for i in range(1, 8):
+        lines.append(f"x{i}: &x{i} [" + ", ".join([f"*x{i - 1}"] * 10) + "]")
+    return "\n".join(lines) + "\n"
+
+
+def _run(argv, capsys, timeout=30.0):
+    start = time.perf_counter()
+    try:
+        code = main(argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    captured = capsys.readouterr()
+    assert time.perf_counter() - start < timeout
+    return code, captured.out, captured.err
+
+
+def _one_line_exit_2(code, err, *fragments):
+    lines = err.strip().splitlines()
+    assert code == 2, err
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    assert len(lines[0]) < 1500
+    for f in fragments:
+        assert f in lines[0], (f, lines[0])
+
+
+# --------------------------------------------------------------------------- parameter files
+
+PARAM_TEXTS = {
+    "empty": ("", "empty"),
+    "comment_only": ("# nothing here\n\n   # still nothing\n", "empty"),
+    "duplicate_key": ("table:\n  mass: 40\n  mass: 0.001\n", "duplicate key"),
+    "duplicate_group": ("table: {mass: 40}\ntable: {mass: 3}\n", "duplicate key"),
+    "absurd_mass": ("table: {mass: 1.0e300}\n", "table.mass"),
+    "huge_integer": ("table: {mass: " + "9" * 400 + "}\n", "table.mass"),
+    "huge_integer_int_field": ("sensors: {encoder_counts_per_rev: " + "7" * 400 + "}\n", "encoder_counts_per_rev"),
+    "huge_integer_force": ("loads: {cases: [{fx: " + "1" * 400 + "}]}\n", "loads.cases[0].fx"),
+    "absurd_unbounded": ("nut: {axial_stiffness: 1.0e200}\n", "nut.axial_stiffness"),
+    "nan": ("table: {mass: .nan}\n", "table.mass"),
+    "inf": ("friction: {viscous: .inf}\n", "friction.viscous"),
+    "string_number": ("table: {mass: heavy}\n", "table.mass"),
+    "list_top": ("- 1\n- 2\n", "a mapping"),
+    "scalar_top": ("42\n", "a mapping"),
+    "text_file": (PASSWD_LIKE, "YAML"),
+    "unknown_group": ("tabel: {mass: 3}\n", "tabel"),
+    "integer_key": ("1: {mass: 3}\n", "no such field"),
+    "alias_bomb": (_bomb(), "aliases"),
+    "bomb_in_value": ("table:\n  mass: &m [1, 2, 3]\n" + _bomb_in_value().replace("x0:", "junk:"), "table.mass"),
+    "bad_syntax": ("table: {mass: [1, 2}\n", "invalid YAML"),
+    "tab_indent": ("table:\n\tmass: 3\n", "invalid YAML"),
+    "deep_nesting": ("a: " + "[" * 5000 + "]" * 5000 + "\n", "nested"),
+    "log_period_tiny": ("simulation: {log_period: 1.0e-8}\n", "simulation.log_period"),
+    "seed_like_bool": ("controller: {anti_windup: 3}\n", "anti_windup"),
+    "binary_nul": ("table:\x00\x01\x02 {mass: 3}\n", "UTF-8"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PARAM_TEXTS))
+def test_bad_parameter_files(name, tmp_path, capsys):
+    text, fragment = PARAM_TEXTS[name]
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    argv = ["simulate", "--params", str(path), "--duration", "20", "--out", str(tmp_path / "out")]
+    if name == "log_period_tiny":
+        argv += ["--load-case", "0"]
+    code, _, err = _run(argv, capsys)
+    _one_line_exit_2(code, err, fragment)
+    assert "s3cr3t" not in err and "root:x" not in err
+    assert not (tmp_path / "out" / "metrics.json").exists()
+
+
+@pytest.mark.parametrize("payload", [
+    "table: {mass: 3}\n".encode("utf-16"),
+    "table: {mass: 3}\n".encode("utf-32"),
+    bytes(range(256)) * 4,
+    b"\x89PNG\r\n\x1a\n" + b"\x00" * 64,
+    b"table: {mass: \xff\xfe}\n",
+])
+def test_binary_and_utf16_parameter_files(payload, tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_bytes(payload)
+    code, _, err = _run(["params", "--check", str(path)], capsys)
+    _one_line_exit_2(code, err, "UTF-8")
+
+
+@pytest.mark.parametrize("target", ["/dev/zero", "/dev/null", "directory", "fifo"])
+def test_non_regular_files_are_refused_without_reading(target, tmp_path, capsys):
+    import os
+
+    if target == "directory":
+        target = str(tmp_path)
+    elif target == "fifo":
+        target = str(tmp_path / "fifo")
+        os.mkfifo(target)
+    code, _, err = _run(["params", "--check", target], capsys, timeout=10)
+    _one_line_exit_2(code, err, "a regular file")
+
+
+# --------------------------------------------------------------------------- sweep specs
+
+SPECS = {
+    "letter_index": ("axes:\n  loads.cases[x].fx: [1, 2]\n", "loads.cases[x].fx"),
+    "index_too_large": ("axes:\n  loads.cases[99].fx: [1, 2]\n", "loads.cases[99].fx"),
+    "negative_index": ("axes:\n  loads.cases[-1].fx: [1, 2]\n", "loads.cases[-1].fx"),
+    "index_on_scalar": ("axes:\n  table[0].mass: [1, 2]\n", "table[0].mass"),
+    "integer_axis_key": ("axes:\n  3: [1, 2]\n", "axes"),
+    "float_axis_key": ("axes:\n  1.5: {start: 1, stop: 2, num: 2}\n", "axes"),
+    "integer_axis_key_random": ("axes:\n  7: {low: 1, high: 2}\nsample: {mode: random, n: 2}\n", "axes"),
+    "seed_text": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: abc}\n", "seed"),
+    "seed_negative": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: -1}\n", "seed"),
+    "seed_huge": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: " + "9" * 400 + "}\n",
+                  "seed"),
+    "n_huge": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 1000000000}\n", "--max-cases"),
+    "grid_huge": ("axes:\n  table.mass: {start: 30, stop: 40, num: 100000}\n  feed: {start: 1.0e-4, stop: 1.0e-3, "
+                  "num: 100000}\n", "--max-cases"),
+    "num_huge": ("axes:\n  table.mass: {start: 30, stop: 40, num: " + "9" * 400 + "}\n", "--max-cases"),
+    "range_huge_int": ("axes:\n  table.mass: {start: " + "9" * 400 + ", stop: 40, num: 3}\n", "axes.table.mass"),
+    "value_huge_int": ("axes:\n  table.mass: [" + "9" * 400 + "]\n", "table.mass"),
+    "absurd_value": ("axes:\n  table.mass: [1.0e300]\n", "table.mass"),
+    "bad_plot_x": ("axes:\n  table.mass: [30, 40]\nplot: {x: nut.mass}\n", "plot.x"),
+    "bad_plot_y": ("axes:\n  table.mass: [30, 40]\nplot: {x: table.mass, y: nope}\n", "plot.y"),
+    "bad_plot_color": ("axes:\n  table.mass: [30, 40]\nplot: {x: table.mass, color: nope}\n", "plot.color"),
+    "duplicate_axis": ("axes:\n  table.mass: [30]\n  table.mass: [40]\n", "duplicate key"),
+    "empty": ("", "empty"),
+    "base_dev_zero": ("base: {file: /dev/zero}\naxes:\n  table.mass: [30, 40]\n", "base.file"),
+    "base_missing": ("base: {file: nothere.yaml}\naxes:\n  table.mass: [30, 40]\n", "base.file"),
+    "base_text_file": ("base: {file: secret.txt}\naxes:\n  table.mass: [30, 40]\n", "YAML"),
+    "base_set_int_key": ("base: {set: {3: 4}}\naxes:\n  table.mass: [30, 40]\n", "base.set"),
+    "bomb": (_bomb(), "aliases"),
+    "bomb_as_axis": ("axes:\n  table.mass: &m [30, 40]\n" + _bomb_in_value().replace("x0:", "junk:"), "junk"),
+    "scenario_bad": ("scenario: {feed: fast}\naxes:\n  table.mass: [30]\n", "feed"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SPECS))
+def test_bad_sweep_specs(name, tmp_path, capsys):
+    text, fragment = SPECS[name]
+    (tmp_path / "secret.txt").write_text(PASSWD_LIKE)
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(text)
+    code, _, err = _run(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--no-progress"],
+                        capsys)
+    _one_line_exit_2(code, err, fragment)
+    assert "s3cr3t" not in err and "root:x" not in err
+    assert not (tmp_path / "out" / "results.csv").exists()
+
+
+def test_references_resolve_relative_to_the_referring_file(tmp_path, capsys, monkeypatch):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "rig.yaml").write_text("table: {mass: 1.0e9}\n")
+    spec = tmp_path / "sub" / "spec.yaml"
+    spec.write_text("base: {file: rig.yaml}\naxes:\n  table.mass: [30, 40]\n")
+    monkeypatch.chdir(tmp_path)  # the reference is found beside the spec, not in the working folder
+    code, _, err = _run(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1"], capsys)
+    _one_line_exit_2(code, err, "table.mass")
+
+
+def test_sweep_cap_can_be_raised(tmp_path):
+    from drakecreep.errors import InputError
+    from drakecreep.sim.sweep import grid
+
+    axes = {"table.mass": list(range(1, 31)), "feed": [1e-3] * 10}
+    with pytest.raises(InputError, match="max-cases"):
+        grid(axes, max_cases=100)
+    assert len(grid(axes, max_cases=300)) == 300
+
+
+# --------------------------------------------------------------------------- measured files
+
+GOOD_META = "u_units: N\nu_gain: 1.0\n"
+GOOD_CSV = "t,x_ref,x_motor,u\n" + "".join(f"{i * 0.001},{i * 1e-6},{i * 1e-6},0.5\n" for i in range(50))
+
+MEASURED = {
+    "csv_utf16": (None, GOOD_META, "UTF-8"),
+    "csv_binary": (b"\x00\x01\x02\xff" * 100, GOOD_META, "UTF-8"),
+    "csv_nul": (b"t,x_ref,x_motor,u\n0,0,0,\x000\n", GOOD_META, "column u"),
+    "csv_empty": (b"", GOOD_META, "run.csv"),
+    "csv_text_cell": (GOOD_CSV.replace("0.5\n", "half\n", 1).encode(), GOOD_META, "column u"),
+    "csv_short_row": ((GOOD_CSV + "1,2\n").encode(), GOOD_META, "row 51"),
+    "csv_huge_number": ((GOOD_CSV + "0.06," + "9" * 400 + ",0,0\n").encode(), GOOD_META, ""),
+    "meta_empty": (GOOD_CSV.encode(), "", "empty"),
+    "meta_duplicate": (GOOD_CSV.encode(), "u_units: N\nu_units: A\n", "duplicate key"),
+    "meta_utf16": (GOOD_CSV.encode(), None, "UTF-8"),
+    "meta_params_dev_zero": (GOOD_CSV.encode(), GOOD_META + "params: /dev/zero\n", "params"),
+    "meta_params_missing": (GOOD_CSV.encode(), GOOD_META + "params: ../nothere/rig.yaml\n", "params"),
+    "meta_params_text": (GOOD_CSV.encode(), GOOD_META + "params: secret.txt\n", "YAML"),
+    "meta_bomb": (GOOD_CSV.encode(), _bomb(), "aliases"),
+    "meta_bomb_value": (GOOD_CSV.encode(), "u_units: N\nnotes: &n [1]\n" + _bomb_in_value().replace("x0:", "zz:"),
+                        "zz"),
+    "meta_list": (GOOD_CSV.encode(), "- 1\n", "u_units"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MEASURED))
+def test_bad_measured_files(name, tmp_path, capsys):
+    csv_bytes, meta_text, fragment = MEASURED[name]
+    (tmp_path / "secret.txt").write_text(PASSWD_LIKE)
+    csv_path = tmp_path / "run.csv"
+    csv_path.write_bytes(csv_bytes if csv_bytes is not None else GOOD_CSV.encode("utf-16"))
+    meta = tmp_path / "run.yaml"
+    if meta_text is None:
+        meta.write_bytes(GOOD_META.encode("utf-16"))
+    else:
+        meta.write_text(meta_text)
+    code, _, err = _run(["diagnose", str(csv_path)], capsys)
+    _one_line_exit_2(code, err, fragment)
+    assert "s3cr3t" not in err and "root:x" not in err
+
+
+def _mat_bytes():
+    from drakecreep.gap.measured import emps_path
+
+    return emps_path("estimation").read_bytes()
+
+
+@pytest.mark.parametrize("mangle", ["empty", "text", "header_only", "truncated_1k", "truncated_half", "flipped",
+                                    "zeros"])
+def test_bad_mat_files(mangle, tmp_path, capsys):
+    data = _mat_bytes()
+    payload = {
+        "empty": b"",
+        "text": b"this is not a mat file\n" * 10,
+        "header_only": data[:128],
+        "truncated_1k": data[:1024],
+        "truncated_half": data[: len(data) // 2],
+        "flipped": data[:200] + bytes(b ^ 0x5A for b in data[200:4000]) + data[4000:],
+        "zeros": data[:128] + b"\x00" * 4096,
+    }[mangle]
+    path = tmp_path / "bad.mat"
+    path.write_bytes(payload)
+    code, _, err = _run(["diagnose", str(path)], capsys)
+    _one_line_exit_2(code, err, str(path))
+
+
+# --------------------------------------------------------------------------- output folders and options
+
+@pytest.mark.parametrize("argv", [
+    ["simulate", "--out", "{file}"],
+    ["simulate", "--out", "{file}/sub"],
+    ["report", "--out", "{file}"],
+    ["diagnose", "estimation", "--out", "{file}"],
+    ["sweep", "{spec}", "--out", "{file}", "--workers", "1"],
+])
+def test_output_folder_is_checked_before_the_work(argv, tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("keep me\n")
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("axes:\n  table.mass: [30, 40]\n")
+    argv = [a.format(file=afile, spec=spec) for a in argv]
+    code, _, err = _run(argv, capsys, timeout=20)
+    _one_line_exit_2(code, err, "--out")
+    assert afile.read_text() == "keep me\n"
+
+
+def test_missing_score_file_is_found_before_the_diagnosis(tmp_path, capsys):
+    code, _, err = _run(["diagnose", "estimation", "--score", str(tmp_path / "nothere.mat")], capsys, timeout=20)
+    _one_line_exit_2(code, err, "nothere.mat")
+
+
+@pytest.mark.parametrize("address", ["garbage", "tcp://127.0.0.1:1", "tcp://[::1", ""])
+def test_bad_or_unreachable_scheduler(address, tmp_path, capsys, monkeypatch):
+    import drakecreep.sim.sweep as sweep
+
+    monkeypatch.setattr(sweep, "DASK_TIMEOUT", 1.0)
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("axes:\n  table.mass: [30, 40]\n")
+    code, _, err = _run(["sweep", str(spec), "--out", str(tmp_path / "o"), "--scheduler", address, "--no-progress"],
+                        capsys, timeout=25)
+    _one_line_exit_2(code, err, "--scheduler")
+
+
+def test_scheduler_without_workers_times_out_with_a_message():
+    from distributed import LocalCluster
+
+    from drakecreep.errors import InputError
+    from drakecreep.sim.sweep import connect_dask
+
+    with LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        start = time.perf_counter()
+        with pytest.raises(InputError, match="worker"):
+            connect_dask(cluster.scheduler_address, timeout=1.0)
+        assert time.perf_counter() - start < 10
+
+
+# --------------------------------------------------------------------------- the top-level guard
+
+def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
+    import drakecreep.cli.params as cmd
+
+    def boom(args):
+        raise ZeroDivisionError("a bug")
+
+    monkeypatch.setattr(cmd, "run", boom)
+    code, _, err = _run(["params"], capsys)
+    assert code == 1 and len(err.strip().splitlines()) == 1
+    assert "ZeroDivisionError: a bug" in err and "--debug" in err
+    code, _, err = _run(["--debug", "params"], capsys)
+    assert code == 1 and "Traceback" in err and "ZeroDivisionError: a bug" in err.strip().splitlines()[-1]
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["hertz", "--balls", "9" * 400], "--balls"),
+    (["hertz", "--balls", "0"], "--balls"),
+    (["hertz", "--youngs-modulus", "1e308"], "--youngs-modulus"),
+    (["hertz", "--preload", "inf"], "--preload"),
+    (["hertz", "--lead", "-1"], "--lead"),
+    (["gap-benchmark", "--samples", "10"], "--samples"),
+    (["gap-benchmark", "--n-per-effect", "0", "--n-null", "0", "--n-ool", "0"], "--n-per-effect"),
+    (["margins", "--feed", "1e-300"], "--feed"),
+    (["report", "--out", "{tmp}/r", "--low-feed", "1e-300"], "--low-feed"),
+    (["simulate", "--out", "{tmp}/s", "--feed", "1e-300"], "--feed"),
+    (["modal", "{tmp}/u16.csv"], "UTF-8"),
+    (["modal", "/dev/zero"], "regular file"),
+    (["sweep", "{tmp}/spec.yaml", "--max-cases", "0"], "--max-cases"),
+])
+def test_bad_options(argv, fragment, tmp_path, capsys):
+    (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
+    (tmp_path / "spec.yaml").write_text("axes:\n  table.mass: [30, 40]\n")
+    code, _, err = _run([a.format(tmp=tmp_path) for a in argv], capsys)
+    _one_line_exit_2(code, err, fragment)
+
+
+def test_full_disk_is_one_line_exit_1(monkeypatch, capsys):
+    import errno
+
+    import drakecreep.cli.params as cmd
+
+    def full(args):
+        raise OSError(errno.ENOSPC, "No space left on device", "/out/results.csv")
+
+    monkeypatch.setattr(cmd, "run", full)
+    code, _, err = _run(["params"], capsys)
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "No space left on device" in err
+
+
+def test_too_long_a_path_is_bad_input(capsys):
+    code, _, err = _run(["emps", "--data", "9" * 400], capsys)
+    _one_line_exit_2(code, err, "File name too long")

@@ -1,0 +1,18 @@
+"""Plot helpers of report/plots.py: labels with units."""
+
+from drakecreep.params import preset
+from drakecreep.report.plots import axis_label, column_label
+
+
+def test_axis_labels_carry_the_parameters_si_unit():
+    p = preset("paper")
+    assert axis_label(p, "nut.axial_stiffness") == "nut.axial_stiffness (N/m)"
+    assert axis_label(p, "loads.cases[2].fx") == "loads.cases[2].fx (N)"
+    assert axis_label(p, "friction.static_ratio") == "friction.static_ratio"  # dimensionless
+    assert axis_label(p, "feed") == "feed (m/s)"
+
+
+def test_metric_columns_become_labels_with_units():
+    assert column_label("fluctuation_rate_percent") == "fluctuation rate (%)"
+    assert column_label("max_fluctuation_mm_s") == "max fluctuation (mm/s)"
+    assert column_label("stick_fraction") == "stick fraction"

@@ -1,0 +1,89 @@
+"""Runs that would never end: the divergence guard, the wall-clock limit and Ctrl-C keep what was computed."""
+
+import json
+import os
+import signal
+import time
+
+import pytest
+
+import drakecreep.sim.simulation as simulation
+from drakecreep.cli import main
+from drakecreep.params import with_value
+from drakecreep.scenario import Scenario
+from drakecreep.sim.simulation import MAX_TABLE_SPEED, simulate
+
+
+@pytest.fixture(scope="module")
+def diverging(paper):
+    """A velocity loop 4000x too stiff with the torque limit raised 10^4x: the discrete loop is unstable."""
+    p = with_value(paper, "controller.velocity_gain", 5e8)
+    p = with_value(p, "controller.velocity_integral_gain", 5e10)
+    p = with_value(p, "motor.peak_torque", 1e5)
+    return with_value(p, "simulation.steady_start", 0.3)
+
+
+def test_divergence_stops_the_run_quickly_with_partial_results(diverging):
+    start = time.perf_counter()
+    r = simulate(diverging, Scenario(feed=1e-3, load_case=1, duration=1.0))
+    assert time.perf_counter() - start < 30
+    assert not r.ok and r.status.startswith("diverged at t = ") and "\n" not in r.status
+    assert 0 < r.time[-1] < 0.1 and len(r.time) > 2  # kept up to the stop
+    assert r.metrics is None  # no creep metrics of a run that left the physics
+
+
+def test_the_guard_does_not_touch_a_healthy_run(short_paper):
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6))
+    assert r.ok
+    assert abs(r.signals["table_speed"]).max() < MAX_TABLE_SPEED / 100
+
+
+def test_cli_diverging_run_one_line_exit_1_results_saved(diverging, tmp_path, capsys, monkeypatch):
+    from drakecreep.params import save_params
+
+    path = tmp_path / "div.yaml"
+    save_params(diverging, path)
+    code = main(["simulate", "--params", str(path), "--load-case", "1", "--duration", "1", "--no-plot",
+                 "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 1 and len(err.strip().splitlines()) == 1 and "diverged" in err
+    body = json.loads((tmp_path / "out" / "metrics.json").read_text())
+    assert body["summary"]["status"].startswith("diverged") and "timeseries.csv" in body["files"]
+
+
+def test_wall_clock_limit(short_paper):
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=60.0), wall_limit=0.3)
+    assert r.status.startswith("stopped at t = ") and "wall-clock" in r.status
+    assert r.time[-1] < 60.0
+
+
+def test_ctrl_c_keeps_what_was_computed(short_paper, tmp_path, capsys, monkeypatch):
+    # a real SIGINT, sent from inside the run once it is under way (as a user's Ctrl-C would arrive)
+    real = simulation._guard
+
+    def guard(simulator, root, read_speeds, bounds, wall_limit):
+        report = real(simulator, root, read_speeds, bounds, wall_limit)
+        inner = simulator.get_monitor() if hasattr(simulator, "get_monitor") else None
+        sent = []
+
+        def monitor(context):
+            if context.get_time() > 0.4 and not sent:
+                sent.append(1)
+                os.kill(os.getpid(), signal.SIGINT)
+            return inner(context) if inner else None
+
+        if inner is not None:
+            simulator.set_monitor(monitor)
+        return report
+
+    monkeypatch.setattr(simulation, "_guard", guard)
+    from drakecreep.params import save_params
+
+    path = tmp_path / "p.yaml"
+    save_params(short_paper, path)
+    code = main(["simulate", "--params", str(path), "--duration", "30", "--no-plot", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 130 and "interrupted" in err
+    body = json.loads((tmp_path / "o" / "metrics.json").read_text())
+    assert body["summary"]["status"].startswith("interrupted")
+    assert 0.4 < body["summary"]["sim_time_s"] < 30

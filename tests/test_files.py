@@ -1,0 +1,147 @@
+"""The atomic writer and output sets under faults: a SIGKILL during a write, a failing writer, a full disk."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.files import (OutputSet, check_output_dir, read_input_text, read_manifest, resolve_reference,
+                              write_atomic, write_text)
+
+_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _child(code):
+    """A Python child running ``code`` from the worktree root; it prints READY when it is mid-write."""
+    return subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], cwd=_ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def _kill_when_ready(proc):
+    line = proc.stdout.readline()
+    if line.strip() != "READY":
+        proc.kill()
+        _, err = proc.communicate(timeout=10)
+        raise AssertionError(err)
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate(timeout=10)  # reaps the child and closes its pipes
+    assert proc.returncode == -signal.SIGKILL
+
+
+def test_sigkill_during_a_write_leaves_the_old_file_whole(tmp_path):
+    target = tmp_path / "timeseries.csv"
+    target.write_text("old,complete\n1,2\n")
+    proc = _child(f"""
+        import sys, time
+        from drakecreep.files import write_atomic
+        def write(tmp):
+            with open(tmp, "w") as fh:
+                fh.write("new,partial\\n" * 1000)
+                fh.flush()
+                print("READY", flush=True)
+                time.sleep(60)
+        write_atomic({str(target)!r}, write)
+    """)
+    _kill_when_ready(proc)
+    assert target.read_text() == "old,complete\n1,2\n"
+    # only a hidden temporary file may be left, never a partial target
+    assert {p.name for p in tmp_path.iterdir() if not p.name.startswith(".")} == {"timeseries.csv"}
+
+
+def test_sigkill_between_files_of_a_set_leaves_no_manifest(tmp_path):
+    with OutputSet(tmp_path, "metrics.json") as out:
+        out.write_text("timeseries.csv", "run 1\n")
+        out.commit({"status": "ok"})
+    assert read_manifest(tmp_path / "metrics.json") is not None
+    proc = _child(f"""
+        import time
+        from drakecreep.files import OutputSet
+        with OutputSet({str(tmp_path)!r}, "metrics.json") as out:
+            out.write_text("timeseries.csv", "run 2\\n")
+            print("READY", flush=True)
+            time.sleep(60)
+            out.commit({{"status": "ok"}})
+    """)
+    _kill_when_ready(proc)
+    # the new CSV is there, but no metrics.json claims it (or the old run) complete
+    assert (tmp_path / "timeseries.csv").read_text() == "run 2\n"
+    assert not (tmp_path / "metrics.json").exists()
+
+
+def test_manifest_names_the_files_of_its_run_and_detects_a_mix(tmp_path):
+    with OutputSet(tmp_path, "manifest.json") as out:
+        out.write_text("a.txt", "A")
+        out.write("b.bin", lambda tmp: Path(tmp).write_bytes(b"\x00\x01"))
+        out.commit({"status": "ok"})
+    body = read_manifest(tmp_path / "manifest.json")
+    assert set(body["files"]) == {"a.txt", "b.bin"} and body["status"] == "ok" and len(body["run_id"]) == 32
+    (tmp_path / "a.txt").write_text("from another run")
+    assert read_manifest(tmp_path / "manifest.json") is None
+    assert read_manifest(tmp_path / "manifest.json", verify=False) is not None
+
+
+def test_a_failing_writer_keeps_the_old_file_and_removes_its_temporary(tmp_path):
+    target = tmp_path / "results.csv"
+    target.write_text("old\n")
+
+    def full_disk(tmp):
+        with open(tmp, "w") as fh:
+            fh.write("half a ro")
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError, match="No space"):
+        write_atomic(target, full_disk)
+    assert target.read_text() == "old\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["results.csv"]
+
+
+def test_files_are_written_0644_less_the_umask(tmp_path):
+    old = os.umask(0o022)
+    try:
+        path = write_text(tmp_path / "x.json", "{}")
+    finally:
+        os.umask(old)
+    assert oct(path.stat().st_mode & 0o777) == oct(0o644)
+
+
+def test_temporary_keeps_the_suffix_for_format_by_extension(tmp_path):
+    seen = []
+    write_atomic(tmp_path / "plot.png", lambda tmp: (seen.append(tmp), Path(tmp).write_text("")))
+    assert seen[0].endswith(".png")
+
+
+def test_inputs_are_regular_bounded_utf8(tmp_path):
+    (tmp_path / "ok.yaml").write_text("a: 1\n")
+    assert read_input_text(tmp_path / "ok.yaml") == "a: 1\n"
+    (tmp_path / "big.yaml").write_text("a" * 2000)
+    with pytest.raises(InputError, match="at most 1000 bytes"):
+        read_input_text(tmp_path / "big.yaml", max_bytes=1000)
+    with pytest.raises(InputError, match="regular file"):
+        read_input_text("/dev/zero")
+    (tmp_path / "u16.yaml").write_bytes("a: 1\n".encode("utf-16"))
+    with pytest.raises(InputError, match="UTF-8"):
+        read_input_text(tmp_path / "u16.yaml")
+
+
+def test_references_are_relative_to_the_referring_file(tmp_path, monkeypatch):
+    (tmp_path / "d").mkdir()
+    (tmp_path / "d" / "rig.yaml").write_text("x: 1\n")
+    monkeypatch.chdir("/")
+    assert resolve_reference("rig.yaml", tmp_path / "d" / "meta.yaml", "params") == tmp_path / "d" / "rig.yaml"
+    for bad in ("nothere.yaml", "/dev/zero", "", 3, None):
+        with pytest.raises(InputError, match="params"):
+            resolve_reference(bad, tmp_path / "d" / "meta.yaml", "params")
+
+
+def test_output_dir_checks(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    for bad in (tmp_path / "afile", tmp_path / "afile" / "sub"):
+        with pytest.raises(InputError, match="--out"):
+            check_output_dir(bad)
+    assert check_output_dir(tmp_path / "new" / "dir").is_dir()
