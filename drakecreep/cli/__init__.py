@@ -17,12 +17,14 @@ import re
 import textwrap
 import os
 import sys
+import threading
+import time
 import traceback
 
 from drakecreep import __version__
 from drakecreep.errors import DrakecreepError
 
-__all__ = ["main", "build_parser", "COMMANDS"]
+__all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "plain"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = [
@@ -38,6 +40,11 @@ COMMANDS = [
     "reproduce_paper", "compensate",
     "diagnose", "gap_benchmark",
 ]
+
+
+#: Commands that can take more than ~2 s and report no progress of their own: an elapsed-time bar on stderr
+#: (on a terminal, or with DRAKECREEP_PROGRESS=1).
+HEARTBEAT = ("report", "compensate", "reproduce-paper", "margins", "tune", "critical", "modal", "emps", "simulate")
 
 
 def plain(text):
@@ -69,6 +76,41 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
+def _add_common(parser, suppress):
+    """``-q/--quiet`` and ``-v/--verbose``, before or after the command."""
+    default = argparse.SUPPRESS if suppress else None
+    parser.add_argument("-q", "--quiet", action="store_true", default=default or False,
+                        help="no progress on stderr (results and errors only)")
+    parser.add_argument("-v", "--verbose", action="count", default=default or 0,
+                        help="more detail on stderr: INFO logging; -vv DEBUG logging and tracebacks (as --debug)")
+
+
+def _heartbeat(command):
+    """Start an elapsed-time tqdm bar on stderr; returns a function that stops it."""
+    from tqdm import tqdm
+
+    stop = threading.Event()
+    bar = tqdm(desc=f"drakecreep {command}", bar_format="{desc}: {elapsed} elapsed", file=sys.stderr,
+               delay=2.0, mininterval=0.5)
+
+    start = time.monotonic()
+
+    def tick():
+        while not stop.wait(0.5):
+            if time.monotonic() - start >= 2.0:  # short jobs stay silent
+                bar.refresh()
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+
+    def done():
+        stop.set()
+        thread.join()
+        bar.close()
+
+    return done
+
+
 def build_parser():
     """Build the top-level parser with every registered subcommand."""
     parser = _Parser(
@@ -76,12 +118,13 @@ def build_parser():
         description="Ball-screw feed drive in Drake: simulate creep, analyse servo loops, diagnose sim-to-real gaps.",
     )
     parser.add_argument("--version", action="version", version=f"drakecreep {__version__}")
+    _add_common(parser, suppress=False)
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an unexpected error")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name in COMMANDS:
         module = importlib.import_module(f"drakecreep.cli.{name}")
-        module.add_parser(sub)
+        _add_common(module.add_parser(sub), suppress=True)
     return parser
 
 
@@ -90,7 +133,17 @@ def main(argv=None):
     os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
     args = parser.parse_args(argv)
-    debug = getattr(args, "debug", False)
+    if args.verbose:
+        import logging
+
+        logging.basicConfig(level=logging.DEBUG if args.verbose > 1 else logging.INFO, stream=sys.stderr)
+    saved = os.environ.get("TQDM_DISABLE")
+    if args.quiet:
+        os.environ["TQDM_DISABLE"] = "1"  # every tqdm bar of the library (tqdm >= 4.66), also in worker processes
+    # the elapsed-time bar only on a terminal (logs and pipes keep one line per message), or when forced
+    show = sys.stderr.isatty() or os.environ.get("DRAKECREEP_PROGRESS") == "1"
+    stop = _heartbeat(args.command) if args.command in HEARTBEAT and show and not args.quiet else None
+    debug = getattr(args, "debug", False) or args.verbose > 1
     prefix = f"drakecreep {args.command}"
     try:
         return int(args.func(args) or 0)
@@ -120,6 +173,14 @@ def main(argv=None):
         hint = "" if debug else " (run again with --debug for the traceback)"
         print(f"{prefix}: internal error: {type(err).__name__}: {what}{hint}", file=sys.stderr)
         return 1
+    finally:
+        if stop is not None:
+            stop()
+        if args.quiet:
+            if saved is None:
+                os.environ.pop("TQDM_DISABLE", None)
+            else:
+                os.environ["TQDM_DISABLE"] = saved
 
 
 #: errors of a path given by the user (exit 2); other OSErrors (a full disk, I/O errors) exit 1

@@ -55,8 +55,8 @@ def load_runs(data, meta=None):
     return runs
 
 
-def pick(runs, spec, default_parity):
-    """Runs selected by a comma list of labels or indices, or by index parity."""
+def pick(runs, spec, default_parity, option="--train"):
+    """Runs selected by a comma list of labels or indices, or by index parity (errors name ``option``)."""
     if not spec:
         return [r for i, r in enumerate(runs) if i % 2 == default_parity]
     out = []
@@ -68,7 +68,7 @@ def pick(runs, spec, default_parity):
         elif item.isascii() and item.isdigit() and len(item) < 10 and int(item) < len(runs):
             out.append(runs[int(item)])
         else:
-            raise InputError("runs", item, "a run label or index among " + ", ".join(labels))
+            raise InputError(option, item, "a run label or index among " + ", ".join(labels))
     return out
 
 
@@ -79,7 +79,7 @@ def run(args):
     from drakecreep.report.gap_report import to_json_dict, write_report
 
     runs = load_runs(args.data, args.meta)
-    train, test = pick(runs, args.train, 0), pick(runs, args.test, 1)
+    train, test = pick(runs, args.train, 0, "--train"), pick(runs, args.test, 1, "--test")
     if set(r.label for r in train) & set(r.label for r in test):
         raise InputError("--test", args.test, "runs disjoint from the training runs")
     # everything the end of the run needs is checked before the diagnosis starts
@@ -88,13 +88,14 @@ def run(args):
     score_runs = load_runs(args.score, None) if args.score else None
     cfg = DiagnosisConfig(screw_lead=args.screw_lead * 1e-3,
                           motor_period=None if args.motor_period is None else args.motor_period * 1e-3,
-                          progress=True)
+                          progress=not args.quiet)
     result = diagnose(train, test, cfg)
     result["data"] = str(args.data)
     result["train_runs"] = [r.label for r in train]
     result["test_runs"] = [r.label for r in test]
     if args.score:
-        print(f"[diagnose] scoring the fixed diagnosis on {args.score}", file=sys.stderr, flush=True)
+        if not args.quiet:
+            print(f"[diagnose] scoring the fixed diagnosis on {args.score}", file=sys.stderr, flush=True)
         result["scored"] = score_fixed(result, score_runs)
         result["scored"]["data"] = str(args.score)
     if args.out:
@@ -104,7 +105,8 @@ def run(args):
             sc.update({"nominal": result["nominal"], "claimed": result["claimed"], "ranking": [],
                        "unexplained_share": sc["unexplained_share"]})
             write_report(sc, Path(args.out) / "scored", title=f"Fixed diagnosis scored on {args.score}")
-        print(f"[diagnose] wrote {html_path} and {json_path}", file=sys.stderr)
+        if not args.quiet:
+            print(f"[diagnose] wrote {html_path} and {json_path}", file=sys.stderr)
     if args.json:
         print_json(to_json_dict(result))
     else:

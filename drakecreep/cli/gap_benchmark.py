@@ -50,7 +50,7 @@ def run(args):
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
-                        n_ool=args.n_ool, progress=True, n_samples=args.samples)
+                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples)
     if args.json:
         print_json(res)
         return 0

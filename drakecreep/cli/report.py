@@ -18,6 +18,7 @@ def add_parser(subparsers):
                    help="low-speed feed of the simulation and the pole map (default 0.1)")
     p.add_argument("--load-case", type=int, default=3, metavar="N", help="load case (default 3)")
     p.add_argument("--no-sim-grid", action="store_true", help="skip the simulated creep markers on the pole map")
+    p.add_argument("--json", action="store_true", help="print one JSON object (the written files and the margins)")
     p.set_defaults(func=run)
     return p
 
@@ -38,5 +39,13 @@ def run(args):
         source += f", friction law {args.friction}"
     result = build_report(params, args.out, feed=scenario.feed, load_case=scenario.load_case, low_feed=low,
                           source=source, sim_grid=None if args.no_sim_grid else (6, 6))
+    if args.json:
+        import json
+
+        from drakecreep.cli._common import print_json
+
+        print_json({"html": str(result["html"]), "json": str(result["json"]), "pngs": result.get("pngs"),
+                    "margins": json.loads(result["json"].read_text()), "wall_time_s": result["timings"]["total"]})
+        return 0
     print(f"wrote {result['html']} ({result['timings']['total']:.1f} s)")
     return 0

@@ -69,7 +69,7 @@ def run(args):
     try:
         result = run_sweep(
             spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,
-            scheduler=scheduler, out_dir=args.out, progress=not args.no_progress, retries=args.retries,
+            scheduler=scheduler, out_dir=args.out, progress=not (args.no_progress or args.quiet), retries=args.retries,
             columns=spec.metrics, batch_size=args.batch if args.batch > 1 else None, extra_outputs=extra,
         )
     finally:

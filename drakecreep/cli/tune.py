@@ -1,5 +1,7 @@
 """``drakecreep tune``: PI gains for a velocity-loop bandwidth and phase margin, P gain for the position loop."""
 
+import sys
+
 from drakecreep.cli._common import add_params_options, number, params_from_args, print_json
 from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
@@ -22,6 +24,8 @@ def add_parser(subparsers):
                    help="velocity-loop phase margin in deg (default 60)")
     p.add_argument("--feed", type=number, default=1.0, metavar="MM_PER_S", help="operating feed in mm/s (default 1)")
     p.add_argument("--load-case", type=int, default=3, metavar="N", help="load case (default 3)")
+    p.add_argument("--write", metavar="FILE",
+                   help="write the parameters with the tuned gains to FILE (YAML; simulate --params FILE reads it)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
     return p
@@ -29,6 +33,10 @@ def add_parser(subparsers):
 
 def run(args):
     """Tune and print."""
+    if not args.bandwidth > 0:  # refused before any import or linearization
+        raise InputError("--bandwidth", args.bandwidth, "a bandwidth > 0 Hz")
+    if not 0 < args.phase_margin < 90:
+        raise InputError("--phase-margin", args.phase_margin, "a phase margin in (0, 90) deg")
     from drakecreep.cli.margins import print_margins, scenario_from_args
     from drakecreep.servo.tuning import tune
 
@@ -41,6 +49,13 @@ def run(args):
             raise InputError("--" + err.field, err.value, err.allowed) from None
         raise
     summary = result.summary()
+    if args.write:
+        from drakecreep.params import save_params
+
+        save_params(result.params, args.write)
+        summary["params_file"] = str(args.write)
+        if not args.json:
+            print(f"wrote {args.write}", file=sys.stderr)
     if args.json:
         print_json(to_jsonable(summary))
         return 0

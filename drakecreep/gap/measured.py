@@ -496,7 +496,8 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
         candidates = [csv_path.with_suffix(".yaml"), csv_path.with_suffix(".yml")]
         meta_path = next((p for p in candidates if p.exists()), None)
         if meta_path is None:
-            raise InputError("meta_path", str(candidates[0]), "a metadata YAML beside the CSV (or pass meta_path)")
+            raise InputError("metadata", str(candidates[0]),
+                             "a metadata YAML beside the CSV (or name it: diagnose --meta FILE)")
     from drakecreep.files import MAX_DATA_BYTES, check_input_file
     from drakecreep.params import load_yaml_file
 

@@ -132,6 +132,24 @@ class SimulationResult:
         out.update(self.stats)
         return out
 
+    def to_dataframe(self):
+        """The time series as a :class:`pandas.DataFrame`, SI units in the column names.
+
+        Columns are those of ``timeseries.csv`` (:meth:`save`): ``t_s`` then ``<signal>_<unit>``, e.g.
+        ``table_speed_m_per_s``, ``spring_force_N``; so ``pandas.read_csv("timeseries.csv")`` gives the
+        same table.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
+        import pandas as pd
+
+        cols = {"t_s": np.asarray(self.time, dtype=float)}
+        for name, values in self.signals.items():
+            cols[f"{name}_{_unit_tag(self.units[name])}"] = np.asarray(values, dtype=float)
+        return pd.DataFrame(cols)
+
     def save(self, out_dir, extra=None):
         """Write ``timeseries.csv``, ``params.yaml`` and, last, ``metrics.json`` to ``out_dir`` as one set.
 

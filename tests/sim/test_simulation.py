@@ -140,3 +140,17 @@ def test_convergence_check_reports_disagreement_and_can_be_off(short_paper):
     assert r.summary()["converged"] is False
     off = simulate(with_value(short_paper, "simulation.convergence_check", False), Scenario(feed=1e-4, duration=0.5))
     assert off.metrics.converged is None and "convergence_runs" not in off.stats
+
+
+    assert r.metrics.mean_speed == pytest.approx(0.1e-3, rel=0.05)
+
+
+def test_to_dataframe_has_si_columns_and_matches_the_saved_csv(low_feed, tmp_path):
+    import pandas as pd
+
+    frame = low_feed.to_dataframe()
+    assert frame.columns[0] == "t_s" and "table_speed_m_per_s" in frame and "spring_force_N" in frame
+    np.testing.assert_array_equal(frame["table_speed_m_per_s"].to_numpy(), low_feed.signals["table_speed"])
+    saved = pd.read_csv(low_feed.save(tmp_path)["timeseries"])
+    assert list(saved.columns) == list(frame.columns)
+    np.testing.assert_allclose(saved["table_speed_m_per_s"], frame["table_speed_m_per_s"], rtol=1e-9, atol=1e-15)

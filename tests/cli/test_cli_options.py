@@ -1,0 +1,85 @@
+import json
+
+import pytest
+import yaml
+
+from drakecreep import cli
+from drakecreep.params import load_params
+
+
+def _subparsers():
+    parser = cli.build_parser()
+    action = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    return parser, action.choices
+
+
+def test_quiet_and_verbose_before_or_after_the_command():
+    parser = cli.build_parser()
+    assert parser.parse_args(["-q", "hertz"]).quiet and parser.parse_args(["hertz", "-q"]).quiet
+    assert not parser.parse_args(["hertz"]).quiet
+    assert parser.parse_args(["-vv", "hertz"]).verbose == 2 and parser.parse_args(["hertz", "-v"]).verbose == 1
+
+
+def test_heartbeat_appears_on_stderr_for_a_long_job_and_not_with_quiet(monkeypatch, capsys):
+    import time
+
+    import drakecreep.cli.hertz as hertz
+
+    def slow(args):
+        time.sleep(3.2)
+        return 0
+
+    monkeypatch.setattr(cli, "HEARTBEAT", ("hertz",))
+    monkeypatch.setenv("DRAKECREEP_PROGRESS", "1")  # stderr is not a terminal under pytest: force it
+    monkeypatch.setattr(hertz, "run", slow)
+    assert cli.main(["hertz"]) == 0
+    err = capsys.readouterr().err
+    assert "drakecreep hertz: 00:0" in err and "elapsed" in err
+    assert cli.main(["-q", "hertz"]) == 0
+    assert "elapsed" not in capsys.readouterr().err
+    monkeypatch.delenv("DRAKECREEP_PROGRESS")
+    assert cli.main(["hertz"]) == 0
+    assert "elapsed" not in capsys.readouterr().err  # not a terminal: one line per message in logs
+
+
+def test_tune_write_gives_a_file_simulate_accepts(tmp_path, capsys):
+    path = tmp_path / "tuned.yaml"
+    assert cli.main(["-q", "tune", "--bandwidth", "30", "--write", str(path), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    params = load_params(path)
+    assert params.controller.velocity_gain == pytest.approx(summary["velocity_gain_Ns_per_m"], rel=1e-12)
+    assert summary["params_file"] == str(path)
+    assert isinstance(yaml.safe_load(path.read_text()), dict)
+    out = tmp_path / "sim"
+    assert cli.main(["-q", "simulate", "--params", str(path), "--duration", "1.2", "--no-plot", "--out", str(out),
+                     "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["status"] == "ok"
+
+
+@pytest.mark.parametrize("name", ["simulate", "critical", "hertz", "modal", "margins", "tune", "report", "emps",
+                                  "reproduce-paper", "compensate", "diagnose", "gap-benchmark"])
+def test_every_computing_command_has_json(name):
+    _, commands = _subparsers()
+    assert "--json" in commands[name].format_help()
+
+
+def test_every_command_documents_quiet_and_verbose():
+    parser, commands = _subparsers()
+    for name, sub in [("drakecreep", parser), *commands.items()]:
+        text = sub.format_help()
+        assert "-q, --quiet" in text and "-v, --verbose" in text, name
+
+
+@pytest.mark.parametrize("args, option", [(["--bandwidth", "-5"], "--bandwidth"), (["--phase-margin", "95"], "--phase-margin")])
+def test_tune_refuses_bad_targets_before_any_work(args, option, capsys, monkeypatch):
+    import drakecreep.cli.margins
+    import drakecreep.servo.tuning
+
+    def no_work(*a, **k):
+        raise AssertionError("the targets must be checked before the operating point and the tuning")
+
+    monkeypatch.setattr(drakecreep.servo.tuning, "tune", no_work)
+    monkeypatch.setattr(drakecreep.cli.margins, "scenario_from_args", no_work)
+    assert cli.main(["tune", *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"error: {option}: got" in err[0]

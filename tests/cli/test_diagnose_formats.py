@@ -1,0 +1,40 @@
+import json
+
+import pytest
+
+from drakecreep import cli
+from drakecreep.data import example_path
+from drakecreep.gap.measured import load_measured, save_measured
+
+EXAMPLE = example_path("emps_segment.csv")  # t[ms], x[mm], u[V]
+
+
+def _diagnose(capsys, *args):
+    assert cli.main(["-q", "diagnose", *map(str, args), "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_csv_in_mm_and_ms_gives_the_si_result(tmp_path, capsys):
+    header = [line for line in EXAMPLE.read_text().splitlines() if not line.startswith("#")][0]
+    assert "[ms]" in header and "[mm]" in header
+    si_csv, _ = save_measured(load_measured(EXAMPLE), tmp_path / "emps_segment.csv")
+    assert si_csv.read_text().splitlines()[0].startswith("t[s],x_ref[m],x_motor[m]")
+    shop, si = _diagnose(capsys, EXAMPLE), _diagnose(capsys, si_csv)
+    for key in ("claimed", "train_runs", "test_runs"):
+        assert shop[key] == si[key]
+    assert [r["effect"] for r in shop["ranking"]] == [r["effect"] for r in si["ranking"]]
+    for name, value in shop["nominal"]["params"].items():
+        assert value == pytest.approx(si["nominal"]["params"][name], rel=1e-9, abs=1e-9), name
+
+
+def test_missing_metadata_names_the_option(tmp_path, capsys):
+    (tmp_path / "run.csv").write_text("t,x_ref,x_motor,u\n0,0,0,0\n")
+    assert cli.main(["diagnose", str(tmp_path / "run.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--meta" in err[0] and "meta_path" not in err[0]
+
+
+def test_bad_run_selection_names_the_option(capsys):
+    assert cli.main(["diagnose", str(EXAMPLE), "--test", "r9"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("drakecreep diagnose: error: --test: got 'r9'")
