@@ -334,32 +334,46 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     return out
 
 
-def replay_drakecreep(run, params=None, quantize=True):
+def replay_drakecreep(run, params=None, quantize=True, load_case=0):
     """Replay ``run`` through the project's feed-drive diagram (``controller: {kind: drakecreep}``).
 
     The diagram is :func:`drakecreep.model.diagram.build_diagram` of ``params`` (default
-    ``run.meta.params``) with the measured reference (first-order hold, speed from its slope) in place of
-    the ramp reference and ``f_ext`` added to the axial force on the table. Positions are taken relative
-    to the first sample (the diagram starts at rest at 0).
+    ``run.meta.params``): PI cascade with ``params.controller``'s gains and periods, encoder and scale of
+    ``params.sensors`` (ideal when ``quantize`` is false), motor, elastic screw and table with their
+    friction law; the ramp reference is replaced by the measured one (``TrajectorySource`` of a
+    first-order hold, the speed its slope) and ``f_ext`` is added to the push on the table. Positions are
+    relative to the first sample (the diagram starts at rest at 0, in equilibrium under ``load_case``), and
+    simulated with ``params.simulation``'s integrator (leaf systems: a measured reference is no symbolic
+    function of time).
+
+    Parameters
+    ----------
+    run : drakecreep.gap.measured.MeasuredRun
+    params : drakecreep.params.DriveParams, optional
+    quantize : bool
+    load_case : int
+        Load case of ``params`` the run was taken under (0 = unloaded).
 
     Returns
     -------
     DrakeReplayResult
-        ``u`` is the force command [N] (the PI cascade's output); ``force = u_gain u + f_ext``.
+        ``u`` is the force command [N] of the cascade; ``force = u_gain u + f_ext``.
     """
+    import dataclasses
+
     from drakecreep.model.diagram import build_diagram
     from drakecreep.params import DriveParams
     from drakecreep.scenario import Scenario
+    from drakecreep.sim.simulation import make_simulator
 
-    check_replayable(run) if params is None else None
-    params = run.meta.params if params is None else params
+    if params is None:
+        check_replayable(run)
+        params = run.meta.params
     if not isinstance(params, DriveParams):
         raise InputError("params", type(params).__name__, "drakecreep DriveParams (a params file)")
     if not quantize:
-        import dataclasses
-
-        params = dataclasses.replace(params, sensors=dataclasses.replace(params.sensors, encoder_counts_per_rev=0,
-                                                                       scale_resolution=0.0))
+        params = dataclasses.replace(params, sensors=dataclasses.replace(
+            params.sensors, encoder_counts_per_rev=0, scale_resolution=0.0))
     start = _time.perf_counter()
     t = run.t - run.t[0]
     x_origin = float(run.x_motor[0])
@@ -368,15 +382,22 @@ def replay_drakecreep(run, params=None, quantize=True):
     reference = TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr])))
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
     ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
-    fd = build_diagram(params, Scenario(feed=max(float(np.max(np.abs(vr))), 1e-6), duration=float(t[-1])),
-                       reference=reference, external_force=ext)
-    from drakecreep.sim.simulate import simulate_feed_drive
-
-    sim = simulate_feed_drive(fd, float(t[-1]), sample_times=t)
+    feed = float(np.max(np.abs(vr))) or 1e-6
+    scenario = Scenario(feed=min(feed, 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
+    fd = build_diagram(params, scenario, reference=reference, external_force=ext)
+    b = DiagramBuilder()
+    system = b.AddSystem(fd.diagram)
+    logs = {key: LogVectorOutput(system.GetOutputPort(key), b, run.dt)
+            for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
+    root = b.Build()
+    context = root.CreateDefaultContext()
+    simulator = make_simulator(root, context, params.simulation)
+    simulator.AdvanceTo(float(t[-1]))
+    data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
     ratio = params.screw.lead / (2 * math.pi)
-    x_motor = sim["motor_angle"] * ratio + x_origin
-    x_table = sim["table_position"] + x_origin
-    u = sim["force_command"]
+    x_motor = data["motor.motor_state"][0] * ratio + x_origin
+    x_table = data["table.table_state"][0] + x_origin
+    u = data["controller.controller_signals"][1]
     force = u * run.u_gain + f_ext
     return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
                              wall_time=_time.perf_counter() - start)
