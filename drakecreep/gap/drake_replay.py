@@ -77,7 +77,8 @@ class DrakeReplayResult:
     """Simulated samples beside the measured run (arrays on ``run.t``).
 
     ``x_motor``, ``x_table``: positions at the sample instants [m]; ``u``: controller output of each sample
-    [unit of u]; ``force``: the force applied over the sample, ``u_gain u_applied + f_ext`` [N];
+    [unit of u]; ``force``: the force ``u_gain u_applied + f_ext`` [N] at the end of sample interval
+    ``[t_k, t_k+1)`` (without a computation delay: held over the whole interval);
     ``wall_time``: seconds the simulation took.
     """
 
@@ -133,7 +134,8 @@ class DrakeReplay:
         h = run.dt
         self.h = h
         self.max_step = h if max_step is None else float(max_step)
-        t = run.t - run.t[0]
+        # the controller's clock: sample k at k h (the recorded time stamps may jitter)
+        t = np.arange(run.n) * h
         self.t = t
         sensors = run.meta.sensors
         res = (sensors.encoder_resolution if ctrl.feedback == "motor" else sensors.scale_resolution) if quantize else 0.0
@@ -189,7 +191,7 @@ class DrakeReplay:
         self._log_motor = LogVectorOutput(motor, b, h)
         self._log_table = LogVectorOutput(table, b, h)
         self._log_u = LogVectorOutput(self.controller.GetOutputPort("u"), b, h)
-        self._log_force = LogVectorOutput(add.get_output_port(), b, h)
+        self._log_force = LogVectorOutput(self.controller.GetOutputPort("force"), b, h)
         self.diagram = b.Build()
         self.diagram.set_name("measured_replay")
         self.simulator = Simulator(self.diagram)
@@ -217,16 +219,19 @@ class DrakeReplay:
         for log in (self._log_motor, self._log_table, self._log_u, self._log_force):
             log.FindMutableLog(self.context).Clear()
         self.simulator.Initialize()
-        self.simulator.AdvanceTo(float(self.t[-1]))
+        self.simulator.AdvanceTo(float(self.run.n * self.h))
         n = self.run.n
         out = {}
         for name, log in (("motor", self._log_motor), ("table", self._log_table), ("u", self._log_u),
                           ("force", self._log_force)):
             lg = log.FindLog(self.context)
-            out[name] = _on_samples(lg.sample_times(), lg.data(), self.t)
+            out[name] = _on_samples(lg.sample_times(), lg.data(), np.arange(n + 1) * self.h)
+        # a log taken at t_k holds the discrete state from before the update at t_k: the output of sample k
+        # (held over [t_k, t_k+1)) is the log at t_k+1
+        f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
         return DrakeReplayResult(
-            run=self.run, x_motor=out["motor"][0][:n], x_table=out["table"][0][:n], u=out["u"][0][:n],
-            force=out["force"][0][:n], parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
+            run=self.run, x_motor=out["motor"][0][:n], x_table=out["table"][0][:n], u=out["u"][0][1:],
+            force=out["force"][0][1:] + f_ext, parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
             wall_time=_time.perf_counter() - start)
 
 
