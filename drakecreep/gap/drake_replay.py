@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.symbolic import Expression, MakeVectorVariable
+from pydrake.symbolic import Expression, MakeVectorVariable, Variable
 from pydrake.systems.primitives import Adder, LogVectorOutput, MatrixGain, SymbolicVectorSystem, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
@@ -243,7 +243,6 @@ class _CompiledPP:
     """
 
     def __init__(self, builder, leaf):
-        from pydrake.symbolic import Variable
         from pydrake.systems.primitives import Demultiplexer, Multiplexer, ZeroOrderHold
 
         sym = leaf.ToSymbolic()
@@ -296,11 +295,13 @@ def compiled_axis(flexible, initial_state):
     x = MakeVectorVariable(len(initial_state), "x")
     u = MakeVectorVariable(1, "F")
     p = MakeVectorVariable(len(AXIS_PARAMETERS), "p")
+    time = Variable("t")
+    ctx.SetTime(Expression(time))
     ctx.SetContinuousState([Expression(v) for v in x])
     ctx.get_mutable_numeric_parameter(0).SetFromVector([Expression(v) for v in p])
     sym.GetInputPort("force").FixValue(ctx, [Expression(u[0])])
     xdot = sym.EvalTimeDerivatives(ctx).CopyToVector()
-    system = SymbolicVectorSystem(state=x, input=u, parameter=p, dynamics=xdot,
+    system = SymbolicVectorSystem(time=time, state=x, input=u, parameter=p, dynamics=xdot,
                                   output=[Expression(v) for v in x])
     return system
 

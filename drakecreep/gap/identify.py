@@ -165,14 +165,19 @@ class _Problem:
     def __init__(self, replays, base, names):
         self.replays, self.base, self.names = replays, dict(base), tuple(names)
         self.log = np.array([n in LOG_SCALED for n in self.names])
+        # x = value / scale: one unit of x is a typical size of the parameter (force terms: the Coulomb level)
+        force = max(abs(base.get("coulomb", 0.0)), 1.0)
+        typical = {"friction_drift": 1e-2, "friction_ripple_cos": 0.3, "friction_ripple_sin": 0.3,
+                   "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
+                   "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
+                   "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2}
         scale = []
-        for n in self.names:
-            v = abs(base[n])
-            ref = max(abs(base.get("coulomb", 0.0)), 1.0) if n in ("offset", "coulomb_asym", "stribeck_extra") else 1.0
-            scale.append(1.0 if self.log[len(scale)] else max(v, ref))
+        for i, n in enumerate(self.names):
+            scale.append(1.0 if self.log[i] else max(abs(base[n]), typical.get(n, 0.0)) or 1.0)
         self.scale = np.array(scale)
         self.evaluations = 0
         self.seconds = 0.0
+        self._last = None
 
     def to_x(self, values):
         v = np.array([values[n] for n in self.names], dtype=float)
@@ -197,7 +202,28 @@ class _Problem:
         return results
 
     def residual(self, x):
-        return self.residual_of(self.simulate(self.to_values(x)))
+        x = np.asarray(x, dtype=float)
+        if self._last is not None and np.array_equal(self._last[0], x):
+            return self._last[1]
+        r = self.residual_of(self.simulate(self.to_values(x)))
+        self._last = (x.copy(), r)
+        return r
+
+    def jacobian(self, x, step, hi):
+        """Forward differences with an ABSOLUTE step in the scaled variables (backwards at an upper bound).
+
+        (scipy's ``diff_step`` is relative to ``|x|`` and falls back to ~1e-8 at ``x = 0``, where the
+        counted replay does not change at all.)
+        """
+        x = np.asarray(x, dtype=float)
+        r0 = self.residual(x)
+        J = np.empty((r0.size, x.size))
+        for i in range(x.size):
+            h = step if x[i] + step <= hi[i] else -step
+            xi = x.copy()
+            xi[i] += h
+            J[:, i] = (self.residual_of(self.simulate(self.to_values(xi))) - r0) / h
+        return J
 
     @staticmethod
     def residual_of(results):
@@ -212,7 +238,7 @@ class _Problem:
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,
-             bounds=None, max_nfev=20, quantize=True, replays=None, diff_step=1e-2, **preprocess):
+             bounds=None, max_nfev=20, quantize=True, replays=None, diff_step=0.05, **preprocess):
     """Identify the replay axis on training runs (see the module docstring).
 
     Parameters
@@ -237,8 +263,9 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     replays : sequence of DrakeReplay, optional
         Prebuilt replay diagrams of ``runs`` (same ``flexible``/``delay``), reused without a rebuild.
     diff_step : float
-        Relative finite-difference step of the Jacobian; large enough to step over the encoder's counts
-        (the replay is piecewise smooth in the parameters once the position is counted).
+        Absolute finite-difference step of the Jacobian in the scaled variables (5 % of a log-scaled value, or
+        5 % of a typical size): large enough to step over the encoder's counts (the replay with a counted position
+        is only piecewise smooth in the parameters).
     **preprocess
         Options of the IDIM pre-processing.
 
@@ -281,7 +308,8 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
                 if not lo[i] < hi[i]:
                     raise InputError(f"bounds.{name}", bounds[name], "(lo, hi) with lo < hi (lo > 0 on a log scale)")
         x0 = np.clip(x0, np.where(np.isfinite(lo), lo + 1e-9, lo), np.where(np.isfinite(hi), hi - 1e-9, hi))
-        sol = least_squares(prob.residual, x0, bounds=(lo, hi), method="trf", x_scale="jac", diff_step=diff_step,
+        sol = least_squares(prob.residual, x0, jac=lambda x: prob.jacobian(x, diff_step, hi), bounds=(lo, hi),
+                            method="trf", x_scale=1.0,
                             max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)
         values = prob.to_values(sol.x)
         cost = float(sol.cost)

@@ -2,18 +2,24 @@
 
 Rigid (``flexible=False``), state ``[x, v]``::
 
-    M dv/dt = F - f(v) - offset
+    M dv/dt = F + r(x, t) - f(v, x, t) - offset
 
 Two-mass (``flexible=True``), state ``[x_m, v_m, x_t, v_t]``: the motor side (rotor, coupling and screw
 reflected to the table, ``m_m = motor_mass_fraction * M``) and the table (``m_t = M - m_m``) joined by
 the axial stiffness ``k`` and damping ``c`` of the screw chain::
 
-    m_m dv_m/dt = F - k (x_m - x_t) - c (v_m - v_t)
+    m_m dv_m/dt = F + r(x_m, t) - k (x_m - x_t) - c (v_m - v_t)
     m_t dv_t/dt = k (x_m - x_t) + c (v_m - v_t) - f(v_t) - offset
 
 with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecreep.model.friction`)::
 
-    f(v) = s(v) (Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)) + (Fv + dFv s(v)) v
+    f(v) = L(x, t) [s(v) (Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)) + (Fv + dFv s(v)) v]
+    L(x, t) = 1 + fc cos(2 pi x / Lf) + fs sin(2 pi x / Lf) + drift t      (position-dependent, thermal)
+
+and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
+plus a fixed time frequency ``f_r``)::
+
+    r(x_m, t) = pc cos(2 pi x_m / Lp) + ps sin(2 pi x_m / Lp) + tc cos(2 pi f_r t) + ts sin(2 pi f_r t)
 
 ``dFc``, ``dFv`` make it asymmetric (``Fc + dFc`` forward, ``Fc - dFc`` backward). ``F`` is the drive
 force plus any external force (input ``force``, N). The offset is the constant force of the IDIM
@@ -32,6 +38,7 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.errors import InputError
 from drakecreep.model._scalar import exp, tanh, vector
+from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
            "set_axis_parameters", "axis_friction"]
@@ -50,13 +57,27 @@ AXIS_PARAMETERS = {
     "motor_mass_fraction": 0.2,
     "stiffness": 1e8,
     "damping": 0.0,
+    "position_ripple_cos": 0.0,
+    "position_ripple_sin": 0.0,
+    "position_period": 2.5e-3,
+    "friction_ripple_cos": 0.0,
+    "friction_ripple_sin": 0.0,
+    "friction_period": 0.1,
+    "time_ripple_cos": 0.0,
+    "time_ripple_sin": 0.0,
+    "ripple_frequency": 50.0,
+    "friction_drift": 0.0,
 }
 AXIS_UNITS = {
     "mass": "kg", "viscous": "N s/m", "viscous_asym": "N s/m", "coulomb": "N", "coulomb_asym": "N", "offset": "N",
     "stribeck_extra": "N", "stribeck_velocity": "m/s", "regularization_velocity": "m/s",
     "motor_mass_fraction": "-", "stiffness": "N/m", "damping": "N s/m",
+    "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
+    "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
+    "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
 }
-_POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness")
+_POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "position_period",
+             "friction_period", "ripple_frequency")
 _NAMES = tuple(AXIS_PARAMETERS)
 
 
@@ -78,13 +99,26 @@ def axis_parameters(**values):
     return np.array([out[n] for n in _NAMES])
 
 
-def axis_friction(v, p):
-    """Friction force [N] opposing ``v`` for a parameter vector ``p`` (order of :data:`AXIS_PARAMETERS`)."""
+def axis_friction(v, p, x=0.0, t=0.0):
+    """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] for a parameter vector
+    ``p`` (order of :data:`AXIS_PARAMETERS`)."""
     P = dict(zip(_NAMES, p))
     s = tanh(v / P["regularization_velocity"])
     w = v / P["stribeck_velocity"]
-    return (s * (P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w))
-            + (P["viscous"] + P["viscous_asym"] * s) * v)
+    phase = 2.0 * math.pi * x / P["friction_period"]
+    level = (1.0 + P["friction_ripple_cos"] * cos(phase) + P["friction_ripple_sin"] * sin(phase)
+             + P["friction_drift"] * t)
+    return level * (s * (P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w))
+                    + (P["viscous"] + P["viscous_asym"] * s) * v)
+
+
+def axis_ripple(x, t, p):
+    """Position-periodic (cogging, lead-error harmonic force) plus time-periodic ripple force [N] along +x."""
+    P = dict(zip(_NAMES, p))
+    a = 2.0 * math.pi * x / P["position_period"]
+    b = 2.0 * math.pi * P["ripple_frequency"] * t
+    return (P["position_ripple_cos"] * cos(a) + P["position_ripple_sin"] * sin(a)
+            + P["time_ripple_cos"] * cos(b) + P["time_ripple_sin"] * sin(b))
 
 
 def set_axis_parameters(axis, context, **values):
@@ -142,15 +176,17 @@ def MeasuredAxis_(T):
             p = self._p(context)
             P = dict(zip(_NAMES, p))
             F = self._force.Eval(context)[0]
+            t = context.get_time()
             if self.flexible:
                 m_m = P["motor_mass_fraction"] * P["mass"]
                 m_t = P["mass"] - m_m
                 spring = P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
-                a_m = (F - spring) / m_m
-                a_t = (spring - axis_friction(x[3], p) - P["offset"]) / m_t
+                a_m = (F + axis_ripple(x[0], t, p) - spring) / m_m
+                a_t = (spring - axis_friction(x[3], p, x[2], t) - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
             else:
-                rates = [x[1], (F - axis_friction(x[1], p) - P["offset"]) / P["mass"]]
+                push = F + axis_ripple(x[0], t, p) - axis_friction(x[1], p, x[0], t) - P["offset"]
+                rates = [x[1], push / P["mass"]]
             derivatives.get_mutable_vector().SetFromVector(vector(rates))
 
         def _calc_motor(self, context, output):
@@ -163,7 +199,7 @@ def MeasuredAxis_(T):
 
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            output.SetAtIndex(0, axis_friction(x[-1], self._p(context)))
+            output.SetAtIndex(0, axis_friction(x[-1], self._p(context), x[-2], context.get_time()))
 
     return Impl
 
