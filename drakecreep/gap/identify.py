@@ -171,8 +171,14 @@ class _Problem:
                    "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
                    "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
                    "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2}
+        # phase-like parameters: a step must move the phase over a run by much less than a cycle
+        fine = {"ripple_frequency": 1.0, "position_period": 0.01 * base["position_period"],
+                "friction_period": 0.05 * base["friction_period"]}
         scale = []
         for i, n in enumerate(self.names):
+            if n in fine:
+                scale.append(fine[n])
+                continue
             scale.append(1.0 if self.log[i] else max(abs(base[n]), typical.get(n, 0.0)) or 1.0)
         self.scale = np.array(scale)
         self.evaluations = 0

@@ -25,12 +25,12 @@ def _synthetic(run, truth, seed):
 @pytest.fixture(scope="module")
 def runs():
     full = load_emps("estimation").runs[0]
-    # 2.5 s windows with both directions of motion
-    return [_synthetic(full.slice(a, a + 2500), TRUTH, seed) for seed, a in enumerate((0, 5000))]
+    # 1.5 s windows with both directions of motion
+    return [_synthetic(full.slice(a, a + 1500), TRUTH, seed) for seed, a in enumerate((0, 5000))]
 
 
 def test_output_error_recovers_the_friction_of_a_known_axis(runs):
-    idf = identify(runs, uncertain=("viscous", "coulomb", "offset"), max_nfev=10,
+    idf = identify(runs, uncertain=("viscous", "coulomb", "offset"), max_nfev=6,
                    fixed={"mass": PUBLISHED_IDIM["M"], "regularization_velocity": 1e-3})
     for name in ("viscous", "coulomb", "offset"):
         assert abs(idf.parameters[name] - TRUTH[name]) < max(3 * idf.ci95[name], 0.02 * abs(TRUTH[name])), name
