@@ -13,7 +13,7 @@ import argparse
 import tempfile
 import time
 
-from drakecreep.cli.diagnose import load_runs, pick
+from drakecreep.gap.runs import load_runs, pick
 from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose
 from drakecreep.report.gap_report import write_report
 from drakecreep.gap.idim import fit_idim
