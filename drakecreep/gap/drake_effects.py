@@ -161,7 +161,8 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
     effect : DrakeEffect or str
     train, test : sequence of MeasuredRun
     nominal : drakecreep.gap.identify.Identified
-        The identified nominal model (its parameters are the start; its delay is kept).
+        The identified nominal model, or a model already augmented (its parameters are the start; its
+        delay and two-mass option are kept).
     max_nfev : int
         Least-squares evaluations per start.
     refit : tuple of str
@@ -184,7 +185,8 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         f = residual_peak_frequency(train, base, delay=nominal.delay)
         starts = ({"ripple_frequency": f},)
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
-    replays = [DrakeReplay(r, flexible=effect.flexible, delay=nominal.delay) for r in train]
+    flexible = effect.flexible or nominal.flexible
+    replays = [DrakeReplay(r, flexible=flexible, delay=nominal.delay) for r in train]
     best = None
     for start in starts:
         fixed = dict(base)
@@ -196,14 +198,14 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
             k = w * w * share * (1 - share) * m
             fixed.update(stiffness=k, damping=0.05 * 2 * math.sqrt(k * share * (1 - share) * m))
         fixed.update(start)
-        idf = identify(train, uncertain, flexible=effect.flexible, delay=nominal.delay, fixed=fixed,
+        idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixed,
                        bounds=effect.bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:
             best = idf
     train_rms = _rms(e["force"] for e in best.train_errors.values())
-    test_errors, test_rms = score_parameters(test, best.parameters, flexible=effect.flexible, delay=nominal.delay)
+    test_errors, test_rms = score_parameters(test, best.parameters, flexible=flexible, delay=nominal.delay)
     return EffectFit(name=effect.name, parameters=best.parameters, identified=best, delay=nominal.delay,
-                     flexible=effect.flexible, train_force_error=train_rms, test_force_error=test_rms,
+                     flexible=flexible, train_force_error=train_rms, test_force_error=test_rms,
                      test_errors=test_errors, seconds=_time.perf_counter() - t0)
 
 
@@ -219,16 +221,17 @@ def fit_delay(train, test, nominal, *, max_delay=3.0, xatol=0.05):
 
     t0 = _time.perf_counter()
     base = dict(nominal.parameters)
+    flexible = nominal.flexible
 
     def cost(d):
-        prob = _Problem([DrakeReplay(r, delay=d) for r in train], base, ())
+        prob = _Problem([DrakeReplay(r, delay=d, flexible=flexible) for r in train], base, ())
         r = prob.residual_of(prob.simulate(base))
         return 0.5 * float(r @ r)
 
     sol = minimize_scalar(cost, bounds=(0.0, float(max_delay)), method="bounded", options={"xatol": xatol})
     d = float(sol.x)
-    train_errors, train_rms = score_parameters(train, base, delay=d)
-    test_errors, test_rms = score_parameters(test, base, delay=d)
-    return EffectFit(name="control_delay", parameters=base, identified=None, delay=d, flexible=False,
+    train_errors, train_rms = score_parameters(train, base, delay=d, flexible=flexible)
+    test_errors, test_rms = score_parameters(test, base, delay=d, flexible=flexible)
+    return EffectFit(name="control_delay", parameters=base, identified=None, delay=d, flexible=flexible,
                      train_force_error=train_rms, test_force_error=test_rms, test_errors=test_errors,
                      seconds=_time.perf_counter() - t0)
