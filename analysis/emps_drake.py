@@ -1,10 +1,13 @@
 """EMPS through the Drake model: identify on the estimation file, rank effects on its held-out cycles,
 augment, refit on the whole estimation file, then replay the validation file ONCE with everything fixed.
 
-1. ``DATA_EMPS.mat`` is split at every reversal of the reference (half cycles); even parts train, odd
-   parts are held out (both sets hold both directions).
+1. ``DATA_EMPS.mat`` is split at every reversal of the reference (half cycles); alternate pairs of
+   half cycles train and are held out (both sets hold both directions: with even/odd half cycles every
+   training part moved forward and Coulomb friction and offset could not be separated).
 2. Nominal: IDIM-LS start + output-error refinement of viscous, Coulomb, offset through the Drake replay
    (:mod:`drakecreep.gap.identify`).
+   (steps 2-4 are :func:`drakecreep.gap.drake_diagnosis.diagnose_drake`; the augmented model is also
+   written to ``emps_augmented.yaml``)
 3. Each candidate of :data:`drakecreep.gap.drake_effects.DRAKE_EFFECTS` and the computation delay is
    fitted on the training cycles (nominal friction refined with it) and replayed, fixed, on the held-out
    parts. An effect passes when its held-out force error is lower than the nominal's by more than twice
@@ -19,12 +22,12 @@ Run: ``python analysis/emps_drake.py [--max-nfev N] [--effects a,b,...]`` (minut
 """
 
 import argparse
-import math
 import time
 
 import numpy as np
 
-from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, fit_delay, fit_effect, score_parameters
+from drakecreep.gap.drake_diagnosis import NOMINAL_PARAMETERS, diagnose_drake
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors
 from drakecreep.gap.identify import identify
 from drakecreep.gap.measured import load_emps
@@ -41,12 +44,6 @@ def describe(fit):
     if fit.name == "control_delay":
         return f"delay {fit.delay:.2f} samples"
     return ", ".join(f"{k}={fit.parameters[k]:.4g}" for k in DRAKE_EFFECTS[fit.name].parameters)
-
-
-def paired_gain(nominal, candidate):
-    """Mean and standard error of the per-cycle held-out force error decrease [points of %]."""
-    d = np.array([nominal[k]["force"] - candidate[k]["force"] for k in nominal])
-    return float(d.mean()), float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("inf")
 
 
 def split_half_cycles(run):
@@ -73,52 +70,33 @@ def main():
     t_start = time.perf_counter()
     est = load_emps("estimation").run()
     cycles = split_half_cycles(est)
-    train, held = cycles[0::2], cycles[1::2]
+    # alternate PAIRS of half cycles (one out, one back) so that both sets move both ways
+    train = [p for i, p in enumerate(cycles) if i % 4 in (0, 1)]
+    held = [p for i, p in enumerate(cycles) if i % 4 in (2, 3)]
     print(f"estimation file: {len(cycles)} parts between reversals, {len(train)} train / {len(held)} held out")
-    nominal = identify(train, ("viscous", "coulomb", "offset"), max_nfev=args.max_nfev)
+    diag = diagnose_drake(train, held, [e.strip() for e in args.effects.split(",")], max_nfev=args.max_nfev,
+                          progress=lambda line: print(f"  [{time.perf_counter() - t_start:5.0f} s] {line}", flush=True))
+    nominal = diag.nominal
     print("\n".join(nominal.summary()))
-    nom_held, nom_rms = score_parameters(held, nominal.parameters)
-    print(f"nominal: held-out force error {nom_rms:.3f} % (rms over cycles)   [{time.perf_counter() - t_start:.0f} s]")
-    passed = []
     print(f"{'effect':22s} {'train F%':>9s} {'held F%':>9s} {'gain':>8s} {'+-2se':>8s} {'s':>6s}")
-    for name in args.effects.split(","):
-        name = name.strip()
-        fit = fit_delay(train, held, nominal) if name == "control_delay" else \
-            fit_effect(name, train, held, nominal, max_nfev=args.max_nfev)
-        gain, se = paired_gain(nom_held, fit.test_errors)
-        if gain > 2 * se:
-            passed.append((gain, fit))
-        print(f"{name:22s} {fit.train_force_error:9.3f} {fit.test_force_error:9.3f} {gain:8.3f} {2 * se:8.3f} "
-              f"{fit.seconds:6.0f}{'  passes' if gain > 2 * se else ''}  {describe(fit)}", flush=True)
+    for r in diag.ranking:
+        print(f"{r.name:22s} {r.fit.train_force_error:9.3f} {r.fit.test_force_error:9.3f} {r.gain:8.3f} "
+              f"{2 * r.standard_error:8.3f} {r.fit.seconds:6.0f}{'  passes' if r.passes else ''}  {describe(r.fit)}")
     for name, why in NOT_RANKED.items():
         print(f"{name:22s} not ranked: {why}")
-    # greedy forward selection, best single gain first
-    passed.sort(key=lambda gf: -gf[0])
-    kept, current, current_held = [], None, nom_held
-    fitted = ["viscous", "coulomb", "offset"]
-    for _, fit in passed:
-        if current is not None:
-            fit = fit_delay(train, held, current) if fit.name == "control_delay" else \
-                fit_effect(fit.name, train, held, current, max_nfev=args.max_nfev, refit=tuple(fitted))
-        gain, se = paired_gain(current_held, fit.test_errors)
-        keep = gain > 2 * se
-        print(f"  + {fit.name:20s} on top of {' + '.join(f.name for f in kept) or 'nominal'}: held {fit.test_force_error:.3f} %, "
-              f"gain {gain:.3f} +- {2 * se:.3f} -> {'KEPT' if keep else 'dropped'}", flush=True)
-        if keep:
-            kept.append(fit)
-            current, current_held = fit, fit.test_errors
-            if fit.name != "control_delay":
-                fitted += [p for p in DRAKE_EFFECTS[fit.name].parameters if p not in fitted]
-    diag_time = time.perf_counter() - t_start
-    print(f"diagnosis on the estimation file: {diag_time:.0f} s wall")
+    print("\n".join(diag.summary()))
+    print(f"diagnosis on the estimation file: {diag.seconds:.0f} s wall")
+    diag.save_model("emps_augmented.yaml")
 
-    # the augmented model: nominal + kept effects, refitted on the whole estimation file
-    last = kept[-1] if kept else None
-    flexible = last.flexible if last else False
-    delay = last.delay if last else nominal.delay
-    fixed = dict(last.parameters if last else nominal.parameters)
-    final = identify([est], tuple(fitted), flexible=flexible, delay=delay, fixed=fixed, max_nfev=args.max_nfev)
-    print("augmented model (" + (" + ".join(f.name for f in kept) or "nothing kept") + "), fitted on DATA_EMPS.mat:")
+    # the augmented model refitted on the whole estimation file
+    fitted = list(NOMINAL_PARAMETERS)
+    for name in diag.claimed:
+        if name != "control_delay":
+            fitted += [p for p in DRAKE_EFFECTS[name].parameters if p not in fitted]
+    flexible, delay = diag.model["flexible"], diag.model["delay"]
+    final = identify([est], tuple(fitted), flexible=flexible, delay=delay, fixed=diag.model["parameters"],
+                     max_nfev=args.max_nfev)
+    print("augmented model (" + (" + ".join(diag.claimed) or "nothing claimed") + "), refitted on DATA_EMPS.mat:")
     print("\n".join(final.summary()))
     val = load_emps("validation").run()
     print(f"{'':44s} " + " ".join(f"{s:>9s}" for s in SIGNALS) + "   [% of ||y||]")

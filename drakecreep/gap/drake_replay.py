@@ -243,7 +243,7 @@ class _CompiledPP:
     """
 
     def __init__(self, builder, leaf):
-        from pydrake.systems.primitives import Demultiplexer, Multiplexer, ZeroOrderHold
+        from pydrake.systems.primitives import Multiplexer, ZeroOrderHold
 
         sym = leaf.ToSymbolic()
         ctx = sym.CreateDefaultContext()

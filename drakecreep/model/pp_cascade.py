@@ -17,7 +17,6 @@ Discrete state: ``[q[k-1] .. q[k-N] (N = len(taps)), u[k] .. u[k-n], applied]``.
 
 import math
 
-import numpy as np
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
