@@ -10,7 +10,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 
 from drakecreep.gap.drake_diagnosis import load_model  # noqa: E402
 from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors  # noqa: E402
