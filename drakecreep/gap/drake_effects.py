@@ -67,7 +67,9 @@ DRAKE_EFFECTS = {
                                      ("friction_ripple_cos", "friction_ripple_sin", "friction_period"),
                                      tuple({"friction_period": p} for p in (0.02, 0.06, 0.2)),
                                      signature="friction level that varies smoothly along the travel",
-                                     bounds={"friction_period": (2e-3, 1.0)}),
+                                     # |cos| + |sin| < 1 keeps the friction level positive everywhere
+                                     bounds={"friction_period": (2e-3, 1.0), "friction_ripple_cos": (-0.5, 0.5),
+                                             "friction_ripple_sin": (-0.5, 0.5)}),
     "position_ripple": DrakeEffect("position_ripple", ("position_ripple_cos", "position_ripple_sin", "position_period"),
                                    tuple({"position_period": p} for p in (1.25e-3, 2.5e-3, 5e-3)),
                                    signature="force ripple periodic in position (cogging, lead-error harmonic)",
