@@ -147,10 +147,11 @@ def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0
     from scipy.signal import welch
 
     total = None
+    nperseg = min(4096, min(r.n for r in runs))  # one frequency grid for runs of different lengths
     for r in runs:
         res = DrakeReplay(r, delay=delay).simulate(parameters)
-        f, p = welch(r.force - res.force, fs=1.0 / r.dt, nperseg=min(4096, r.n))
-        total = p if total is None else total + np.interp(f, f, p)
+        f, p = welch(r.force - res.force, fs=1.0 / runs[0].dt, nperseg=nperseg)
+        total = p if total is None else total + p
     band = (f >= fmin) & (f <= min(fmax, f[-1]))
     return float(f[band][np.argmax(total[band])])
 
