@@ -13,6 +13,7 @@ from pathlib import Path
 
 from drakecreep.cli._common import positive_float, print_json
 from drakecreep.errors import InputError
+from drakecreep.gap.runs import load_runs, pick  # noqa: F401 (re-exported: the library side)
 
 __all__ = ["add_parser", "run", "load_runs", "pick"]
 
@@ -38,40 +39,6 @@ def add_parser(subparsers):
     return p
 
 
-def load_runs(data, meta=None):
-    """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles."""
-    from drakecreep.gap.diagnosis import split_cycles
-    from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
-
-    if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):
-        md = load_emps(data)
-    else:
-        if not Path(data).exists():
-            raise FileNotFoundError(2, "No such file or directory", str(data))
-        md = load_measured(data, meta)
-    runs = list(md.runs)
-    if len(runs) == 1:
-        runs = split_cycles(runs[0])
-    return runs
-
-
-def pick(runs, spec, default_parity, option="--train"):
-    """Runs selected by a comma list of labels or indices, or by index parity (errors name ``option``)."""
-    if not spec:
-        return [r for i, r in enumerate(runs) if i % 2 == default_parity]
-    out = []
-    labels = [r.label for r in runs]
-    for item in spec.split(","):
-        item = item.strip()
-        if item in labels:
-            out.append(runs[labels.index(item)])
-        elif item.isascii() and item.isdigit() and len(item) < 10 and int(item) < len(runs):
-            out.append(runs[int(item)])
-        else:
-            raise InputError(option, item, "a run label or index among " + ", ".join(labels))
-    return out
-
-
 def run(args):
     """Diagnose, print the answer, write the report."""
     from drakecreep.files import check_output_dir
@@ -86,10 +53,27 @@ def run(args):
     if args.out:
         check_output_dir(args.out)
     score_runs = load_runs(args.score, None) if args.score else None
+    from drakecreep.gap.drake_replay import check_replayable
+
+    for r in train + test:  # a controller it cannot replay, a missing params file: one line, before any work
+        check_replayable(r)
+    own = [r for r in test if r.meta.controller.kind == "drakecreep"]
     cfg = DiagnosisConfig(screw_lead=args.screw_lead * 1e-3,
                           motor_period=None if args.motor_period is None else args.motor_period * 1e-3,
                           progress=not args.quiet)
-    result = diagnose(train, test, cfg)
+    # the rigid inverse-dynamics ranking; its closed-loop part replays the EMPS P-P law only
+    result = diagnose(train, test, cfg, replay=not own)
+    if own:
+        from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+
+        print(f"[diagnose] closed-loop replay of {len(own)} held-out run(s) through the project's diagram",
+              file=sys.stderr, flush=True)
+        errors = {r.label: drake_replay_errors(replay_drakecreep(r)) for r in own}
+        result["drake_replay"] = errors
+        result["summary"].append("Held-out replay through the drakecreep diagram of the params file, errors in % "
+                                 "of ||y||: " + "; ".join(
+                                     f"{k}: position {e['position']:.3g}, force {e['force']:.3g}"
+                                     for k, e in errors.items()))
     result["data"] = str(args.data)
     result["train_runs"] = [r.label for r in train]
     result["test_runs"] = [r.label for r in test]

@@ -99,7 +99,8 @@ def initial_conditions(params, scenario):
     return dict(theta0=theta0, force0=force0, x_ref0=x_ref0, theta_counted0=theta_counted)
 
 
-def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, drive=None):
+def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, drive=None, reference=None,
+                  external_force=None):
     """Wire the feed drive for ``scenario`` from ``params``.
 
     Parameters
@@ -116,6 +117,12 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         side turns at exactly the feed speed (:class:`~drakecreep.model.drive_source.ConstantSpeedDrive`, the
         paper's Fig. 2); the controller's signals are then not recorded. Default: ``scenario.drive`` if
         the scenario has one (:class:`~drakecreep.model.drive_source.DriveScenario`), else ``"cascade"``.
+    reference : pydrake System, optional
+        A system with one 2-vector output ``[x_ref (m), v_ref (m/s)]`` used instead of the ramp
+        :class:`~drakecreep.model.reference.FeedReference` (e.g. a ``TrajectorySource`` of a measured
+        reference, :mod:`drakecreep.gap.drake_replay`).
+    external_force : pydrake System, optional
+        A system with one 1-vector output, a force (N, +x) added to the push on the table.
 
     Returns
     -------
@@ -141,7 +148,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         [ic["force0"] * params.screw.lead / (2 * math.pi)] if params.motor.current_loop_time_constant > 0 else []
     )
     s = {}
-    s["reference"] = FeedReference(scenario.feed, params.simulation.acceleration_time, ic["x_ref0"])
+    s["reference"] = (FeedReference(scenario.feed, params.simulation.acceleration_time, ic["x_ref0"])
+                      if reference is None else reference)
     s["controller"] = CascadeController(
         gains, params.screw.lead, force_limit(params), initial_force=ic["force0"], initial_angle=ic["theta_counted0"]
     )
@@ -170,10 +178,20 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         ports = add_nut_friction(builder, s, params, scenario, ports)
     if "controller" in s:
         ports = add_compensation(builder, s, params, scenario, ports)
+    if external_force is not None:
+        from pydrake.systems.primitives import Adder
+
+        s["external_force"] = builder.AddSystem(external_force)
+        s["external_force"].set_name("external_force")
+        s["external_push_sum"] = push = builder.AddSystem(Adder(2, 1))
+        push.set_name("external_push_sum")
+        builder.Connect(external_force.get_output_port(0), push.get_input_port(1))
+        builder.Connect(push.get_output_port(0), ports["axial_force"])
+        ports["axial_force"] = push.get_input_port(0)
 
     c = builder.Connect
     if "controller" in s:
-        c(s["reference"].GetOutputPort("reference"), s["controller"].GetInputPort("reference"))
+        c(s["reference"].get_output_port(0), s["controller"].GetInputPort("reference"))
         c(s["encoder"].GetOutputPort("motor_measured"), s["controller"].GetInputPort("motor_measured"))
         c(s["scale"].GetOutputPort("table_position_measured"), s["controller"].GetInputPort("table_position_measured"))
         c(s["controller"].GetOutputPort("torque_command"), ports["torque"])
@@ -188,7 +206,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     signals = tuple(sig for sig in SIGNALS if sig[1][0] in s)
     for _, (system, port, _), _ in signals:
         if (system, port) not in exported:
-            builder.ExportOutput(s[system].GetOutputPort(port), f"{system}.{port}")
+            out = s[system].get_output_port(0) if system == "reference" else s[system].GetOutputPort(port)
+            builder.ExportOutput(out, f"{system}.{port}")
             exported.add((system, port))
     if s["table"].law.num_states:
         builder.ExportOutput(s["table"].GetOutputPort("friction_state"), "table.friction_state")

@@ -1,0 +1,195 @@
+"""The diagnosis on the Drake replay model: identify, rank effects on held-out runs, augment greedily.
+
+:func:`diagnose_drake` returns a typed :class:`DrakeDiagnosis` (no dict with private keys):
+
+1. nominal: :func:`drakecreep.gap.identify.identify` of viscous, Coulomb and offset on the training runs;
+2. ranking: every candidate of :data:`~drakecreep.gap.drake_effects.DRAKE_EFFECTS` (and the computation
+   delay) fitted on the training runs and replayed, fixed, on the held-out runs
+   (:class:`~drakecreep.gap.drake_effects.EffectFit`);
+3. a candidate *passes* when its held-out force error is below the reference model's by more than
+   ``k_se`` standard errors of the per-run paired differences (the threshold comes from the held-out runs'
+   own spread, not from a constant);
+4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
+   augmented so far and kept only if they pass again against it.
+
+The augmented model is what :meth:`DrakeDiagnosis.save_model` writes (YAML: the axis parameters, the
+two-mass option and the delay), and what :func:`load_model` reads back for a replay.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
+from drakecreep.gap.identify import identify
+from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
+
+__all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "paired_gain", "load_model", "NOMINAL_PARAMETERS"]
+
+NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
+
+
+def paired_gain(reference, candidate):
+    """Mean and standard error of the per-run held-out force error decrease [points of %].
+
+    Parameters
+    ----------
+    reference, candidate : dict
+        Run label -> replay errors (as :func:`drakecreep.gap.drake_replay.drake_replay_errors`).
+    """
+    d = np.array([reference[k]["force"] - candidate[k]["force"] for k in reference])
+    se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("inf")
+    return float(d.mean()), se
+
+
+@dataclass(frozen=True)
+class RankedEffect:
+    """One candidate against the nominal model: its fit, held-out gain [points of %] and whether it passes."""
+
+    fit: EffectFit
+    gain: float
+    standard_error: float
+    passes: bool
+
+    @property
+    def name(self):
+        """Effect name."""
+        return self.fit.name
+
+
+@dataclass(frozen=True)
+class DrakeDiagnosis:
+    """Result of :func:`diagnose_drake`.
+
+    Attributes
+    ----------
+    nominal : drakecreep.gap.identify.Identified
+    nominal_test_errors : dict
+        Held-out run label -> replay errors [%] of the nominal model.
+    ranking : tuple of RankedEffect
+        Best held-out gain first.
+    claimed : tuple of str
+        Effects kept by the greedy selection, in order.
+    model : dict
+        ``parameters`` (all axis parameters, SI), ``flexible``, ``delay`` of the augmented model.
+    test_errors : dict
+        Held-out replay errors [%] of the augmented model.
+    not_ranked : dict
+        Effects that are never ranked, with the reason.
+    seconds : float
+    """
+
+    nominal: object
+    nominal_test_errors: dict
+    ranking: tuple
+    claimed: tuple
+    model: dict
+    test_errors: dict
+    not_ranked: dict = field(default_factory=lambda: dict(NOT_RANKED))
+    seconds: float = 0.0
+    k_se: float = 2.0
+
+    def summary(self):
+        """Lines of text."""
+        rms = lambda errs: math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+        lines = [f"nominal held-out force error {rms(self.nominal_test_errors):.3f} %"]
+        for r in self.ranking:
+            lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, gain {r.gain:+.3f} "
+                         f"+- {self.k_se * r.standard_error:.3f}{'  passes' if r.passes else ''}")
+        if self.claimed:
+            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
+        else:
+            lines.append("claimed: nothing (no candidate improves the held-out replay beyond the run-to-run spread)")
+        return lines
+
+    def save_model(self, path):
+        """Write the augmented model as YAML (SI values with units; ``flexible``, ``delay`` [samples])."""
+        data = {"kind": "drakecreep.measured_axis", "flexible": bool(self.model["flexible"]),
+                "delay_samples": float(self.model["delay"]), "claimed": list(self.claimed),
+                "parameters": {k: float(v) for k, v in self.model["parameters"].items()},
+                "units": {k: AXIS_UNITS[k] for k in self.model["parameters"]}}
+        Path(path).write_text(yaml.safe_dump(data, sort_keys=False))
+        return Path(path)
+
+
+def load_model(path):
+    """Read a model written by :meth:`DrakeDiagnosis.save_model`: ``(parameters, flexible, delay)``."""
+    data = yaml.safe_load(Path(path).read_text())
+    if not isinstance(data, dict) or data.get("kind") != "drakecreep.measured_axis":
+        raise InputError("model", str(path), "a YAML written by DrakeDiagnosis.save_model")
+    params = data.get("parameters") or {}
+    for k in params:
+        if k not in AXIS_PARAMETERS:
+            raise InputError(f"model.parameters.{k}", params[k], "one of " + ", ".join(AXIS_PARAMETERS))
+    return dict(params), bool(data.get("flexible", False)), float(data.get("delay_samples", 0.0))
+
+
+def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=None):
+    """Diagnose the gap of the Drake replay model (see the module docstring).
+
+    Parameters
+    ----------
+    train, test : sequence of drakecreep.gap.measured.MeasuredRun
+        Fitting on ``train`` only; ``test`` is replayed with fixed parameters. At least two held-out runs
+        (the claim threshold is their paired spread).
+    effects : sequence of str, optional
+        Candidates (names of ``DRAKE_EFFECTS`` or ``"control_delay"``); default all of them.
+    max_nfev : int
+        Least-squares evaluations per start.
+    k_se : float
+        Standard errors a held-out gain must exceed.
+    progress : callable, optional
+        Called with a line of text after each step.
+
+    Returns
+    -------
+    DrakeDiagnosis
+    """
+    t0 = _time.perf_counter()
+    train, test = list(train), list(test)
+    if not train or len(test) < 2:
+        raise InputError("runs", f"{len(train)} training, {len(test)} held-out", ">= 1 training and >= 2 held-out runs")
+    names = tuple(effects) if effects is not None else tuple(DRAKE_EFFECTS) + ("control_delay",)
+    for n in names:
+        if n != "control_delay" and n not in DRAKE_EFFECTS:
+            why = NOT_RANKED.get(n, "one of " + ", ".join(tuple(DRAKE_EFFECTS) + ("control_delay",)))
+            raise InputError("effects", n, why)
+    say = progress or (lambda line: None)
+    nominal = identify(train, NOMINAL_PARAMETERS, max_nfev=max_nfev)
+    nom_test, _ = score_parameters(test, nominal.parameters)
+    say(f"nominal identified ({nominal.n_evaluations} replays)")
+    ranking = []
+    for n in names:
+        fit = fit_delay(train, test, nominal) if n == "control_delay" else fit_effect(n, train, test, nominal,
+                                                                                       max_nfev=max_nfev)
+        gain, se = paired_gain(nom_test, fit.test_errors)
+        ranking.append(RankedEffect(fit=fit, gain=gain, standard_error=se, passes=gain > k_se * se))
+        say(f"{n}: held-out gain {gain:+.3f} +- {k_se * se:.3f} points of %")
+    ranking.sort(key=lambda r: -r.gain)
+    claimed, current, current_test = [], nominal, nom_test
+    fitted = list(NOMINAL_PARAMETERS)
+    model = {"parameters": dict(nominal.parameters), "flexible": False, "delay": nominal.delay}
+    for r in ranking:
+        if not r.passes:
+            continue
+        fit = r.fit
+        if claimed:
+            fit = fit_delay(train, test, current) if r.name == "control_delay" else \
+                fit_effect(r.name, train, test, current, max_nfev=max_nfev, refit=tuple(fitted))
+        gain, se = paired_gain(current_test, fit.test_errors)
+        say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: gain {gain:+.3f} +- {k_se * se:.3f}")
+        if gain > k_se * se:
+            claimed.append(r.name)
+            current, current_test = fit, fit.test_errors
+            if r.name != "control_delay":
+                fitted += [p for p in DRAKE_EFFECTS[r.name].parameters if p not in fitted]
+            model = {"parameters": dict(fit.parameters), "flexible": fit.flexible, "delay": fit.delay}
+    return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
+                          model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se)

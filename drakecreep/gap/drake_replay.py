@@ -1,0 +1,409 @@
+"""Replay of a measured run through a Drake diagram: the measured reference drives the model in closed loop.
+
+Two diagrams, chosen by the run's controller metadata (:class:`drakecreep.gap.measured.ControllerMeta`):
+
+``kind: p_p_cascade`` (EMPS)::
+
+    TrajectorySource(x_ref, first-order hold) --x_ref--> PPCascade --force--> Adder --force--> MeasuredAxis
+    TrajectorySource(f_ext, zero-order hold) -------------------------------->  ^                |
+                                           PPCascade <--position-- motor_state (or table_state) -+
+
+  :class:`~drakecreep.model.pp_cascade.PPCascade` on the declared sample time and encoder resolution,
+  :class:`~drakecreep.model.axis.MeasuredAxis` rigid or two-mass, its coefficients numeric parameters
+  (:class:`DrakeReplay` keeps the built diagram; :meth:`DrakeReplay.simulate` takes new parameter
+  values without a rebuild).
+
+``kind: drakecreep``: the project's own feed-drive diagram (:func:`drakecreep.model.diagram.build_diagram`,
+PI cascade with the gains, sensors and mechanics of ``MeasuredMeta.params``) with its reference replaced by
+the measured one and ``f_ext`` added on the table (:func:`replay_drakecreep`).
+
+The simulated signals are sampled at the run's instants (the controller's sample times) and compared
+sample by sample: ``u``, ``x_motor``, ``x_table`` and ``force = u_gain u + f_ext``
+(:class:`DrakeReplayResult`, :func:`drake_replay_errors`).
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.symbolic import Expression, MakeVectorVariable, Variable
+from pydrake.systems.primitives import Adder, LogVectorOutput, MatrixGain, SymbolicVectorSystem, TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+
+from drakecreep.errors import InputError
+from drakecreep.gap.idim import filtered_derivatives, relative_error
+from drakecreep.model.axis import AXIS_PARAMETERS, MeasuredAxis, MeasuredAxis_, axis_parameters
+from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
+
+__all__ = [
+    "DrakeReplay",
+    "DrakeReplayResult",
+    "drake_replay",
+    "drake_replay_errors",
+    "axis_from_idim",
+    "replay_drakecreep",
+    "check_replayable",
+]
+
+
+def check_replayable(run):
+    """Raise :class:`InputError` unless the run's metadata names a controller this module can replay."""
+    ctrl = run.meta.controller
+    if ctrl is None:
+        raise InputError("controller", None, "a controller in the run metadata (p_p_cascade or drakecreep)")
+    if ctrl.kind == "drakecreep" and run.meta.params is None:
+        raise InputError("params", None, "a drakecreep params file in the metadata for controller kind drakecreep")
+    if ctrl.kind == "p_p_cascade" and abs(ctrl.sample_time - run.dt) > 1e-6 * run.dt:
+        raise InputError("controller.sample_time", ctrl.sample_time, f"the run's sample time {run.dt:g} s")
+    if run.n < 20:
+        raise InputError("run", f"{run.n} samples", "at least 20 samples")
+
+
+def axis_from_idim(params, **extra):
+    """Axis parameter values (a dict) from IDIM ``M, Fv, Fc, offset`` (mapping or IdimResult) plus ``extra``."""
+    p = params.params if hasattr(params, "params") else params
+    values = {"mass": p["M"], "viscous": p["Fv"], "coulomb": p["Fc"], "offset": p.get("offset", 0.0)}
+    values.update(extra)
+    return values
+
+
+@dataclass(frozen=True)
+class DrakeReplayResult:
+    """Simulated samples beside the measured run (arrays on ``run.t``).
+
+    ``x_motor``, ``x_table``: positions at the sample instants [m]; ``u``: controller output of each sample
+    [unit of u]; ``force``: the force ``u_gain u_applied + f_ext`` [N] at the end of sample interval
+    ``[t_k, t_k+1)`` (without a computation delay: held over the whole interval);
+    ``wall_time``: seconds the simulation took.
+    """
+
+    run: object
+    x_motor: np.ndarray
+    x_table: np.ndarray
+    u: np.ndarray
+    force: np.ndarray
+    parameters: dict = field(default_factory=dict)
+    wall_time: float = 0.0
+
+    @property
+    def x_sim(self):
+        """Alias of ``x_motor`` (the fed-back position of the EMPS loop)."""
+        return self.x_motor
+
+    @property
+    def force_sim(self):
+        """Alias of ``force``."""
+        return self.force
+
+
+class DrakeReplay:
+    """The ``p_p_cascade`` replay diagram of one run, built once.
+
+    Parameters
+    ----------
+    run : drakecreep.gap.measured.MeasuredRun
+        Reference, ``f_ext``, controller and sensor metadata, initial position.
+    flexible : bool
+        Two-mass axis (``True``) or rigid (``False``).
+    delay : float
+        Computation delay [samples], >= 0 (fractional allowed).
+    quantize : bool
+        Count the fed-back position with ``run.meta.sensors.encoder_resolution`` (or
+        ``scale_resolution`` for ``feedback: table``).
+    accuracy, max_step : float
+        Integrator (Runge-Kutta 3, error controlled) settings; ``max_step`` defaults to the sample time.
+    compiled : bool
+        Simulate the axis as a ``SymbolicVectorSystem`` made from :class:`MeasuredAxis` (no Python in the
+        integration loop, its coefficients a symbolic ``parameter`` vector) rather than the leaf system.
+    """
+
+    def __init__(self, run, flexible=False, delay=0.0, quantize=True, accuracy=1e-4, max_step=None, compiled=True):
+        check_replayable(run)
+        ctrl = run.meta.controller
+        if ctrl.kind != "p_p_cascade":
+            raise InputError("controller.kind", ctrl.kind, "p_p_cascade (use replay_drakecreep for drakecreep)")
+        if not (isinstance(delay, (int, float)) and math.isfinite(delay) and delay >= 0):
+            raise InputError("delay", delay, "a number of samples >= 0")
+        self.run, self.flexible, self.delay = run, bool(flexible), float(delay)
+        self.accuracy = float(accuracy)
+        h = run.dt
+        self.h = h
+        self.max_step = h if max_step is None else float(max_step)
+        # the controller's clock: sample k at k h (the recorded time stamps may jitter)
+        t = np.arange(run.n) * h
+        self.t = t
+        sensors = run.meta.sensors
+        res = (sensors.encoder_resolution if ctrl.feedback == "motor" else sensors.scale_resolution) if quantize else 0.0
+        b = DiagramBuilder()
+        # the reference a controller sees at t_k is x_ref[k]; a first-order hold is exact at the samples
+        ref = b.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, run.x_ref.reshape(1, -1))))
+        ref.set_name("reference")
+        f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
+        ext = b.AddSystem(TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1))))
+        ext.set_name("f_ext")
+        x0, v0 = float(run.x_motor[0]), float(run.x_motor[1] - run.x_motor[0]) / h
+        self.x0, self.v0 = x0, v0
+        n_delay = int(math.floor(self.delay))
+        history = [float(run.u[0])] * (n_delay + 1)
+        ctrl_state = pp_initial_state(ctrl.position_filter, self.delay, x0, v0, h, history)
+        self.compiled = bool(compiled)
+        leaf = PPCascade(ctrl.kp, ctrl.kv, ctrl.saturation, h, ctrl.position_filter, run.u_gain, res, self.delay,
+                         ctrl_state)
+        if self.compiled and leaf.frac == 0:
+            self.controller = _CompiledPP(b, leaf)
+        else:
+            self.controller = b.AddSystem(leaf)
+            self.controller.set_name("controller")
+        axis_x0 = [x0, v0, x0, v0] if self.flexible else [x0, v0]
+        if self.compiled:
+            self.axis = b.AddSystem(compiled_axis(self.flexible, axis_x0))
+            states = self.axis.get_output_port(0)
+            force_in = self.axis.get_input_port(0)
+            sel = {"motor": [0, 1], "table": [len(axis_x0) - 2, len(axis_x0) - 1]}
+        else:
+            self.axis = b.AddSystem(MeasuredAxis(self.flexible, axis_parameters(), axis_x0))
+            force_in = self.axis.GetInputPort("force")
+        self.axis.set_name("axis")
+        add = b.AddSystem(Adder(2, 1))
+        b.Connect(ref.get_output_port(), self.controller.GetInputPort("x_ref"))
+        b.Connect(self.controller.GetOutputPort("force"), add.get_input_port(0))
+        b.Connect(ext.get_output_port(), add.get_input_port(1))
+        b.Connect(add.get_output_port(), force_in)
+
+        def port(which):  # "motor" / "table": [x, v] of that side
+            if not self.compiled:
+                return self.axis.GetOutputPort(f"{which}_state")
+            g = np.zeros((2, len(axis_x0)))
+            g[0, sel[which][0]] = g[1, sel[which][1]] = 1.0
+            gain = b.AddSystem(MatrixGain(g))
+            b.Connect(states, gain.get_input_port())
+            return gain.get_output_port()
+
+        motor, table = port("motor"), port("table")
+        pick = b.AddSystem(MatrixGain(np.array([[1.0, 0.0]])))
+        b.Connect(motor if ctrl.feedback == "motor" else table, pick.get_input_port())
+        b.Connect(pick.get_output_port(), self.controller.GetInputPort("position"))
+        self._log_motor = LogVectorOutput(motor, b, h)
+        self._log_table = LogVectorOutput(table, b, h)
+        self._log_u = LogVectorOutput(self.controller.GetOutputPort("u"), b, h)
+        self._log_force = LogVectorOutput(self.controller.GetOutputPort("force"), b, h)
+        self.diagram = b.Build()
+        self.diagram.set_name("measured_replay")
+        self.simulator = Simulator(self.diagram)
+        self.context = self.simulator.get_mutable_context()
+        self.axis.GetMyMutableContextFromRoot(self.context).SetContinuousState(axis_x0)
+        if isinstance(self.controller, _CompiledPP):
+            self.controller.set_initial_state(self.context)
+        self._default = self.context.Clone()
+        from pydrake.systems.analysis import ResetIntegratorFromFlags
+
+        ResetIntegratorFromFlags(self.simulator, "runge_kutta3", self.max_step)
+        self.simulator.get_mutable_integrator().set_target_accuracy(self.accuracy)
+
+    def simulate(self, parameters):
+        """Simulate the run with axis parameters ``parameters`` (a dict by name; see :data:`AXIS_PARAMETERS`).
+
+        Returns
+        -------
+        DrakeReplayResult
+        """
+        start = _time.perf_counter()
+        vec = axis_parameters(**parameters)
+        self.context.SetTimeStateAndParametersFrom(self._default)
+        self.axis.GetMyMutableContextFromRoot(self.context).get_mutable_numeric_parameter(0).SetFromVector(vec)
+        for log in (self._log_motor, self._log_table, self._log_u, self._log_force):
+            log.FindMutableLog(self.context).Clear()
+        self.simulator.Initialize()
+        self.simulator.AdvanceTo(float(self.run.n * self.h))
+        n = self.run.n
+        out = {}
+        for name, log in (("motor", self._log_motor), ("table", self._log_table), ("u", self._log_u),
+                          ("force", self._log_force)):
+            lg = log.FindLog(self.context)
+            out[name] = _on_samples(lg.sample_times(), lg.data(), np.arange(n + 1) * self.h)
+        # a log taken at t_k holds the discrete state from before the update at t_k: the output of sample k
+        # (held over [t_k, t_k+1)) is the log at t_k+1
+        f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
+        return DrakeReplayResult(
+            run=self.run, x_motor=out["motor"][0][:n], x_table=out["table"][0][:n], u=out["u"][0][1:],
+            force=out["force"][0][1:] + f_ext, parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
+            wall_time=_time.perf_counter() - start)
+
+
+class _CompiledPP:
+    """:class:`PPCascade` (integer delay) as a memoryless ``SymbolicVectorSystem`` update sampled by a
+    ``ZeroOrderHold`` whose state is the controller's discrete state (as :mod:`drakecreep.sim.compiled`).
+
+    Exposes ``GetInputPort("x_ref" | "position")`` and ``GetOutputPort("force" | "u")`` like the leaf.
+    """
+
+    def __init__(self, builder, leaf):
+        from pydrake.systems.primitives import Multiplexer, ZeroOrderHold
+
+        sym = leaf.ToSymbolic()
+        ctx = sym.CreateDefaultContext()
+        n = len(leaf.initial_state)
+        xd = MakeVectorVariable(n, "xd")
+        inp = MakeVectorVariable(2, "in")
+        ctx.SetDiscreteState(0, [Expression(v) for v in xd])
+        sym.GetInputPort("x_ref").FixValue(ctx, [Expression(inp[0])])
+        sym.GetInputPort("position").FixValue(ctx, [Expression(inp[1])])
+        update = sym.EvalUniquePeriodicDiscreteUpdate(ctx).get_vector(0).CopyToVector()
+        constant = Variable("unused_constant_state")
+        self.update = builder.AddSystem(SymbolicVectorSystem(
+            state=[constant], input=np.concatenate([inp, xd]), dynamics=[Expression(0.0)], output=update))
+        self.update.set_name("controller_update")
+        self.hold = builder.AddSystem(ZeroOrderHold(leaf.period, n))
+        self.hold.set_name("controller")
+        self.mux = builder.AddSystem(Multiplexer([1, 1, n]))
+        builder.Connect(self.mux.get_output_port(0), self.update.get_input_port(0))
+        builder.Connect(self.update.get_output_port(0), self.hold.get_input_port())
+        builder.Connect(self.hold.get_output_port(), self.mux.get_input_port(2))
+        g_force = np.zeros((1, n))
+        g_force[0, n - 1] = leaf.gain
+        g_u = np.zeros((1, n))
+        g_u[0, len(leaf.taps)] = 1.0
+        self.force = builder.AddSystem(MatrixGain(g_force))
+        self.u = builder.AddSystem(MatrixGain(g_u))
+        builder.Connect(self.hold.get_output_port(), self.force.get_input_port())
+        builder.Connect(self.hold.get_output_port(), self.u.get_input_port())
+        self.initial_state = list(leaf.initial_state)
+
+    def GetInputPort(self, name):
+        return self.mux.get_input_port({"x_ref": 0, "position": 1}[name])
+
+    def GetOutputPort(self, name):
+        return {"force": self.force, "u": self.u}[name].get_output_port()
+
+    def set_initial_state(self, context):
+        self.hold.SetVectorState(self.hold.GetMyMutableContextFromRoot(context), self.initial_state)
+
+
+def compiled_axis(flexible, initial_state):
+    """:class:`MeasuredAxis` as a ``SymbolicVectorSystem``: input ``[F]``, parameters in
+    :data:`AXIS_PARAMETERS` order, output the full state ``[x_m, v_m(, x_t, v_t)]``.
+
+    The equations are the leaf system's, evaluated once on symbolic variables (``ToSymbolic``).
+    """
+    sym = MeasuredAxis_[Expression](flexible, axis_parameters(), initial_state)
+    ctx = sym.CreateDefaultContext()
+    x = MakeVectorVariable(len(initial_state), "x")
+    u = MakeVectorVariable(1, "F")
+    p = MakeVectorVariable(len(AXIS_PARAMETERS), "p")
+    time = Variable("t")
+    ctx.SetTime(Expression(time))
+    ctx.SetContinuousState([Expression(v) for v in x])
+    ctx.get_mutable_numeric_parameter(0).SetFromVector([Expression(v) for v in p])
+    sym.GetInputPort("force").FixValue(ctx, [Expression(u[0])])
+    xdot = sym.EvalTimeDerivatives(ctx).CopyToVector()
+    system = SymbolicVectorSystem(time=time, state=x, input=u, parameter=p, dynamics=xdot,
+                                  output=[Expression(v) for v in x])
+    return system
+
+
+def _on_samples(times, data, t):
+    """Columns of a log at the instants ``t`` (the last logged value at or before each instant)."""
+    idx = np.searchsorted(times, t + 1e-9 * max(1.0, float(t[-1])), side="right") - 1
+    if idx[0] < 0:
+        raise RuntimeError("the replay log starts after the first sample")
+    return data[:, idx]
+
+
+def drake_replay(run, parameters, flexible=False, delay=0.0, quantize=True):
+    """Build the replay diagram of ``run`` and simulate it once (see :class:`DrakeReplay`)."""
+    return DrakeReplay(run, flexible=flexible, delay=delay, quantize=quantize).simulate(parameters)
+
+
+def drake_replay_errors(result, cutoff=100.0, order=4):
+    """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
+
+    Velocity and acceleration of the measured and simulated motor positions go through the same IDIM
+    processing (Butterworth ``cutoff`` forward-backward, central differences); ``x_table`` is added when the
+    run has a linear scale.
+    """
+    run = result.run
+    _, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
+    _, dq_s, ddq_s = filtered_derivatives(result.x_motor, run.dt, cutoff, order)
+    out = {
+        "position": relative_error(run.x_motor, result.x_motor),
+        "velocity": relative_error(dq, dq_s),
+        "acceleration": relative_error(ddq, ddq_s),
+        "force": relative_error(run.force, result.force),
+    }
+    if run.x_table is not None:
+        out["table_position"] = relative_error(run.x_table, result.x_table)
+    return out
+
+
+def replay_drakecreep(run, params=None, quantize=True, load_case=0):
+    """Replay ``run`` through the project's feed-drive diagram (``controller: {kind: drakecreep}``).
+
+    The diagram is :func:`drakecreep.model.diagram.build_diagram` of ``params`` (default
+    ``run.meta.params``): PI cascade with ``params.controller``'s gains and periods, encoder and scale of
+    ``params.sensors`` (ideal when ``quantize`` is false), motor, elastic screw and table with their
+    friction law; the ramp reference is replaced by the measured one (``TrajectorySource`` of a
+    first-order hold, the speed its slope) and ``f_ext`` is added to the push on the table. Positions are
+    relative to the first sample (the diagram starts at rest at 0, in equilibrium under ``load_case``), and
+    simulated with ``params.simulation``'s integrator (leaf systems: a measured reference is no symbolic
+    function of time).
+
+    Parameters
+    ----------
+    run : drakecreep.gap.measured.MeasuredRun
+    params : drakecreep.params.DriveParams, optional
+    quantize : bool
+    load_case : int
+        Load case of ``params`` the run was taken under (0 = unloaded).
+
+    Returns
+    -------
+    DrakeReplayResult
+        ``u`` is the force command [N] of the cascade; ``force = u_gain u + f_ext``.
+    """
+    import dataclasses
+
+    from drakecreep.model.diagram import build_diagram
+    from drakecreep.params import DriveParams
+    from drakecreep.scenario import Scenario
+    from drakecreep.sim.simulation import make_simulator
+
+    if params is None:
+        check_replayable(run)
+        params = run.meta.params
+    if not isinstance(params, DriveParams):
+        raise InputError("params", type(params).__name__, "drakecreep DriveParams (a params file)")
+    if not quantize:
+        params = dataclasses.replace(params, sensors=dataclasses.replace(
+            params.sensors, encoder_counts_per_rev=0, scale_resolution=0.0))
+    start = _time.perf_counter()
+    t = run.t - run.t[0]
+    x_origin = float(run.x_motor[0])
+    xr = run.x_ref - x_origin
+    vr = np.gradient(xr, t)
+    reference = TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr])))
+    f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
+    ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
+    feed = float(np.max(np.abs(vr))) or 1e-6
+    scenario = Scenario(feed=min(feed, 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
+    fd = build_diagram(params, scenario, reference=reference, external_force=ext)
+    b = DiagramBuilder()
+    system = b.AddSystem(fd.diagram)
+    logs = {key: LogVectorOutput(system.GetOutputPort(key), b, run.dt)
+            for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
+    root = b.Build()
+    context = root.CreateDefaultContext()
+    simulator = make_simulator(root, context, params.simulation)
+    simulator.AdvanceTo(float(t[-1]))
+    data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
+    ratio = params.screw.lead / (2 * math.pi)
+    x_motor = data["motor.motor_state"][0] * ratio + x_origin
+    x_table = data["table.table_state"][0] + x_origin
+    u = data["controller.controller_signals"][1]
+    force = u * run.u_gain + f_ext
+    return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
+                             wall_time=_time.perf_counter() - start)

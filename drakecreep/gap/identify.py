@@ -1,0 +1,388 @@
+"""Identification of the replay axis from training runs: IDIM-LS start, then output-error refinement in Drake.
+
+1. **Start** (:func:`idim_start`): the IDIM linear least squares of :mod:`drakecreep.gap.idim` (one
+   pre-processing: Butterworth, central differences, decimation, borders) on all training runs stacked:
+   ``tau = M ddq + Fv dq + Fc sign(dq) + offset``. When every run moves one way ``sign(dq)`` and the
+   constant column are the same regressor: Coulomb and offset cannot be told apart; the offset is then
+   fixed at 0 and a warning says so.
+2. **Refinement** (:func:`identify`): the parameters the user marks as uncertain (any of
+   :data:`drakecreep.model.axis.AXIS_PARAMETERS`: friction levels, asymmetry, Stribeck level and speed,
+   axial stiffness and damping, ...) are fitted by :func:`scipy.optimize.least_squares` on the closed-loop
+   replay error: each evaluation sets the values in the context of the replay diagrams
+   (:class:`~drakecreep.gap.drake_replay.DrakeReplay`, built once per run) and simulates them. The residual
+   is, per run and sample, the drive force error over the run's force norm and the position error over
+   the run's position norm, both weighted so that each run counts equally.
+3. **Confidence** (:class:`Identified`): ``cov = s^2 (J^T J)^-1`` from the Jacobian at the solution,
+   ``s^2 = ||r||^2 / (m - p)``, times the integrated autocorrelation time of the residual (closed-loop
+   residuals are correlated in time: ``m`` samples carry about ``m / tau_int`` independent ones), 95 %
+   intervals ``+-1.96 std``. They still assume the model structure is right; a warning is raised for any pair of fitted parameters correlated beyond
+   ``|rho| > 0.95`` (not separable by these runs) and for a rank-deficient Jacobian.
+
+Parameters that must stay positive are fitted on a log scale; the others on a scale of their start value.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors
+from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
+from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
+
+__all__ = ["IdimStart", "Identified", "idim_start", "identify", "LOG_SCALED", "CORRELATION_LIMIT"]
+
+#: parameters fitted on a log scale (they must stay > 0)
+LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "damping", "viscous",
+              "coulomb", "stribeck_extra")
+#: |correlation| above which two fitted parameters are reported as not separable
+CORRELATION_LIMIT = 0.95
+_ONE_WAY_SHARE = 0.02
+
+
+@dataclass(frozen=True)
+class IdimStart:
+    """IDIM-LS on the stacked training runs: values in :data:`AXIS_PARAMETERS` names, std, warnings."""
+
+    parameters: dict
+    std: dict
+    fit_error_percent: float
+    warnings: tuple = ()
+
+
+def idim_start(runs, **preprocess):
+    """IDIM-LS start values from all training runs (one pre-processing, :func:`drakecreep.gap.idim.idim_signals`).
+
+    Parameters
+    ----------
+    runs : sequence of drakecreep.gap.measured.MeasuredRun
+    **preprocess
+        Options of :func:`~drakecreep.gap.idim.idim_signals`.
+
+    Returns
+    -------
+    IdimStart
+    """
+    runs = list(runs)
+    if not runs:
+        raise InputError("runs", 0, "at least one training run")
+    sig = [idim_signals(r, **preprocess) for r in runs]
+    dq = np.concatenate([s.dq for s in sig])
+    ddq = np.concatenate([s.ddq for s in sig])
+    tau = np.concatenate([s.tau for s in sig])
+    W = regressor(dq, ddq)
+    warnings = []
+    moving = np.abs(dq) > 1e-3 * max(np.max(np.abs(dq)), 1e-12)
+    forward = float(np.mean(dq[moving] > 0)) if moving.any() else 0.5
+    cols = list(range(len(PARAMETER_NAMES)))
+    if min(forward, 1 - forward) < _ONE_WAY_SHARE:
+        warnings.append(f"the training runs move one way ({100 * forward:.1f} % of moving samples forward): "
+                        "Coulomb friction and the offset are not separable; offset fixed at 0")
+        cols = [0, 1, 2]
+    Ws = W[:, cols]
+    if np.linalg.matrix_rank(Ws) < Ws.shape[1]:
+        raise InputError("runs", [r.label for r in runs], "motions that excite acceleration and speed")
+    theta, *_ = np.linalg.lstsq(Ws, tau, rcond=None)
+    r = tau - Ws @ theta
+    n, p = Ws.shape
+    cov = float(r @ r) / (n - p) * np.linalg.inv(Ws.T @ Ws)
+    full = np.zeros(len(PARAMETER_NAMES))
+    std = np.zeros(len(PARAMETER_NAMES))
+    full[cols] = theta
+    std[cols] = np.sqrt(np.diag(cov))
+    names = {"M": "mass", "Fv": "viscous", "Fc": "coulomb", "offset": "offset"}
+    if full[2] < 0:
+        warnings.append(f"IDIM gives a negative Coulomb level ({full[2]:.3g} N): set to 0")
+        full[2] = 0.0
+    if full[1] < 0:
+        warnings.append(f"IDIM gives a negative viscous coefficient ({full[1]:.3g} N s/m): set to 0")
+        full[1] = 0.0
+    return IdimStart(parameters={names[k]: float(v) for k, v in zip(PARAMETER_NAMES, full)},
+                     std={names[k]: float(v) for k, v in zip(PARAMETER_NAMES, std)},
+                     fit_error_percent=relative_error(tau, Ws @ theta), warnings=tuple(warnings))
+
+
+@dataclass(frozen=True)
+class Identified:
+    """Result of :func:`identify`.
+
+    Attributes
+    ----------
+    parameters : dict
+        All axis parameters (fitted and fixed), SI.
+    fitted : tuple of str
+        The names refined by output error.
+    std, ci95 : dict
+        Standard deviation and 95 % half-width of each fitted parameter (see the module docstring).
+    correlation : numpy.ndarray
+        Correlation matrix of the fitted parameters.
+    warnings : tuple of str
+        Separability and start-value warnings.
+    start : IdimStart
+    train_errors : dict
+        Run label -> replay errors [%] with the identified parameters.
+    cost_start, cost : float
+        ``0.5 ||r||^2`` at the start and at the solution.
+    n_evaluations : int
+        Replays of the training set (one per residual evaluation).
+    evaluations_per_s : float
+    flexible : bool
+    delay : float
+    """
+
+    parameters: dict
+    fitted: tuple
+    std: dict
+    ci95: dict
+    correlation: np.ndarray
+    warnings: tuple
+    start: IdimStart
+    train_errors: dict
+    cost_start: float
+    cost: float
+    n_evaluations: int
+    evaluations_per_s: float
+    flexible: bool = False
+    delay: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+    def summary(self):
+        """Lines of text: the fitted values with their intervals, the warnings."""
+        lines = [f"identified ({'two-mass' if self.flexible else 'rigid'} axis, delay {self.delay:g} samples, "
+                 f"{self.n_evaluations} replays at {self.evaluations_per_s:.2f}/s):"]
+        for name in self.fitted:
+            lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        return lines
+
+
+class _Problem:
+    def __init__(self, replays, base, names):
+        self.replays, self.base, self.names = replays, dict(base), tuple(names)
+        self.log = np.array([n in LOG_SCALED for n in self.names])
+        # x = value / scale: one unit of x is a typical size of the parameter (force terms: the Coulomb level)
+        force = max(abs(base.get("coulomb", 0.0)), 1.0)
+        typical = {"friction_drift": 1e-2, "friction_ripple_cos": 0.3, "friction_ripple_sin": 0.3,
+                   "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
+                   "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
+                   "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2}
+        # phase-like parameters: a step must move the phase over a run by much less than a cycle
+        fine = {"ripple_frequency": 1.0, "position_period": 0.01 * base["position_period"],
+                "friction_period": 0.05 * base["friction_period"]}
+        scale = []
+        for i, n in enumerate(self.names):
+            if n in fine:
+                scale.append(fine[n])
+                continue
+            scale.append(1.0 if self.log[i] else max(abs(base[n]), typical.get(n, 0.0)) or 1.0)
+        self.scale = np.array(scale)
+        self.evaluations = 0
+        self.seconds = 0.0
+        self._last = None
+
+    def to_x(self, values):
+        v = np.array([values[n] for n in self.names], dtype=float)
+        return np.where(self.log, np.log(np.maximum(v, 1e-300)), v / self.scale)
+
+    def scalar_x(self, i, value):
+        if self.log[i]:
+            return math.log(value) if value > 0 else -np.inf
+        return value / self.scale[i]
+
+    def to_values(self, x):
+        v = np.where(self.log, np.exp(x), x * self.scale)
+        out = dict(self.base)
+        out.update(zip(self.names, (float(a) for a in v)))
+        return out
+
+    def simulate(self, values):
+        start = _time.perf_counter()
+        results = [rep.simulate(values) for rep in self.replays]
+        self.evaluations += 1
+        self.seconds += _time.perf_counter() - start
+        return results
+
+    def residual(self, x):
+        x = np.asarray(x, dtype=float)
+        if self._last is not None and np.array_equal(self._last[0], x):
+            return self._last[1]
+        r = self.residual_of(self.simulate(self.to_values(x)))
+        self._last = (x.copy(), r)
+        return r
+
+    def jacobian(self, x, step, hi):
+        """Forward differences with an ABSOLUTE step in the scaled variables (backwards at an upper bound).
+
+        (scipy's ``diff_step`` is relative to ``|x|`` and falls back to ~1e-8 at ``x = 0``, where the
+        counted replay does not change at all.)
+        """
+        x = np.asarray(x, dtype=float)
+        r0 = self.residual(x)
+        J = np.empty((r0.size, x.size))
+        for i in range(x.size):
+            h = step if x[i] + step <= hi[i] else -step
+            xi = x.copy()
+            xi[i] += h
+            J[:, i] = (self.residual_of(self.simulate(self.to_values(xi))) - r0) / h
+        return J
+
+    @staticmethod
+    def residual_of(results):
+        parts = []
+        for res in results:
+            run = res.run
+            w = 1.0 / math.sqrt(run.n)
+            parts.append(w * (res.force - run.force) / (np.linalg.norm(run.force) / math.sqrt(run.n)))
+            xs = run.x_motor - run.x_motor.mean()
+            parts.append(w * (res.x_motor - run.x_motor) / (np.linalg.norm(xs) / math.sqrt(run.n) or 1.0))
+        return np.concatenate(parts)
+
+
+def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,
+             bounds=None, max_nfev=20, quantize=True, replays=None, diff_step=0.05, **preprocess):
+    """Identify the replay axis on training runs (see the module docstring).
+
+    Parameters
+    ----------
+    runs : sequence of drakecreep.gap.measured.MeasuredRun
+        Training runs (``p_p_cascade`` metadata). Never pass a validation run here.
+    uncertain : sequence of str
+        Parameters refined by output error (names of :data:`~drakecreep.model.axis.AXIS_PARAMETERS`);
+        empty: the IDIM start only.
+    flexible : bool
+        Two-mass axis.
+    delay : float
+        Computation delay [samples] of the replay.
+    fixed : dict, optional
+        Values that override the IDIM start (and the axis defaults) before refinement.
+    bounds : dict, optional
+        ``name -> (lo, hi)`` in SI for the refined parameters.
+    max_nfev : int
+        Largest number of residual evaluations of the least squares (each replays every run).
+    quantize : bool
+        Encoder counts in the replay.
+    replays : sequence of DrakeReplay, optional
+        Prebuilt replay diagrams of ``runs`` (same ``flexible``/``delay``), reused without a rebuild.
+    diff_step : float
+        Absolute finite-difference step of the Jacobian in the scaled variables (5 % of a log-scaled value, or
+        5 % of a typical size): large enough to step over the encoder's counts (the replay with a counted position
+        is only piecewise smooth in the parameters).
+    **preprocess
+        Options of the IDIM pre-processing.
+
+    Returns
+    -------
+    Identified
+    """
+    runs = list(runs)
+    uncertain = tuple(uncertain)
+    for name in uncertain:
+        if name not in AXIS_PARAMETERS:
+            raise InputError("uncertain", name, "names among " + ", ".join(AXIS_PARAMETERS))
+    if len(set(uncertain)) != len(uncertain):
+        raise InputError("uncertain", list(uncertain), "distinct names")
+    if int(max_nfev) != max_nfev or max_nfev < 1:
+        raise InputError("max_nfev", max_nfev, "an integer >= 1")
+    start = idim_start(runs, **preprocess)
+    base = dict(AXIS_PARAMETERS)
+    base.update(start.parameters)
+    base["regularization_velocity"] = _regularization(runs)
+    base.update(fixed or {})
+    warnings = list(start.warnings)
+    if any("offset fixed at 0" in w for w in warnings) and "offset" in uncertain and "coulomb" in uncertain:
+        warnings.append("'coulomb' and 'offset' both marked uncertain on one-way data: 'offset' left at 0")
+        uncertain = tuple(n for n in uncertain if n != "offset")
+    if replays is None:
+        replays = [DrakeReplay(r, flexible=flexible, delay=delay, quantize=quantize) for r in runs]
+    prob = _Problem(replays, base, uncertain)
+    r0 = prob.residual_of(prob.simulate(base))
+    cost_start = 0.5 * float(r0 @ r0)
+    values = base
+    std, ci, corr = {}, {}, np.zeros((0, 0))
+    cost = cost_start
+    if uncertain:
+        x0 = prob.to_x(base)
+        lo, hi = np.full(x0.size, -np.inf), np.full(x0.size, np.inf)
+        for i, name in enumerate(uncertain):
+            if bounds and name in bounds:
+                lo[i], hi[i] = (prob.scalar_x(i, b) for b in bounds[name])
+                if not lo[i] < hi[i]:
+                    raise InputError(f"bounds.{name}", bounds[name], "(lo, hi) with lo < hi (lo > 0 on a log scale)")
+        x0 = np.clip(x0, np.where(np.isfinite(lo), lo + 1e-9, lo), np.where(np.isfinite(hi), hi - 1e-9, hi))
+        sol = least_squares(prob.residual, x0, jac=lambda x: prob.jacobian(x, diff_step, hi), bounds=(lo, hi),
+                            method="trf", x_scale=1.0,
+                            max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)
+        values = prob.to_values(sol.x)
+        cost = float(sol.cost)
+        std, ci, corr, more = _confidence(sol, prob, values)
+        warnings += more
+    results = prob.simulate(values)
+    errors = {res.run.label + (f"#{i}" if sum(r.run.label == res.run.label for r in results) > 1 else ""):
+              drake_replay_errors(res) for i, res in enumerate(results)}
+    rate = prob.evaluations / prob.seconds if prob.seconds > 0 else float("nan")
+    return Identified(parameters=values, fitted=uncertain, std=std, ci95=ci, correlation=corr,
+                      warnings=tuple(warnings), start=start, train_errors=errors, cost_start=cost_start, cost=cost,
+                      n_evaluations=prob.evaluations, evaluations_per_s=rate, flexible=bool(flexible),
+                      delay=float(delay))
+
+
+def _regularization(runs):
+    """``tanh`` width of the friction: 1 % of the median moving speed, within [1e-5, 1e-3] m/s."""
+    speeds = []
+    for r in runs:
+        v = np.abs(np.diff(r.x_ref)) / r.dt
+        speeds.append(np.median(v[v > 0]) if np.any(v > 0) else 1e-3)
+    return float(np.clip(0.01 * np.median(speeds), 1e-5, 1e-3))
+
+
+def _correlation_time(r, limit=0.05, max_lag=2000):
+    """Integrated autocorrelation time ``1 + 2 sum rho(k)`` (summed while ``rho > limit``) of a residual."""
+    r = np.asarray(r, dtype=float) - np.mean(r)
+    n = r.size
+    if n < 4 or not np.any(r):
+        return 1.0
+    f = np.fft.rfft(r, 2 * n)
+    acf = np.fft.irfft(f * np.conj(f))[: min(n, max_lag)]
+    acf = acf / acf[0]
+    tau = 1.0
+    for k in range(1, acf.size):
+        if acf[k] < limit:
+            break
+        tau += 2.0 * acf[k]
+    return float(tau)
+
+
+def _confidence(sol, prob, values):
+    """Std, 95 % half-widths and correlations of the fitted parameters (SI) from the Jacobian."""
+    J = sol.jac
+    m, p = J.shape
+    # residuals of a closed-loop replay are correlated in time: count independent samples as m / tau_int
+    inflation = _correlation_time(sol.fun)
+    s2 = 2.0 * sol.cost / max(m - p, 1)
+    # d value / d x: the chain rule of the scaling
+    v = np.array([values[n] for n in prob.names])
+    dvdx = np.where(prob.log, v, prob.scale)
+    Jv = J / dvdx
+    warnings = []
+    JTJ = Jv.T @ Jv
+    rank = np.linalg.matrix_rank(JTJ)
+    cov = inflation * s2 * np.linalg.pinv(JTJ)
+    if rank < p:
+        warnings.append(f"the replay error does not depend on {p - rank} combination(s) of "
+                        + ", ".join(prob.names) + ": not identifiable from these runs")
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    corr = np.nan_to_num(corr)
+    for i in range(p):
+        for j in range(i + 1, p):
+            if abs(corr[i, j]) > CORRELATION_LIMIT:
+                warnings.append(f"{prob.names[i]} and {prob.names[j]} are not separable by these runs "
+                                f"(correlation {corr[i, j]:+.3f})")
+    std = dict(zip(prob.names, (float(x) for x in sd)))
+    return std, {k: 1.96 * s for k, s in std.items()}, corr, warnings

@@ -1,0 +1,207 @@
+"""A feed axis for replaying measured runs: rigid or two-mass, friction with identifiable parameters.
+
+Rigid (``flexible=False``), state ``[x, v]``::
+
+    M dv/dt = F + r(x, t) - f(v, x, t) - offset
+
+Two-mass (``flexible=True``), state ``[x_m, v_m, x_t, v_t]``: the motor side (rotor, coupling and screw
+reflected to the table, ``m_m = motor_mass_fraction * M``) and the table (``m_t = M - m_m``) joined by
+the axial stiffness ``k`` and damping ``c`` of the screw chain::
+
+    m_m dv_m/dt = F + r(x_m, t) - k (x_m - x_t) - c (v_m - v_t)
+    m_t dv_t/dt = k (x_m - x_t) + c (v_m - v_t) - f(v_t) - offset
+
+with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecreep.model.friction`)::
+
+    f(v) = L(x, t) [s(v) (Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)) + (Fv + dFv s(v)) v]
+    L(x, t) = 1 + fc cos(2 pi x / Lf) + fs sin(2 pi x / Lf) + drift t      (position-dependent, thermal)
+
+and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
+plus a fixed time frequency ``f_r``)::
+
+    r(x_m, t) = pc cos(2 pi x_m / Lp) + ps sin(2 pi x_m / Lp) + tc cos(2 pi f_r t) + ts sin(2 pi f_r t)
+
+``dFc``, ``dFv`` make it asymmetric (``Fc + dFc`` forward, ``Fc - dFc`` backward). ``F`` is the drive
+force plus any external force (input ``force``, N). The offset is the constant force of the IDIM
+model (``tau = M ddq + Fv dq + Fc sign(dq) + offset``, :mod:`drakecreep.gap.idim`).
+
+Every coefficient is a Drake *numeric parameter* (:data:`AXIS_PARAMETERS`): an identification sets
+them in the context (:func:`set_axis_parameters`) and simulates the same diagram again, without a
+rebuild.
+"""
+
+import math
+
+import numpy as np
+from pydrake.systems.framework import BasicVector_, LeafSystem_
+from pydrake.systems.scalar_conversion import TemplateSystem
+
+from drakecreep.errors import InputError
+from drakecreep.model._scalar import exp, tanh, vector
+from drakecreep.model.disturbances import cos, sin
+
+__all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
+           "set_axis_parameters", "axis_friction"]
+
+#: numeric parameters, in order, with their default values
+AXIS_PARAMETERS = {
+    "mass": 1.0,
+    "viscous": 0.0,
+    "viscous_asym": 0.0,
+    "coulomb": 0.0,
+    "coulomb_asym": 0.0,
+    "offset": 0.0,
+    "stribeck_extra": 0.0,
+    "stribeck_velocity": 1e-3,
+    "regularization_velocity": 1e-3,
+    "motor_mass_fraction": 0.2,
+    "stiffness": 1e8,
+    "damping": 0.0,
+    "position_ripple_cos": 0.0,
+    "position_ripple_sin": 0.0,
+    "position_period": 2.5e-3,
+    "friction_ripple_cos": 0.0,
+    "friction_ripple_sin": 0.0,
+    "friction_period": 0.1,
+    "time_ripple_cos": 0.0,
+    "time_ripple_sin": 0.0,
+    "ripple_frequency": 50.0,
+    "friction_drift": 0.0,
+}
+AXIS_UNITS = {
+    "mass": "kg", "viscous": "N s/m", "viscous_asym": "N s/m", "coulomb": "N", "coulomb_asym": "N", "offset": "N",
+    "stribeck_extra": "N", "stribeck_velocity": "m/s", "regularization_velocity": "m/s",
+    "motor_mass_fraction": "-", "stiffness": "N/m", "damping": "N s/m",
+    "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
+    "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
+    "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
+}
+_POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "position_period",
+             "friction_period", "ripple_frequency")
+_NAMES = tuple(AXIS_PARAMETERS)
+
+
+def axis_parameters(**values):
+    """Validated parameter vector (defaults of :data:`AXIS_PARAMETERS` for the names not given)."""
+    out = dict(AXIS_PARAMETERS)
+    for name, value in values.items():
+        if name not in out:
+            raise InputError(f"axis.{name}", value, "one of " + ", ".join(_NAMES))
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            raise InputError(f"axis.{name}", value, "a finite number") from None
+        if not math.isfinite(x) or (name in _POSITIVE and x <= 0):
+            raise InputError(f"axis.{name}", value, "a finite number" + (" > 0" if name in _POSITIVE else ""))
+        out[name] = x
+    if not 0 < out["motor_mass_fraction"] < 1:
+        raise InputError("axis.motor_mass_fraction", out["motor_mass_fraction"], "a number in (0, 1)")
+    return np.array([out[n] for n in _NAMES])
+
+
+def axis_friction(v, p, x=0.0, t=0.0):
+    """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] for a parameter vector
+    ``p`` (order of :data:`AXIS_PARAMETERS`)."""
+    P = dict(zip(_NAMES, p))
+    s = tanh(v / P["regularization_velocity"])
+    w = v / P["stribeck_velocity"]
+    phase = 2.0 * math.pi * x / P["friction_period"]
+    level = (1.0 + P["friction_ripple_cos"] * cos(phase) + P["friction_ripple_sin"] * sin(phase)
+             + P["friction_drift"] * t)
+    return level * (s * (P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w))
+                    + (P["viscous"] + P["viscous_asym"] * s) * v)
+
+
+def axis_ripple(x, t, p):
+    """Position-periodic (cogging, lead-error harmonic force) plus time-periodic ripple force [N] along +x."""
+    P = dict(zip(_NAMES, p))
+    a = 2.0 * math.pi * x / P["position_period"]
+    b = 2.0 * math.pi * P["ripple_frequency"] * t
+    return (P["position_ripple_cos"] * cos(a) + P["position_ripple_sin"] * sin(a)
+            + P["time_ripple_cos"] * cos(b) + P["time_ripple_sin"] * sin(b))
+
+
+def set_axis_parameters(axis, context, **values):
+    """Write parameters (by name) into ``axis``'s context (``context``: the root context of its diagram
+    or its own); the others keep their value."""
+    vec = axis.GetMyMutableContextFromRoot(context).get_mutable_numeric_parameter(0)
+    for name, value in values.items():
+        if name not in AXIS_PARAMETERS:
+            raise InputError(f"axis.{name}", value, "one of " + ", ".join(_NAMES))
+        vec.SetAtIndex(_NAMES.index(name), float(value))
+
+
+@TemplateSystem.define("MeasuredAxis_")
+def MeasuredAxis_(T):
+    class Impl(LeafSystem_[T]):
+        """Rigid or two-mass axis with parameterised friction.
+
+        Input ports
+        -----------
+        force : 1, drive plus external force (N)
+
+        Output ports
+        ------------
+        motor_state : 2, ``[x_m (m), v_m (m/s)]`` (the motor encoder's view)
+        table_state : 2, ``[x_t (m), v_t (m/s)]`` (the linear scale's view; = motor_state when rigid)
+        friction_force : 1, ``f(v_t)`` (N)
+        """
+
+        def _construct(self, flexible=False, parameters=None, initial_state=None, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.flexible = bool(flexible)
+            self.parameters = axis_parameters() if parameters is None else np.asarray(parameters, dtype=float)
+            if self.parameters.shape != (len(_NAMES),):
+                raise InputError("axis.parameters", self.parameters.shape, f"{len(_NAMES)} values")
+            n = 4 if self.flexible else 2
+            self.initial_state = [0.0] * n if initial_state is None else [float(v) for v in initial_state]
+            if len(self.initial_state) != n:
+                raise InputError("axis.initial_state", len(self.initial_state), f"{n} entries")
+            self.DeclareContinuousState(BasicVector_[T](self.initial_state), num_q=n // 2, num_v=n // 2, num_z=0)
+            self.DeclareNumericParameter(BasicVector_[T](self.parameters))
+            self._force = self.DeclareVectorInputPort("force", 1)
+            deps = {self.xc_ticket(), self.all_parameters_ticket()}
+            self.DeclareVectorOutputPort("motor_state", 2, self._calc_motor, prerequisites_of_calc=deps)
+            self.DeclareVectorOutputPort("table_state", 2, self._calc_table, prerequisites_of_calc=deps)
+            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction, prerequisites_of_calc=deps)
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.flexible, other.parameters, other.initial_state, converter=converter)
+
+        def _p(self, context):
+            return context.get_numeric_parameter(0).CopyToVector()
+
+        def DoCalcTimeDerivatives(self, context, derivatives):
+            x = context.get_continuous_state_vector().CopyToVector()
+            p = self._p(context)
+            P = dict(zip(_NAMES, p))
+            F = self._force.Eval(context)[0]
+            t = context.get_time()
+            if self.flexible:
+                m_m = P["motor_mass_fraction"] * P["mass"]
+                m_t = P["mass"] - m_m
+                spring = P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
+                a_m = (F + axis_ripple(x[0], t, p) - spring) / m_m
+                a_t = (spring - axis_friction(x[3], p, x[2], t) - P["offset"]) / m_t
+                rates = [x[1], a_m, x[3], a_t]
+            else:
+                push = F + axis_ripple(x[0], t, p) - axis_friction(x[1], p, x[0], t) - P["offset"]
+                rates = [x[1], push / P["mass"]]
+            derivatives.get_mutable_vector().SetFromVector(vector(rates))
+
+        def _calc_motor(self, context, output):
+            x = context.get_continuous_state_vector().CopyToVector()
+            output.SetFromVector(vector([x[0], x[1]]))
+
+        def _calc_table(self, context, output):
+            x = context.get_continuous_state_vector().CopyToVector()
+            output.SetFromVector(vector([x[-2], x[-1]]))
+
+        def _calc_friction(self, context, output):
+            x = context.get_continuous_state_vector().CopyToVector()
+            output.SetAtIndex(0, axis_friction(x[-1], self._p(context), x[-2], context.get_time()))
+
+    return Impl
+
+
+MeasuredAxis = MeasuredAxis_[None]

@@ -1,0 +1,47 @@
+"""diagnose_drake: a typed diagnosis on runs with a known, withheld effect."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_diagnosis import DrakeDiagnosis, diagnose_drake, load_model
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import load_emps
+
+TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=4.0, viscous_asym=-40.0)
+
+
+@pytest.fixture(scope="module")
+def runs():
+    full = load_emps("estimation").runs[0]
+    out = []
+    for seed, a in enumerate((0, 3000, 6000, 9000, 12000)):
+        run = full.slice(a, a + 1000)
+        res = DrakeReplay(run).simulate(TRUTH)
+        u = res.u + np.random.default_rng(seed).normal(0.0, 0.5 / run.u_gain, res.u.size)
+        out.append(dataclasses.replace(run, x_motor=res.x_motor, u=u, label=f"w{a}"))
+    return out
+
+
+def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
+    diag = diagnose_drake(runs[:2], runs[2:], effects=("asymmetric_friction", "thermal_drift"), max_nfev=4)
+    assert isinstance(diag, DrakeDiagnosis)
+    assert diag.claimed == ("asymmetric_friction",)
+    assert diag.ranking[0].name == "asymmetric_friction" and diag.ranking[0].passes
+    # while moving, coulomb_asym * s(v)^2 is a constant like the offset: only their sum is well determined
+    p = diag.model["parameters"]
+    assert abs(p["coulomb_asym"] + p["offset"] - (4.0 + PUBLISHED_IDIM["offset"])) < 0.3
+    assert abs(p["viscous_asym"] + 40.0) < 8.0
+    params, flexible, delay = load_model(diag.save_model(tmp_path / "augmented.yaml"))
+    assert params == pytest.approx(diag.model["parameters"]) and not flexible and delay == 0.0
+    assert any("claimed: asymmetric_friction" in line for line in diag.summary())
+
+
+def test_bad_requests(runs):
+    with pytest.raises(InputError, match="effects"):
+        diagnose_drake(runs[:2], runs[2:], effects=("backlash",))
+    with pytest.raises(InputError, match="runs"):
+        diagnose_drake(runs[:2], runs[2:3])

@@ -1,0 +1,64 @@
+"""Effects switched into the Drake replay model (drakecreep.gap.drake_effects) on runs with a known truth."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, fit_effect, residual_peak_frequency
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.identify import identify
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import load_emps
+
+NOMINAL = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3)
+
+
+def _runs(truth, starts=(0, 5000, 10000, 15000), n=1200):
+    full = load_emps("estimation").runs[0]
+    out = []
+    for seed, a in enumerate(starts):
+        run = full.slice(a, a + n)
+        res = DrakeReplay(run).simulate(truth)
+        u = res.u + np.random.default_rng(seed).normal(0.0, 0.5 / run.u_gain, res.u.size)
+        out.append(dataclasses.replace(run, x_motor=res.x_motor, u=u, label=f"w{a}"))
+    return out
+
+
+def test_a_time_ripple_is_found_at_its_frequency_and_shrinks_the_held_out_replay():
+    truth = dict(NOMINAL, time_ripple_cos=6.0, time_ripple_sin=-3.0, ripple_frequency=37.0)
+    runs = _runs(truth)
+    train, test = runs[0::2], runs[1::2]
+    nominal = identify(train, (), fixed={"regularization_velocity": 1e-3})
+    assert abs(residual_peak_frequency(train, nominal.parameters) - 37.0) < 1.0
+    fit = fit_effect("time_ripple", train, test, nominal, max_nfev=12, refit=())
+    assert abs(fit.parameters["ripple_frequency"] - 37.0) < 0.2
+    assert abs(fit.parameters["time_ripple_cos"] - 6.0) < 1.0
+    assert abs(fit.parameters["time_ripple_sin"] + 3.0) < 1.0
+    from drakecreep.gap.drake_effects import score_parameters
+
+    _, nominal_test = score_parameters(test, nominal.parameters)
+    assert fit.test_force_error < 0.8 * nominal_test
+
+
+def test_effects_outside_the_replay_axis_are_refused_not_ranked():
+    assert not set(NOT_RANKED) & set(DRAKE_EFFECTS)
+    with pytest.raises(InputError, match="backlash"):
+        fit_effect("backlash", [], [], None)
+    with pytest.raises(InputError, match="effect"):
+        fit_effect("nonsense", [], [], None)
+
+
+def test_compiled_axis_carries_every_effect_term():
+    run = load_emps("estimation").runs[0].slice(0, 400)
+    p = dict(NOMINAL, stribeck_extra=3.0, stribeck_velocity=5e-3, coulomb_asym=1.5, viscous_asym=-20.0,
+             friction_ripple_cos=0.1, friction_period=0.05, position_ripple_sin=2.0, time_ripple_cos=3.0,
+             ripple_frequency=40.0, friction_drift=0.01)
+    for flexible in (False, True):
+        p2 = dict(p, stiffness=3e6, damping=300.0) if flexible else p
+        a = DrakeReplay(run, flexible=flexible).simulate(p2)
+        b = DrakeReplay(run, flexible=flexible, compiled=False).simulate(p2)
+        c = DrakeReplay(run, flexible=flexible).simulate(dict(NOMINAL, stiffness=3e6, damping=300.0))
+        assert np.max(np.abs(a.x_motor - b.x_motor)) < 1e-9
+        assert np.max(np.abs(a.u - c.u)) > 1e-3  # the terms act

@@ -1,0 +1,111 @@
+"""The replay through the Drake diagram (drakecreep.gap.drake_replay) on a slice of the EMPS estimation run."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim, drake_replay_errors, replay_drakecreep
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun, load_emps
+from drakecreep.gap.replay import replay
+from drakecreep.model.sensors import quantize
+
+
+@pytest.fixture(scope="module")
+def run():
+    return load_emps("estimation").runs[0].slice(0, 1500)
+
+
+@pytest.fixture(scope="module")
+def nominal(run):
+    return DrakeReplay(run).simulate(axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-4))
+
+
+def test_controller_follows_the_documented_law(run, nominal):
+    """u[k] recomputed from the simulated motor position (counts, 2-tap mean, difference, clip) is the logged u."""
+    c = run.meta.controller
+    q = quantize(nominal.x_motor, run.meta.sensors.encoder_resolution)
+    qf = 0.5 * q[1:] + 0.5 * q[:-1]
+    dq = np.diff(qf) / run.dt
+    u = np.clip(c.kp * c.kv * (run.x_ref[2:] - q[2:]) - c.kv * dq, -c.saturation, c.saturation)
+    assert np.max(np.abs(u - nominal.u[2:])) < 1e-9 * c.saturation
+    # the force held over sample k is gain * u[k] (no delay) plus f_ext
+    assert np.allclose(nominal.force, run.u_gain * nominal.u)
+
+
+def test_rigid_drake_replay_matches_the_exact_stepper(run, nominal):
+    """Same plant, same controller: the Drake diagram and the exact piecewise stepper agree."""
+    exact = replay(run, PUBLISHED_IDIM, quantize=True)
+    travel = np.ptp(run.x_motor)
+    assert np.max(np.abs(nominal.x_motor - exact.x_sim)) < 2e-4 * travel
+    assert np.linalg.norm(nominal.u - exact.u_sim) < 0.03 * np.linalg.norm(exact.u_sim)
+
+
+def test_compiled_and_leaf_paths_agree(run, nominal):
+    leaf = DrakeReplay(run, compiled=False).simulate(axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-4))
+    assert np.max(np.abs(leaf.x_motor - nominal.x_motor)) < 1e-9
+    assert np.max(np.abs(leaf.u - nominal.u)) < 1e-6
+
+
+def test_parameters_change_without_rebuild(run, nominal):
+    rep = DrakeReplay(run)
+    heavy = rep.simulate(axis_from_idim(dict(PUBLISHED_IDIM, M=2 * PUBLISHED_IDIM["M"]), regularization_velocity=1e-4))
+    again = rep.simulate(axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-4))
+    assert np.max(np.abs(again.x_motor - nominal.x_motor)) < 1e-9
+    assert drake_replay_errors(heavy)["force"] > drake_replay_errors(again)["force"]
+
+
+@pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
+def test_computation_delay_holds_older_outputs(run, delay, shift):
+    """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later."""
+    short = run.slice(0, 300)
+    res = DrakeReplay(short, delay=delay).simulate(axis_from_idim(PUBLISHED_IDIM))
+    assert np.allclose(res.force[shift:], run.u_gain * res.u[:res.u.size - shift])
+    if delay % 1:
+        whole = DrakeReplay(short, delay=delay - 0.5).simulate(axis_from_idim(PUBLISHED_IDIM))
+        later = DrakeReplay(short, delay=delay + 0.5).simulate(axis_from_idim(PUBLISHED_IDIM))
+        gap_lo = np.abs(res.x_motor - whole.x_motor).max()
+        gap_hi = np.abs(res.x_motor - later.x_motor).max()
+        assert 0 < gap_lo < np.abs(later.x_motor - whole.x_motor).max()
+        assert 0 < gap_hi < np.abs(later.x_motor - whole.x_motor).max()
+
+
+def test_two_mass_axis_with_a_stiff_screw_is_the_rigid_axis(run, nominal):
+    stiff = DrakeReplay(run, flexible=True, max_step=2e-4).simulate(axis_from_idim(
+        PUBLISHED_IDIM, regularization_velocity=1e-4, stiffness=1e9, damping=2e4, motor_mass_fraction=0.2))
+    assert np.max(np.abs(stiff.x_motor - nominal.x_motor)) < 1e-4 * np.ptp(run.x_motor)
+    soft = DrakeReplay(run, flexible=True).simulate(axis_from_idim(
+        PUBLISHED_IDIM, regularization_velocity=1e-4, stiffness=2e6, damping=200.0))
+    assert np.max(np.abs(soft.x_table - soft.x_motor)) > 1e-6  # the screw stretches
+
+
+def test_bad_metadata_is_refused_before_work(run):
+    slow = dataclasses.replace(run.meta, controller=dataclasses.replace(run.meta.controller, sample_time=2e-3))
+    with pytest.raises(InputError, match="sample_time"):
+        DrakeReplay(dataclasses.replace(run, meta=slow))
+    own = dataclasses.replace(run.meta, controller=ControllerMeta(kind="drakecreep"), params=None)
+    with pytest.raises(InputError, match="params"):
+        replay_drakecreep(dataclasses.replace(run, meta=own))
+    with pytest.raises(InputError, match="delay"):
+        DrakeReplay(run, delay=-1)
+
+
+def test_drakecreep_kind_replays_its_own_simulation():
+    """A run simulated by the project's diagram, replayed through it from its measured reference, comes back."""
+    from drakecreep.params import preset
+    from drakecreep.scenario import Scenario
+    from drakecreep.sim.simulation import simulate
+
+    p = preset("rigid_axis")
+    p = dataclasses.replace(p, simulation=dataclasses.replace(p.simulation, log_period=1e-3, steady_start=0.05))
+    sim = simulate(p, Scenario(feed=0.01, load_case=0, duration=0.15), backend="compiled")
+    s = sim.signals
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=p, controller=ControllerMeta(kind="drakecreep"))
+    run = MeasuredRun(t=sim.time, x_ref=s["x_ref"], x_motor=s["motor_position"], u=s["force_command"], meta=meta,
+                      x_table=s["table_position"])
+    back = replay_drakecreep(run)
+    assert np.max(np.abs(back.x_motor - run.x_motor)) < 1e-7
+    assert np.max(np.abs(back.x_table - run.x_table)) < 1e-7
+    assert np.linalg.norm(back.u - run.u) < 0.01 * np.linalg.norm(run.u)

@@ -1,0 +1,57 @@
+"""Identification (drakecreep.gap.identify) on runs whose truth is known: the Drake replay's own output."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.errors import InputError
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.identify import identify, idim_start
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import load_emps
+
+TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb=24.0, viscous=180.0, offset=-2.0)
+
+
+def _synthetic(run, truth, seed):
+    """The run with x_motor and u replaced by the replay of ``truth`` (plus force noise of 0.5 N rms)."""
+    res = DrakeReplay(run).simulate(truth)
+    rng = np.random.default_rng(seed)
+    u = res.u + rng.normal(0.0, 0.5 / run.u_gain, res.u.size)
+    return dataclasses.replace(run, x_motor=res.x_motor, u=u)
+
+
+@pytest.fixture(scope="module")
+def runs():
+    full = load_emps("estimation").runs[0]
+    # 1.5 s windows with both directions of motion
+    return [_synthetic(full.slice(a, a + 1500), TRUTH, seed) for seed, a in enumerate((0, 5000))]
+
+
+def test_output_error_recovers_the_friction_of_a_known_axis(runs):
+    idf = identify(runs, uncertain=("viscous", "coulomb", "offset"), max_nfev=6,
+                   fixed={"mass": PUBLISHED_IDIM["M"], "regularization_velocity": 1e-3})
+    for name in ("viscous", "coulomb", "offset"):
+        assert abs(idf.parameters[name] - TRUTH[name]) < max(3 * idf.ci95[name], 0.02 * abs(TRUTH[name])), name
+        assert idf.ci95[name] > 0
+    assert idf.cost <= idf.cost_start
+    assert idf.n_evaluations >= 4 and idf.evaluations_per_s > 0
+
+
+def test_one_way_runs_warn_that_coulomb_and_offset_are_not_separable():
+    full = load_emps("estimation").runs[0]
+    v = np.diff(full.x_ref)
+    start = int(np.argmax(v > 1e-6 * full.dt))
+    stop = start + int(np.argmax(v[start:] <= 0))
+    one_way = full.slice(max(start - 100, 0), stop)
+    st = idim_start([one_way])
+    assert any("not separable" in w for w in st.warnings)
+    assert st.parameters["offset"] == 0.0
+
+
+def test_identify_refuses_unknown_names(runs):
+    with pytest.raises(InputError, match="uncertain"):
+        identify(runs, uncertain=("friction",))
+    with pytest.raises(InputError, match="bounds.coulomb"):
+        identify(runs[:1], uncertain=("coulomb",), bounds={"coulomb": (30.0, 10.0)})
