@@ -27,10 +27,12 @@ def test_rigid_axis_differs_from_paper_only_where_marked(paper):
     # the compensation study variant: every changed value carries a [variant] comment
     text = preset_text("rigid_axis")
     marked = {line.split(":")[0].strip() for line in text.splitlines() if "[variant]" in line and not line.startswith("#")}
-    assert marked == {"bearing_stiffness", "axial_stiffness", "velocity_gain", "velocity_integral_gain"}
+    assert marked == {"bearing_stiffness", "axial_stiffness", "velocity_gain", "velocity_integral_gain",
+                      "preload_torque", "load_friction_coefficient", "nut_friction_on"}  # the former nut (issue 15)
     rigid = preset("rigid_axis")
     changed = {"screw.bearing_stiffness", "nut.axial_stiffness", "controller.velocity_gain",
-               "controller.velocity_integral_gain"}
+               "controller.velocity_integral_gain", "nut.preload_torque", "nut.load_friction_coefficient",
+               "friction.nut_friction_on"}
     for path in changed:
         assert get_value(rigid, path) != get_value(paper, path)
     for path in changed:

@@ -43,6 +43,7 @@ from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.paper.creep import friction_slope
 from drakecreep.model.diagram import build_diagram, build_plant
 from drakecreep.errors import InputError
+from drakecreep.params import with_value
 from drakecreep.model.friction import make_friction_law
 from drakecreep.model.motor import motor_inertia
 from drakecreep.model.screw import ScrewDrive, axial_damping, axial_stiffness, screw_inertia
@@ -119,6 +120,20 @@ class OperatingPoint:
         return (self.damping + self.friction_slope) / (2.0 * math.sqrt(self.stiffness * self.mass))
 
 
+def nut_on_table(params):
+    """``params`` with the ball nut's friction lumped on the table for the linear analysis.
+
+    The linearization (operating point, plant, controller, closed loop) models one friction law on the
+    table; the nut's drag on the screw (``friction.nut_friction_on: screw``, the default since issue 15) is
+    not linearized yet, so its level is lumped with the guides' here: the same total Coulomb level and
+    steady motor torque, but its slope acts at the table's speed instead of the screw's. An approximation,
+    stated in ``docs/physics_review.md``.
+    """
+    if params.friction.nut_friction_on == "table":
+        return params
+    return with_value(params, "friction.nut_friction_on", "table")
+
+
 def operating_point(params, scenario):
     """Steady sliding state of ``build_diagram(params, scenario, continuous=True, ideal_sensors=True)``.
 
@@ -141,6 +156,7 @@ def operating_point(params, scenario):
     """
     if params.friction.law == "gms":
         raise InputError("friction.law", "gms", "coulomb, stribeck or lugre (linearization needs a smooth law)")
+    params = nut_on_table(params)
     g = params.controller
     v = scenario.feed
     load = params.load_case(scenario.load_case)
@@ -252,6 +268,7 @@ def linearize_plant(params, scenario, op=None):
         Input ``torque_command`` (N m); outputs :data:`PLANT_OUTPUTS` (rad, rad/s, m, m/s, N, N);
         states ``motor.theta, motor.omega(, motor.tau), table.x, table.v(, table.w)``.
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     plant = build_plant(params, scenario.load_case)
     ports = [plant.GetOutputPort(n) for n in ("motor_state", "table_state", "axial_force", "friction_force")]
@@ -277,6 +294,7 @@ def linearize_controller(params, scenario, op=None):
         Inputs :data:`CONTROLLER_INPUTS` (m, m/s, rad, rad/s, m); output ``torque_command`` (N m);
         state ``controller.integrator`` (N). Unsaturated, so the anti-windup term has no slope.
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     ctrl = CascadeController(_continuous_gains(params), params.screw.lead, force_limit(params),
                              initial_force=op.controller[0])
@@ -306,6 +324,7 @@ def closed_loop_derivatives(params, scenario, op=None, state=None):
     (ndarray, ndarray)
         The state vector used and its time derivative, in the diagram's state order.
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     fd = build_diagram(params, scenario, continuous=True, ideal_sensors=True)
     context = fd.diagram.CreateDefaultContext()
@@ -326,6 +345,7 @@ def linearize_closed_loop(params, scenario, op=None):
         No inputs (the reference is inside the diagram); outputs the diagram's recorded signals
         (:data:`drakecreep.model.diagram.SIGNALS` names); its poles are the closed-loop poles.
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     fd = build_diagram(params, scenario, continuous=True, ideal_sensors=True)
     d = fd.diagram
@@ -379,6 +399,7 @@ def linearize_mechanism(params, scenario, op=None):
         friction_force``; for a static friction law its poles are the roots of
         ``M s^2 + (C + C1) s + K`` (paper eq. 2).
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     b = DiagramBuilder()
     screw = b.AddSystem(ScrewDrive(params.screw, params.nut))
@@ -414,6 +435,7 @@ def two_mass_model(params, scenario, op=None):
     control.StateSpace
         Input ``torque_command``; outputs ``motor_speed`` (rad/s) and ``table_speed`` (m/s).
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     r = params.screw.lead / (2.0 * math.pi)
     J = motor_inertia(params.motor, screw_inertia(params.screw))
@@ -447,6 +469,7 @@ def finite_difference_jacobian(params, scenario, op=None, rel_step=1e-6):
     ndarray
         ``n x n``, in the diagram's state order (compare with ``linearize_closed_loop(...).A``).
     """
+    params = nut_on_table(params)
     op = op or operating_point(params, scenario)
     x0, _ = closed_loop_derivatives(params, scenario, op)
     fd = build_diagram(params, scenario, continuous=True, ideal_sensors=True)

@@ -7,14 +7,14 @@ from drakecreep.cli import main
 
 
 def test_simulate_json(tmp_path, capsys):
-    code = main(["simulate", "--feed", "0.1", "--duration", "1.5", "--load-case", "1", "--out", str(tmp_path), "--json",
+    code = main(["simulate", "--feed", "0.2", "--duration", "1.5", "--load-case", "1", "--out", str(tmp_path), "--json",
                  "--no-plot"])
     assert code == 0
     out = json.loads(capsys.readouterr().out)
     for key in ("mean_speed_mm_s", "max_fluctuation_mm_s", "fluctuation_rate_percent", "stick_fraction",
                 "stick_slip_cycles", "sim_time_s", "wall_time_s"):
         assert key in out
-    assert out["stick_slip_cycles"] > 0 and out["mean_speed_mm_s"] == pytest.approx(0.1, rel=0.01)
+    assert out["stick_slip_cycles"] > 0 and out["mean_speed_mm_s"] == pytest.approx(0.2, rel=0.01)
     assert (tmp_path / "timeseries.csv").exists() and (tmp_path / "metrics.json").exists()
 
 

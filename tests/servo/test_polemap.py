@@ -38,6 +38,9 @@ def test_scale_stiffness_keeps_damping(paper):
 
 
 def test_pole_map_small(paper):
+    # at the nut friction level this map was measured with (0.01 N m, 0.01: 26 N at load case 3); with the
+    # catalogue nut (157 N) the simulated point above the boundary still creeps at 0.1 mm/s
+    paper = with_value(with_value(paper, "nut.preload_torque", 0.01), "nut.load_friction_coefficient", 0.01)
     sc = Scenario(feed=0.1e-3, load_case=3)
     pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=3, sim_grid=(1, 2))
     assert pm.closed_loop.shape == (3, 2) == pm.damping.shape

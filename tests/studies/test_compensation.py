@@ -105,11 +105,9 @@ def test_feedforward_and_dither_do_not_remove_creep_within_reach(within_reach):
         assert within_reach[("static", feed)]["creep"] and within_reach[("static", feed)]["fluctuation_vs_none"] > 0.9
         assert within_reach[("dither", feed)]["creep"] and within_reach[("dither", feed)]["fluctuation_vs_none"] > 0.9
     assert within_reach[("dither", 0.02)]["fluctuation_vs_none"] < 0.5
-    # The earlier claim "the measured-speed model chatters about zero speed at 0.02 mm/s" (1.6-2.3x none) does
-    # not survive the merged model's convergence check: run at 1e-4 and checked against 1e-5 and 1e-6, the
-    # static-measured run at 0.02 mm/s slides (0.0012 mm/s against 0.18 without compensation, converged).
-    # That is the converged answer; the assertion of chatter was removed rather than kept on an unconverged run.
-    assert not within_reach[("static-measured", 0.02)]["creep"]
+    # (the former claim "the measured-speed model chatters about zero speed at 0.02 mm/s" was an integrator
+    # artefact: 2149 % at accuracy 1e-4, 115 % at 1e-5, and 1e-5 vs 1e-6 still disagree -- the convergence
+    # check of issue 15 reports it unconverged, so nothing is asserted about that row)
 
 
 def test_lugre_lowers_the_critical_speed_within_reach():
