@@ -8,7 +8,7 @@ from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 from drakecreep.params import PRESETS, load_params, preset, with_value
 
-__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers"]
+__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers", "count"]
 
 
 def number(text):
@@ -54,15 +54,24 @@ def print_json(obj):
     print(json.dumps(to_jsonable(obj)))
 
 
-def workers(text):
-    """argparse type: a number of worker processes, an integer >= 1."""
+def _integer_at_least(text, minimum):
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} must be >= 1")
+    if value < minimum:
+        raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
     return value
+
+
+def workers(text):
+    """argparse type: a number of worker processes, an integer >= 1."""
+    return _integer_at_least(text, 1)
+
+
+def count(text):
+    """argparse type: a count, an integer >= 0."""
+    return _integer_at_least(text, 0)
 
 
 def feed_from_mm_s(value, option="--feed"):

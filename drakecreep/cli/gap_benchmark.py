@@ -2,21 +2,9 @@
 
 import sys
 
-from drakecreep.cli._common import print_json
+from drakecreep.cli._common import count, print_json
 
 __all__ = ["add_parser", "run"]
-
-
-def _count(text):
-    import argparse
-
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if n < 0:
-        raise argparse.ArgumentTypeError(f"{n} must be >= 0")
-    return n
 
 
 def add_parser(subparsers):
@@ -30,10 +18,10 @@ def add_parser(subparsers):
                    help=f"held-out seeds (from {HELDOUT_SEEDS}, reported) or development seeds (from {DEV_SEEDS})")
     p.add_argument("--kinds", nargs="+", choices=CONTROLLER_KINDS, default=list(CONTROLLER_KINDS),
                    help="controller kinds of the truth")
-    p.add_argument("--n-per-effect", type=_count, default=10, help="datasets per library effect with SNR >= 3 (default 10)")
-    p.add_argument("--n-null", type=_count, default=10, help="null datasets per controller kind (default 10)")
-    p.add_argument("--n-ool", type=_count, default=6, help="datasets per out-of-library effect and kind (default 6)")
-    p.add_argument("--samples", type=_count, default=3000, help="samples per run at 1 kHz (default 3000)")
+    p.add_argument("--n-per-effect", type=count, default=10, help="datasets per library effect with SNR >= 3 (default 10)")
+    p.add_argument("--n-null", type=count, default=10, help="null datasets per controller kind (default 10)")
+    p.add_argument("--n-ool", type=count, default=6, help="datasets per out-of-library effect and kind (default 6)")
+    p.add_argument("--samples", type=count, default=3000, help="samples per run at 1 kHz (default 3000)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
