@@ -370,7 +370,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0):
     from drakecreep.model.diagram import build_diagram
     from drakecreep.params import DriveParams
     from drakecreep.scenario import Scenario
-    from drakecreep.sim.simulation import make_simulator
+    from drakecreep.sim.simulation import make_simulator, target_accuracy
 
     if params is None:
         check_replayable(run)
@@ -397,7 +397,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0):
             for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
     root = b.Build()
     context = root.CreateDefaultContext()
-    simulator = make_simulator(root, context, params.simulation)
+    simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
     simulator.AdvanceTo(float(t[-1]))
     data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
     ratio = params.screw.lead / (2 * math.pi)
