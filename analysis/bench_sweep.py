@@ -28,6 +28,7 @@ import time
 import numpy as np
 from numba import njit
 
+from drakecreep.sim.simulation import target_accuracy
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
@@ -185,7 +186,7 @@ def run_numba(params, scenario):
     lag = model.lag > 0
     scales = np.array([1.0, 1.0] + ([1.0] if lag else []) + [1e-3, 1e-3] + [1.0] * model.nz)
     return simulate_rk3(pack(params, scenario), s0, np.array(xd0, dtype=float), scenario.duration,
-                        params.simulation.max_step, params.simulation.accuracy, scales, 3 + lag)
+                        params.simulation.max_step, target_accuracy(params), scales, 3 + lag)
 
 
 # --------------------------------------------------------------------------- measurements

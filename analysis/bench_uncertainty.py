@@ -23,6 +23,7 @@ import time
 import numpy as np
 import pandas as pd
 
+from drakecreep.sim.simulation import target_accuracy
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
@@ -96,13 +97,13 @@ def main():
             params = base
             for path in spec.paths:
                 params = with_value(params, path, float(row[path]))
-            params = with_value(params, "simulation.accuracy", base.simulation.accuracy / 10)
+            params = with_value(params, "simulation.accuracy", target_accuracy(base) / 10)
             tight = simulate(params, Scenario(feed=float(row["feed"]), load_case=3, duration=args.duration))
             same = bool(tight.metrics.creep) == bool(row["creep"])
             agree += same
             if not same:
                 flips.append((int(row["rig"]), float(row["feed"]) * 1e3, bool(row["creep"])))
-        print(f"\nconvergence: {agree}/{len(pick)} verdicts unchanged at accuracy {base.simulation.accuracy / 10:g} "
+        print(f"\nconvergence: {agree}/{len(pick)} verdicts unchanged at accuracy {target_accuracy(base) / 10:g} "
               f"({time.perf_counter() - t0:.0f} s); changed (rig, feed mm/s, default verdict): {flips}")
 
     if args.holdout is not None:

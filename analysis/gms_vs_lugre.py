@@ -11,6 +11,7 @@ Run: ``python analysis/gms_vs_lugre.py [--preset paper]``
 
 import argparse
 
+from drakecreep.sim.simulation import target_accuracy
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
@@ -32,9 +33,9 @@ def main():
     base = preset(args.preset)
     variants = [
         ("lugre", {"friction.law": "lugre"}),
-        ("lugre, accuracy/10", {"friction.law": "lugre", "simulation.accuracy": base.simulation.accuracy / 10}),
+        ("lugre, accuracy/10", {"friction.law": "lugre", "simulation.accuracy": target_accuracy(base) / 10}),
         ("gms N=4 C=1e4", {"friction.law": "gms"}),
-        ("gms N=4 C=1e4, accuracy/10", {"friction.law": "gms", "simulation.accuracy": base.simulation.accuracy / 10}),
+        ("gms N=4 C=1e4, accuracy/10", {"friction.law": "gms", "simulation.accuracy": target_accuracy(base) / 10}),
         ("gms N=1 C=1e4", {"friction.law": "gms", "friction.gms_elements": 1}),
         ("gms N=8 C=1e4", {"friction.law": "gms", "friction.gms_elements": 8}),
         ("gms N=4 C=1e3", {"friction.law": "gms", "friction.gms_attraction": 1e3}),
