@@ -33,10 +33,8 @@ import numpy as np
 from drakecreep.gap.effects import (
     EFFECTS,
     EffectContext,
-    Term,
     get_effect,
     idim_data,
-    position_grid_step,
     replay_with_effects,
 )
 from drakecreep.errors import InputError
@@ -481,7 +479,7 @@ def diagnose(train_runs, test_runs, config=None, replay=True):
     base = fit_effect((), train, test, ctx, {})
     nominal = base.nominal
     ratio = None
-    _log(cfg, f"nominal: " + ", ".join(f"{k}={v:.4g}" for k, v in nominal.items()))
+    _log(cfg, "nominal: " + ", ".join(f"{k}={v:.4g}" for k, v in nominal.items()))
     names = cfg.effects or tuple(e.name for e in EFFECTS)
     ranking = []
     not_identifiable = []

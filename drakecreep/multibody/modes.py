@@ -165,7 +165,7 @@ def linearize_mechanics(drive, context=None):
     plant.SetVelocities(pc, np.zeros(plant.num_velocities()))
     lin = FirstOrderTaylorApproximation(plant, pc, input_port_index=InputPortSelection.kNoInput,
                     output_port_index=OutputPortSelection.kNoOutput)
-    nq, nv = plant.num_positions(), plant.num_velocities()
+    nq = plant.num_positions()
     a = lin.A()
     mass = plant.CalcMassMatrix(pc)
     n_map = plant.MakeVelocityToQDotMap(pc)

@@ -221,7 +221,6 @@ class BatchedFeedDrive(LeafSystem):
         discrete_state.get_mutable_vector().SetFromVector(np.concatenate([v_cmd, integ, counted, force, tick]))
 
     def _output(self, context, output):
-        c = self.c
         _, _, _, x, v, _ = self._split(context.get_continuous_state_vector().CopyToVector())
         x_ref, _ = self._reference(context.get_time())
         output.SetFromVector(np.concatenate([x_ref, x, v]))
