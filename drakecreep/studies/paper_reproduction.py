@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from drakecreep.errors import InputError
+from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.model.lumped import lumped
 from drakecreep.paper.creep import critical_speed_of
 from drakecreep.params import get_value, preset, with_value
@@ -220,13 +221,16 @@ def check_trends(rows):
     return out
 
 
-def simulated_creep_boundary(params, load_case, lo=0.01e-3, hi=2e-3, points=8, iterations=6, duration=2.0):
+def simulated_creep_boundary(params, load_case, lo=0.01e-3, hi=2e-3, points=8, iterations=6, duration=2.0,
+                             drive="cascade"):
     """Critical speed (m/s): the upper edge of the feeds that creep under ``load_case``, from simulations.
 
     A feed creeps when the table stops in the steady window (:attr:`FeedMetrics.creep`). The model
     need not creep at every feed below the edge (the paper preset creeps from ~0.05 to ~0.25 mm/s and
     not slower), so ``points`` feeds spaced evenly in log between ``lo`` and ``hi`` are simulated first,
     then the step from the highest creeping one to the next is bisected (in log speed).
+    ``drive="constant_speed"`` simulates the paper's Fig. 2 mechanism instead of the servo drive (the motor
+    side turns at exactly the feed speed: :class:`~drakecreep.model.drive_source.DriveScenario`).
 
     Returns
     -------
@@ -239,7 +243,8 @@ def simulated_creep_boundary(params, load_case, lo=0.01e-3, hi=2e-3, points=8, i
     p = with_value(params, "simulation.steady_start", min(params.simulation.steady_start, 0.5 * duration))
 
     def creeps(v):
-        return simulate(p, Scenario(feed=float(v), load_case=load_case, duration=duration)).metrics.creep
+        return simulate(p, scenario_with_drive(drive, feed=float(v), load_case=load_case,
+                                               duration=duration)).metrics.creep
 
     feeds = np.geomspace(lo, hi, points)
     flags = [creeps(v) for v in feeds]
