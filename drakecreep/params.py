@@ -375,6 +375,10 @@ class ControllerParams(_Params):
     sampled: bool = field(default=True, metadata=dict(unit="-", doc="discrete controller; false = continuous"))
     velocity_period: float = _q(2.5e-4, "s", 0.0, 0.1, lo_open=True, doc="velocity loop sample time")
     position_period: float = _q(1.0e-3, "s", 0.0, 1.0, lo_open=True, doc="position loop sample time")
+    computation_delay: float = _q(
+        1.0, "samples", 0.0, 100.0,
+        doc="sampled only: velocity samples from reading the encoder to applying the command (fractions allowed)",
+    )
 
     def _check(self):
         ratio = self.position_period / self.velocity_period
