@@ -490,6 +490,11 @@ class CompensationParams(_Params):
         "motor", "-", choices=("motor", "table"),
         doc="measured speed of static/lugre: motor encoder (semi-closed) or table speed (ideal linear scale)",
     )
+    speed_source: str = _q(
+        "encoder", "-", choices=("encoder", "ideal"),
+        doc="sampled controller: compensators run at the velocity-loop rate on the backward difference of the "
+            "counts, output held and delayed like the command (encoder), or continuously on the true speed (ideal)",
+    )
 
 
 @dataclass(frozen=True)
