@@ -6,7 +6,7 @@ difference, output held and delayed like the command) and ``ideal`` (continuous,
 one Markdown table: per method, load case and feed, the speed fluctuation (mm/s) and its ratio to no
 compensation under each source.
 
-Run: python analysis/compensation_speed_source.py [PRESET] [--feeds 0.05,0.1,0.2] [--load-cases 1,2,3]
+Run: python analysis/compensation_speed_source.py [PRESET] [--feeds 0.05,0.1,0.2] [--load-cases 1,2,3] [--delay N]
      python analysis/compensation_speed_source.py --from DIR_ENCODER DIR_IDEAL   (rows.json of two
      ``drakecreep compensate --speed-source ... --out DIR`` runs)
 """
@@ -35,6 +35,7 @@ def table(by_source):
     head = "| method | load | feed (mm/s) | " + " | ".join(
         f"{s}: fluct. (mm/s) | {s}: x none | {s}: creep" for s in SOURCES) + " |"
     lines = [head, "|" + " --- |" * (3 + 3 * len(SOURCES))]
+    unconverged = []
     for key in keys:
         cells = []
         for s in SOURCES:
@@ -43,9 +44,14 @@ def table(by_source):
                 cells += ["-", "-", "-"]
                 continue
             ratio = r.get("fluctuation_vs_none", float("nan"))
-            cells += [f"{r['max_fluctuation_mm_s']:.4f}", "" if key[0] == "none" else f"{ratio:.2f}",
+            mark = "" if r.get("converged") in (True, None) else " (u)"
+            if mark:
+                unconverged.append((s,) + key)
+            cells += [f"{r['max_fluctuation_mm_s']:.4f}{mark}", "" if key[0] == "none" else f"{ratio:.2f}",
                       "yes" if r["creep"] else "no"]
         lines.append(f"| {key[0]} | {key[1]} | {key[2]:g} | " + " | ".join(cells) + " |")
+    lines.append("")
+    lines.append(f"(u): the run's convergence check disagreed (metrics.converged false): {len(unconverged)} rows")
     return "\n".join(lines)
 
 
@@ -56,12 +62,15 @@ def main(argv=None):
     ap.add_argument("--load-cases", default="1,2,3")
     ap.add_argument("--duration", type=float, default=2.0)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--delay", type=float, default=None, help="controller.computation_delay (default: the preset's)")
     ap.add_argument("--from", dest="dirs", nargs=2, metavar=("DIR_ENCODER", "DIR_IDEAL"))
     a = ap.parse_args(argv)
     if a.dirs:
         by_source = {s: json.loads((Path(d) / "rows.json").read_text())["rows"] for s, d in zip(SOURCES, a.dirs)}
     else:
         params = preset(a.preset)
+        if a.delay is not None:
+            params = with_value(params, "controller.computation_delay", a.delay)
         feeds = [float(x) for x in a.feeds.split(",")]
         loads = [int(x) for x in a.load_cases.split(",")]
         by_source = {s: rows_for(params, s, feeds, loads, a.duration, a.workers) for s in SOURCES}
