@@ -47,7 +47,7 @@ def table(by_source):
             mark = "" if r.get("converged") in (True, None) else " (u)"
             if mark:
                 unconverged.append((s,) + key)
-            cells += [f"{r['max_fluctuation_mm_s']:.4f}{mark}", "" if key[0] == "none" else f"{ratio:.2f}",
+            cells += [f"{r['max_fluctuation_mm_s']:.3g}{mark}", "" if key[0] == "none" else f"{ratio:.2g}",
                       "yes" if r["creep"] else "no"]
         lines.append(f"| {key[0]} | {key[1]} | {key[2]:g} | " + " | ".join(cells) + " |")
     lines.append("")
