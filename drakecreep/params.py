@@ -375,6 +375,10 @@ class ControllerParams(_Params):
     sampled: bool = field(default=True, metadata=dict(unit="-", doc="discrete controller; false = continuous"))
     velocity_period: float = _q(2.5e-4, "s", 0.0, 0.1, lo_open=True, doc="velocity loop sample time")
     position_period: float = _q(1.0e-3, "s", 0.0, 1.0, lo_open=True, doc="position loop sample time")
+    computation_delay: float = _q(
+        1.0, "samples", 0.0, 100.0,
+        doc="sampled only: velocity samples from reading the encoder to applying the command (fractions allowed)",
+    )
 
     def _check(self):
         ratio = self.position_period / self.velocity_period
@@ -485,6 +489,11 @@ class CompensationParams(_Params):
     velocity_source: str = _q(
         "motor", "-", choices=("motor", "table"),
         doc="measured speed of static/lugre: motor encoder (semi-closed) or table speed (ideal linear scale)",
+    )
+    speed_source: str = _q(
+        "encoder", "-", choices=("encoder", "ideal"),
+        doc="sampled controller: compensators run at the velocity-loop rate on the backward difference of the "
+            "counts, output held and delayed like the command (encoder), or continuously on the true speed (ideal)",
     )
 
 

@@ -177,7 +177,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     if drive != "constant_speed":
         ports = add_nut_friction(builder, s, params, scenario, ports)
     if "controller" in s:
-        ports = add_compensation(builder, s, params, scenario, ports)
+        ports = add_compensation(builder, s, params, scenario, ports, angle0=ic["theta_counted0"],
+                                 torque0=ic["force0"] * params.screw.lead / (2 * math.pi))
     if external_force is not None:
         from pydrake.systems.primitives import Adder
 
