@@ -25,7 +25,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors
+from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay",
@@ -134,7 +134,7 @@ def _rms(values):
 
 def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=None):
     """Replay ``runs`` with FIXED parameters: ``({label: errors}, rms force error [%])`` (no fitting)."""
-    replays = replays or [DrakeReplay(r, flexible=flexible, delay=delay) for r in runs]
+    replays = replays or [make_replay(r, flexible=flexible, delay=delay, free=()) for r in runs]
     errors = {}
     for i, rep in enumerate(replays):
         label = rep.run.label if rep.run.label not in errors else f"{rep.run.label}#{i}"
@@ -149,7 +149,7 @@ def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0
     total = None
     nperseg = min(4096, min(r.n for r in runs))  # one frequency grid for runs of different lengths
     for r in runs:
-        res = DrakeReplay(r, delay=delay).simulate(parameters)
+        res = make_replay(r, delay=delay, free=()).simulate(parameters)
         f, p = welch(r.force - res.force, fs=1.0 / runs[0].dt, nperseg=nperseg)
         total = p if total is None else total + p
     band = (f >= fmin) & (f <= min(fmax, f[-1]))
@@ -189,7 +189,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         starts = ({"ripple_frequency": f},)
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
     flexible = effect.flexible or nominal.flexible
-    replays = [DrakeReplay(r, flexible=flexible, delay=nominal.delay) for r in train]
+    replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
     best = None
     for start in starts:
         fixed = dict(base)
