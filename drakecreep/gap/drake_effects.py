@@ -22,10 +22,9 @@ import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors, make_replay
+from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay",
@@ -156,7 +155,7 @@ def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0
     return float(f[band][np.argmax(total[band])])
 
 
-def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset")):
+def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset"), starts=None):
     """Fit ``effect`` on ``train`` (with the nominal friction ``refit`` refined too) and score it on ``test``.
 
     Parameters
@@ -170,6 +169,9 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         Least-squares evaluations per start.
     refit : tuple of str
         Nominal parameters refined together with the effect's.
+    starts : sequence of dict, optional
+        Start values instead of the effect's own starts (e.g. the best start of the inverse-dynamics screen,
+        :func:`drakecreep.gap.screen.screen_effect`).
 
     Returns
     -------
@@ -183,10 +185,16 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         effect = DRAKE_EFFECTS[effect]
     t0 = _time.perf_counter()
     base = dict(nominal.parameters)
-    starts = effect.starts
-    if effect.name == "time_ripple":
-        f = residual_peak_frequency(train, base, delay=nominal.delay)
-        starts = ({"ripple_frequency": f},)
+    if starts is not None:
+        starts = tuple(dict(x) for x in starts)
+    elif effect.name == "axial_mode":
+        # one start: the largest peak of the nominal replay's force residual between 5 and 300 Hz
+        starts = ({"axial_mode_hz": residual_peak_frequency(train, base, fmin=5.0, fmax=300.0,
+                                                             delay=nominal.delay)},)
+    elif effect.name == "time_ripple":
+        starts = ({"ripple_frequency": residual_peak_frequency(train, base, delay=nominal.delay)},)
+    else:
+        starts = effect.starts
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
     flexible = effect.flexible or nominal.flexible
     replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
@@ -212,9 +220,12 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
                      test_errors=test_errors, seconds=_time.perf_counter() - t0)
 
 
-def fit_delay(train, test, nominal, *, max_delay=3.0, xatol=0.05):
-    """The computation delay [samples] as a continuous parameter: a bounded scalar search on the training
-    replay's cost (the delay is structural, so each value builds its replay diagrams), then a score on ``test``.
+def fit_delay(train, test, nominal, *, max_delay=3.0, start=None):
+    """The computation delay [samples]: the training replay's cost at every whole delay ``0 .. max_delay``
+    (the sampled fast path) and at ``start`` (a fractional value, e.g. the inverse-dynamics scan of
+    :func:`drakecreep.gap.screen.screen_delay`, replayed by :class:`~drakecreep.gap.drake_replay.DrakeReplay`); the lowest cost wins and is
+    scored on ``test``. (A full continuous search rebuilds a leaf-controller diagram per value: about 10x
+    the cost; see docs/gap_diagnosis.md.)
 
     Returns
     -------
@@ -227,12 +238,17 @@ def fit_delay(train, test, nominal, *, max_delay=3.0, xatol=0.05):
     flexible = nominal.flexible
 
     def cost(d):
-        prob = _Problem([DrakeReplay(r, delay=d, flexible=flexible) for r in train], base, ())
+        prob = _Problem([make_replay(r, delay=d, flexible=flexible, free=()) for r in train], base, ())
         r = prob.residual_of(prob.simulate(base))
         return 0.5 * float(r @ r)
 
-    sol = minimize_scalar(cost, bounds=(0.0, float(max_delay)), method="bounded", options={"xatol": xatol})
-    d = float(sol.x)
+    if not (isinstance(max_delay, (int, float)) and 0 <= max_delay <= 10):
+        raise InputError("max_delay", max_delay, "a number of samples in [0, 10]")
+    delays = [float(d) for d in range(int(math.floor(max_delay)) + 1)]
+    if start is not None and 0 <= start <= max_delay and float(start) not in delays:
+        delays.append(float(start))
+    costs = [cost(d) for d in delays]
+    d = delays[int(np.argmin(costs))]
     train_errors, train_rms = score_parameters(train, base, delay=d, flexible=flexible)
     test_errors, test_rms = score_parameters(test, base, delay=d, flexible=flexible)
     return EffectFit(name="control_delay", parameters=base, identified=None, delay=d, flexible=flexible,

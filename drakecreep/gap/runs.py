@@ -10,7 +10,7 @@ from drakecreep.errors import InputError
 __all__ = ["load_runs", "pick"]
 
 
-def load_runs(data, meta=None):
+def load_runs(data, meta=None, split=True):
     """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles.
 
     Parameters
@@ -20,6 +20,8 @@ def load_runs(data, meta=None):
         (CSV, Parquet, HDF5, or ``.mat`` with ``meta``; see ``docs/measured_format.md``).
     meta : str or path, optional
         Metadata YAML of a measured run (default: beside it).
+    split : bool
+        Split a single-run file into out-and-back cycles (False: the file's runs as they are).
 
     Returns
     -------
@@ -35,7 +37,7 @@ def load_runs(data, meta=None):
             raise FileNotFoundError(2, "No such file or directory", str(data))
         md = load_measured(data, meta)
     runs = list(md.runs)
-    if len(runs) == 1:
+    if split and len(runs) == 1:
         runs = split_cycles(runs[0])
     return runs
 
