@@ -27,7 +27,7 @@ from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
 
-__all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay",
+__all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
            "score_parameters", "residual_peak_frequency"]
 
 
@@ -141,8 +141,14 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
     return errors, _rms(e["force"] for e in errors.values())
 
 
-def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0):
-    """Frequency [Hz] of the largest peak of the replay force residual's spectrum (Welch), over ``runs``."""
+def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0, prominent=False):
+    """Frequency [Hz] of the largest peak of the replay force residual's spectrum (Welch), over ``runs``.
+
+    ``prominent``: the peak that stands highest above the spectrum's running median (in log scale), not the
+    largest value (a closed-loop residual's spectrum falls with frequency: its largest value sits at the low
+    end of any band; a structural mode is a narrow peak above its neighbours).
+    """
+    from scipy.ndimage import median_filter
     from scipy.signal import welch
 
     total = None
@@ -152,7 +158,32 @@ def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0
         f, p = welch(r.force - res.force, fs=1.0 / runs[0].dt, nperseg=nperseg)
         total = p if total is None else total + p
     band = (f >= fmin) & (f <= min(fmax, f[-1]))
+    if prominent:
+        logp = np.log10(np.maximum(total, 1e-300))
+        lift = logp - median_filter(logp, size=15, mode="nearest")
+        return float(f[band][np.argmax(lift[band])])
     return float(f[band][np.argmax(total[band])])
+
+
+def physical_bounds(effect, base, fmin=5.0, fmax=300.0):
+    """Bounds that depend on the model being augmented (SI, ``name -> (lo, hi)``).
+
+    * ``axial_mode``: stiffness between the values that put the two-mass mode at ``fmin`` and ``fmax`` Hz
+      (the issue's 5-300 Hz search; a fit at the upper bound means "no mode below it") and damping up to
+      twice the critical damping at ``fmax``; this also keeps the sampled replay's sub-step count bounded;
+    * ``stribeck``: Stribeck speed at least twice the friction's regularization speed (below it the Stribeck
+      term and the ``tanh`` regularization are the same shape) and at most 0.1 m/s.
+    """
+    out = {}
+    if effect.name == "axial_mode":
+        share = base.get("motor_mass_fraction", 0.2)
+        m_red = share * (1 - share) * base["mass"]
+        k = [(2 * math.pi * f) ** 2 * m_red for f in (fmin, fmax)]
+        c_hi = 2.0 * 2.0 * math.sqrt(k[1] * m_red)
+        out = {"stiffness": (k[0], k[1]), "damping": (1e-4 * c_hi, c_hi)}
+    elif effect.name == "stribeck":
+        out = {"stribeck_velocity": (2.0 * base.get("regularization_velocity", 1e-3), 0.1)}
+    return out
 
 
 def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset"), starts=None):
@@ -188,15 +219,17 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
     if starts is not None:
         starts = tuple(dict(x) for x in starts)
     elif effect.name == "axial_mode":
-        # one start: the largest peak of the nominal replay's force residual between 5 and 300 Hz
+        # one start: the most prominent peak of the nominal replay's force residual between 5 and 300 Hz
         starts = ({"axial_mode_hz": residual_peak_frequency(train, base, fmin=5.0, fmax=300.0,
-                                                             delay=nominal.delay)},)
+                                                             delay=nominal.delay, prominent=True)},)
     elif effect.name == "time_ripple":
         starts = ({"ripple_frequency": residual_peak_frequency(train, base, delay=nominal.delay)},)
     else:
         starts = effect.starts
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
     flexible = effect.flexible or nominal.flexible
+    bounds = dict(effect.bounds)
+    bounds.update(physical_bounds(effect, base))
     replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
     best = None
     for start in starts:
@@ -210,7 +243,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
             fixed.update(stiffness=k, damping=0.05 * 2 * math.sqrt(k * share * (1 - share) * m))
         fixed.update(start)
         idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixed,
-                       bounds=effect.bounds, max_nfev=max_nfev, replays=replays)
+                       bounds=bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:
             best = idf
     train_rms = _rms(e["force"] for e in best.train_errors.values())

@@ -205,12 +205,17 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     starts = [dict(s) for s in effect.starts]
     if effect.name == "time_ripple":
         starts = [{"ripple_frequency": f} for f in _peak_frequencies(tr, base, effect.bounds["ripple_frequency"])]
+    from drakecreep.gap.drake_effects import physical_bounds
+
+    bounds = dict(effect.bounds)
+    bounds.update(physical_bounds(effect, base))
     for key, dense in _DENSE.items():
         if key in effect.parameters:
-            starts = [dict(s, **{key: v}) for s in starts[:1] for v in dense]
+            lo, hi = bounds.get(key, (-np.inf, np.inf))
+            starts = [dict(s, **{key: v}) for s in starts[:1] for v in dense if lo < v < hi] or starts
     best, best_cost = None, math.inf
     for s in starts:
-        values, cost = _fit(tr, base, names, s, effect.bounds)
+        values, cost = _fit(tr, base, names, s, bounds)
         if cost < best_cost:
             best, best_cost = values, cost
     train_err = _errors(tr, best)
@@ -250,7 +255,9 @@ def screen_delay(train, nominal_parameters, *, max_delay=3.0, step=0.05):
     base.update(nominal_parameters)
     best, best_err = 0.0, math.inf
     for d in np.arange(0.0, max_delay + 1e-9, step):
-        err = _rms(_errors([_signals(r, d) for r in train], base))
+        # the centred acceleration at t_k sees the mean of the forces held before and after t_k: an undelayed
+        # held force is the measured one shifted by half a sample
+        err = _rms(_errors([_signals(r, d + 0.5) for r in train], base))
         if err < best_err:
             best, best_err = float(d), err
     return best
