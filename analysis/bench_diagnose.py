@@ -10,7 +10,7 @@ time is the one the issue asks for.
 With ``--validate`` it then refits the augmented model on the whole estimation file and replays the
 validation file once, parameters fixed (``analysis/emps_drake.py``'s last step): force error target < 6 %.
 
-Run: ``python analysis/bench_diagnose.py [--validate]``
+Run from the repository root: ``PYTHONPATH=. python analysis/bench_diagnose.py [--validate]``
 """
 
 import argparse
@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 from drakecreep.gap.drake_diagnosis import diagnose_drake
-from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.drake_replay import DrakeReplay
 from drakecreep.gap.identify import idim_start
 from drakecreep.gap.measured import load_emps
 
@@ -42,7 +42,7 @@ def main():
     train = [p for i, p in enumerate(parts) if i % 4 in (0, 1)]
     held = [p for i, p in enumerate(parts) if i % 4 in (2, 3)]
     start = time.perf_counter()
-    DrakeReplay(est).simulate(axis_from_idim(idim_start([est]).parameters, regularization_velocity=1e-3))
+    DrakeReplay(est).simulate(dict(idim_start([est]).parameters, regularization_velocity=1e-3))
     baseline = time.perf_counter() - start
     start = time.perf_counter()
     diag = diagnose_drake(train, held, progress=lambda line: print(f"  [{time.perf_counter() - start:5.0f} s] {line}",

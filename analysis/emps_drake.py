@@ -24,13 +24,13 @@ Run: ``python analysis/emps_drake.py [--max-nfev N] [--effects a,b,...]`` (minut
 import argparse
 import time
 
-import numpy as np
 
 from drakecreep.gap.drake_diagnosis import NOMINAL_PARAMETERS, diagnose_drake
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
 from drakecreep.gap.measured import load_emps
+from drakecreep.gap.runs import split_half_cycles  # noqa: F401 (used here and by bench_diagnose)
 from drakecreep.gap.replay import PUBLISHED_REPLAY_ERRORS
 
 SIGNALS = ("position", "velocity", "acceleration", "force")
@@ -44,22 +44,6 @@ def describe(fit):
     if fit.name == "control_delay":
         return f"delay {fit.delay:.2f} samples"
     return ", ".join(f"{k}={fit.parameters[k]:.4g}" for k in DRAKE_EFFECTS[fit.name].parameters)
-
-
-def split_half_cycles(run):
-    """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``)."""
-    import dataclasses
-
-    v = np.gradient(run.x_ref, run.dt)
-    s = np.sign(v) * (np.abs(v) > 0.01 * np.max(np.abs(v)))
-    nz = np.flatnonzero(s)
-    flips = nz[1:][np.diff(s[nz]) != 0]
-    cuts = [0] + [int(c) for c in flips] + [run.n]
-    parts = []
-    for a, b in zip(cuts[:-1], cuts[1:]):
-        if b - a >= 500:
-            parts.append(dataclasses.replace(run.slice(a, b), label=f"{run.label}@{len(parts)}"))
-    return parts
 
 
 def main():

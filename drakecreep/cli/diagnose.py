@@ -3,7 +3,8 @@
 DATA is an EMPS .mat file ('estimation' / 'validation' name the benchmark files) or a measured run: CSV,
 Parquet, HDF5 or .mat with a metadata YAML beside it or given with --meta; units in the column headers
 (t[ms], x_motor[mm], u[V]) are converted. The format is documented in docs/measured_format.md; an example
-ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split into out-and-back cycles; the
+ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split at every reversal of the
+reference; by default alternate pairs of parts train and are held out (--train/--test choose). The
 training runs are fitted, the held-out runs only replayed with every parameter fixed.
 
 Runs of controller kind p_p_cascade are replayed in closed loop through the Drake model (P-P cascade +
@@ -31,8 +32,9 @@ def add_parser(subparsers):
                    "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
-                   "(default: even indices)")
-    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices)")
+                   "(default: even indices; parts of one split run: 0, 1, 4, 5, ...)")
+    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of "
+                   "one split run: 2, 3, 6, 7, ...)")
     p.add_argument("--screw-lead", type=positive_float, default=2.5, metavar="MM",
                    help="screw lead [mm] (default 2.5; used by the rigid where-analysis of kind drakecreep runs only)")
     p.add_argument("--motor-period", type=positive_float, metavar="MM",
@@ -54,8 +56,15 @@ def run(args):
     from drakecreep.files import check_output_dir
     from drakecreep.gap.drake_replay import check_replayable
 
-    runs = load_runs(args.data, args.meta)
-    train, test = pick(runs, args.train, 0, "--train"), pick(runs, args.test, 1, "--test")
+    runs = load_runs(args.data, args.meta, split=False)
+    own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
+    # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
+    # both sets move both ways), into out-and-back cycles for the kind drakecreep branch
+    split = len(runs) == 1
+    runs = load_runs(args.data, args.meta, split=True if own else "half") if split else runs
+    pairs = split and not own
+    train = pick(runs, args.train, 0, "--train", pairs=pairs)
+    test = pick(runs, args.test, 1, "--test", pairs=pairs)
     if set(r.label for r in train) & set(r.label for r in test):
         raise InputError("--test", args.test, "runs disjoint from the training runs")
     # everything the end of the run needs is checked before the diagnosis starts
@@ -65,7 +74,6 @@ def run(args):
         check_replayable(r)
     if not train:
         raise InputError("--train", args.train, "at least one training run")
-    own = any(r.meta.controller.kind == "drakecreep" for r in train + test)
     # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
     score_runs = load_runs(args.score, None, split=own) if args.score else None
     for r in score_runs or ():
@@ -73,8 +81,9 @@ def run(args):
     if own:
         return _run_drakecreep_kind(args, train, test, score_runs)
     if len(test) < 2:
-        raise InputError("--test", args.test or f"{len(test)} run(s)",
-                         "at least two held-out runs (the claim threshold is their run-to-run spread)")
+        raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
+                         "at least two held-out runs (the claim threshold is their run-to-run spread; "
+                         "choose with --train/--test)")
     for r in score_runs or ():
         if r.meta.controller.kind != "p_p_cascade":
             raise InputError("--score", args.score, "runs of controller kind p_p_cascade, like the diagnosed ones")

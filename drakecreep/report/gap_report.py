@@ -233,7 +233,8 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
         rows.append(row)
-    return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in nominal.fitted},
+    shown = ("mass",) + tuple(n for n in nominal.fitted if n != "mass")
+    return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in shown},
                                     "ci95": nominal.ci95, "warnings": list(nominal.warnings),
                                     "held_out_force_error_percent": _rms_force(nominal_test_errors),
                                     "held_out_errors": nominal_test_errors},
