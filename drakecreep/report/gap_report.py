@@ -271,9 +271,6 @@ def _fig_png(fig):
 
 
 def _drake_figures(diagnosis, residuals=None):
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     figs = []
