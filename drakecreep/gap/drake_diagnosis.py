@@ -5,8 +5,8 @@
 1. nominal: :func:`drakecreep.gap.identify.identify` of viscous, Coulomb and offset on the training runs;
 2. ranking: every candidate of :data:`~drakecreep.gap.drake_effects.DRAKE_EFFECTS` (and the computation
    delay) is first fitted on the training runs' inverse dynamics (:mod:`drakecreep.gap.screen`, the axis's
-   own force terms, milliseconds): a candidate whose held-out inverse-dynamics gain does not pass is not
-   fitted further (the claim needs both gains); the others are fitted by closed-loop output error on the
+   own force terms, seconds): a candidate whose held-out inverse-dynamics gain is not above one standard
+   error is not fitted further (the claim needs both gains); the others are fitted by closed-loop output error on the
    training runs from the screen's best start and replayed, fixed, on the held-out runs
    (:class:`~drakecreep.gap.drake_effects.EffectFit`);
 3. a candidate *passes* when its held-out force error is below the reference model's by more than
@@ -150,7 +150,7 @@ def load_model(path):
 
 
 def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=None, screen=True,
-                   on_nominal=None, on_ranking=None):
+                   screen_k_se=1.0, on_nominal=None, on_ranking=None):
     """Diagnose the gap of the Drake replay model (see the module docstring).
 
     Parameters
@@ -169,7 +169,10 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
     screen : bool
         Pre-screen every candidate on inverse dynamics (:mod:`drakecreep.gap.screen`): its best start is the
         only closed-loop start, and a candidate whose held-out inverse-dynamics gain does not pass is not
-        fitted in closed loop (the claim rule needs both gains). False: every candidate from its own starts.
+        fitted in closed loop (the claim needs both gains). False: every candidate from its own starts.
+    screen_k_se : float
+        Standard errors the held-out inverse-dynamics gain must exceed to pass the screen (looser than ``k_se``:
+        the screen only drops candidates the inverse dynamics does not support).
     on_nominal, on_ranking : callable, optional
         Called with ``(nominal, nominal_test_errors)`` once the nominal model is identified, and with
         ``(nominal, nominal_test_errors, ranking)`` once every candidate is ranked, before the greedy
@@ -200,7 +203,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
             sc = ScreenResult("control_delay", {}, *(float("nan"),) * 3, float("nan"), float("nan"), True)
             fit = fit_delay(train, test, nominal, start=screen_delay(train, nominal.parameters))
         else:
-            sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=k_se) if screen else None
+            sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=screen_k_se) if screen \
+                else None
             if sc is not None and not sc.passes:
                 ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
                                             screen=sc, effect=n))
