@@ -24,6 +24,12 @@ def add_parser(subparsers):
                        help="built-in parameter set (default: paper_calibrated)")
     p.add_argument("--calibrate", metavar="ROWS",
                    help="fit the two disturbance amplitudes to these two rows first, e.g. 4,6 (about 30 s)")
+    p.add_argument("--validate", action="store_true",
+                   help="also: leave-one-out over the five distinct experiments and the competing hypotheses "
+                        "(lead error, force ripple, grating interpolation error, speed quantization) on the "
+                        "model with the four effects off (about 2 min); writes validation.md/.json")
+    p.add_argument("--sensitivity", action="store_true",
+                   help="with --validate: vary each fixed shape over its plausible range (about 5 min more)")
     p.add_argument("--no-critical", action="store_true", help="skip the critical speed per load case (bisection)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--out", default="out/reproduce-paper", metavar="DIR", help="output folder")
@@ -44,6 +50,8 @@ def run(args):
     from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
     from drakecreep.params import load_params, preset
 
+    if args.sensitivity and not args.validate:
+        raise InputError("--sensitivity", True, "only with --validate")
     params = load_params(args.params) if args.params else preset(args.preset)
     name = args.params or args.preset
     rows = CALIBRATION_ROWS
@@ -59,11 +67,19 @@ def run(args):
     if not rows:  # nothing calibrated: every row is a prediction
         for r in report["rows"]:
             r["calibrated"] = False
+    validation = None
+    if args.validate:
+        from drakecreep.studies.table_fluctuation import write_validation
+
+        validation = write_validation(args.out, params, with_sensitivity=args.sensitivity)
+        report["paths"].update(validation.pop("paths"))
     if args.json:
         print_json(dict(rows=report["rows"], trends=report["trends"], critical=report["critical"],
-                        window=report["window"], calibration=info,
+                        window=report["window"], calibration=info, validation=validation,
                         out={k: str(v) for k, v in report["paths"].items()}))
     else:
         print(report["paths"]["markdown"].read_text(), end="")
+        if validation is not None:
+            print(report["paths"]["validation_markdown"].read_text(), end="")
         print("wrote " + ", ".join(str(p) for p in report["paths"].values()))
     return 0

@@ -56,7 +56,7 @@ from drakecreep.sim.metrics import speed_fluctuation
 __all__ = [
     "Effect", "EFFECTS", "SHAPES", "HYPOTHESES", "DURATION", "experiments", "Responses", "simulate_responses",
     "predict", "fit", "leave_one_out", "compare_hypotheses", "signatures", "sensitivity", "verify",
-    "rounding_noise_percent", "validate", "validation_markdown", "base_params",
+    "rounding_noise_percent", "validate", "validation_markdown", "write_validation", "base_params",
 ]
 
 #: simulated time of every experiment (s), as the paper's simulation (the rig was measured over 50 s)
@@ -617,3 +617,25 @@ def validation_markdown(v):
                 lines.append(f"| {h} | " + " | ".join(f"{cell[x]:.1f}" for x in values) + " |")
             lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def write_validation(out_dir, params=None, with_sensitivity=False):
+    """Run :func:`validate` on ``params`` (its four effects switched off) and write ``validation.md`` and
+    ``validation.json`` to ``out_dir``.
+
+    Returns
+    -------
+    dict
+        The validation (:func:`validate`) plus ``paths`` (``validation_markdown``, ``validation_json``).
+    """
+    import json
+    from pathlib import Path
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    v = validate(params, with_sensitivity=with_sensitivity)
+    paths = dict(validation_markdown=out / "validation.md", validation_json=out / "validation.json")
+    paths["validation_markdown"].write_text(validation_markdown(v))
+    paths["validation_json"].write_text(json.dumps(v, indent=2) + "\n")
+    v["paths"] = paths
+    return v
