@@ -55,7 +55,7 @@ from drakecreep.sim.metrics import speed_fluctuation
 
 __all__ = [
     "Effect", "EFFECTS", "SHAPES", "HYPOTHESES", "DURATION", "experiments", "Responses", "simulate_responses",
-    "predict", "fit", "leave_one_out", "compare_hypotheses", "signatures", "sensitivity", "verify",
+    "predict", "fit", "leave_one_out", "compare_hypotheses", "paired_comparison", "signatures", "sensitivity", "verify",
     "rounding_noise_percent", "validate", "validation_markdown", "write_validation", "base_params",
 ]
 
@@ -504,6 +504,31 @@ def verify(params, responses, experiments_, shapes, amplitudes):
     return out
 
 
+def paired_comparison(hypotheses):
+    """The best hypothesis (by mean held-out error) against each other, fold by fold.
+
+    Returns
+    -------
+    list of dict
+        ``against``, ``best_wins`` (folds where the best has the smaller absolute held-out error, of
+        ``folds``), ``sign_test_p`` (two-sided binomial sign test). With five folds the smallest possible
+        p is 2 / 2^5 = 0.0625: five experiments cannot separate two hypotheses at the 5 % level this way.
+    """
+    from scipy.stats import binomtest
+
+    best = hypotheses[0]
+    out = []
+    for other in hypotheses[1:]:
+        a = [abs(p["held_out_error_percent"]) for p in best["experiments"]]
+        b = [abs(p["held_out_error_percent"]) for p in other["experiments"]]
+        wins = sum(x < y for x, y in zip(a, b))
+        ties = sum(x == y for x, y in zip(a, b))
+        n = len(a) - ties
+        out.append(dict(best=best["hypothesis"], against=other["hypothesis"], best_wins=wins, folds=n,
+                        sign_test_p=float(binomtest(wins, n).pvalue) if n else 1.0))
+    return out
+
+
 def _indistinguishable(sig, noise):
     """Pairs of effects whose normalized signatures differ by less than the rounding noise at every experiment."""
     out = []
@@ -536,7 +561,8 @@ def validate(params=None, *, shapes=None, with_sensitivity=True,
     dict
         ``experiments``, ``shapes`` (report units), ``rounding_noise_percent``, ``hypotheses`` (from
         :func:`compare_hypotheses`), ``signatures``, ``indistinguishable``, ``sensitivity`` (or None),
-        ``verification``, ``base_mm_s`` (the base model's measured fluctuation per experiment).
+        ``verification``, ``paired`` (:func:`paired_comparison`), ``base_mm_s`` (the base model's measured
+        fluctuation per experiment).
     """
     base = base_params(params)
     shapes = _shape_values(base, shapes)
@@ -553,6 +579,7 @@ def validate(params=None, *, shapes=None, with_sensitivity=True,
     if unknown:
         raise InputError("verify_hypotheses", unknown, "hypotheses of " + ", ".join(by))
     verification = {n: verify(base, responses, exps, shapes, by[n]["amplitudes"]) for n in names}
+    paired = paired_comparison(hyps)
     sens = sensitivity(base, responses, exps, shapes) if with_sensitivity else None
     return dict(
         experiments=exps,
@@ -561,7 +588,7 @@ def validate(params=None, *, shapes=None, with_sensitivity=True,
         rounding_noise_percent=noise,
         base_mm_s=[predict(responses[(e["load_case"], e["feed_mm_s"])], {}, shapes) * 1e3 for e in exps],
         hypotheses=hyps, signatures=sig, indistinguishable=_indistinguishable(sig, noise),
-        sensitivity=sens, verification=verification,
+        sensitivity=sens, verification=verification, paired=paired,
         effects={n: dict(field=e.field, bounds=[b * e.scale for b in e.bounds], unit=e.label, source=e.source)
                  for n, e in EFFECTS.items()},
     )
@@ -602,6 +629,10 @@ def validation_markdown(v):
               "| --- | " + " | ".join("---" for _ in lab) + " |"]
     for name, rows in v["verification"].items():
         lines.append(f"| {name} | " + " | ".join(f"{r['direct_mm_s']:.4f} / {r['superposed_mm_s']:.4f}" for r in rows) + " |")
+    lines += ["", f"## Best ({v['hypotheses'][0]['hypothesis']}) against each, fold by fold", "",
+              "| against | folds the best wins | two-sided sign test p |", "| --- | --- | --- |"]
+    for d in v["paired"]:
+        lines.append(f"| {d['against']} | {d['best_wins']} of {d['folds']} | {d['sign_test_p']:.3f} |")
     if v["sensitivity"]:
         lines += ["", "## Sensitivity to the fixed shapes (mean held-out error, %)", ""]
         for path in SHAPES:
