@@ -30,9 +30,9 @@ def add_parser(subparsers):
     p.add_argument("--validate", action="store_true",
                    help="also: leave-one-out over the five distinct experiments and the competing hypotheses "
                         "(lead error, force ripple, grating interpolation error, speed quantization) on the "
-                        "model with the four effects off (about 2-3 min); writes validation.md/.json")
+                        "model with the four effects off (about 1 min of computing); writes validation.md/.json")
     p.add_argument("--sensitivity", action="store_true",
-                   help="with --validate: vary each fixed shape over its plausible range (about 5 min more)")
+                   help="with --validate: vary each fixed shape over its plausible range (about 2.5 min more)")
     p.add_argument("--no-critical", action="store_true", help="skip the critical speed per load case (bisection)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--out", default="out/reproduce-paper", metavar="DIR", help="output folder")
