@@ -529,8 +529,8 @@ def paired_comparison(hypotheses):
     return out
 
 
-def _indistinguishable(sig, noise):
-    """Pairs of effects whose normalized signatures differ by less than the rounding noise at every experiment."""
+def _signature_differences(sig, noise):
+    """Largest difference (%) between the normalized signatures of each pair of effects, against the rounding noise."""
     out = []
     for a, b in combinations(sig, 2):
         diff = max(abs(x - y) * 100.0 for x, y in zip(sig[a], sig[b]))
@@ -560,7 +560,7 @@ def validate(params=None, *, shapes=None, with_sensitivity=True,
     -------
     dict
         ``experiments``, ``shapes`` (report units), ``rounding_noise_percent``, ``hypotheses`` (from
-        :func:`compare_hypotheses`), ``signatures``, ``indistinguishable``, ``sensitivity`` (or None),
+        :func:`compare_hypotheses`), ``signatures``, ``signature_differences``, ``sensitivity`` (or None),
         ``verification``, ``paired`` (:func:`paired_comparison`), ``base_mm_s`` (the base model's measured
         fluctuation per experiment).
     """
@@ -587,7 +587,7 @@ def validate(params=None, *, shapes=None, with_sensitivity=True,
                 for path in SHAPES},
         rounding_noise_percent=noise,
         base_mm_s=[predict(responses[(e["load_case"], e["feed_mm_s"])], {}, shapes) * 1e3 for e in exps],
-        hypotheses=hyps, signatures=sig, indistinguishable=_indistinguishable(sig, noise),
+        hypotheses=hyps, signatures=sig, signature_differences=_signature_differences(sig, noise),
         sensitivity=sens, verification=verification, paired=paired,
         effects={n: dict(field=e.field, bounds=[b * e.scale for b in e.bounds], unit=e.label, source=e.source)
                  for n, e in EFFECTS.items()},
@@ -622,7 +622,7 @@ def validation_markdown(v):
     for name, s in v["signatures"].items():
         lines.append(f"| {name} | " + " | ".join(f"{x:.3f}" for x in s) + " |")
     lines += ["", "| pair | largest signature difference (%) | below rounding noise |", "| --- | --- | --- |"]
-    for d in v["indistinguishable"]:
+    for d in v["signature_differences"]:
         lines.append(f"| {d['effects']} | {d['max_difference_percent']:.1f} | {d['below_rounding_noise']} |")
     lines += ["", "## Check: full Drake simulation at the in-sample amplitudes", "",
               "| hypothesis | " + " | ".join(f"{x} direct / superposed (mm/s)" for x in lab) + " |",
