@@ -6,8 +6,8 @@ per revolution) gives an ideal sensor, which is what linearization needs (a quan
 The linear scale may also carry an **interpolation error**: an incremental grating of signal period
 ``p`` (20 um for the common glass scales) is read by interpolating its sine/cosine signals, and
 imperfect signals (amplitude, offset, phase errors) leave an error periodic in the position with the
-signal period, typically up to 1-2 % of ``p`` (Heidenhain, *Interpolation and digitizing electronics*,
-"interpolation error"; Renishaw quote +-0.03-0.1 um "sub-divisional error" on 20 um scales). The
+signal period ([assumed] from manufacturers' data, "interpolation error" / "sub-divisional error": tens of
+nm up to about 1 % of ``p`` on 20 um scales). The
 reading is ``quantize(x + a sin(2 pi x / p), resolution)`` (:func:`scale_reading`), one formula for the
 Drake system and for evaluating the sensor on a recorded position.
 

@@ -105,7 +105,7 @@ EFFECTS = {
         "a slow vibration or pneumatic pulsation reaching the table; 0.001-50 N (up to 11 % of the 434 N load)"),
     "grating": Effect(
         "grating", "sensors.scale_interpolation_error", False, 0.0, (1e-10, 2e-6), "nm", 1e9,
-        "interpolation error of a 20 um grating: typically up to 1-2 % of the signal period (0.2-0.4 um)"),
+        "interpolation error of a 20 um grating: manufacturers quote tens of nm up to ~1 % of the signal period; 0.1-2000 nm searched"),
     "quantization": Effect(
         "quantization", "sensors.scale_resolution", False, 0.0, (1e-10, 1e-6), "nm", 1e9,
         "counting step of an interpolated scale, 1-1000 nm (the preset assumes 50 nm)"),
