@@ -400,6 +400,14 @@ class SensorParams(_Params):
 
     encoder_counts_per_rev: int = _q(2**23, "counts/rev", 0, doc="motor encoder resolution")
     scale_resolution: float = _q(50e-9, "m", 0.0, 1e-3, doc="linear scale resolution")
+    scale_interpolation_error: float = _q(
+        0.0, "m", 0.0, 1e-4, doc="amplitude of the scale's interpolation error, periodic in x with the signal period"
+    )
+    scale_signal_period: float = _q(20e-6, "m", 0.0, 1e-2, lo_open=True, doc="signal period of the scale's grating")
+    speed_meter_period: float = _q(
+        1e-3, "s", 0.0, 1.0, lo_open=True,
+        doc="sample period of a speed measured by differencing the scale (studies.table_fluctuation)",
+    )
 
 
 @dataclass(frozen=True)

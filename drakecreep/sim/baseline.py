@@ -37,6 +37,9 @@ def unsupported(params):
     d = p.disturbance
     if d.lead_error_amplitude > 0 or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
+    if p.sensors.scale_interpolation_error > 0 and p.controller.position_feedback == "table":
+        return ("sensors.scale_interpolation_error", p.sensors.scale_interpolation_error,
+                "0 with the scale in the loop (the plain-Python equations have no interpolation error)")
     if p.compensation.method != "none":
         return ("compensation.method", p.compensation.method, "none (the plain-Python equations have no compensator)")
     if p.controller.sampled and not float(p.controller.computation_delay).is_integer():

@@ -64,6 +64,7 @@ def test_calibration_is_deterministic_and_gives_the_stored_preset():
     for path, _ in CALIBRATED_FIELDS:
         assert info["values"][path] == pytest.approx(get_value(stored, path), rel=1e-9)
     assert max(abs(v) for v in info["residuals_percent"]) < 1.0
+    assert info["converged"] is True  # the fitted point passed the convergence check
 
 
 @pytest.mark.parametrize("rows", [(3, 5), (1, 2, 3), (7, 1), ()])
