@@ -1,7 +1,5 @@
 import pytest
 
-from drakecreep.params import with_value
-
 from drakecreep.errors import InputError
 from drakecreep.studies.paper_reproduction import (
     CALIBRATED_FIELDS, CALIBRATION_ROWS, calibrate, check_trends, paper_rows, reproduce,
@@ -51,13 +49,9 @@ def test_uncalibrated_paper_preset_is_far_too_smooth():
 
 
 def test_calibration_is_deterministic_and_gives_the_stored_preset():
-    # paper_calibrated was fitted with the former nut (0.01 N m, 0.01, on the table) and without computation
-    # delay, which it keeps until it is refitted with the catalogue nut and the one-sample delay of the paper
-    # preset (issue 15; with the delay the fit gives a lead error of 9.128e-7 m against the stored 9.168e-7 m)
+    # paper_calibrated is the paper preset (nut's drag on the screw, one-sample delay) plus the two fitted
+    # amplitudes: refitting from the paper preset must give the stored values
     start = preset("paper")
-    for path, value in (("nut.preload_torque", 0.01), ("nut.load_friction_coefficient", 0.01),
-                        ("friction.nut_friction_on", "table"), ("controller.computation_delay", 0.0)):
-        start = with_value(start, path, value)
     _, info = calibrate(start)
     stored = preset("paper_calibrated")
     assert info["rows"] == list(CALIBRATION_ROWS) and info["start"] == [1.0, 1.0]
