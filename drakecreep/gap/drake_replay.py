@@ -389,9 +389,9 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     zero-order hold) is added to the push on the table. Positions are relative to the first sample (the
     diagram starts at rest at 0, in equilibrium under ``load_case``).
 
-    ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem``\ s
+    ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem`` systems
     (:func:`drakecreep.sim.compiled.compile_diagram`, the reference and ``f_ext`` its ``inputs`` port, fed
-    by C++ ``TrajectorySource``\ s: no Python in the loop); ``"leaf"`` the Python leaf systems (same
+    by C++ ``TrajectorySource`` systems: no Python in the loop); ``"leaf"`` the Python leaf systems (same
     equations, same integrator; kept as the cross-check, ``tests/gap/test_drake_replay.py``).
 
     Parameters

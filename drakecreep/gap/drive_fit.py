@@ -96,7 +96,7 @@ SEPARABILITY = 0.95
 MIN_SAMPLES = 50
 MIN_DURATION = 0.1
 #: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
-_STEP = 0.02
+_STEP = 0.1
 _BOUND = 4.0
 #: Lead-error periods tried: the lead divided by these harmonics.
 LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
@@ -368,14 +368,16 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None):
         return cache[key]
 
     def jacobian(theta):
-        # forward differences with a fixed step of 2 % in each field (the adaptive integrator makes the
-        # residual a slightly rough function of the values: a step near machine precision would amplify it)
-        r = residual(theta)
+        # central differences with a fixed step of _STEP in log(value - lower bound): the adaptive integrator
+        # and the counting sensors make the residual a slightly rough function of the values (a step near
+        # machine precision would amplify that), and a one-sided step of a few % leaves a curvature error
+        # that differs between fields of very different force contributions
         cols = []
         for i in range(theta.size):
             step = np.zeros(theta.size)
-            step[i] = _STEP if theta[i] + _STEP <= _BOUND else -_STEP
-            cols.append((residual(theta + step) - r) / step[i])
+            step[i] = _STEP
+            hi, lo_ = np.minimum(theta + step, _BOUND), np.maximum(theta - step, -_BOUND)
+            cols.append((residual(hi) - residual(lo_)) / (hi[i] - lo_[i]))
         return np.column_stack(cols)
 
     sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, _BOUND), max_nfev=max_nfev,
@@ -410,23 +412,51 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None):
 
 # --------------------------------------------------------------------------- candidate effects
 
-def _amplitude_fit(runs, base, amp_path, trial, fixed, replayer, base_sims, scale):
-    """Amplitude of a disturbance (linear in its first order): two secant steps from a trial amplitude.
+def _screen(runs, base, amp_path, trial, fixed, replayer, r0, scale):
+    """One replay at a trial amplitude: the residual's slope in the amplitude and the linear optimum.
 
-    Returns ``(amplitude, sse)`` with the SSE of the training force residual at that amplitude.
+    Returns ``(amplitude, predicted_sse, state)``; ``state`` continues in :func:`_refine`.
     """
-    r0 = _residual(runs, base_sims, scale)
     params = _with(base, fixed)
-    a, r_a = trial, _residual(runs, replayer(runs, _with(params, {amp_path: trial})), scale)
-    for _ in range(2):
-        d = (r0 - r_a) / a  # dy/da: the residual decreases by d per unit amplitude
-        if float(d @ d) == 0:
-            return 0.0, float(r0 @ r0)
-        a_new = float(np.clip(a + (r_a @ d) / float(d @ d), 0.0, 50 * trial))
-        if a_new == 0.0:
-            return 0.0, float(r0 @ r0)
-        a, r_a = a_new, _residual(runs, replayer(runs, _with(params, {amp_path: a_new})), scale)
+    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: trial})), scale)
+    d = (r0 - r_a) / trial  # the residual decreases by d per unit amplitude (first order)
+    dd = float(d @ d)
+    if dd == 0.0:
+        return 0.0, float(r0 @ r0), None
+    a = float(np.clip((r0 @ d) / dd, 0.0, 50 * trial))
+    r_lin = r0 - a * d
+    return a, float(r_lin @ r_lin), (params, trial, r_a)
+
+
+def _refine(runs, amp_path, a, state, replayer, r0, scale):
+    """Replay at the screened amplitude and take one secant step; ``(amplitude, sse)`` (measured, not predicted)."""
+    if state is None or a == 0.0:
+        return 0.0, float(r0 @ r0)
+    params, trial, r_t = state
+    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: a})), scale)
+    if abs(a - trial) > 1e-3 * trial:
+        d = (r_t - r_a) / (a - trial)
+        if float(d @ d) > 0:
+            a2 = float(np.clip(a + (r_a @ d) / float(d @ d), 0.0, 50 * trial))
+            r_2 = _residual(runs, replayer(runs, _with(params, {amp_path: a2})), scale)
+            if float(r_2 @ r_2) < float(r_a @ r_a):
+                return a2, float(r_2 @ r_2)
     return a, float(r_a @ r_a)
+
+
+def _amplitude_effect(runs, base, amp_path, grid_path, grid, trial, replayer, base_sims, scale):
+    """Screen every grid value with one replay, refine the best: ``(values, sse)``."""
+    r0 = _residual(runs, base_sims, scale)
+    best = None
+    for g in grid:
+        a, sse, state = _screen(runs, base, amp_path, trial, {grid_path: g}, replayer, r0, scale)
+        if best is None or sse < best[1]:
+            best = (g, sse, a, state)
+    if best is None:
+        return {}, float(r0 @ r0)
+    g, _, a, state = best
+    a, sse = _refine(runs, amp_path, a, state, replayer, r0, scale)
+    return {grid_path: g, amp_path: a}, sse
 
 
 def _ripple_frequencies(runs, sims, k=2):
@@ -449,31 +479,20 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
     scale = _force_scale(runs)
     lead = base.screw.lead
     if name == "lead_error":
-        best = None
-        for k in LEAD_HARMONICS:
-            fixed = {"disturbance.lead_error_period": lead / k}
-            a, sse = _amplitude_fit(runs, base, "disturbance.lead_error_amplitude", 1e-6, fixed, replayer,
-                                    base_sims, scale)
-            if best is None or sse < best[1]:
-                best = ({**fixed, "disturbance.lead_error_amplitude": a}, sse)
-        values, sse = best
+        values, sse = _amplitude_effect(runs, base, "disturbance.lead_error_amplitude", "disturbance.lead_error_period",
+                                        [lead / k for k in LEAD_HARMONICS], 1e-6, replayer, base_sims, scale)
     elif name == "force_ripple":
-        best = None
-        for f in _ripple_frequencies(runs, base_sims):
-            fixed = {"disturbance.ripple_frequency": f}
-            a, sse = _amplitude_fit(runs, base, "disturbance.force_ripple", 0.1 * scale, fixed, replayer,
-                                    base_sims, scale)
-            if best is None or sse < best[1]:
-                best = ({**fixed, "disturbance.force_ripple": a}, sse)
-        if best is None:
+        values, sse = _amplitude_effect(runs, base, "disturbance.force_ripple", "disturbance.ripple_frequency",
+                                        _ripple_frequencies(runs, base_sims), 0.1 * scale, replayer, base_sims,
+                                        scale)
+        if not values:
             return {}, 0.0
-        values, sse = best
     elif name == "stribeck":
         start = base if base.friction.law != "coulomb" else with_value(base, "friction.law", "stribeck")
         paths = ("friction.static_ratio", "friction.stribeck_velocity")
         if start.friction.static_ratio <= 1.0:
             start = with_value(start, "friction.static_ratio", 1.2)
-        fitted_params, _, _, sse = fit_drive(runs, start, paths, replayer, max_nfev=max_nfev)
+        fitted_params, _, _, sse = fit_drive(runs, start, paths, replayer, max_nfev=min(max_nfev, 4))
         values = {p: get_value(fitted_params, p) for p in paths}
         if start.friction.law != base.friction.law:
             values["friction.law"] = start.friction.law
@@ -562,6 +581,8 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     base_sims = replay(train, params)
     candidates = []
     for name in names:
+        if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):
+            continue  # already fitted as uncertain
         values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev)
         if values is None:
             continue
