@@ -40,7 +40,10 @@ Steps:
    ``t_(1-alpha, n-1)`` standard errors of those paired differences
    (:func:`drakecreep.gap.drake_diagnosis.paired_gain`: the threshold is the held-out runs' own spread,
    ``alpha`` = :data:`drakecreep.gap.claims.ALPHA`), and :func:`drakecreep.gap.claims.replay_test` must pass
-   (pooled force-error energy shrinks and a majority of the runs improve). Passing candidates are added
+   with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
+   changes when the uncertain fields are refitted with one training run left out (as
+   :func:`drakecreep.gap.claims.replay_null`), and a majority of the runs improve. Without that null (one
+   training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are added
    greedily, best first, each tested again on top of what is already claimed.
 
 Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
@@ -182,6 +185,10 @@ class DriveDiagnosis:
         Best held-out gain first.
     claimed : tuple of str
     not_ranked : dict
+    replay_null : float or None
+        Largest relative change of the pooled held-out force-error energy when the uncertain fields are
+        refitted with one training run left out: the shrink a claim must beat (None: not available, and
+        then nothing is claimed).
     simulations : int
         Closed-loop replays run.
     seconds : float
@@ -197,6 +204,7 @@ class DriveDiagnosis:
     claimed: tuple
     test_errors: dict
     not_ranked: dict = field(default_factory=lambda: dict(NOT_IN_MODEL))
+    replay_null: float | None = None
     simulations: int = 0
     seconds: float = 0.0
 
@@ -207,7 +215,9 @@ class DriveDiagnosis:
             return math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))
 
         lines = [f"held-out force error: params file {rms(self.prior_test_errors):.3f} %, "
-                 f"fitted {rms(self.nominal_test_errors):.3f} %"]
+                 f"fitted {rms(self.nominal_test_errors):.3f} %"
+                 + ("" if self.replay_null is None else
+                    f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
             lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {f.lower:.4g} .. {f.upper:.4g}; "
                          f"params file {f.prior:.4g})")
@@ -240,6 +250,7 @@ class DriveDiagnosis:
             "candidates": [{k: v for k, v in dataclasses.asdict(c).items()} for c in self.candidates],
             "claimed": list(self.claimed),
             "test_errors": self.test_errors,
+            "replay_null": self.replay_null,
             "not_ranked": dict(self.not_ranked),
             "params": params_to_dict(self.params),
             "simulations": self.simulations,
@@ -518,20 +529,45 @@ def _with_any(params, values):
     return params
 
 
-def _held_out(name, values, train_gain, test, current, current_errors, replayer):
+def _energy(errors, labels):
+    return [errors[k]["force"] ** 2 for k in labels]
+
+
+def _replay_null(train, test, params, uncertain, replayer, nominal_errors):
+    """Run-to-run variation of the held-out replay: refit the uncertain fields with each training run left out.
+
+    Returns the largest relative change of the pooled held-out force-error energy (the shrink an effect must
+    beat, as :func:`drakecreep.gap.claims.replay_null`), or ``None`` when it cannot be computed (one training
+    run, or nothing fitted).
+    """
+    if len(train) < 2 or not uncertain:
+        return None
+    labels = list(nominal_errors)
+    e_nom = float(np.sum(_energy(nominal_errors, labels)))
+    changes = []
+    for i in range(len(train)):
+        rest = train[:i] + train[i + 1:]
+        refit = fit_drive(rest, params, uncertain, replayer, max_nfev=4)[0]
+        e = float(np.sum(_energy(replayer.errors(test, refit), labels)))
+        changes.append(abs(1.0 - e / e_nom) if e_nom > 0 else 0.0)
+    return float(max(changes))
+
+
+def _held_out(name, values, train_gain, test, current, current_errors, replayer, null):
     """Replay the candidate on the held-out runs and decide whether it passes."""
     errs = replayer.errors(test, _with_any(current, values))
     gain, se = paired_gain(current_errors, errs)
     n = len(test)
     bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
-    e_cur = [current_errors[k]["force"] ** 2 for k in current_errors]
-    e_eff = [errs[k]["force"] ** 2 for k in current_errors]
-    rt = replay_test(e_cur, e_eff, 0.0)
-    ok = bool(train_gain > 0 and gain > bar and rt["passes"])
+    labels = list(current_errors)
+    rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
+    ok = bool(null is not None and train_gain > 0 and gain > bar and rt["passes"])
     reason = ("passes" if ok else
               "no gain on the training runs" if train_gain <= 0 else
               f"held-out gain {gain:+.3f} <= {bar:.3f} (t quantile x standard error of {n} runs)" if gain <= bar else
-              f"pooled shrink {100 * rt['shrink']:.1f} %, {rt['runs_better']}/{n} runs better")
+              f"pooled shrink {100 * rt['shrink']:.1f} % (run-to-run null {100 * rt['threshold']:.1f} %), "
+              f"{rt['runs_better']}/{n} runs better" if not rt["passes"] else
+              "provisional: no run-to-run null (needs >= 2 training runs and a fitted field)")
     return EffectResult(name=name, values=dict(values), train_gain=float(train_gain), test_errors=errs, gain=gain,
                         standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason)
 
@@ -578,6 +614,9 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     params, fitted, warnings, sse0 = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev)
     nominal_errors = replay.errors(test, params)
     say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
+    null = _replay_null(train, test, params, uncertain, replay, nominal_errors) if names else None
+    if names:
+        say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %"))
     base_sims = replay(train, params)
     candidates = []
     for name in names:
@@ -589,7 +628,7 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         if not values:
             candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, "nothing to fit"))
             continue
-        candidates.append(_held_out(name, values, train_gain, test, params, nominal_errors, replay))
+        candidates.append(_held_out(name, values, train_gain, test, params, nominal_errors, replay, null))
         c = candidates[-1]
         say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f})")
     candidates.sort(key=lambda c: -c.gain)
@@ -597,7 +636,8 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     for c in candidates:
         if not c.passes:
             continue
-        again = c if not claimed else _held_out(c.name, c.values, c.train_gain, test, current, current_errors, replay)
+        again = c if not claimed else _held_out(c.name, c.values, c.train_gain, test, current, current_errors, replay,
+                                                null)
         if again.passes:
             claimed.append(c.name)
             current, current_errors = _with_any(current, c.values), again.test_errors
@@ -605,4 +645,4 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
-                          simulations=replay.count, seconds=_time.perf_counter() - t0)
+                          replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0)
