@@ -43,7 +43,9 @@ Steps:
    with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
    changes when the uncertain fields are refitted with one training run left out (as
    :func:`drakecreep.gap.claims.replay_null`), and a majority of the runs improve. Without that null (one
-   training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are added
+   training run, or no uncertain field) candidates are ranked but never claimed.
+4. With an effect claimed, the uncertain fields are fitted again on the augmented model (a missing effect
+   biases them and widens their intervals); ``fitted`` and ``test_errors`` are those of the final model. Passing candidates are added
    greedily, best first, each tested again on top of what is already claimed.
 
 Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
@@ -176,6 +178,7 @@ class DriveDiagnosis:
     prior, params : DriveParams
         The run's params file and the augmented one (fitted values + claimed effects).
     fitted : tuple of FittedParameter
+        Of the final (augmented) model.
     warnings : tuple of str
         Parameters not separable or poorly determined by the training runs.
     prior_test_errors, nominal_test_errors, test_errors : dict
@@ -225,6 +228,10 @@ class DriveDiagnosis:
         for c in self.candidates:
             lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f})"
                          f"{'  passes' if c.passes else ''}: {c.reason}")
+            if c.passes:
+                lines.append("    fitted " + ", ".join(
+                    f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"
+                    for k, v in c.values.items()))
         if self.claimed:
             lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
         else:
@@ -356,6 +363,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None):
     -------
     params : DriveParams
     fitted : tuple of FittedParameter
+        Of the final (augmented) model.
     warnings : tuple of str
     sse : float
         Final sum of squared (scaled) residuals.
@@ -642,6 +650,13 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
             claimed.append(c.name)
             current, current_errors = _with_any(current, c.values), again.test_errors
             say(f"claimed {c.name}")
+    if claimed and uncertain:
+        # the uncertain fields again, on the augmented model: a missing effect biases them and widens their
+        # intervals (its residual is autocorrelated), so the values kept are the ones fitted with it in place
+        current, fitted, warnings, _ = fit_drive(train, current, uncertain, replay, max_nfev=max_nfev)
+        fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
+        current_errors = replay.errors(test, current)
+        say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)}")
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,

@@ -91,6 +91,9 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
     assert d.lead_error_period == pytest.approx(truth.screw.lead / 12)
     assert d.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
     assert all(not c.passes for c in result.candidates[1:])
+    # refitted with the lead error in place, the friction level is the true one again (and well determined)
+    (seal,) = result.fitted
+    assert seal.contains(truth.table.seal_force) and seal.prior == RIG.table.seal_force and not result.warnings
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
 
