@@ -106,6 +106,8 @@ _BOUND = 4.0
 #: Lead-error periods tried: the lead divided by these harmonics.
 LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
 
+#: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
+_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude",), "force_ripple": ("disturbance.force_ripple",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude, period lead/k)",
@@ -653,7 +655,10 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     if claimed and uncertain:
         # the uncertain fields again, on the augmented model: a missing effect biases them and widens their
         # intervals (its residual is autocorrelated), so the values kept are the ones fitted with it in place
-        current, fitted, warnings, _ = fit_drive(train, current, uncertain, replay, max_nfev=max_nfev)
+        # jointly with the claimed effects' amplitudes (fixed, they would carry the bias of the first fit)
+        amplitudes = tuple(p for name in claimed for p in _AMPLITUDES.get(name, ())
+                           if get_value(current, p) > 0)
+        current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
         fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
         current_errors = replay.errors(test, current)
         say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)}")

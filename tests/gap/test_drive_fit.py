@@ -91,9 +91,12 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
     assert d.lead_error_period == pytest.approx(truth.screw.lead / 12)
     assert d.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
     assert all(not c.passes for c in result.candidates[1:])
-    # refitted with the lead error in place, the friction level is the true one again (and well determined)
-    (seal,) = result.fitted
+    # refitted jointly with the lead error's amplitude, the friction level is the true one again (and well
+    # determined), and the amplitude's interval holds the truth
+    seal, amplitude = result.fitted
+    assert seal.path == "table.seal_force" and amplitude.path == "disturbance.lead_error_amplitude"
     assert seal.contains(truth.table.seal_force) and seal.prior == RIG.table.seal_force and not result.warnings
+    assert amplitude.contains(2e-6) and amplitude.unit == "m"
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
 
