@@ -28,8 +28,9 @@ Steps:
    ``(1 + rho) / (1 - rho)`` for the residual's lag-1 autocorrelation ``rho`` (closed-loop residuals are
    not white); a warning names every pair whose estimates correlate above :data:`SEPARABILITY` (not
    separable from these runs) and every field whose interval spans more than a factor 10.
-   The diagram is recompiled for every evaluation: compiling it takes about 0.03 s, against 0.5-5 s to
-   simulate a run, so symbolic parameters (``SymbolicVectorSystem(parameter=...)``) would save < 5 %.
+   The diagram is recompiled for every evaluation: compiling it takes about 0.03 s, against 0.1-1.1 s CPU to
+   replay a 0.5 s run (test rig to ``paper`` preset, ``analysis/bench_drive_fit.py``), so symbolic parameters
+   (``SymbolicVectorSystem(parameter=...)``) would save a few per cent.
 2. **Candidate effects that are parts of the Drake model** (:data:`EFFECTS`): lead error (amplitude fitted,
    period a harmonic of the lead), force ripple at a fixed frequency (frequency from the peaks of the
    training residual's spectrum), Stribeck weakening (static ratio and Stribeck velocity fitted), the
@@ -43,10 +44,11 @@ Steps:
    with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
    changes when the uncertain fields are refitted with one training run left out (as
    :func:`drakecreep.gap.claims.replay_null`), and a majority of the runs improve. Without that null (one
-   training run, or no uncertain field) candidates are ranked but never claimed.
-4. With an effect claimed, the uncertain fields are fitted again on the augmented model (a missing effect
-   biases them and widens their intervals); ``fitted`` and ``test_errors`` are those of the final model. Passing candidates are added
-   greedily, best first, each tested again on top of what is already claimed.
+   training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are
+   added greedily, best first, each tested again on top of what is already claimed.
+4. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
+   claimed effects' amplitudes (a missing effect biases them and widens their intervals); ``fitted`` and
+   ``test_errors`` are those of the final model.
 
 Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
 """

@@ -7,6 +7,7 @@ loop, so that a 0.5 s run replays in well under a second.
 """
 
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -129,7 +130,7 @@ def test_augmented_params_file_feeds_simulate_margins_and_report(lead_case, tmp_
     assert cli.main(["report", "--params", str(path), "--load-case", "0", "--no-sim-grid", "-q",
                      "--out", str(tmp_path / "report")]) == 0
     assert (tmp_path / "report" / "index.html").exists()
-    js = result.to_json()
+    js = json.loads(json.dumps(result.to_json()))
     assert js["claimed"] == ["lead_error"] and js["params"]["disturbance"]["lead_error_amplitude"] > 0
     capsys.readouterr()
 
