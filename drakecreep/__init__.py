@@ -21,6 +21,7 @@ The front door (each name is imported from its subpackage on first use, so ``imp
 ``analyze_loops``             linearized velocity and position loops, margins (:mod:`drakecreep.servo.loops`)
 ``critical_speed``            the paper's eq. 11 (:mod:`drakecreep.paper.creep`)
 ``load_measured``, ``diagnose``  measured runs and the sim-to-real gap diagnosis (:mod:`drakecreep.gap`)
+``diagnose_drake``            the gap diagnosis on the Drake replay model (what ``drakecreep diagnose`` runs)
 ============================  ==============================================================
 """
 
@@ -46,6 +47,7 @@ _API = {
     "critical_speed": "drakecreep.paper.creep",
     "load_measured": "drakecreep.gap.measured",
     "diagnose": "drakecreep.gap.diagnosis",
+    "diagnose_drake": "drakecreep.gap.drake_diagnosis",
 }
 
 __all__ = ["__version__", *_API]

@@ -375,6 +375,10 @@ class ControllerParams(_Params):
     sampled: bool = field(default=True, metadata=dict(unit="-", doc="discrete controller; false = continuous"))
     velocity_period: float = _q(2.5e-4, "s", 0.0, 0.1, lo_open=True, doc="velocity loop sample time")
     position_period: float = _q(1.0e-3, "s", 0.0, 1.0, lo_open=True, doc="position loop sample time")
+    computation_delay: float = _q(
+        1.0, "samples", 0.0, 100.0,
+        doc="sampled only: velocity samples from reading the encoder to applying the command (fractions allowed)",
+    )
 
     def _check(self):
         ratio = self.position_period / self.velocity_period
@@ -396,6 +400,14 @@ class SensorParams(_Params):
 
     encoder_counts_per_rev: int = _q(2**23, "counts/rev", 0, doc="motor encoder resolution")
     scale_resolution: float = _q(50e-9, "m", 0.0, 1e-3, doc="linear scale resolution")
+    scale_interpolation_error: float = _q(
+        0.0, "m", 0.0, 1e-4, doc="amplitude of the scale's interpolation error, periodic in x with the signal period"
+    )
+    scale_signal_period: float = _q(20e-6, "m", 0.0, 1e-2, lo_open=True, doc="signal period of the scale's grating")
+    speed_meter_period: float = _q(
+        1e-3, "s", 0.0, 1.0, lo_open=True,
+        doc="sample period of a speed measured by differencing the scale (studies.table_fluctuation)",
+    )
 
 
 @dataclass(frozen=True)
@@ -485,6 +497,11 @@ class CompensationParams(_Params):
     velocity_source: str = _q(
         "motor", "-", choices=("motor", "table"),
         doc="measured speed of static/lugre: motor encoder (semi-closed) or table speed (ideal linear scale)",
+    )
+    speed_source: str = _q(
+        "encoder", "-", choices=("encoder", "ideal"),
+        doc="sampled controller: compensators run at the velocity-loop rate on the backward difference of the "
+            "counts, output held and delayed like the command (encoder), or continuously on the true speed (ideal)",
     )
 
 

@@ -28,6 +28,10 @@ def add_parser(subparsers):
                    help="comma-separated feeds in mm/s (default 0.05,0.1,0.2,0.5,1,2,5)")
     p.add_argument("--load-cases", default="1,2,3", metavar="N", help="comma-separated load cases (default 1,2,3)")
     p.add_argument("--duration", type=positive_float, default=2.0, metavar="S", help="simulated time per run (default 2)")
+    p.add_argument("--speed-source", choices=("encoder", "ideal"), default=None,
+                   help="speed the compensators read (default: from the parameters, compensation.speed_source): "
+                        "encoder = at the velocity-loop rate on the count difference, output held and delayed "
+                        "like the command; ideal = continuously on the true motor speed")
     p.add_argument("--critical", action="store_true", help="also the lowest feed without creep (bisection)")
     p.add_argument("--robustness", action="store_true", help="also the model off by +-30 %% in each parameter")
     p.add_argument("--workers", type=int, default=2, metavar="N", help="processes (default 2)")
@@ -52,6 +56,10 @@ def run(args):
     from drakecreep.scenario import MAX_FEED
 
     params = params_from_args(args)
+    if args.speed_source is not None:
+        from drakecreep.params import with_value
+
+        params = with_value(params, "compensation.speed_source", args.speed_source)
     from drakecreep.files import check_output_dir
 
     feeds = _list(args.feeds, "--feeds", float, lambda v: 1e-4 <= v <= MAX_FEED * 1e3,

@@ -2,6 +2,8 @@
 
 The drive is the preset's (or ``--params``') axial chain, moving mass and friction law under a load case,
 reduced to one mass on one spring (:func:`drakecreep.model.lumped.lumped`), like every other command.
+The mass carries the friction the model applies to the table: with the ball nut's drag on the screw (the
+default) only the guides' share, which is what eq. 11's Fig. 2 mechanism sees.
 Prints the damping ratio ς (with the friction slope C1 = dF/dv of the friction law at ``--feed``), D at the
 feed, the critical ratio D0 = sqrt(4πς) and the critical speed v0 in mm/s. Any lumped value can be
 overridden for a what-if. Units at this edge: stiffness N/µm, speeds mm/s, everything else SI.
@@ -68,14 +70,17 @@ def _drive(args):
         raise InputError("--fs", drive.breakaway, f">= Fd ({drive.coulomb:g} N)")
     source = args.params or f"preset {args.preset}"
     return drive, source + (" with " + ", ".join("--" + o for o in OVERRIDES if getattr(args, o) is not None)
-                            if changes else ""), params.friction.law
+                            if changes else ""), params.friction.law, params.friction.nut_friction_on
 
 
 def run(args):
     """Compute and print the creep boundary."""
     if not (math.isfinite(args.feed) and args.feed > 0):
         raise InputError("--feed", args.feed, "a finite speed > 0 in mm/s")
-    d, source, law_name = _drive(args)
+    d, source, law_name, nut_on = _drive(args)
+    # the lumped mass carries the friction the model applies to the table (drakecreep.model.lumped)
+    friction_on_mass = ("guides only (the ball nut's drag acts on the screw, motor side of the spring)"
+                        if nut_on == "screw" else "guides and ball nut")
     v = args.feed * 1e-3
     K, M, C, Fs, Fd = d.stiffness, d.mass, d.damping, d.breakaway, d.coulomb
     c1 = float(creep.friction_slope(d.steady_friction, v))
@@ -86,6 +91,7 @@ def run(args):
     v0_sc = creep.critical_speed_of(d)
     result = {
         "inputs": {"source": source, "load_case": d.load_case, "friction_law": law_name,
+                   "friction_on_mass": friction_on_mass,
                    "stiffness_N_per_um": K * 1e-6, "mass_kg": M, "damping_Ns_per_m": C,
                    "Fs_N": Fs, "Fd_N": Fd, "feed_mm_per_s": args.feed},
         "C1_Ns_per_m": c1,
@@ -103,6 +109,7 @@ def run(args):
     i = result["inputs"]
     print(f"inputs ({i['source']}, load case {d.load_case}): K = {i['stiffness_N_per_um']:.4g} N/um, "
           f"M = {M:.4g} kg, C = {C:.4g} N s/m, Fs = {Fs:.4g} N, Fd = {Fd:.4g} N, law = {law_name}")
+    print(f"friction on the mass: {friction_on_mass}")
     print(f"feed v            = {args.feed:.4g} mm/s")
     print(f"C1 = dF/dv at v   = {c1:.4g} N s/m")
     print(f"zeta              = {zeta:.4g}")

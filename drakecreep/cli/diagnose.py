@@ -1,15 +1,21 @@
-"""``drakecreep diagnose``: where the sim-to-real gap of the rigid model lies, which effect explains it, how far it shrinks.
+"""``drakecreep diagnose``: where the sim-to-real gap of the Drake replay model lies, which effect explains it, how far it shrinks.
 
 DATA is an EMPS .mat file ('estimation' / 'validation' name the benchmark files) or a measured run: CSV,
 Parquet, HDF5 or .mat with a metadata YAML beside it or given with --meta; units in the column headers
 (t[ms], x_motor[mm], u[V]) are converted. The format is documented in docs/measured_format.md; an example
-ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split into out-and-back cycles; the
-training runs are fitted, the held-out runs only scored. ``--score FILE`` finally scores the finished
-diagnosis, with every parameter fixed, on another file (e.g. the EMPS validation set).
+ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split at every reversal of the
+reference; by default alternate pairs of parts train and are held out (--train/--test choose). The
+training runs are fitted, the held-out runs only replayed with every parameter fixed.
+
+Runs of controller kind p_p_cascade are replayed in closed loop through the Drake model (P-P cascade +
+MeasuredAxis, docs/gap_diagnosis.md): the nominal axis is identified on the training runs, every candidate
+effect is screened on inverse dynamics, fitted in closed loop and replayed on the held-out runs, and the
+effects that pass are added greedily. --out writes ranking.json as soon as the ranking is known, then
+diagnosis.html, diagnosis.json and augmented_model.yaml; ``--score FILE`` replays the augmented model, every
+parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
 """
 
 import sys
-from pathlib import Path
 
 from drakecreep.cli._common import positive_float, print_json
 from drakecreep.errors import InputError
@@ -21,81 +27,201 @@ __all__ = ["add_parser", "run", "load_runs", "pick"]
 def add_parser(subparsers):
     """Register ``diagnose``."""
     p = subparsers.add_parser("diagnose", help="sim-to-real gap diagnosis of measured runs (where, which effect, shrink)",
-                              description="\n\n".join(__doc__.split("\n\n")[:2]))
+                              description="\n\n".join(__doc__.split("\n\n")[:3]))
     p.add_argument("data", metavar="DATA", help="EMPS .mat file (or 'estimation'), or a measured run "
                    "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
-                   "(default: even indices)")
-    p.add_argument("--test", metavar="RUNS", help="held-out runs (default: odd indices)")
+                   "(default: even indices; parts of one split run: 0, 1, 4, 5, ...)")
+    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of "
+                   "one split run: 2, 3, 6, 7, ...)")
     p.add_argument("--screw-lead", type=positive_float, default=2.5, metavar="MM",
-                   help="screw lead [mm] (default 2.5: one EMPS motor revolution at the load)")
+                   help="screw lead [mm] (default 2.5; used by the rigid where-analysis of kind drakecreep runs only)")
     p.add_argument("--motor-period", type=positive_float, metavar="MM",
-                   help="table travel per motor revolution [mm] (default: the lead, direct drive)")
-    p.add_argument("--score", metavar="FILE", help="after the diagnosis, score it (parameters fixed) on this file")
-    p.add_argument("--out", metavar="DIR", help="write diagnosis.html and diagnosis.json here")
+                   help="table travel per motor revolution [mm] (kind drakecreep runs only; default: the lead)")
+    p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
+                   "ones: stribeck, asymmetric_friction, position_friction, position_ripple, time_ripple, "
+                   "thermal_drift, axial_mode, control_delay)")
+    p.add_argument("--score", metavar="FILE", help="after the diagnosis, replay the augmented model (parameters "
+                   "fixed) on this file")
+    p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
+                   "augmented_model.yaml here")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p
 
 
 def run(args):
-    """Diagnose, print the answer, write the report."""
+    """Check everything, diagnose, print the answer, write the report."""
     from drakecreep.files import check_output_dir
-    from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
-    from drakecreep.report.gap_report import to_json_dict, write_report
+    from drakecreep.gap.drake_replay import check_replayable
 
-    runs = load_runs(args.data, args.meta)
-    train, test = pick(runs, args.train, 0, "--train"), pick(runs, args.test, 1, "--test")
+    runs = load_runs(args.data, args.meta, split=False)
+    own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
+    # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
+    # both sets move both ways), into out-and-back cycles for the kind drakecreep branch
+    split = len(runs) == 1
+    runs = load_runs(args.data, args.meta, split=True if own else "half") if split else runs
+    pairs = split and not own
+    train = pick(runs, args.train, 0, "--train", pairs=pairs)
+    test = pick(runs, args.test, 1, "--test", pairs=pairs)
     if set(r.label for r in train) & set(r.label for r in test):
         raise InputError("--test", args.test, "runs disjoint from the training runs")
     # everything the end of the run needs is checked before the diagnosis starts
     if args.out:
         check_output_dir(args.out)
-    score_runs = load_runs(args.score, None) if args.score else None
-    from drakecreep.gap.drake_replay import check_replayable
-
-    for r in train + test:  # a controller it cannot replay, a missing params file: one line, before any work
+    for r in train + test:  # a controller it cannot replay, a missing params file
         check_replayable(r)
-    own = [r for r in test if r.meta.controller.kind == "drakecreep"]
+    if not train:
+        raise InputError("--train", args.train, "at least one training run")
+    # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
+    score_runs = load_runs(args.score, None, split=own) if args.score else None
+    for r in score_runs or ():
+        check_replayable(r)
+    if own:
+        return _run_drakecreep_kind(args, train, test, score_runs)
+    if len(test) < 2:
+        raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
+                         "at least two held-out runs (the claim threshold is their run-to-run spread; "
+                         "choose with --train/--test)")
+    for r in score_runs or ():
+        if r.meta.controller.kind != "p_p_cascade":
+            raise InputError("--score", args.score, "runs of controller kind p_p_cascade, like the diagnosed ones")
+    effects = None
+    if getattr(args, "effects", None):
+        from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
+
+        effects = tuple(e.strip() for e in args.effects.split(",") if e.strip())
+        for e in effects:
+            if e != "control_delay" and e not in DRAKE_EFFECTS:
+                raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
+                    tuple(DRAKE_EFFECTS) + ("control_delay",))))
+    return _run_drake(args, train, test, score_runs, effects)
+
+
+def _say(args):
+    quiet = getattr(args, "quiet", False)
+    return (lambda line: None) if quiet else (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True))
+
+
+def _run_drake(args, train, test, score_runs, effects=None):
+    """The product path: :func:`drakecreep.gap.drake_diagnosis.diagnose_drake` on p_p_cascade runs."""
+    import json
+
+    from drakecreep.files import OutputSet
+    from drakecreep.gap.drake_diagnosis import diagnose_drake
+    from drakecreep.gap.drake_effects import score_parameters
+    from drakecreep.report.gap_report import drake_to_json_dict, ranking_json, write_drake_report
+
+    say = _say(args)
+    outset = OutputSet(args.out, "manifest.json").start() if args.out else None
+    extra = {"data": str(args.data), "train_runs": [r.label for r in train], "test_runs": [r.label for r in test]}
+
+    def keep_ranking(nominal, nominal_test, ranking):
+        if outset is not None:  # written before the greedy augmentation: a late failure keeps it
+            body = dict(ranking_json(nominal, nominal_test, ranking), **extra)
+            path = outset.write_text("ranking.json", json.dumps(body, indent=1))
+            say(f"ranking written to {path}")
+
+    say(f"{len(train)} training, {len(test)} held-out runs; identifying the nominal axis")
+    diag = diagnose_drake(train, test, effects, progress=say, on_ranking=keep_ranking)
+    model = diag.model
+    if score_runs:
+        say(f"replaying the augmented model on {args.score} (parameters fixed)")
+        nominal_scored, _ = score_parameters(score_runs, diag.nominal.parameters, delay=diag.nominal.delay)
+        augmented_scored, _ = score_parameters(score_runs, model["parameters"], flexible=model["flexible"],
+                                               delay=model["delay"])
+        extra["scored"] = {"data": str(args.score), "nominal": nominal_scored, "augmented": augmented_scored}
+    if outset is not None:
+        residuals = _residuals(diag, test[0])
+        outset.write("augmented_model.yaml", lambda tmp: diag.save_model(tmp))
+        html_path, _ = write_drake_report(diag, args.out, residuals=residuals, outset=outset, **extra)
+        outset.commit(dict(report="sim-to-real gap diagnosis (Drake model)", html="diagnosis.html",
+                           json="diagnosis.json", model="augmented_model.yaml", ranking="ranking.json"))
+        say(f"wrote {html_path}, diagnosis.json and augmented_model.yaml")
+    if args.json:
+        print_json(drake_to_json_dict(diag, **extra))
+        return 0
+    print("\n".join(diag.summary()))
+    if score_runs:
+        print(f"Replayed on {args.score} (every parameter fixed), force error [%] nominal -> augmented:")
+        for lab, e in extra["scored"]["augmented"].items():
+            n = extra["scored"]["nominal"][lab]
+            print(f"  {lab}: force {n['force']:.3f} -> {e['force']:.3f}, position {n['position']:.4g} -> "
+                  f"{e['position']:.4g}")
+    return 0
+
+
+def _residuals(diag, run):
+    """Measured minus replayed force and position of one held-out run, nominal and augmented (for the report)."""
+    from drakecreep.gap.drake_replay import make_replay
+
+    out = {"label": run.label, "t": run.t - run.t[0]}
+    m = diag.model
+    for key, params, flexible, delay in (("nominal", diag.nominal.parameters, False, diag.nominal.delay),
+                                         ("augmented", m["parameters"], m["flexible"], m["delay"])):
+        res = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(params)
+        out[key] = {"force": run.force - res.force, "position": run.x_motor - res.x_motor}
+    return out
+
+
+def _run_drakecreep_kind(args, train, test, score_runs):
+    """Runs of ``controller: {kind: drakecreep}`` (the project's own PI-cascade diagram and params file).
+
+    ---- BRANCH FOR kind: drakecreep ----
+    The identification and augmentation of ``DriveParams`` through the project's diagram lives in
+    ``drakecreep.gap.drive_fit`` (its own work item). When that module exists, its ``diagnose_drive(train, test,
+    ...)`` is called; otherwise the previous behaviour: the rigid inverse-dynamics ranking of
+    :mod:`drakecreep.gap.diagnosis`, then the held-out runs replayed through the params file's diagram.
+    """
+    import importlib.util
+
+    say = _say(args)
+    if importlib.util.find_spec("drakecreep.gap.drive_fit") is not None:
+        from drakecreep.gap.drive_fit import diagnose_drive
+
+        result = diagnose_drive(train, test, progress=say, out=args.out, score=score_runs)
+        if args.json:
+            from drakecreep.files import to_jsonable
+
+            print_json(to_jsonable(result.to_json() if hasattr(result, "to_json") else result))
+        elif hasattr(result, "summary"):
+            print("\n".join(result.summary()))
+        return 0
+    # ---- previous behaviour (until drive_fit exists) ----
+    from pathlib import Path
+
+    from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
+    from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+    from drakecreep.report.gap_report import to_json_dict, write_report
+
     cfg = DiagnosisConfig(screw_lead=args.screw_lead * 1e-3,
                           motor_period=None if args.motor_period is None else args.motor_period * 1e-3,
                           progress=not args.quiet)
-    # the rigid inverse-dynamics ranking; its closed-loop part replays the EMPS P-P law only
-    result = diagnose(train, test, cfg, replay=not own)
-    if own:
-        from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-
-        print(f"[diagnose] closed-loop replay of {len(own)} held-out run(s) through the project's diagram",
-              file=sys.stderr, flush=True)
-        errors = {r.label: drake_replay_errors(replay_drakecreep(r)) for r in own}
-        result["drake_replay"] = errors
-        result["summary"].append("Held-out replay through the drakecreep diagram of the params file, errors in % "
-                                 "of ||y||: " + "; ".join(
-                                     f"{k}: position {e['position']:.3g}, force {e['force']:.3g}"
-                                     for k, e in errors.items()))
+    result = diagnose(train, test, cfg, replay=False)
+    say(f"closed-loop replay of {len(test)} held-out run(s) through the project's diagram")
+    errors = {r.label: drake_replay_errors(replay_drakecreep(r)) for r in test}
+    result["drake_replay"] = errors
+    result["summary"].append("Held-out replay through the drakecreep diagram of the params file, errors in % "
+                             "of ||y||: " + "; ".join(f"{k}: position {e['position']:.3g}, force {e['force']:.3g}"
+                                                      for k, e in errors.items()))
     result["data"] = str(args.data)
     result["train_runs"] = [r.label for r in train]
     result["test_runs"] = [r.label for r in test]
-    if args.score:
-        if not args.quiet:
-            print(f"[diagnose] scoring the fixed diagnosis on {args.score}", file=sys.stderr, flush=True)
+    if score_runs:
+        say(f"scoring the fixed diagnosis on {args.score}")
         result["scored"] = score_fixed(result, score_runs)
         result["scored"]["data"] = str(args.score)
     if args.out:
         html_path, json_path = write_report(result, args.out)
-        if args.score:
+        if score_runs:
             sc = dict(result["scored"])
             sc.update({"nominal": result["nominal"], "claimed": result["claimed"], "ranking": [],
                        "unexplained_share": sc["unexplained_share"]})
             write_report(sc, Path(args.out) / "scored", title=f"Fixed diagnosis scored on {args.score}")
-        if not args.quiet:
-            print(f"[diagnose] wrote {html_path} and {json_path}", file=sys.stderr)
+        say(f"wrote {html_path} and {json_path}")
     if args.json:
         print_json(to_json_dict(result))
     else:
         print("\n".join(result["summary"]))
-        if args.score:
-            print(f"Scored on {args.score} (parameters fixed):")
-            print("\n".join(result["scored"]["summary"]))
     return 0

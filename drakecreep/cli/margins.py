@@ -25,7 +25,7 @@ def add_parser(subparsers):
         description="Linearize the feed-drive diagram at steady sliding (AutoDiff) and print gain, phase and "
                     "delay margins, crossover, closed-loop bandwidth and sensitivity peak of the velocity loop "
                     "(broken at the speed feedback) and the position loop (broken at the position feedback), "
-                    "for the controller as configured (sampled: ZOH and sample delays included) and continuous.",
+                    "for the controller as configured (sampled: ZOH, sample delays and controller.computation_delay included) and continuous.",
     )
     add_params_options(p)
     p.add_argument("--feed", type=number, default=1.0, metavar="MM_PER_S", help="operating feed in mm/s (default 1)")
@@ -78,8 +78,17 @@ def run(args):
           f"K = {op['stiffness_N_per_um']:.4g} N/um, C1 = {op['friction_slope_C1_Ns_per_m']:.4g} N s/m, "
           f"zeta = {op['zeta']:.4g}")
     print_margins(summary)
+    if "computation_delay_samples" in summary:
+        print(f"computation delay: {summary['computation_delay_samples']:g} velocity samples "
+              f"({summary['computation_delay_ms']:.3g} ms; controller.computation_delay), in the sampled loops")
     if "sampling_phase_cost_deg" in summary:
         c = summary["sampling_phase_cost_deg"]
-        print(f"phase lost to sampling and hold: velocity {c['velocity']:.1f} deg, position {c['position']:.1f} deg")
+        print(f"phase lost to sampling, hold and computation delay: velocity {c['velocity']:.1f} deg, "
+              f"position {c['position']:.1f} deg")
+    if "computation_delay_cost" in summary:
+        c = summary["computation_delay_cost"]
+        print("of which the computation delay: " + ", ".join(
+            f"{loop} {c[loop]['phase_margin_deg']:.2f} deg PM, {c[loop]['gain_margin_dB']:.2f} dB GM, "
+            f"{c[loop]['delay_margin_ms']:.3g} ms delay margin" for loop in ("velocity", "position")))
     print(f"first mechanical resonance: {summary['resonance_Hz']:.4g} Hz, damping ratio {summary['resonance_damping']:.4g}")
     return 0

@@ -15,15 +15,24 @@ def add_parser(subparsers):
             "Simulate the paper's six feeds (load cases 1-3 at 1 mm/s; load case 3 at 0.5, 1, 2 mm/s), 5 s each, "
             "and compare the maximum table-speed fluctuation over t >= simulation.steady_start with the paper's "
             "experiment and simulation. Writes table8_9.md, table8_9.csv, rows.json and the two figures to --out. "
-            "Default parameters: the paper_calibrated preset (two disturbance amplitudes fitted to rows 4 and 6)."
+            "Default parameters: the paper_calibrated preset (two disturbance amplitudes fitted to rows 4 and 6). "
+            "--validate: leave-one-out over the five distinct experiments (rows 3 and 5 are one) and the competing "
+            "explanations of the measured fluctuation, on the given parameters (default: the uncalibrated paper "
+            "preset) with the four effects off; speeds in mm/s, errors in % (docs/tables_8_9.md)."
         ),
     )
     group = p.add_mutually_exclusive_group()
     group.add_argument("--params", metavar="FILE", help="parameter file (YAML, SI units)")
-    group.add_argument("--preset", default="paper_calibrated", choices=PRESETS,
-                       help="built-in parameter set (default: paper_calibrated)")
+    group.add_argument("--preset", default=None, choices=PRESETS,
+                       help="built-in parameter set (default: paper_calibrated; for --validate: paper)")
     p.add_argument("--calibrate", metavar="ROWS",
                    help="fit the two disturbance amplitudes to these two rows first, e.g. 4,6 (about 30 s)")
+    p.add_argument("--validate", action="store_true",
+                   help="also: leave-one-out over the five distinct experiments and the competing hypotheses "
+                        "(lead error, force ripple, grating interpolation error, speed quantization) on the "
+                        "model with the four effects off (about 1 min of computing); writes validation.md/.json")
+    p.add_argument("--sensitivity", action="store_true",
+                   help="with --validate: vary each fixed shape over its plausible range (about 2.5 min more)")
     p.add_argument("--no-critical", action="store_true", help="skip the critical speed per load case (bisection)")
     p.add_argument("--no-plots", action="store_true", help="skip the figures")
     p.add_argument("--out", default="out/reproduce-paper", metavar="DIR", help="output folder")
@@ -44,6 +53,10 @@ def run(args):
     from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
     from drakecreep.params import load_params, preset
 
+    if args.sensitivity and not args.validate:
+        raise InputError("--sensitivity", True, "only with --validate")
+    explicit = args.params is not None or args.preset is not None
+    args.preset = args.preset or "paper_calibrated"
     params = load_params(args.params) if args.params else preset(args.preset)
     name = args.params or args.preset
     rows = CALIBRATION_ROWS
@@ -59,11 +72,21 @@ def run(args):
     if not rows:  # nothing calibrated: every row is a prediction
         for r in report["rows"]:
             r["calibrated"] = False
+    validation = None
+    if args.validate:
+        from drakecreep.studies.table_fluctuation import write_validation
+
+        # the model the effects are added to: the given parameters, else the uncalibrated paper preset
+        base = (load_params(args.params) if args.params else preset(args.preset)) if explicit else preset("paper")
+        validation = write_validation(args.out, base, with_sensitivity=args.sensitivity)
+        report["paths"].update(validation.pop("paths"))
     if args.json:
         print_json(dict(rows=report["rows"], trends=report["trends"], critical=report["critical"],
-                        window=report["window"], calibration=info,
+                        window=report["window"], calibration=info, validation=validation,
                         out={k: str(v) for k, v in report["paths"].items()}))
     else:
         print(report["paths"]["markdown"].read_text(), end="")
+        if validation is not None:
+            print(report["paths"]["validation_markdown"].read_text(), end="")
         print("wrote " + ", ".join(str(p) for p in report["paths"].values()))
     return 0

@@ -22,13 +22,12 @@ import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors
+from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
 
-__all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay",
+__all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
            "score_parameters", "residual_peak_frequency"]
 
 
@@ -134,7 +133,7 @@ def _rms(values):
 
 def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=None):
     """Replay ``runs`` with FIXED parameters: ``({label: errors}, rms force error [%])`` (no fitting)."""
-    replays = replays or [DrakeReplay(r, flexible=flexible, delay=delay) for r in runs]
+    replays = replays or [make_replay(r, flexible=flexible, delay=delay, free=()) for r in runs]
     errors = {}
     for i, rep in enumerate(replays):
         label = rep.run.label if rep.run.label not in errors else f"{rep.run.label}#{i}"
@@ -142,21 +141,52 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
     return errors, _rms(e["force"] for e in errors.values())
 
 
-def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0):
-    """Frequency [Hz] of the largest peak of the replay force residual's spectrum (Welch), over ``runs``."""
+def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0, prominent=False):
+    """Frequency [Hz] of the largest peak of the replay force residual's spectrum (Welch), over ``runs``.
+
+    ``prominent``: the peak that stands highest above the spectrum's running median (in log scale), not the
+    largest value (a closed-loop residual's spectrum falls with frequency: its largest value sits at the low
+    end of any band; a structural mode is a narrow peak above its neighbours).
+    """
+    from scipy.ndimage import median_filter
     from scipy.signal import welch
 
     total = None
     nperseg = min(4096, min(r.n for r in runs))  # one frequency grid for runs of different lengths
     for r in runs:
-        res = DrakeReplay(r, delay=delay).simulate(parameters)
+        res = make_replay(r, delay=delay, free=()).simulate(parameters)
         f, p = welch(r.force - res.force, fs=1.0 / runs[0].dt, nperseg=nperseg)
         total = p if total is None else total + p
     band = (f >= fmin) & (f <= min(fmax, f[-1]))
+    if prominent:
+        logp = np.log10(np.maximum(total, 1e-300))
+        lift = logp - median_filter(logp, size=15, mode="nearest")
+        return float(f[band][np.argmax(lift[band])])
     return float(f[band][np.argmax(total[band])])
 
 
-def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset")):
+def physical_bounds(effect, base, fmin=5.0, fmax=300.0):
+    """Bounds that depend on the model being augmented (SI, ``name -> (lo, hi)``).
+
+    * ``axial_mode``: stiffness between the values that put the two-mass mode at ``fmin`` and ``fmax`` Hz
+      (the issue's 5-300 Hz search; a fit at the upper bound means "no mode below it") and damping up to
+      twice the critical damping at ``fmax``; this also keeps the sampled replay's sub-step count bounded;
+    * ``stribeck``: Stribeck speed at least twice the friction's regularization speed (below it the Stribeck
+      term and the ``tanh`` regularization are the same shape) and at most 0.1 m/s.
+    """
+    out = {}
+    if effect.name == "axial_mode":
+        share = base.get("motor_mass_fraction", 0.2)
+        m_red = share * (1 - share) * base["mass"]
+        k = [(2 * math.pi * f) ** 2 * m_red for f in (fmin, fmax)]
+        c_hi = 2.0 * 2.0 * math.sqrt(k[1] * m_red)
+        out = {"stiffness": (k[0], k[1]), "damping": (1e-4 * c_hi, c_hi)}
+    elif effect.name == "stribeck":
+        out = {"stribeck_velocity": (2.0 * base.get("regularization_velocity", 1e-3), 0.1)}
+    return out
+
+
+def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset"), starts=None):
     """Fit ``effect`` on ``train`` (with the nominal friction ``refit`` refined too) and score it on ``test``.
 
     Parameters
@@ -170,6 +200,9 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         Least-squares evaluations per start.
     refit : tuple of str
         Nominal parameters refined together with the effect's.
+    starts : sequence of dict, optional
+        Start values instead of the effect's own starts (e.g. the best start of the inverse-dynamics screen,
+        :func:`drakecreep.gap.screen.screen_effect`).
 
     Returns
     -------
@@ -183,13 +216,21 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         effect = DRAKE_EFFECTS[effect]
     t0 = _time.perf_counter()
     base = dict(nominal.parameters)
-    starts = effect.starts
-    if effect.name == "time_ripple":
-        f = residual_peak_frequency(train, base, delay=nominal.delay)
-        starts = ({"ripple_frequency": f},)
+    if starts is not None:
+        starts = tuple(dict(x) for x in starts)
+    elif effect.name == "axial_mode":
+        # one start: the most prominent peak of the nominal replay's force residual between 5 and 300 Hz
+        starts = ({"axial_mode_hz": residual_peak_frequency(train, base, fmin=5.0, fmax=300.0,
+                                                             delay=nominal.delay, prominent=True)},)
+    elif effect.name == "time_ripple":
+        starts = ({"ripple_frequency": residual_peak_frequency(train, base, delay=nominal.delay)},)
+    else:
+        starts = effect.starts
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
     flexible = effect.flexible or nominal.flexible
-    replays = [DrakeReplay(r, flexible=flexible, delay=nominal.delay) for r in train]
+    bounds = dict(effect.bounds)
+    bounds.update(physical_bounds(effect, base))
+    replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
     best = None
     for start in starts:
         fixed = dict(base)
@@ -202,7 +243,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
             fixed.update(stiffness=k, damping=0.05 * 2 * math.sqrt(k * share * (1 - share) * m))
         fixed.update(start)
         idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixed,
-                       bounds=effect.bounds, max_nfev=max_nfev, replays=replays)
+                       bounds=bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:
             best = idf
     train_rms = _rms(e["force"] for e in best.train_errors.values())
@@ -212,9 +253,12 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
                      test_errors=test_errors, seconds=_time.perf_counter() - t0)
 
 
-def fit_delay(train, test, nominal, *, max_delay=3.0, xatol=0.05):
-    """The computation delay [samples] as a continuous parameter: a bounded scalar search on the training
-    replay's cost (the delay is structural, so each value builds its replay diagrams), then a score on ``test``.
+def fit_delay(train, test, nominal, *, max_delay=3.0, start=None):
+    """The computation delay [samples]: the training replay's cost at every whole delay ``0 .. max_delay``
+    (the sampled fast path) and at ``start`` (a fractional value, e.g. the inverse-dynamics scan of
+    :func:`drakecreep.gap.screen.screen_delay`, replayed by :class:`~drakecreep.gap.drake_replay.DrakeReplay`); the lowest cost wins and is
+    scored on ``test``. (A full continuous search rebuilds a leaf-controller diagram per value: about 10x
+    the cost; see docs/gap_diagnosis.md.)
 
     Returns
     -------
@@ -227,12 +271,17 @@ def fit_delay(train, test, nominal, *, max_delay=3.0, xatol=0.05):
     flexible = nominal.flexible
 
     def cost(d):
-        prob = _Problem([DrakeReplay(r, delay=d, flexible=flexible) for r in train], base, ())
+        prob = _Problem([make_replay(r, delay=d, flexible=flexible, free=()) for r in train], base, ())
         r = prob.residual_of(prob.simulate(base))
         return 0.5 * float(r @ r)
 
-    sol = minimize_scalar(cost, bounds=(0.0, float(max_delay)), method="bounded", options={"xatol": xatol})
-    d = float(sol.x)
+    if not (isinstance(max_delay, (int, float)) and 0 <= max_delay <= 10):
+        raise InputError("max_delay", max_delay, "a number of samples in [0, 10]")
+    delays = [float(d) for d in range(int(math.floor(max_delay)) + 1)]
+    if start is not None and 0 <= start <= max_delay and float(start) not in delays:
+        delays.append(float(start))
+    costs = [cost(d) for d in delays]
+    d = delays[int(np.argmin(costs))]
     train_errors, train_rms = score_parameters(train, base, delay=d, flexible=flexible)
     test_errors, test_rms = score_parameters(test, base, delay=d, flexible=flexible)
     return EffectFit(name="control_delay", parameters=base, identified=None, delay=d, flexible=flexible,

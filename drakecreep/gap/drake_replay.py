@@ -42,6 +42,8 @@ from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 
 __all__ = [
     "DrakeReplay",
+    "SampledReplay",
+    "make_replay",
     "DrakeReplayResult",
     "drake_replay",
     "drake_replay_errors",
@@ -283,6 +285,212 @@ class _CompiledPP:
 
     def set_initial_state(self, context):
         self.hold.SetVectorState(self.hold.GetMyMutableContextFromRoot(context), self.initial_state)
+
+
+class SampledReplay:
+    """The ``p_p_cascade`` replay as ONE discrete-time ``SymbolicVectorSystem`` on a sub-sample clock (fast path).
+
+    The controller and the axis are the same leaf systems as in :class:`DrakeReplay`
+    (:class:`~drakecreep.model.pp_cascade.PPCascade`, :class:`~drakecreep.model.axis.MeasuredAxis`), turned
+    into symbolic expressions with ``ToSymbolic`` and fused into one update that ticks ``m`` times per
+    sample (period ``h / m``). State ``[controller (discrete), axis (x, v[, x_t, v_t]), j]``, ``j`` the tick
+    within the sample::
+
+        j == 0 (t = t_k):  controller update from x_ref[k] and the axis position (counted), as PPCascade
+        every tick:        one explicit-midpoint step of the axis over h / m, force = gain applied + f_ext[k]
+        j <- (j + 1) mod m
+
+    so no error-controlled integrator runs between the 1 kHz events. ``m`` comes from the stiffest rate of
+    the axis at the parameters simulated (friction slope ``Fc / v_reg`` over the mass; twice the axial
+    mode's angular frequency): ``h / m`` times that rate stays below ``rate_step`` (a rebuild happens only when new parameter values
+    need more ticks than the built system has).
+
+    Only the parameters named in ``free`` stay symbolic (``parameter=`` of the system); every other axis
+    parameter is substituted by its value at build time, so the expression carries no term whose
+    coefficient is zero (a nominal axis has no ripple, drift or Stribeck term to evaluate). Simulating with
+    other values of non-free parameters rebuilds the system (kept in a small cache).
+
+    Same interface as :class:`DrakeReplay` (``run``, ``simulate(parameters) -> DrakeReplayResult``).
+    Cross-tested against it on EMPS slices (``tests/gap/test_drake_replay.py``). Fractional delays are not
+    supported here (use :class:`DrakeReplay`; :func:`make_replay` chooses).
+    """
+
+    def __init__(self, run, flexible=False, delay=0.0, quantize=True, free=None, rate_step=0.5, min_substeps=1):
+        check_replayable(run)
+        ctrl = run.meta.controller
+        if ctrl.kind != "p_p_cascade":
+            raise InputError("controller.kind", ctrl.kind, "p_p_cascade (use replay_drakecreep for drakecreep)")
+        if not (isinstance(delay, (int, float)) and math.isfinite(delay) and delay >= 0 and delay == int(delay)):
+            raise InputError("delay", delay, "a whole number of samples >= 0 (fractional: DrakeReplay)")
+        if not (isinstance(rate_step, (int, float)) and 0 < rate_step <= 1):
+            raise InputError("rate_step", rate_step, "a number in (0, 1]")
+        self.run, self.flexible, self.delay = run, bool(flexible), float(delay)
+        self.quantize, self.rate_step, self.min_substeps = bool(quantize), float(rate_step), int(min_substeps)
+        self.free = tuple(free) if free is not None else tuple(AXIS_PARAMETERS)
+        for name in self.free:
+            if name not in AXIS_PARAMETERS:
+                raise InputError("free", name, "names among " + ", ".join(AXIS_PARAMETERS))
+        self.h = run.dt
+        self.t = np.arange(run.n) * self.h
+        self._built = {}
+        self.substeps = None
+
+    def substeps_for(self, values):
+        """Ticks per sample needed by the parameter vector ``values`` (order of :data:`AXIS_PARAMETERS`)."""
+        P = dict(zip(AXIS_PARAMETERS, values))
+        m_m = P["motor_mass_fraction"] * P["mass"] if self.flexible else P["mass"]
+        m_t = P["mass"] - m_m if self.flexible else P["mass"]
+        level = 1.0 + abs(P["friction_ripple_cos"]) + abs(P["friction_ripple_sin"]) + abs(P["friction_drift"]) * \
+            self.run.n * self.h
+        slope = level * ((abs(P["coulomb"]) + abs(P["coulomb_asym"]) + abs(P["stribeck_extra"])) /
+                         P["regularization_velocity"] + abs(P["viscous"]) + abs(P["viscous_asym"]))
+        rate = slope / m_t
+        if self.flexible:
+            k, c = abs(P["stiffness"]), abs(P["damping"])
+            red = 1.0 / m_m + 1.0 / m_t
+            # an oscillation needs finer steps than a decay: the mode's rate counts twice
+            rate = max(rate, 2.0 * math.sqrt(k * red), c * red)
+        return max(self.min_substeps, int(math.ceil(self.h * rate / self.rate_step)))
+
+    def _key(self, vec):
+        fixed = tuple(float(v) for n, v in zip(AXIS_PARAMETERS, vec) if n not in self.free)
+        return fixed
+
+    def _system(self, vec):
+        need = self.substeps_for(vec)
+        key = self._key(vec)
+        have = self._built.get(key)
+        if have is not None and have[0] >= need:
+            return have
+        m = max(need, 2 * have[0]) if have is not None else need
+        if len(self._built) > 8:
+            self._built.clear()
+        built = (m,) + self._build(vec, m)
+        self._built[key] = built
+        return built
+
+    def _build(self, vec, m):
+        from pydrake.symbolic import if_then_else
+
+        run, h = self.run, self.h
+        ctrl = run.meta.controller
+        sensors = run.meta.sensors
+        res = (sensors.encoder_resolution if ctrl.feedback == "motor" else sensors.scale_resolution) \
+            if self.quantize else 0.0
+        x0, v0 = float(run.x_motor[0]), float(run.x_motor[1] - run.x_motor[0]) / h
+        history = [float(run.u[0])] * (int(self.delay) + 1)
+        ctrl_state = pp_initial_state(ctrl.position_filter, self.delay, x0, v0, h, history)
+        leaf = PPCascade(ctrl.kp, ctrl.kv, ctrl.saturation, h, ctrl.position_filter, run.u_gain, res, self.delay,
+                         ctrl_state)
+        axis_x0 = [x0, v0, x0, v0] if self.flexible else [x0, v0]
+        na, nc = len(axis_x0), len(ctrl_state)
+        time = Variable("t")
+        xc = MakeVectorVariable(nc, "xc")
+        xa = MakeVectorVariable(na, "xa")
+        j = Variable("j")
+        inp = MakeVectorVariable(2, "in")  # x_ref, f_ext
+        p_free = MakeVectorVariable(len(self.free), "p") if self.free else np.zeros(0, dtype=object)
+        p_all = [Expression(p_free[self.free.index(n)]) if n in self.free else Expression(float(v))
+                 for n, v in zip(AXIS_PARAMETERS, vec)]
+        # the controller's periodic update, from the leaf system
+        csym = leaf.ToSymbolic()
+        cctx = csym.CreateDefaultContext()
+        cctx.SetDiscreteState(0, [Expression(v) for v in xc])
+        fb = xa[0] if ctrl.feedback == "motor" else xa[na - 2]
+        csym.GetInputPort("x_ref").FixValue(cctx, [Expression(inp[0])])
+        csym.GetInputPort("position").FixValue(cctx, [Expression(fb)])
+        c_update = csym.EvalUniquePeriodicDiscreteUpdate(cctx).get_vector(0).CopyToVector()
+        first = j < 0.5
+        c_next = [if_then_else(first, c_update[i], Expression(xc[i])) for i in range(nc)]
+        force = leaf.gain * c_next[nc - 1] + inp[1]
+        # the axis derivatives, from the leaf system, with the fixed parameters substituted
+        asym = MeasuredAxis_[Expression](self.flexible, axis_parameters(), axis_x0)
+        actx = asym.CreateDefaultContext()
+        za = MakeVectorVariable(na, "za")
+        zt = Variable("zt")
+        zf = Variable("zF")
+        actx.SetTime(Expression(zt))
+        actx.SetContinuousState([Expression(v) for v in za])
+        actx.get_mutable_numeric_parameter(0).SetFromVector(p_all)
+        asym.GetInputPort("force").FixValue(actx, [Expression(zf)])
+        f_expr = asym.EvalTimeDerivatives(actx).CopyToVector()
+        dt = h / m
+
+        def f(tt, x, F):
+            env = {zt: tt, zf: F}
+            env.update({za[i]: x[i] for i in range(na)})
+            return [fi.Substitute(env) for fi in f_expr]
+
+        x = [Expression(v) for v in xa]
+        k1 = f(Expression(time), x, force)
+        mid = [x[i] + 0.5 * dt * k1[i] for i in range(na)]
+        k2 = f(time + 0.5 * dt, mid, force)
+        a_next = [x[i] + dt * k2[i] for i in range(na)]
+        j_next = if_then_else(j < m - 1.5, j + 1.0, Expression(0.0))
+        state = np.concatenate([xc, xa, [j]])
+        dynamics = list(c_next) + a_next + [j_next]
+        system = SymbolicVectorSystem(time=time, state=state, input=inp, parameter=p_free, dynamics=dynamics,
+                                      output=[Expression(v) for v in state], time_period=dt)
+        b = DiagramBuilder()
+        sysm = b.AddSystem(system)
+        sysm.set_name("sampled_replay")
+        t = self.t
+        ref = b.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, run.x_ref.reshape(1, -1))))
+        f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
+        # breaks half a tick early: every tick of [t_k, t_k+1) reads f_ext[k], whatever the rounding of t
+        ext = b.AddSystem(TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t - 0.5 * dt, f_ext.reshape(1, -1))))
+        from pydrake.systems.primitives import Multiplexer
+
+        mux = b.AddSystem(Multiplexer([1, 1]))
+        b.Connect(ref.get_output_port(), mux.get_input_port(0))
+        b.Connect(ext.get_output_port(), mux.get_input_port(1))
+        b.Connect(mux.get_output_port(0), sysm.get_input_port(0))
+        log = LogVectorOutput(sysm.get_output_port(0), b, h)
+        diagram = b.Build()
+        simulator = Simulator(diagram)
+        context = simulator.get_mutable_context()
+        sysm.GetMyMutableContextFromRoot(context).SetDiscreteState(list(ctrl_state) + axis_x0 + [0.0])
+        default = context.Clone()
+        layout = {"nc": nc, "na": na, "gain": leaf.gain, "u": len(leaf.taps)}
+        return sysm, simulator, context, default, log, layout
+
+    def simulate(self, parameters):
+        """Simulate the run with axis parameters ``parameters`` (a dict by name, see :data:`AXIS_PARAMETERS`).
+
+        Returns
+        -------
+        DrakeReplayResult
+        """
+        start = _time.perf_counter()
+        vec = axis_parameters(**parameters)
+        m, sysm, simulator, context, default, log, layout = self._system(vec)
+        self.substeps = m
+        context.SetTimeStateAndParametersFrom(default)
+        if self.free:
+            sub = sysm.GetMyMutableContextFromRoot(context)
+            sub.get_mutable_numeric_parameter(0).SetFromVector(
+                [vec[list(AXIS_PARAMETERS).index(n)] for n in self.free])
+        log.FindMutableLog(context).Clear()
+        simulator.Initialize()
+        n = self.run.n
+        simulator.AdvanceTo(float(n * self.h))
+        lg = log.FindLog(context)
+        data = _on_samples(lg.sample_times(), lg.data(), np.arange(n + 1) * self.h)
+        nc, na = layout["nc"], layout["na"]
+        f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
+        return DrakeReplayResult(
+            run=self.run, x_motor=data[nc, :n], x_table=data[nc + na - 2, :n], u=data[layout["u"], 1:],
+            force=layout["gain"] * data[nc - 1, 1:] + f_ext,
+            parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
+            wall_time=_time.perf_counter() - start)
+
+
+def make_replay(run, flexible=False, delay=0.0, quantize=True, free=None, sampled=True):
+    """The fastest replay of ``run`` that expresses the request: :class:`SampledReplay` for a whole-sample delay
+    (``sampled=True``), else :class:`DrakeReplay` (error-controlled integration, fractional delays)."""
+    if sampled and float(delay) == int(delay):
+        return SampledReplay(run, flexible=flexible, delay=delay, quantize=quantize, free=free)
+    return DrakeReplay(run, flexible=flexible, delay=delay, quantize=quantize)
 
 
 def compiled_axis(flexible, initial_state):

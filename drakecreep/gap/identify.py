@@ -31,7 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors
+from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
@@ -266,8 +266,10 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         Largest number of residual evaluations of the least squares (each replays every run).
     quantize : bool
         Encoder counts in the replay.
-    replays : sequence of DrakeReplay, optional
-        Prebuilt replay diagrams of ``runs`` (same ``flexible``/``delay``), reused without a rebuild.
+    replays : sequence of DrakeReplay or SampledReplay, optional
+        Prebuilt replay diagrams of ``runs`` (same ``flexible``/``delay``), reused without a rebuild. Default:
+        :func:`~drakecreep.gap.drake_replay.make_replay` with ``free=uncertain`` (the sampled fast path for a
+        whole-sample delay, only the refined parameters symbolic).
     diff_step : float
         Absolute finite-difference step of the Jacobian in the scaled variables (5 % of a log-scaled value, or
         5 % of a typical size): large enough to step over the encoder's counts (the replay with a counted position
@@ -298,7 +300,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         warnings.append("'coulomb' and 'offset' both marked uncertain on one-way data: 'offset' left at 0")
         uncertain = tuple(n for n in uncertain if n != "offset")
     if replays is None:
-        replays = [DrakeReplay(r, flexible=flexible, delay=delay, quantize=quantize) for r in runs]
+        replays = [make_replay(r, flexible=flexible, delay=delay, quantize=quantize, free=uncertain) for r in runs]
     prob = _Problem(replays, base, uncertain)
     r0 = prob.residual_of(prob.simulate(base))
     cost_start = 0.5 * float(r0 @ r0)

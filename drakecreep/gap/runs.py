@@ -7,10 +7,28 @@ from pathlib import Path
 
 from drakecreep.errors import InputError
 
-__all__ = ["load_runs", "pick"]
+__all__ = ["load_runs", "pick", "split_half_cycles"]
 
 
-def load_runs(data, meta=None):
+def split_half_cycles(run, min_samples=500):
+    """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``), at least ``min_samples`` long."""
+    import dataclasses
+
+    import numpy as np
+
+    v = np.gradient(run.x_ref, run.dt)
+    s = np.sign(v) * (np.abs(v) > 0.01 * np.max(np.abs(v)))
+    nz = np.flatnonzero(s)
+    flips = nz[1:][np.diff(s[nz]) != 0]
+    cuts = [0] + [int(c) for c in flips] + [run.n]
+    parts = []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        if b - a >= min_samples:
+            parts.append(dataclasses.replace(run.slice(a, b), label=f"{run.label}@{len(parts)}"))
+    return parts
+
+
+def load_runs(data, meta=None, split=True):
     """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles.
 
     Parameters
@@ -20,6 +38,9 @@ def load_runs(data, meta=None):
         (CSV, Parquet, HDF5, or ``.mat`` with ``meta``; see ``docs/measured_format.md``).
     meta : str or path, optional
         Metadata YAML of a measured run (default: beside it).
+    split : bool or str
+        Split a single-run file into out-and-back cycles (True), into the parts between reversals of the
+        reference (``"half"``, :func:`split_half_cycles`), or not at all (False).
 
     Returns
     -------
@@ -35,15 +56,20 @@ def load_runs(data, meta=None):
             raise FileNotFoundError(2, "No such file or directory", str(data))
         md = load_measured(data, meta)
     runs = list(md.runs)
-    if len(runs) == 1:
+    if split == "half" and len(runs) == 1:
+        runs = split_half_cycles(runs[0])
+    elif split and len(runs) == 1:
         runs = split_cycles(runs[0])
     return runs
 
 
-def pick(runs, spec, default_parity, option="--train"):
+def pick(runs, spec, default_parity, option="--train", pairs=False):
     """Runs selected by a comma list of labels or indices, or by index parity (``default_parity`` 0 or 1);
-    errors name the CLI ``option`` the selection came from."""
+    errors name the CLI ``option`` the selection came from. ``pairs``: the default alternates pairs of runs
+    (indices 0, 1, 4, 5, ... and 2, 3, 6, 7, ...: out-and-back half cycles, so both sets move both ways)."""
     if not spec:
+        if pairs:
+            return [r for i, r in enumerate(runs) if (i // 2) % 2 == default_parity]
         return [r for i, r in enumerate(runs) if i % 2 == default_parity]
     out = []
     labels = [r.label for r in runs]

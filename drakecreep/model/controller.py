@@ -9,8 +9,11 @@ Two variants from one class:
 
 * ``sampled`` (``ControllerParams.sampled``): periodic discrete update at the velocity-loop period;
   the position loop runs every ``position_period / velocity_period`` velocity samples; the speed is
-  the backward difference of the encoder counts; the force command is held (zero-order hold).
-  Discrete state ``[v_cmd, integrator, theta_prev, force, tick]``.
+  the backward difference of the encoder counts; the force command is held (zero-order hold) and
+  applied after ``computation_delay = n + f`` samples (:class:`drakecreep.model.delay.OutputDelay`:
+  ``force[k-n]`` from ``t_k + f h`` on; 1 in the presets).
+  Discrete state ``[v_cmd, integrator, theta_prev, force, tick]`` followed, for a delay > 0, by the
+  queue ``force[k-1] .. force[k-n]`` and (``f > 0``) the applied force; ``force`` is the newest command.
 * continuous: the integrator is the only (continuous) state; the speed comes from the motor state.
   This is the variant to linearize.
 
@@ -24,6 +27,7 @@ from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.model._scalar import clip, vector, where
+from drakecreep.model.delay import OutputDelay
 
 __all__ = ["CascadeController", "CascadeController_", "force_limit"]
 
@@ -46,8 +50,8 @@ def CascadeController_(T):
 
         Output ports
         ------------
-        torque_command : 1, N m
-        controller_signals : 3, ``[v_cmd (m/s), force command (N), integrator (N)]``
+        torque_command : 1, N m, the applied (delayed) command
+        controller_signals : 3, ``[v_cmd (m/s), newest force command (N), integrator (N)]``
         """
 
         def _construct(self, gains, lead, limit, initial_force=0.0, initial_angle=0.0, converter=None):
@@ -66,9 +70,10 @@ def CascadeController_(T):
             self._u_table_position_measured = self.DeclareVectorInputPort("table_position_measured", 1)
             if g.sampled:
                 f0 = self.initial_force
-                self.initial_state = [0.0, f0, self.initial_angle, f0, 0.0]
+                self.delay = OutputDelay(g.computation_delay)
+                self.initial_state = [0.0, f0, self.initial_angle, f0, 0.0] + self.delay.initial(f0)
                 self.DeclareDiscreteState(BasicVector_[T](self.initial_state))
-                self.DeclarePeriodicDiscreteUpdateEvent(g.velocity_period, 0.0, self._update)
+                self.delay.declare(self, g.velocity_period, self._update, self._switch)
                 deps = {self.xd_ticket()}
                 self.DeclareVectorOutputPort("torque_command", 1, self._torque_sampled, prerequisites_of_calc=deps)
                 self.DeclareVectorOutputPort("controller_signals", 3, self._signals_sampled, prerequisites_of_calc=deps)
@@ -104,7 +109,8 @@ def CascadeController_(T):
 
         # -- sampled ------------------------------------------------------------------------
         def _update(self, context, discrete_state):
-            v_held, integ, theta_prev, _, tick = context.get_discrete_state_vector().CopyToVector()
+            x = context.get_discrete_state_vector().CopyToVector()
+            v_held, integ, theta_prev, force_before, tick = x[:5]
             g = self.gains
             theta = self._u_motor_measured.Eval(context)[0]
             speed = (theta - theta_prev) / g.velocity_period * self.ratio
@@ -113,11 +119,18 @@ def CascadeController_(T):
             n = g.position_divider
             next_tick = where(tick > n - 1.5, 0.0 * tick, tick + 1.0)
             discrete_state.get_mutable_vector().SetFromVector(
-                vector([v_cmd, integ + g.velocity_period * rate, theta, force, next_tick])
+                vector([v_cmd, integ + g.velocity_period * rate, theta, force, next_tick]
+                       + self.delay.advance(force_before, x[5:]))
             )
 
+        def _switch(self, context, discrete_state):
+            x = context.get_discrete_state_vector().CopyToVector()
+            discrete_state.get_mutable_vector().SetFromVector(
+                vector(list(x[:5]) + self.delay.switched(x[3], x[5:])))
+
         def _torque_sampled(self, context, output):
-            output.SetAtIndex(0, context.get_discrete_state_vector().GetAtIndex(3) * self.ratio)
+            x = context.get_discrete_state_vector().CopyToVector()
+            output.SetAtIndex(0, self.delay.applied(x[3], x[5:]) * self.ratio)
 
         def _signals_sampled(self, context, output):
             x = context.get_discrete_state_vector().CopyToVector()

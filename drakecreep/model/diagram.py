@@ -161,7 +161,9 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     s["table"] = NutTable(params, load)
     counts = 0 if ideal_sensors else params.sensors.encoder_counts_per_rev
     s["encoder"] = MotorEncoder(counts)
-    s["scale"] = LinearScale(0.0 if ideal_sensors else params.sensors.scale_resolution)
+    sensors = params.sensors
+    s["scale"] = (LinearScale(0.0) if ideal_sensors else
+                  LinearScale(sensors.scale_resolution, sensors.scale_interpolation_error, sensors.scale_signal_period))
     for name, system in s.items():
         system.set_name(name)
         builder.AddSystem(system)
@@ -177,7 +179,8 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     if drive != "constant_speed":
         ports = add_nut_friction(builder, s, params, scenario, ports)
     if "controller" in s:
-        ports = add_compensation(builder, s, params, scenario, ports)
+        ports = add_compensation(builder, s, params, scenario, ports, angle0=ic["theta_counted0"],
+                                 torque0=ic["force0"] * params.screw.lead / (2 * math.pi))
     if external_force is not None:
         from pydrake.systems.primitives import Adder
 

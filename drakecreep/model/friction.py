@@ -106,6 +106,10 @@ class FrictionLaw:
         """Tangent stiffness (N/m) of the contact when stuck (``inf`` for stateless laws)."""
         return np.inf
 
+    def breakaway(self, Fc, Fs):
+        """Largest friction force (N) the law holds at rest: ``Fs`` (the static level) for laws with one."""
+        return Fs
+
 
 @dataclass(frozen=True)
 class CoulombFriction(FrictionLaw):
@@ -115,6 +119,10 @@ class CoulombFriction(FrictionLaw):
 
     def force(self, v, z, Fc, Fs):
         return Fc * tanh(v / self.regularization_velocity) + self.viscous * v
+
+    def breakaway(self, Fc, Fs):
+        """``Fc``: the law has no static level above the sliding one (no friction drop, no creep)."""
+        return Fc
 
 
 @dataclass(frozen=True)

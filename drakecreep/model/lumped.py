@@ -2,6 +2,12 @@
 
 One place computes the lumped values every analytic result uses (eq. 11's critical speed, the sweep map's
 ``v0`` curve, the paper reproduction, ``drakecreep critical``), from the same functions the Drake systems use.
+
+The friction of the lumped mass is the friction the model applies to the table
+(:func:`~drakecreep.model.nut_table.table_friction_levels`): with the ball nut's drag on the screw's rotation
+(``friction.nut_friction_on: screw``, the default since issue 15) that is the guides' share only; the nut's
+drag then acts on the motor side of the spring, where the paper's Fig. 2 mechanism (motor side at a constant
+speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the paper lumps it.
 """
 
 from __future__ import annotations
@@ -9,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drakecreep.model.friction import FrictionLaw, make_friction_law
-from drakecreep.model.nut_table import friction_levels, moving_mass
+from drakecreep.model.nut_table import moving_mass, table_friction_levels
 from drakecreep.model.screw import axial_damping, axial_stiffness, screw_inertia
 
 __all__ = ["LumpedDrive", "lumped", "axial_mode_frequency"]
@@ -28,7 +34,9 @@ class LumpedDrive:
     mass : float
         M, kg: table plus nut.
     coulomb, breakaway : float
-        Fc (the paper's Fd) and Fs, N, for the load case.
+        Fc (the paper's Fd) and Fs, N, for the load case: the friction acting on the table (the guides'
+        share when the nut's drag is on the screw). ``breakaway`` is the law's
+        (:meth:`~drakecreep.model.friction.FrictionLaw.breakaway`): ``Fc`` for the Coulomb law, which has no drop.
     law : FrictionLaw
         The friction law of ``params.friction`` (its steady-state curve gives the slope C1).
     load_case : int
@@ -59,14 +67,15 @@ def lumped(params, load_case=0, x=0.0):
     x : float
         Table position (m); the shaft's stiffness depends on it.
     """
-    fc, fs = friction_levels(params, params.load_case(load_case))
+    fc, fs = table_friction_levels(params, params.load_case(load_case))
+    law = make_friction_law(params.friction)
     return LumpedDrive(
         stiffness=float(axial_stiffness(params.screw, params.nut, x)),
         damping=float(axial_damping(params.screw, params.nut, x)),
         mass=float(moving_mass(params)),
         coulomb=float(fc),
-        breakaway=float(fs),
-        law=make_friction_law(params.friction),
+        breakaway=float(law.breakaway(fc, fs)),
+        law=law,
         load_case=int(load_case),
     )
 

@@ -10,7 +10,8 @@ At each sample ``t_k = k h`` (offset 0, period ``h``)::
 and the drive force ``gain * u`` is held (zero-order hold). A computation delay of ``delay = n + f``
 samples (``n`` integer, ``0 <= f < 1``) applies ``u[k-n]`` from ``t_k + f h`` on: ``f = 0`` is one
 periodic update; ``f > 0`` adds a second periodic update at offset ``f h`` that switches the
-applied value. The documented EMPS law is ``delay = 0``.
+applied value (validation and events: :mod:`drakecreep.model.delay`, shared with the PI cascade).
+The documented EMPS law is ``delay = 0``.
 
 Discrete state: ``[q[k-1] .. q[k-N] (N = len(taps)), u[k] .. u[k-n], applied]``.
 """
@@ -22,6 +23,7 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.errors import InputError
 from drakecreep.model._scalar import clip, vector
+from drakecreep.model.delay import OutputDelay, split_delay
 from drakecreep.model.sensors import quantize
 
 __all__ = ["PPCascade", "PPCascade_", "pp_initial_state"]
@@ -71,11 +73,8 @@ def PPCascade_(T):
             self.kp, self.kv, self.saturation = float(kp), float(kv), float(saturation)
             self.period, self.gain, self.resolution = float(period), float(gain), float(resolution)
             self.taps = tuple(float(c) for c in taps)
-            if not (math.isfinite(delay) and delay >= 0):
-                raise InputError("controller.delay", delay, "a number of samples >= 0")
+            self.n_delay, self.frac = split_delay(delay, "controller.delay")
             self.delay = float(delay)
-            self.n_delay = int(math.floor(self.delay))
-            self.frac = self.delay - self.n_delay
             n = len(self.taps) + self.n_delay + 2
             self.initial_state = [0.0] * n if initial_state is None else [float(v) for v in initial_state]
             if len(self.initial_state) != n:
@@ -83,9 +82,7 @@ def PPCascade_(T):
             self._x_ref = self.DeclareVectorInputPort("x_ref", 1)
             self._position = self.DeclareVectorInputPort("position", 1)
             self.DeclareDiscreteState(BasicVector_[T](self.initial_state))
-            self.DeclarePeriodicDiscreteUpdateEvent(self.period, 0.0, self._update)
-            if self.frac > 0:
-                self.DeclarePeriodicDiscreteUpdateEvent(self.period, self.frac * self.period, self._switch)
+            OutputDelay(self.delay, "controller.delay").declare(self, self.period, self._update, self._switch)
             deps = {self.xd_ticket()}
             self.DeclareVectorOutputPort("force", 1, self._calc_force, prerequisites_of_calc=deps)
             self.DeclareVectorOutputPort("u", 1, self._calc_u, prerequisites_of_calc=deps)

@@ -11,7 +11,7 @@ import numpy as np
 
 from drakecreep.files import to_jsonable
 
-__all__ = ["to_json_dict", "write_report"]
+__all__ = ["to_json_dict", "write_report", "drake_to_json_dict", "ranking_json", "write_drake_report"]
 
 
 def _clean(obj):
@@ -199,4 +199,203 @@ def write_report(result, out_dir, title="Sim-to-real gap diagnosis"):
            + "\n".join(parts) + "</body></html>")
     html_path = outset.write_text("diagnosis.html", doc)
     outset.commit(dict(report=title, html="diagnosis.html", json="diagnosis.json"))
+    return html_path, json_path
+
+
+# --------------------------------------------------------------------------------------------------------------
+# The diagnosis on the Drake model (drakecreep.gap.drake_diagnosis.DrakeDiagnosis): what `drakecreep diagnose`
+# writes for p_p_cascade runs.
+
+
+def _rms_force(errors):
+    vals = [e["force"] for e in errors.values()]
+    return float(np.sqrt(np.mean(np.square(vals)))) if vals else float("nan")
+
+
+def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
+    """JSON-ready ranking (also written alone, before the greedy augmentation and any late replay)."""
+    rows = []
+    for r in ranking:
+        sc = r.screen
+        row = {"effect": r.name, "screened_out": bool(r.screened_out), "passes": bool(r.passes)}
+        if sc is not None:
+            row["inverse_dynamics"] = {"held_out_force_error_percent": sc.test_error, "gain_points": sc.gain,
+                                       "standard_error_points": sc.standard_error, "passes": bool(sc.passes),
+                                       "start": sc.start}
+        if not r.screened_out:
+            from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+            names = DRAKE_EFFECTS[r.name].parameters if r.name in DRAKE_EFFECTS else ()
+            row["closed_loop"] = {"held_out_force_error_percent": r.fit.test_force_error,
+                                  "train_force_error_percent": r.fit.train_force_error,
+                                  "gain_points": r.gain, "standard_error_points": r.standard_error,
+                                  "threshold_points": k_se * r.standard_error,
+                                  "parameters": {n: r.fit.parameters[n] for n in names},
+                                  "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
+        rows.append(row)
+    shown = ("mass",) + tuple(n for n in nominal.fitted if n != "mass")
+    return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in shown},
+                                    "ci95": nominal.ci95, "warnings": list(nominal.warnings),
+                                    "held_out_force_error_percent": _rms_force(nominal_test_errors),
+                                    "held_out_errors": nominal_test_errors},
+                        "ranking": rows})
+
+
+def drake_to_json_dict(diagnosis, **extra):
+    """JSON-ready form of a :class:`~drakecreep.gap.drake_diagnosis.DrakeDiagnosis` (plus ``extra`` keys:
+    ``data``, ``train_runs``, ``test_runs``, ``scored``, ...)."""
+    d = ranking_json(diagnosis.nominal, diagnosis.nominal_test_errors, diagnosis.ranking, diagnosis.k_se)
+    d.update(to_jsonable({
+        "model_kind": "drakecreep.measured_axis (Drake replay: P-P cascade + MeasuredAxis)",
+        "claimed": list(diagnosis.claimed),
+        "model": diagnosis.model,
+        "held_out_errors": diagnosis.test_errors,
+        "held_out_force_error_percent": {"nominal": _rms_force(diagnosis.nominal_test_errors),
+                                         "augmented": _rms_force(diagnosis.test_errors)},
+        "not_ranked": diagnosis.not_ranked,
+        "k_se": diagnosis.k_se,
+        "seconds": diagnosis.seconds,
+        "summary": diagnosis.summary(),
+    }))
+    d.update(to_jsonable(extra))
+    return d
+
+
+def _fig_png(fig):
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _drake_figures(diagnosis, residuals=None):
+    import matplotlib.pyplot as plt
+
+    figs = []
+    ranked = list(diagnosis.ranking)
+    if ranked:
+        fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
+        y = np.arange(len(ranked))[::-1]
+        cl = [r.gain if not r.screened_out else np.nan for r in ranked]
+        se = [diagnosis.k_se * r.standard_error if not r.screened_out else 0.0 for r in ranked]
+        sc = [r.screen.gain if r.screen is not None else np.nan for r in ranked]
+        ax.barh(y + 0.2, cl, 0.4, xerr=se, color=["tab:green" if r.passes else "tab:gray" for r in ranked],
+                label=f"closed-loop replay (bar: {diagnosis.k_se:g} SE)")
+        ax.barh(y - 0.2, sc, 0.4, color="tab:blue", alpha=0.5, label="inverse dynamics (screen)")
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_yticks(y, [r.name + (" (screened out)" if r.screened_out else "") for r in ranked])
+        ax.set_xlabel("held-out force error decrease [points of %]")
+        ax.legend(fontsize=8, loc="lower right")
+        figs.append((_fig_png(fig), "Which effect: held-out gain against the nominal model, per candidate "
+                                    "(green: passes the claim threshold)"))
+    labels = list(diagnosis.nominal_test_errors)
+    if labels:
+        fig, ax = plt.subplots(figsize=(8, 3))
+        x = np.arange(len(labels))
+        ax.bar(x - 0.2, [diagnosis.nominal_test_errors[k]["force"] for k in labels], 0.4, label="nominal")
+        ax.bar(x + 0.2, [diagnosis.test_errors[k]["force"] for k in labels], 0.4,
+               label="augmented: " + (" + ".join(diagnosis.claimed) or "nothing claimed"))
+        ax.set_xticks(x, labels, rotation=30, fontsize=8)
+        ax.set_ylabel("force error [% of ||F||]")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2)
+        figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
+    if residuals:
+        fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+        t = residuals["t"]
+        for key, lab in (("nominal", "nominal"), ("augmented", "augmented")):
+            axes[0].plot(t, residuals[key]["force"], lw=0.6, label=lab)
+            axes[1].plot(t, 1e6 * residuals[key]["position"], lw=0.6, label=lab)
+        axes[0].set_ylabel("force residual [N]")
+        axes[1].set_ylabel("position residual [µm]")
+        axes[1].set_xlabel("time [s]")
+        axes[0].legend(fontsize=8)
+        figs.append((_fig_png(fig), f"Where: measured minus replayed, held-out run {residuals['label']}"))
+    return figs
+
+
+def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real gap diagnosis (Drake model)",
+                       outset=None, **extra):
+    """Write ``diagnosis.html`` and ``diagnosis.json`` of a typed Drake diagnosis into ``out_dir``.
+
+    Parameters
+    ----------
+    diagnosis : drakecreep.gap.drake_diagnosis.DrakeDiagnosis
+    out_dir : path-like
+    residuals : dict, optional
+        ``{"label", "t", "nominal": {"force", "position"}, "augmented": {...}}`` of one held-out run.
+    outset : drakecreep.files.OutputSet, optional
+        The output set to write into (its manifest is committed by the caller); default: a new one committed here.
+    **extra
+        Keys added to the JSON (``data``, ``train_runs``, ``test_runs``, ``scored``).
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        ``(html_path, json_path)``.
+    """
+    from drakecreep.files import OutputSet
+    from drakecreep.model.axis import AXIS_UNITS
+    from drakecreep.report.html import escape, figure, page, table
+
+    own = outset is None
+    if own:
+        outset = OutputSet(out_dir, "manifest.json").start()
+    data = drake_to_json_dict(diagnosis, **extra)
+    json_path = outset.write_text("diagnosis.json", json.dumps(data, indent=1))
+    k = diagnosis.k_se
+    nom = diagnosis.nominal
+    parts = [f"<h1>{escape(title)}</h1>"]
+    if extra.get("data"):
+        parts.append(f"<p>Data: <code>{escape(str(extra['data']))}</code>; training runs "
+                     f"{escape(', '.join(extra.get('train_runs', [])))}; held-out runs "
+                     f"{escape(', '.join(extra.get('test_runs', [])))}. Diagnosis {diagnosis.seconds:.0f} s.</p>")
+    parts.append("<h2>Answer</h2><ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
+    parts.append("<p class='note'>A candidate is claimed only when its closed-loop replay of the held-out runs "
+                 f"(parameters fixed from the training runs) beats the current model by more than {k:g} standard "
+                 "errors of the per-run differences, and its inverse-dynamics fit of the held-out runs does too "
+                 "(the screen). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
+    parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
+    parts.append(table(["parameter", "value", "95 % half-width", "unit"],
+                       [[n, f"{nom.parameters[n]:.5g}", f"{nom.ci95.get(n, float('nan')):.3g}", AXIS_UNITS[n]]
+                        for n in nom.fitted]))
+    if nom.warnings:
+        parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in nom.warnings) + "</ul>")
+    rows = []
+    for r in diagnosis.ranking:
+        sc = r.screen
+        scr = "-" if sc is None or not np.isfinite(sc.gain) else f"{sc.gain:+.3f} ± {k * sc.standard_error:.3f}"
+        if r.screened_out:
+            rows.append([r.name, scr, "screened out", "-", "-", ""])
+            continue
+        from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+        names = DRAKE_EFFECTS[r.name].parameters if r.name in DRAKE_EFFECTS else ()
+        params = "; ".join(f"{n} = {r.fit.parameters[n]:.4g} {AXIS_UNITS[n]}" for n in names)
+        if r.name == "control_delay":
+            params = f"delay = {r.fit.delay:.3g} samples"
+        rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f} ± {k * r.standard_error:.3f}",
+                     "yes" if r.passes else "no", params])
+    parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
+    parts.append(table(["effect", "inverse-dynamics gain [points of %]", "closed-loop held-out force error [%]",
+                        "closed-loop gain [points of %]", "passes", "fitted parameters"], rows))
+    parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
+    sig = ("position", "velocity", "acceleration", "force")
+    rows = [[lab] + [f"{diagnosis.nominal_test_errors[lab][s]:.4g} → {diagnosis.test_errors[lab][s]:.4g}"
+                     for s in sig] for lab in diagnosis.nominal_test_errors]
+    parts.append(table(["held-out run"] + [f"{s} error [%] nominal → augmented" for s in sig], rows))
+    scored = extra.get("scored")
+    if scored:
+        parts.append(f"<h2>Scored on {escape(str(scored.get('data', '')))} (every parameter fixed)</h2>")
+        rows = [[lab] + [f"{scored['nominal'][lab][s]:.4g} → {scored['augmented'][lab][s]:.4g}" for s in sig]
+                for lab in scored["augmented"]]
+        parts.append(table(["run"] + [f"{s} error [%] nominal → augmented" for s in sig], rows))
+    parts.append("<h2>Never ranked</h2>")
+    parts.append(table(["effect", "why"], [[n, why] for n, why in diagnosis.not_ranked.items()]))
+    for png, caption in _drake_figures(diagnosis, residuals):
+        parts.append(figure(png, caption))
+    html_path = outset.write_text("diagnosis.html", page(title, parts))
+    if own:
+        outset.commit(dict(report=title, html="diagnosis.html", json="diagnosis.json"))
     return html_path, json_path

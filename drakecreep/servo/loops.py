@@ -16,7 +16,13 @@ Two controller variants:
   with its command held: the inner loop is lifted to the position period (``A^N``,
   ``sum A^i B``), which is exact for this multirate cascade, not an approximation.
 
-The difference of the two phase margins is what sampling and hold cost.
+The computation delay of the sampled controller (``controller.computation_delay = n + f`` samples: the
+command computed at ``t_k`` reaches the motor at ``t_{k+n} + f h``) is in the sampled loops as an exact
+discretization of the plant with a delayed zero-order hold (:func:`delayed_zoh`): ``z^-n`` for the whole
+samples and, for ``f > 0``, the modified z-transform (Astrom & Wittenmark, *Computer-Controlled Systems*,
+3rd ed. 1997, sec. 2.3: the held input switches inside the period), no Pade or Thiran approximation.
+The difference of the two phase margins is what sampling, hold and computation delay cost;
+:meth:`LoopAnalysis.summary` also gives the delay's own share (``computation_delay_cost``).
 Delay margin = phase margin / gain-crossover frequency (the smallest over all crossovers), seconds.
 Bandwidth = first frequency where ``|T| = L/(1+L)`` falls 3 dB below its low-frequency value.
 ``Ms = max |1/(1+L)|``.
@@ -27,6 +33,7 @@ from dataclasses import dataclass, field
 
 import control
 import numpy as np
+from scipy.linalg import expm
 from scipy.optimize import brentq
 
 from drakecreep.errors import InputError
@@ -39,6 +46,7 @@ __all__ = [
     "loop_transfer",
     "sampled_velocity_controller",
     "lift",
+    "delayed_zoh",
     "plant_resonance",
     "LoopAnalysis",
     "analyze_loops",
@@ -194,6 +202,68 @@ def sampled_velocity_controller(params):
                       states=["theta_prev", "integrator"], name="velocity_pi")
 
 
+def _hold_integral(A, B, t):
+    """``(e^{A t}, int_0^t e^{A s} ds B)`` from one matrix exponential (Van Loan's block form)."""
+    n, m = B.shape
+    M = np.zeros((n + m, n + m))
+    M[:n, :n], M[:n, n:] = A * t, B * t
+    E = expm(M)
+    return E[:n, :n], E[:n, n:]
+
+
+def delayed_zoh(P, h, delay=0.0):
+    """Exact discretization at period ``h`` of a continuous plant whose held input arrives ``delay`` samples late.
+
+    The input sequence ``u[k]`` (computed at ``t_k``) drives the plant as ``u[k - n]`` on
+    ``[t_k + f h, t_{k+1} + f h)`` (``delay = n + f``). ``f = 0``: ``control.c2d(P, h, "zoh")`` times
+    ``z^-n``. ``f > 0`` (modified z-transform): ``x[k+1] = Phi x[k] + Gamma0 v[k] + Gamma1 v[k-1]`` with
+    ``Gamma0 = int_0^{h - f h} e^{A s} ds B``, ``Gamma1 = e^{A (h - f h)} int_0^{f h} e^{A s} ds B``,
+    then ``z^-n``. No approximation of the delay.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Continuous plant (any number of inputs and outputs; labels are kept).
+    h : float
+        Sample time (s).
+    delay : float
+        Samples, >= 0.
+
+    Returns
+    -------
+    control.StateSpace
+        Discrete, ``dt = h``; its extra states are the held and queued inputs.
+    """
+    n_whole = int(math.floor(delay))
+    frac = float(delay) - n_whole
+    if not (math.isfinite(delay) and delay >= 0):
+        raise InputError("controller.computation_delay", delay, "a number of samples >= 0")
+    ins, outs = list(P.input_labels), list(P.output_labels)
+    if frac == 0.0:
+        Pd = control.c2d(control.ss(P), h, "zoh")
+    else:
+        A, B, C, D = (np.asarray(M, dtype=float) for M in (P.A, P.B, P.C, P.D))
+        nx, m = B.shape
+        Phi, _ = _hold_integral(A, B, h)
+        E0, G0 = _hold_integral(A, B, h - frac * h)
+        _, Gf = _hold_integral(A, B, frac * h)
+        G1 = E0 @ Gf
+        # state [x, v[k-1]]; at t_k the plant still gets v[k-1] (output feedthrough D acts on it)
+        Ad = np.block([[Phi, G1], [np.zeros((m, nx)), np.zeros((m, m))]])
+        Bd = np.vstack([G0, np.eye(m)])
+        Cd = np.hstack([C, D])
+        Pd = control.ss(Ad, Bd, Cd, np.zeros_like(D), h)
+    if n_whole:
+        m = Pd.ninputs
+        # z^-n on every input: a shift register of n samples per input
+        A = np.kron(np.eye(n_whole, k=-1), np.eye(m))
+        B = np.vstack([np.eye(m)] + [np.zeros((m, m))] * (n_whole - 1))
+        C = np.hstack([np.zeros((m, m))] * (n_whole - 1) + [np.eye(m)])
+        shift = control.ss(A, B, C, np.zeros((m, m)), h)
+        Pd = control.series(shift, Pd)
+    return control.ss(Pd.A, Pd.B, Pd.C, Pd.D, h, inputs=ins, outputs=outs)
+
+
 def lift(sys, n):
     """A discrete system whose input is held for ``n`` of its samples, seen every ``n`` samples.
 
@@ -251,7 +321,7 @@ def loop_transfer(params, scenario, loop="velocity", sampled=None, op=None, plan
             L = -inner
         return control.ss(L, name=f"L_{loop}")
     Tv = g.velocity_period
-    Pd = control.c2d(control.ss(P, name="plant"), Tv, "zoh", name="plant_d")
+    Pd = delayed_zoh(control.ss(P, name="plant"), Tv, g.computation_delay)
     Cv = sampled_velocity_controller(params)
     if loop == "velocity":
         L = -_siso(Cv, "torque_command", "encoder_angle") * _siso(Pd, "motor_angle", "torque_command")
@@ -314,6 +384,18 @@ class LoopAnalysis:
         out = {loop: dict(self.margins[main][loop]) for loop in LOOPS}
         out["controller"] = main
         if self.sampled:
+            g = self.params.controller if self.params is not None else None
+            if g is not None:
+                out["computation_delay_samples"] = g.computation_delay
+                out["computation_delay_ms"] = g.computation_delay * g.velocity_period * 1e3
+            undelayed = self.extra.get("undelayed_margins")
+            if undelayed:
+                # what the computation delay alone costs: sampled margins without it minus with it
+                out["computation_delay_cost"] = {
+                    loop: {k: undelayed[loop][k] - self.margins["sampled"][loop][k]
+                           for k in ("phase_margin_deg", "gain_margin_dB", "delay_margin_ms")}
+                    for loop in LOOPS
+                }
             out["continuous"] = {loop: dict(self.margins["continuous"][loop]) for loop in LOOPS}
             out["sampling_phase_cost_deg"] = {
                 loop: self.margins["continuous"][loop]["phase_margin_deg"] - self.margins["sampled"][loop][
@@ -353,8 +435,17 @@ def analyze_loops(params, scenario):
             L = loop_transfer(params, scenario, loop, sampled=variant == "sampled", op=op, plant=P, controller=K)
             loops[variant][loop] = L
             margins[variant][loop] = loop_margins(L)
+    extra = {}
+    if params.controller.sampled and params.controller.computation_delay > 0:
+        import dataclasses
+
+        bare = dataclasses.replace(params, controller=dataclasses.replace(params.controller, computation_delay=0.0))
+        extra["undelayed_margins"] = {
+            loop: loop_margins(loop_transfer(bare, scenario, loop, sampled=True, op=op, plant=P, controller=K))
+            for loop in LOOPS
+        }
     f, z = plant_resonance(P)
     cl = closed_loop_from_parts(P, K, params.controller.position_feedback).poles()
     return LoopAnalysis(op=op, plant=P, controller=K, loops=loops, margins=margins, resonance_Hz=f,
                         resonance_damping=z, closed_loop_poles=cl, sampled=params.controller.sampled,
-                        params=params, scenario=scenario)
+                        params=params, scenario=scenario, extra=extra)

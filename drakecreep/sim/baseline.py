@@ -37,8 +37,14 @@ def unsupported(params):
     d = p.disturbance
     if d.lead_error_amplitude > 0 or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
+    if p.sensors.scale_interpolation_error > 0 and p.controller.position_feedback == "table":
+        return ("sensors.scale_interpolation_error", p.sensors.scale_interpolation_error,
+                "0 with the scale in the loop (the plain-Python equations have no interpolation error)")
     if p.compensation.method != "none":
         return ("compensation.method", p.compensation.method, "none (the plain-Python equations have no compensator)")
+    if p.controller.sampled and not float(p.controller.computation_delay).is_integer():
+        return ("controller.computation_delay", p.controller.computation_delay,
+                "a whole number of samples (the plain-Python equations switch only at the samples)")
     return None
 
 
@@ -75,6 +81,7 @@ class BaselineModel:
         self.limit = p.motor.peak_torque * 2 * math.pi / sc.lead
         g = p.controller
         self.tracking = g.velocity_integral_gain / g.velocity_gain if (g.anti_windup and g.velocity_integral_gain > 0) else 0.0
+        self.n_delay = int(g.computation_delay) if self.sampled else 0
         counts = p.sensors.encoder_counts_per_rev
         self.enc = 0.0 if counts == 0 else 2 * math.pi / counts
         self.ic = initial_conditions(p, scenario)
@@ -164,9 +171,11 @@ class BaselineModel:
         return out
 
     def update(self, t, s, xd):
-        """One velocity-loop sample: ``xd = [v_cmd, integrator, theta_prev, force, tick]`` -> next."""
+        """One velocity-loop sample: ``xd = [v_cmd, integrator, theta_prev, force, tick, force[k-1] .. force[k-n]]``
+        -> next (``n`` = ``controller.computation_delay``; :meth:`applied` is the force the motor gets)."""
         g = self.p.controller
-        v_held, integ, theta_prev, _, tick = xd
+        v_held, integ, theta_prev, force_before, tick = xd[:5]
+        queue = ([force_before] + list(xd[5:]))[:self.n_delay]
         lag = self.lag > 0
         theta = s[0]
         x = s[2 + lag]
@@ -179,14 +188,18 @@ class BaselineModel:
             v_cmd = v_held
         force, rate = self.pi(v_cmd - speed, integ)
         next_tick = 0.0 if tick > g.position_divider - 1.5 else tick + 1.0
-        return [v_cmd, integ + g.velocity_period * rate, counted, force, next_tick]
+        return [v_cmd, integ + g.velocity_period * rate, counted, force, next_tick] + queue
+
+    def applied(self, xd):
+        """The force applied after a sample: ``force[k - n]``."""
+        return xd[4 + self.n_delay] if self.n_delay else xd[3]
 
     def initial_state(self):
         ic = self.ic
         s = [] if self.sampled else [ic["force0"]]
         s += [ic["theta0"], 0.0] + ([ic["force0"] * self.ratio] if self.lag > 0 else [])
         s += [0.0, 0.0] + [0.0] * (self.nz + self.nz_nut)
-        xd = [0.0, ic["force0"], ic["theta_counted0"], ic["force0"], 0.0]
+        xd = [0.0, ic["force0"], ic["theta_counted0"], ic["force0"], 0.0] + [ic["force0"]] * self.n_delay
         return np.array(s), xd
 
 
@@ -221,7 +234,7 @@ def simulate_baseline(params, scenario, *, method="LSODA", rtol=1e-6, atol=None,
         for k in range(n_samples):
             t0, t1 = k * period, min((k + 1) * period, scenario.duration)
             xd = model.update(t0, s, xd)
-            force = xd[3]
+            force = model.applied(xd)
             j_end = j
             while j_end < n_log and t_log[j_end] <= t1 + 1e-12:
                 j_end += 1

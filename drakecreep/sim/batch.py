@@ -39,7 +39,7 @@ def batch_key(params, scenario):
         p.controller.position_feedback, p.controller.anti_windup, p.motor.current_loop_time_constant > 0,
         p.screw.mounting, p.sensors.encoder_counts_per_rev == 0, p.sensors.scale_resolution == 0,
         scenario.duration, p.simulation.log_period, p.simulation.steady_start, p.simulation.stick_threshold,
-        p.simulation.integrator, target_accuracy(p), p.simulation.max_step,
+        p.simulation.integrator, target_accuracy(p), p.simulation.max_step, p.controller.computation_delay,
         getattr(scenario, "drive", "cascade"),
         nut_friction_levels(p, p.load_case(scenario.load_case))[0] > 0,  # nut friction on the screw: one more law
     )
@@ -64,6 +64,8 @@ class _Columns:
         self.table_feedback = first.p.controller.position_feedback == "table"
         g0 = first.p.controller
         self.period, self.divider = g0.velocity_period, g0.position_divider
+        self.n_delay = first.n_delay  # whole samples (baseline.unsupported), equal in a batch (batch_key)
+        self.nd = 5 + self.n_delay
         self.ratio = col(lambda m: m.ratio)
         self.ea = col(lambda m: m.ea)
         self.inertia = col(lambda m: m.inertia)
@@ -115,7 +117,8 @@ class BatchedFeedDrive(LeafSystem):
 
     Continuous state: the N cases' ``[theta, omega(, tau), x, v(, w(, w_nut))]`` stacked state-major
     (``state[i * N + k]`` is state ``i`` of case ``k``); discrete state: the controllers'
-    ``[v_cmd, integrator, theta_prev, force, tick]``, stacked the same way. Output ``table``:
+    ``[v_cmd, integrator, theta_prev, force, tick, force[k-1] .. force[k-n]]`` (``n`` the computation delay),
+    stacked the same way. Output ``table``:
     ``[x_ref, x, v]`` of every case, stacked.
     """
 
@@ -178,7 +181,8 @@ class BatchedFeedDrive(LeafSystem):
     def DoCalcTimeDerivatives(self, context, derivatives):
         c = self.c
         s = context.get_continuous_state_vector().CopyToVector()
-        force = context.get_discrete_state_vector().CopyToVector().reshape(5, c.n)[3]
+        xd = context.get_discrete_state_vector().CopyToVector().reshape(c.nd, c.n)
+        force = xd[4 + c.n_delay] if c.n_delay else xd[3]
         theta, omega, tau, x, v, w = self._split(s)
         tau_cmd = np.minimum(np.maximum(force * c.ratio, -c.peak), c.peak)
         if not c.lag:
@@ -206,7 +210,9 @@ class BatchedFeedDrive(LeafSystem):
     def _update(self, context, discrete_state):
         c = self.c
         t = context.get_time()
-        v_held, integ, theta_prev, _, tick = context.get_discrete_state_vector().CopyToVector().reshape(5, c.n)
+        xd = context.get_discrete_state_vector().CopyToVector().reshape(c.nd, c.n)
+        v_held, integ, theta_prev, force_before, tick = xd[:5]
+        queue = [force_before] + list(xd[5:])[:c.n_delay - 1] if c.n_delay else []
         theta, _, _, x, _, _ = self._split(context.get_continuous_state_vector().CopyToVector())
         counted = _quantize(theta, c.enc)
         speed = (counted - theta_prev) / c.period * c.ratio
@@ -218,7 +224,8 @@ class BatchedFeedDrive(LeafSystem):
         force = np.clip(u, -c.limit, c.limit)
         integ = integ + c.period * (c.ki * error + c.tracking * (force - u))
         tick = np.where(tick > c.divider - 1.5, 0.0, tick + 1.0)
-        discrete_state.get_mutable_vector().SetFromVector(np.concatenate([v_cmd, integ, counted, force, tick]))
+        discrete_state.get_mutable_vector().SetFromVector(
+            np.concatenate([v_cmd, integ, counted, force, tick] + queue))
 
     def _output(self, context, output):
         _, _, _, x, v, _ = self._split(context.get_continuous_state_vector().CopyToVector())

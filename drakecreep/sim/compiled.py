@@ -8,7 +8,10 @@ become Drake's C++ ``SymbolicVectorSystem``s:
 * ``plant``: continuous state, input = the discrete state, output = recorded signals + continuous state;
 * ``discrete_update`` + ``sampler``: the periodic update ``g(t, x_c, x_d)`` as a memoryless symbolic
   system, held by a ``ZeroOrderHold`` with the diagram's period whose state is the discrete state
-  (no feedthrough, so no algebraic loop).
+  (no feedthrough, so no algebraic loop). Several sampled leaves (controller, compensator on the encoder
+  speed) are fine when they share one period and offset 0: their groups are concatenated. A second
+  timing (a fractional ``controller.computation_delay`` switches the output between samples) is refused
+  with ``NotImplementedError``; :func:`drakecreep.sim.simulation.simulate` says so up front.
 
 Same equations, same state ordering, no Python in the simulation loop (measured about 10x faster end to
 end than the Python leaf systems, see ``analysis/bench_simulation.py``).
@@ -64,9 +67,11 @@ def symbolic_equations(feed_drive, inputs=()):
     context0 = diagram.CreateDefaultContext()
     xc0 = context0.get_continuous_state_vector().CopyToVector()
     nd_groups = context0.num_discrete_state_groups()
-    if nd_groups > 1:
-        raise NotImplementedError("the fast path supports one discrete state group (one sample rate)")
-    xd0 = context0.get_discrete_state(0).value().copy() if nd_groups else np.zeros(0)
+    # every sampled leaf (controller, sampled compensator) has its own group; they share one timing
+    # (checked below), so their states are concatenated into one vector held by one sampler
+    sizes = [context0.get_discrete_state(i).size() for i in range(nd_groups)]
+    xd0 = (np.concatenate([context0.get_discrete_state(i).value() for i in range(nd_groups)])
+           if nd_groups else np.zeros(0))
 
     sym = diagram.ToSymbolic()
     ctx = sym.CreateDefaultContext()
@@ -85,12 +90,21 @@ def symbolic_equations(feed_drive, inputs=()):
     period = 0.0
     update = np.zeros(0, dtype=object)
     if len(xd0):
-        ctx.SetDiscreteState(0, [Expression(v) for v in xd])
+        start = 0
+        for i, n in enumerate(sizes):
+            ctx.SetDiscreteState(i, [Expression(v) for v in xd[start:start + n]])
+            start += n
         attribute = sym.GetUniquePeriodicDiscreteUpdateAttribute()
+        if attribute is None:
+            raise NotImplementedError(
+                "the fast path needs all discrete updates at one period and offset (a fractional "
+                "controller.computation_delay adds a second offset): use simulation.backend: leaf"
+            )
         if attribute.offset_sec() != 0.0:
             raise NotImplementedError("the fast path needs discrete updates with zero offset")
         period = attribute.period_sec()
-        update = sym.EvalUniquePeriodicDiscreteUpdate(ctx).get_vector(0).CopyToVector()
+        values = sym.EvalUniquePeriodicDiscreteUpdate(ctx)
+        update = np.concatenate([values.get_vector(i).CopyToVector() for i in range(nd_groups)])
     derivatives = sym.EvalTimeDerivatives(ctx).CopyToVector()
     values = {}
     signals = []

@@ -285,6 +285,12 @@ def simulate(params, scenario, *, backend=None, wall_limit=None):
     backend = backend or sim.backend
     if backend not in ("compiled", "leaf"):
         raise InputError("backend", backend, "compiled or leaf")
+    delay = params.controller.computation_delay
+    if backend == "compiled" and params.controller.sampled and not float(delay).is_integer():
+        # a fractional delay switches the command between samples: a second event timing, which the
+        # symbolic fast path (one sampler) does not have; the leaf systems run it exactly
+        raise InputError("controller.computation_delay", delay,
+                         "a whole number of samples with simulation.backend: compiled (fractional: backend leaf)")
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration)

@@ -69,7 +69,7 @@ DEFAULT_FEEDS_MM_S = (0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0)
 DEFAULT_METHODS = COMPENSATION_STUDY_METHODS
 #: metric keys of one evaluation row (report units)
 EVAL_KEYS = ("max_fluctuation_mm_s", "fluctuation_rate_percent", "stick_fraction", "creep",
-             "following_error_max_um", "following_error_rms_um")
+             "following_error_max_um", "following_error_rms_um", "converged")
 
 
 def _run_one(job):

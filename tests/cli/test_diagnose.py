@@ -1,60 +1,95 @@
+"""``drakecreep diagnose`` on p_p_cascade runs: the Drake-model diagnosis end to end (short synthetic runs)."""
+
+import dataclasses
 import json
 
 import numpy as np
 import pytest
+import yaml
 
 from drakecreep import cli
-from drakecreep.gap.effects import EffectContext, get_effect, synthesize_run
-from drakecreep.gap.benchmark import out_and_back
-from drakecreep.gap.measured import EMPS_CONTROLLER, MeasuredData, MeasuredMeta, SensorMeta, save_measured
-from drakecreep.gap.replay import RigidModel
+from drakecreep.gap.drake_diagnosis import load_model
+from drakecreep.gap.drake_replay import SampledReplay, axis_from_idim
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import MeasuredData, load_emps, save_measured
 
-META = MeasuredMeta(u_units="V", u_gain=35.15, controller=EMPS_CONTROLLER, sensors=SensorMeta(encoder_resolution=5e-8))
-T = np.arange(3000) * 1e-3
+TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=4.0, viscous_asym=-40.0)
 
 
 @pytest.fixture(scope="module")
 def csv_file(tmp_path_factory):
-    model = RigidModel(M=90.0, Fv=200.0, Fc=20.0, offset=0.0)
-    term = get_effect("asymmetric_friction").replay_term([-50.0], None, EffectContext(), {})
-    rng = np.random.default_rng(2)
-    runs = tuple(synthesize_run(T, out_and_back(v, 0.01), META, model, [term], force_noise=rng.normal(0, 0.5, T.size),
-                                label=f"r{i}") for i, v in enumerate((0.02, 0.03, 0.06, 0.08)))
+    """Five 1 s slices of the EMPS reference, replayed through a known axis with asymmetric friction, noisy force."""
+    full = load_emps("estimation").runs[0]
+    runs = []
+    for i, a in enumerate((0, 3000, 6000, 9000, 12000)):
+        run = full.slice(a, a + 1000)
+        res = SampledReplay(run).simulate(TRUTH)
+        u = res.u + np.random.default_rng(i).normal(0.0, 0.5 / run.u_gain, res.u.size)
+        runs.append(dataclasses.replace(run, t=run.t - run.t[0], x_motor=res.x_motor, u=u, label=f"w{i}"))
     path = tmp_path_factory.mktemp("csv") / "runs.csv"
-    save_measured(MeasuredData(runs=runs, meta=META), path)
+    save_measured(MeasuredData(runs=tuple(runs), meta=runs[0].meta), path)
     return path
 
 
-def test_diagnose_csv_writes_report_and_json(csv_file, tmp_path, capsys):
+def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_file, tmp_path, capsys):
     out = tmp_path / "rep"
-    assert cli.main(["diagnose", str(csv_file), "--train", "r0,r2", "--test", "r1,r3", "--screw-lead", "5",
-                     "--out", str(out), "--json"]) == 0
+    assert cli.main(["diagnose", str(csv_file), "--train", "w0,w1", "--test", "w2,w3,w4", "--effects",
+                     "asymmetric_friction,thermal_drift", "--out", str(out), "--json", "--score", str(csv_file)]) == 0
     captured = capsys.readouterr()
     data = json.loads(captured.out)
-    assert data["claimed"][0] == "asymmetric_friction"
-    assert data["train_runs"] == ["r0", "r2"] and data["test_runs"] == ["r1", "r3"]
-    assert {"where", "ranking", "unexplained_share"} <= set(data)
+    assert data["claimed"] == ["asymmetric_friction"]
+    assert data["train_runs"] == ["w0", "w1"] and data["test_runs"] == ["w2", "w3", "w4"]
+    assert [r["effect"] for r in data["ranking"]][0] == "asymmetric_friction"
+    assert data["held_out_force_error_percent"]["augmented"] < data["held_out_force_error_percent"]["nominal"]
     assert "[diagnose]" in captured.err  # progress on stderr
-    assert (out / "diagnosis.html").read_text().count("data:image/png;base64,") >= 5
-    assert json.loads((out / "diagnosis.json").read_text())["claimed"] == data["claimed"]
+    # the ranking file is written (before the augmentation) and agrees with the final JSON
+    ranking = json.loads((out / "ranking.json").read_text())
+    assert [r["effect"] for r in ranking["ranking"]] == [r["effect"] for r in data["ranking"]]
+    assert json.loads((out / "diagnosis.json").read_text())["claimed"] == ["asymmetric_friction"]
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert {"diagnosis.html", "diagnosis.json", "augmented_model.yaml", "ranking.json"} <= set(manifest["files"])
+    html = (out / "diagnosis.html").read_text()
+    assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
+    params, flexible, delay = load_model(out / "augmented_model.yaml")
+    assert abs(params["viscous_asym"] + 40.0) < 10.0 and not flexible and delay == 0.0
+    # --score replays the augmented model, fixed, on the whole runs of another file
+    scored = data["scored"]
+    assert set(scored["augmented"]) == {"w0", "w1", "w2", "w3", "w4"}
+    assert all(scored["augmented"][k]["force"] < scored["nominal"][k]["force"] for k in scored["augmented"])
 
 
-def test_diagnose_text_and_score(csv_file, capsys):
-    assert cli.main(["diagnose", str(csv_file), "--score", str(csv_file)]) == 0
+def test_text_output(csv_file, capsys):
+    assert cli.main(["diagnose", str(csv_file), "--train", "w0,w1", "--test", "w2,w3", "--effects",
+                     "thermal_drift", "-q"]) == 0
     out = capsys.readouterr().out
-    assert "Best explanation: asymmetric_friction" in out
-    assert "Scored on" in out
+    assert "nominal held-out force error" in out and "claimed:" in out
 
 
-def test_bad_run_label_is_a_one_line_error(csv_file, capsys):
-    assert cli.main(["diagnose", str(csv_file), "--train", "nope"]) == 2
+@pytest.mark.parametrize("argv, word", [
+    (["--train", "nope"], "nope"),
+    (["--train", "w0,w1", "--test", "w1,w2"], "disjoint"),
+    (["--train", "w0,w1", "--test", "w2"], "two held-out"),
+    (["--effects", "backlash"], "backlash"),
+    (["--effects", "no_such_effect"], "no_such_effect"),
+])
+def test_bad_requests_are_one_line_before_any_work(csv_file, capsys, argv, word):
+    assert cli.main(["diagnose", str(csv_file)] + argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "nope" in err[0]
-
-
-def test_overlapping_sets_are_refused(csv_file, capsys):
-    assert cli.main(["diagnose", str(csv_file), "--train", "r0,r1", "--test", "r1"]) == 2
+    assert len(err) == 1 and word in err[0]
 
 
 def test_missing_file(tmp_path, capsys):
     assert cli.main(["diagnose", str(tmp_path / "absent.csv")]) == 2
+
+
+def test_a_score_file_with_another_controller_is_refused_before_work(csv_file, tmp_path, capsys):
+    meta = yaml.safe_load(csv_file.with_suffix(".yaml").read_text()) if csv_file.with_suffix(".yaml").exists() \
+        else None
+    if meta is None:
+        pytest.skip("metadata not beside the CSV")
+    meta["controller"] = {"kind": "pi_cascade"}
+    other = tmp_path / "other.csv"
+    other.write_text(csv_file.read_text())
+    other.with_suffix(".yaml").write_text(yaml.safe_dump(meta))
+    assert cli.main(["diagnose", str(csv_file), "--score", str(other)]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1

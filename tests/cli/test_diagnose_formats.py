@@ -19,12 +19,13 @@ def test_csv_in_mm_and_ms_gives_the_si_result(tmp_path, capsys):
     assert "[ms]" in header and "[mm]" in header
     si_csv, _ = save_measured(load_measured(EXAMPLE), tmp_path / "emps_segment.csv")
     assert si_csv.read_text().splitlines()[0].startswith("t[s],x_ref[m],x_motor[m]")
-    shop, si = _diagnose(capsys, EXAMPLE), _diagnose(capsys, si_csv)
+    opts = ("--train", "0", "--test", "1,2", "--effects", "thermal_drift")
+    shop, si = _diagnose(capsys, EXAMPLE, *opts), _diagnose(capsys, si_csv, *opts)
     for key in ("claimed", "train_runs", "test_runs"):
         assert shop[key] == si[key]
     assert [r["effect"] for r in shop["ranking"]] == [r["effect"] for r in si["ranking"]]
-    for name, value in shop["nominal"]["params"].items():
-        assert value == pytest.approx(si["nominal"]["params"][name], rel=1e-9, abs=1e-9), name
+    for name, value in shop["nominal"]["parameters"].items():
+        assert value == pytest.approx(si["nominal"]["parameters"][name], rel=1e-9, abs=1e-9), name
 
 
 def test_missing_metadata_names_the_option(tmp_path, capsys):

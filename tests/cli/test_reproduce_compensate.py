@@ -18,6 +18,13 @@ def test_reproduce_paper_bad_calibration_rows_exit_2(tmp_path, capsys):
     assert "calibration_rows" in capsys.readouterr().err
 
 
+def test_reproduce_paper_sensitivity_needs_validate_exit_2_before_work(tmp_path, capsys):
+    assert main(["reproduce-paper", "--out", str(tmp_path / "o"), "--sensitivity"]) == 2
+    err = capsys.readouterr().err
+    assert "--sensitivity" in err and "--validate" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
 def test_compensate_json(tmp_path, capsys):
     argv = ["compensate", "--method", "lugre", "--feeds", "1", "--load-cases", "3", "--duration", "0.8",
             "--workers", "1", "--out", str(tmp_path), "--json"]

@@ -2,9 +2,11 @@ import math
 
 import numpy as np
 import pytest
+from pydrake.systems.analysis import Simulator
 
+from drakecreep.errors import InputError
 from drakecreep.model.controller import CascadeController, force_limit
-from drakecreep.params import ControllerParams
+from drakecreep.params import ControllerParams, load_params, save_params, with_value
 
 LEAD = 5e-3
 R = LEAD / (2 * math.pi)
@@ -54,7 +56,8 @@ def test_back_calculation_in_saturation():
 
 
 def test_sampled_update_by_hand():
-    g = _gains()
+    # without computation delay (the default became 1 sample in issue 15; the delay has its own tests below)
+    g = _gains(computation_delay=0.0)
     ctrl = CascadeController(g, LEAD, 1e4, initial_force=5.0, initial_angle=0.099)
     c = ctrl.CreateDefaultContext()
     _fix(ctrl, c, x_table=3e-5)
@@ -88,3 +91,66 @@ def test_conversion_forwards_every_setting(paper):
         assert (converted.lead, converted.limit, converted.initial_force, converted.initial_angle) == (
             LEAD, force_limit(paper), 3.0, 0.5)
     assert force_limit(paper) == pytest.approx(paper.motor.peak_torque * 2 * math.pi / paper.screw.lead)
+
+
+# --------------------------------------------------------------------------- computation delay (issue 15)
+
+def _step(ctrl, c):
+    c.SetDiscreteState(0, ctrl.EvalUniquePeriodicDiscreteUpdate(c).get_vector(0).CopyToVector())
+
+
+def test_whole_sample_delay_applies_the_command_n_samples_late():
+    ctrl = CascadeController(_gains(computation_delay=2.0), LEAD, 1e4, initial_force=5.0, initial_angle=0.099)
+    c = ctrl.CreateDefaultContext()
+    _fix(ctrl, c)
+    # state: the five of the undelayed controller, then force[k-1], force[k-2]
+    np.testing.assert_allclose(c.get_discrete_state_vector().CopyToVector(), [0.0, 5.0, 0.099, 5.0, 0.0, 5.0, 5.0])
+    newest, applied = [], []
+    for k in range(5):
+        _fix(ctrl, c, theta=0.1 + 1e-3 * k)  # the motor turns: a different command every sample
+        _step(ctrl, c)
+        newest.append(ctrl.GetOutputPort("controller_signals").Eval(c)[1])
+        applied.append(ctrl.GetOutputPort("torque_command").Eval(c)[0] / R)
+    assert len(set(np.round(newest, 6))) == 5
+    np.testing.assert_allclose(applied, [5.0, 5.0] + newest[:3])
+
+
+def test_fractional_delay_switches_inside_the_period():
+    h = 2.5e-4
+    ctrl = CascadeController(_gains(computation_delay=1.5), LEAD, 1e4, initial_force=5.0, initial_angle=0.099)
+    sim = Simulator(ctrl)
+    c = sim.get_mutable_context()
+    _fix(ctrl, c)
+    sim.Initialize()
+    forces = []
+    for t in np.arange(0.2, 3.0, 0.5) * h:  # before and after the switch at 0.5 h of each period
+        sim.AdvanceTo(t)
+        forces.append((t / h, ctrl.GetOutputPort("torque_command").Eval(c)[0] / R,
+                       ctrl.GetOutputPort("controller_signals").Eval(c)[1]))
+    # force[0] (computed at t = 0) reaches the motor at 1.5 h; force[1] at 2.5 h
+    newest0, newest1 = forces[0][2], forces[2][2]
+    assert newest0 != pytest.approx(5.0)
+    np.testing.assert_allclose([f[1] for f in forces], [5.0, 5.0, 5.0, newest0, newest0, newest1])
+
+
+def test_delay_is_validated_naming_the_field():
+    for bad in (-1.0, float("nan"), "one"):
+        with pytest.raises(InputError) as err:
+            ControllerParams(computation_delay=bad)
+        assert "computation_delay" in str(err.value)
+
+
+def test_delay_round_trips_through_yaml(paper, tmp_path):
+    params = with_value(paper, "controller.computation_delay", 1.25)
+    save_params(params, tmp_path / "p.yaml")
+    assert load_params(tmp_path / "p.yaml").controller.computation_delay == 1.25
+    assert paper.controller.computation_delay == 1.0  # the preset's stated default
+
+
+def test_conversion_forwards_the_delay(paper):
+    g = with_value(paper, "controller.computation_delay", 2.5).controller
+    ctrl = CascadeController(g, LEAD, force_limit(paper), initial_force=3.0)
+    for converted in (ctrl.ToAutoDiffXd(), ctrl.ToSymbolic()):
+        assert (converted.delay.n, converted.delay.frac) == (2, 0.5)
+        assert converted.num_discrete_state_groups() == 1
+        assert converted.CreateDefaultContext().get_discrete_state_vector().size() == 5 + 3

@@ -10,8 +10,10 @@ from drakecreep.sim.simulation import simulate
 def test_symbolic_equations_evaluate_like_the_leaf_systems(paper):
     drive = build_diagram(paper, Scenario(feed=1e-3))
     eq = symbolic_equations(drive)
-    # 7 states: motor 2, current lag 1, table 2, LuGre bristles of the table and of the nut on the screw
-    assert len(eq.xc) == 7 and len(eq.xd) == 5 and eq.period == paper.controller.velocity_period
+    # 7 states: motor 2, current lag 1, table 2, LuGre bristles of the table and of the nut on the screw;
+    # discrete: the controller's 5 plus its queue of n = computation_delay forces (1 in the preset since issue 15)
+    assert paper.controller.computation_delay == 1.0
+    assert len(eq.xc) == 7 and len(eq.xd) == 6 and eq.period == paper.controller.velocity_period
     c = drive.diagram.CreateDefaultContext()
     c.SetTime(0.02)
     xc = eq.xc0 + np.array([1e-3, 0.5, 0.01, 2e-6, 1e-4, 0.3, 0.2])

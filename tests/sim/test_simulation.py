@@ -1,4 +1,5 @@
 import json
+import math
 
 import numpy as np
 import pytest
@@ -154,3 +155,33 @@ def test_to_dataframe_has_si_columns_and_matches_the_saved_csv(low_feed, tmp_pat
     saved = pd.read_csv(low_feed.save(tmp_path)["timeseries"])
     assert list(saved.columns) == list(frame.columns)
     np.testing.assert_allclose(saved["table_speed_m_per_s"], frame["table_speed_m_per_s"], rtol=1e-9, atol=1e-15)
+
+
+def test_closed_loop_applies_the_command_one_sample_late(short_paper):
+    """Issue 15: the simulated drive applies force[k - 1] over [t_k, t_k+1) with the preset's one-sample delay.
+
+    The log samples at the velocity period; the applied torque logged at t_k is the force command logged at
+    t_(k-1) (through the lead), on both backends; without delay they are the same sample.
+    """
+    p = with_value(with_value(short_paper, "simulation.steady_start", 0.05), "simulation.convergence_check", False)
+    p = with_value(p, "simulation.log_period", p.controller.velocity_period)
+    r = p.screw.lead / (2 * math.pi)
+    scenario = Scenario(feed=1e-3, load_case=3, duration=0.1)
+    assert p.controller.computation_delay == 1.0
+    for backend in ("compiled", "leaf"):
+        s = simulate(p, scenario, backend=backend).signals
+        applied, newest = s["torque_command"] / r, s["force_command"]
+        assert np.ptp(newest) > 1.0  # the ramp's transient moves the command
+        np.testing.assert_allclose(applied[1:], newest[:-1], rtol=1e-12)
+    s0 = simulate(with_value(p, "controller.computation_delay", 0.0), scenario).signals
+    np.testing.assert_allclose(s0["torque_command"] / r, s0["force_command"], rtol=1e-12)
+
+
+def test_fractional_delay_runs_on_the_leaf_systems_and_is_refused_by_the_fast_path(short_paper):
+    p = with_value(with_value(short_paper, "simulation.steady_start", 0.05), "simulation.convergence_check", False)
+    p = with_value(p, "controller.computation_delay", 0.5)
+    scenario = Scenario(feed=1e-3, load_case=3, duration=0.1)
+    with pytest.raises(InputError) as err:
+        simulate(p, scenario, backend="compiled")
+    assert err.value.field == "controller.computation_delay"
+    assert simulate(p, scenario, backend="leaf").ok

@@ -88,14 +88,31 @@ def test_rigid_axis_creeps_without_compensation(within_reach):
     assert all(within_reach[("none", f)]["creep"] for f in (0.02, 0.05, 0.1))
 
 
-@pytest.mark.parametrize("method", ["static-measured", "lugre", "dob"])
 @pytest.mark.parametrize("feed", [0.05, 0.1])
-def test_model_based_compensators_remove_creep_within_reach(within_reach, method, feed):
-    # the issue's test, on the drive where the friction is within the loop's reach: nominal model
-    r = within_reach[(method, feed)]
+def test_lugre_removes_creep_within_reach(within_reach, feed):
+    # the issue's test, on the drive where the friction is within the loop's reach: nominal model. Since issue 15
+    # the compensators run at the loop rate on the encoder speed with the one-sample computation delay; LuGre
+    # still removes the creep (0.0002x none, as with the ideal tachometer)
+    r = within_reach[("lugre", feed)]
     assert not r["creep"]
     assert r["fluctuation_vs_none"] < 0.05
     assert r["following_error_max_um"] < 0.3 * within_reach[("none", feed)]["following_error_max_um"]
+
+
+@pytest.mark.parametrize("method", ["static-measured", "dob"])
+def test_speed_feedback_compensators_need_the_ideal_tachometer_within_reach(within_reach, method):
+    # Issue 15 changed this result. On the ideal continuous tachometer without computation delay, static-measured
+    # and the DOB removed the creep at 0.05 and 0.1 mm/s (0.0003x and 0.001-0.002x none, asserted < 0.05x before).
+    # On the encoder speed at the loop rate with the one-sample delay (the default now) both creep again at
+    # 0.1 mm/s: measured 0.60x (static-measured) and 0.64x (DOB) none, stuck 25-27 % of the time (both converged).
+    # The ideal variant, run here as well, still removes it: the loss is the sampled, delayed speed feedback.
+    r = within_reach[(method, 0.1)]
+    assert r["creep"] and r["fluctuation_vs_none"] > 0.3
+    p = with_value(with_value(preset("rigid_axis"), "compensation.speed_source", "ideal"),
+                   "controller.computation_delay", 0.0)
+    ideal = {row["label"]: row for row in evaluate(p, ("none", method), feeds_mm_s=(0.1,), load_cases=(3,),
+                                                   duration=2.0)}
+    assert not ideal[method]["creep"] and ideal[method]["fluctuation_vs_none"] < 0.05
 
 
 def test_feedforward_and_dither_do_not_remove_creep_within_reach(within_reach):

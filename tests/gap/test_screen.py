@@ -1,0 +1,69 @@
+"""The inverse-dynamics pre-screen (drakecreep.gap.screen) on runs replayed through a known axis."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+from drakecreep.gap.drake_replay import SampledReplay, axis_from_idim
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import load_emps
+from drakecreep.gap.screen import inverse_dynamics_force, screen_delay, screen_effect
+
+BASE = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3)
+
+
+def _runs(truth, delay=0.0, noise=0.5):
+    full = load_emps("estimation").runs[0]
+    out = []
+    for i, a in enumerate((0, 3000, 6000, 9000, 12000)):
+        run = full.slice(a, a + 1000)
+        res = SampledReplay(run, delay=delay).simulate(truth)
+        u = res.u + np.random.default_rng(i).normal(0.0, noise / run.u_gain, res.u.size)
+        out.append(dataclasses.replace(run, x_motor=res.x_motor, u=u, label=f"w{i}"))
+    return out
+
+
+@pytest.fixture(scope="module")
+def asym_runs():
+    return _runs(dict(BASE, coulomb_asym=4.0, viscous_asym=-40.0))
+
+
+def test_the_screen_ranks_the_withheld_effect_above_a_bystander(asym_runs):
+    train, test = asym_runs[:2], asym_runs[2:]
+    asym = screen_effect(DRAKE_EFFECTS["asymmetric_friction"], train, test, BASE)
+    drift = screen_effect(DRAKE_EFFECTS["thermal_drift"], train, test, BASE)
+    assert asym.passes and asym.gain > 0.5 and asym.test_error < asym.nominal_test_error
+    # a friction level drifting over a 1 s run that moves mostly one way partly mimics the asymmetry: the screen
+    # is a necessary condition, not the claim (the closed-loop replay separates them: test_drake_diagnosis.py);
+    # the withheld effect still explains more
+    assert asym.gain > drift.gain and asym.test_error < drift.test_error
+    # the start handed to the closed-loop fit is the withheld value (variable projection: linear parameters)
+    assert asym.start["viscous_asym"] == pytest.approx(-40.0, abs=8.0)
+
+
+def test_inverse_dynamics_of_the_true_axis_is_close_to_the_measured_force(asym_runs):
+    from drakecreep.gap.screen import _signals
+
+    run = asym_runs[0]
+    t, q, dq, ddq, tau = _signals(run)
+    good = inverse_dynamics_force(dict(BASE, coulomb_asym=4.0, viscous_asym=-40.0), t, q, dq, ddq)
+    bad = inverse_dynamics_force(BASE, t, q, dq, ddq)
+    assert np.linalg.norm(tau - good) < 0.6 * np.linalg.norm(tau - bad)
+
+
+def test_a_time_ripple_is_found_near_its_frequency():
+    runs = _runs(dict(BASE, time_ripple_cos=3.0, ripple_frequency=13.0))
+    sc = screen_effect(DRAKE_EFFECTS["time_ripple"], runs[:2], runs[2:], BASE)
+    assert sc.passes and abs(sc.start["ripple_frequency"] - 13.0) < 0.2
+
+
+def test_the_delay_scan_finds_a_whole_sample_delay():
+    runs = _runs(BASE, delay=2.0)
+    assert abs(screen_delay(runs[:2], BASE) - 2.0) <= 0.3
+
+
+def test_modes_and_delays_are_never_screened_out(asym_runs):
+    sc = screen_effect(DRAKE_EFFECTS["axial_mode"], asym_runs[:2], asym_runs[2:], BASE)
+    assert sc.passes and sc.start == {}
