@@ -49,6 +49,7 @@ __all__ = [
     "drake_replay_errors",
     "axis_from_idim",
     "replay_drakecreep",
+    "replay_params",
     "check_replayable",
 ]
 
@@ -548,17 +549,58 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     return out
 
 
-def replay_drakecreep(run, params=None, quantize=True, load_case=0):
+def replay_params(run, params=None, quantize=True):
+    """The :class:`~drakecreep.params.DriveParams` a ``kind: drakecreep`` run is replayed with.
+
+    ``params`` (default ``run.meta.params``) with the run's declared sensor resolutions
+    (``run.meta.sensors``: an encoder count at the load becomes ``encoder_counts_per_rev = lead / count``, the
+    scale resolution is taken as is; a resolution of 0 means "not declared" and keeps the params file's);
+    with ``quantize`` false both sensors are ideal.
+
+    Raises
+    ------
+    InputError
+        No params, or an encoder count that does not divide the lead into a whole number of counts.
+    """
+    import dataclasses
+
+    from drakecreep.params import DriveParams
+
+    if params is None:
+        check_replayable(run)
+        params = run.meta.params
+    if not isinstance(params, DriveParams):
+        raise InputError("params", type(params).__name__, "drakecreep DriveParams (a params file)")
+    sensors = params.sensors
+    declared = run.meta.sensors
+    if declared.encoder_resolution > 0:
+        counts = params.screw.lead / declared.encoder_resolution
+        if abs(counts - round(counts)) > 1e-6 * counts or round(counts) < 1:
+            raise InputError("sensors.encoder_resolution", declared.encoder_resolution,
+                             f"a whole fraction of the lead {params.screw.lead:g} m (lead / counts per revolution)")
+        sensors = dataclasses.replace(sensors, encoder_counts_per_rev=int(round(counts)))
+    if declared.scale_resolution > 0:
+        sensors = dataclasses.replace(sensors, scale_resolution=declared.scale_resolution)
+    if not quantize:
+        sensors = dataclasses.replace(sensors, encoder_counts_per_rev=0, scale_resolution=0.0)
+    return dataclasses.replace(params, sensors=sensors)
+
+
+def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="compiled"):
     """Replay ``run`` through the project's feed-drive diagram (``controller: {kind: drakecreep}``).
 
     The diagram is :func:`drakecreep.model.diagram.build_diagram` of ``params`` (default
-    ``run.meta.params``): PI cascade with ``params.controller``'s gains and periods, encoder and scale of
-    ``params.sensors`` (ideal when ``quantize`` is false), motor, elastic screw and table with their
-    friction law; the ramp reference is replaced by the measured one (``TrajectorySource`` of a
-    first-order hold, the speed its slope) and ``f_ext`` is added to the push on the table. Positions are
-    relative to the first sample (the diagram starts at rest at 0, in equilibrium under ``load_case``), and
-    simulated with ``params.simulation``'s integrator (leaf systems: a measured reference is no symbolic
-    function of time).
+    ``run.meta.params``, with the run's declared sensor resolutions, :func:`replay_params`): PI cascade with
+    ``params.controller``'s gains and periods, encoder and scale (ideal when ``quantize`` is false), motor,
+    elastic screw and table with their friction law and disturbances; the ramp reference is replaced by the
+    measured one (``TrajectorySource`` of a first-order hold, the speed its slope) and ``f_ext`` (a
+    zero-order hold) is added to the push on the table. Positions are relative to the first sample (the
+    diagram starts at rest at 0, in equilibrium under ``load_case``).
+
+    ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem`` systems
+    (:func:`drakecreep.sim.compiled.compile_diagram`, the reference and ``f_ext`` its ``inputs`` port, fed
+    by C++ ``TrajectorySource`` systems: no Python in the loop); ``"leaf"`` the Python leaf systems (same
+    equations, same integrator; kept as the cross-check, ``tests/gap/test_drake_replay.py``).
 
     Parameters
     ----------
@@ -567,27 +609,23 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0):
     quantize : bool
     load_case : int
         Load case of ``params`` the run was taken under (0 = unloaded).
+    backend : {"compiled", "leaf"}
 
     Returns
     -------
     DrakeReplayResult
         ``u`` is the force command [N] of the cascade; ``force = u_gain u + f_ext``.
     """
-    import dataclasses
+    from pydrake.systems.primitives import ConstantVectorSource, Multiplexer
 
     from drakecreep.model.diagram import build_diagram
-    from drakecreep.params import DriveParams
     from drakecreep.scenario import Scenario
+    from drakecreep.sim.compiled import compile_diagram
     from drakecreep.sim.simulation import make_simulator, target_accuracy
 
-    if params is None:
-        check_replayable(run)
-        params = run.meta.params
-    if not isinstance(params, DriveParams):
-        raise InputError("params", type(params).__name__, "drakecreep DriveParams (a params file)")
-    if not quantize:
-        params = dataclasses.replace(params, sensors=dataclasses.replace(
-            params.sensors, encoder_counts_per_rev=0, scale_resolution=0.0))
+    if backend not in ("compiled", "leaf"):
+        raise InputError("backend", backend, "compiled or leaf")
+    params = replay_params(run, params, quantize)
     start = _time.perf_counter()
     t = run.t - run.t[0]
     x_origin = float(run.x_motor[0])
@@ -598,20 +636,41 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0):
     ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
     feed = float(np.max(np.abs(vr))) or 1e-6
     scenario = Scenario(feed=min(feed, 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
-    fd = build_diagram(params, scenario, reference=reference, external_force=ext)
     b = DiagramBuilder()
-    system = b.AddSystem(fd.diagram)
-    logs = {key: LogVectorOutput(system.GetOutputPort(key), b, run.dt)
-            for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
+    if backend == "compiled":
+        fd = build_diagram(params, scenario, reference=ConstantVectorSource(np.zeros(2)),
+                           external_force=ConstantVectorSource(np.zeros(1)))
+        compiled = compile_diagram(fd, inputs=("reference", "external_force"))
+        system = b.AddSystem(compiled.diagram)
+        b.AddSystem(reference)
+        b.AddSystem(ext)
+        mux = b.AddSystem(Multiplexer([2, 1]))
+        b.Connect(reference.get_output_port(), mux.get_input_port(0))
+        b.Connect(ext.get_output_port(), mux.get_input_port(1))
+        b.Connect(mux.get_output_port(0), system.GetInputPort("inputs"))
+        logs = {"signals": LogVectorOutput(system.GetOutputPort("signals"), b, run.dt)}
+        names = compiled.signal_names
+        rows = [names.index(k) for k in ("motor_angle", "table_position", "force_command")]
+    else:
+        fd = build_diagram(params, scenario, reference=reference, external_force=ext)
+        system = b.AddSystem(fd.diagram)
+        logs = {key: LogVectorOutput(system.GetOutputPort(key), b, run.dt)
+                for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
+        rows = None
     root = b.Build()
     context = root.CreateDefaultContext()
+    if backend == "compiled":
+        compiled.set_initial_state(root.GetMutableSubsystemContext(system, context))
     simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
     simulator.AdvanceTo(float(t[-1]))
     data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
-    ratio = params.screw.lead / (2 * math.pi)
-    x_motor = data["motor.motor_state"][0] * ratio + x_origin
-    x_table = data["table.table_state"][0] + x_origin
-    u = data["controller.controller_signals"][1]
+    if rows is not None:
+        angle, x_table, u = data["signals"][rows]
+    else:
+        angle, x_table, u = (data["motor.motor_state"][0], data["table.table_state"][0],
+                             data["controller.controller_signals"][1])
+    x_motor = angle * params.screw.lead / (2 * math.pi) + x_origin
+    x_table = x_table + x_origin
     force = u * run.u_gain + f_ext
     return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
                              wall_time=_time.perf_counter() - start)

@@ -15,6 +15,12 @@ become Drake's C++ ``SymbolicVectorSystem``s:
 
 Same equations, same state ordering, no Python in the simulation loop (measured about 10x faster end to
 end than the Python leaf systems, see ``analysis/bench_simulation.py``).
+
+Signals from outside (a measured reference, an external force): build the feed drive with
+``ConstantVectorSource`` placeholders (``build_diagram(..., reference=ConstantVectorSource([0, 0]))``) and
+name them in ``inputs``; their values become symbolic variables, and the compiled diagram gets an input
+port ``inputs`` (their values concatenated, in the order named) that a ``TrajectorySource`` can drive
+(:func:`drakecreep.gap.drake_replay.replay_drakecreep`).
 """
 
 from dataclasses import dataclass
@@ -40,14 +46,18 @@ class SymbolicEquations:
     signals: np.ndarray
     xc0: np.ndarray
     xd0: np.ndarray
+    inputs: np.ndarray = None
 
 
-def symbolic_equations(feed_drive):
+def symbolic_equations(feed_drive, inputs=()):
     """Evaluate ``feed_drive``'s derivatives, discrete update and signals symbolically.
 
     Parameters
     ----------
     feed_drive : drakecreep.model.diagram.FeedDrive
+    inputs : sequence of str
+        Names of ``ConstantVectorSource`` subsystems whose values become symbolic input variables
+        (``SymbolicEquations.inputs``, concatenated in this order).
 
     Returns
     -------
@@ -70,6 +80,13 @@ def symbolic_equations(feed_drive):
     xc = MakeVectorVariable(len(xc0), "xc")
     xd = MakeVectorVariable(len(xd0), "xd")
     ctx.SetContinuousState([Expression(v) for v in xc])
+    u = []
+    for name in inputs:
+        source = sym.GetSubsystemByName(name)
+        value = source.get_mutable_source_value(source.GetMyMutableContextFromRoot(ctx))
+        names = MakeVectorVariable(value.size(), name)
+        value.SetFromVector([Expression(v) for v in names])
+        u.extend(names)
     period = 0.0
     update = np.zeros(0, dtype=object)
     if len(xd0):
@@ -98,7 +115,7 @@ def symbolic_equations(feed_drive):
         signals.append(values[key][index])
     return SymbolicEquations(
         time=t, xc=xc, xd=xd, derivatives=derivatives, update=update, period=period,
-        signals=np.array(signals, dtype=object), xc0=xc0, xd0=xd0,
+        signals=np.array(signals, dtype=object), xc0=xc0, xd0=xd0, inputs=np.array(u, dtype=object),
     )
 
 
@@ -130,22 +147,26 @@ class CompiledDrive:
             self.sampler.SetVectorState(self.diagram.GetMutableSubsystemContext(self.sampler, context), eq.xd0)
 
 
-def compile_diagram(feed_drive):
+def compile_diagram(feed_drive, inputs=()):
     """Compile ``feed_drive`` into ``SymbolicVectorSystem``s (see module docstring).
 
     Parameters
     ----------
     feed_drive : drakecreep.model.diagram.FeedDrive
+    inputs : sequence of str
+        ``ConstantVectorSource`` subsystems to turn into the exported input port ``inputs``.
 
     Returns
     -------
     CompiledDrive
     """
-    eq = symbolic_equations(feed_drive)
+    eq = symbolic_equations(feed_drive, inputs)
+    nu = len(eq.inputs)
     builder = DiagramBuilder()
     out = np.concatenate([eq.signals, [Expression(v) for v in eq.xc]])
     plant = builder.AddSystem(
-        SymbolicVectorSystem(time=eq.time, state=eq.xc, input=eq.xd, dynamics=eq.derivatives, output=out)
+        SymbolicVectorSystem(time=eq.time, state=eq.xc, input=np.concatenate([eq.xd, eq.inputs]),
+                             dynamics=eq.derivatives, output=out)
     )
     plant.set_name("plant")
     sampler = None
@@ -160,18 +181,34 @@ def compile_diagram(feed_drive):
         constant = Variable("unused_constant_state")
         update = builder.AddSystem(
             SymbolicVectorSystem(
-                time=eq.time, state=[constant], input=np.concatenate([dummy, eq.xc, eq.xd]),
+                time=eq.time, state=[constant], input=np.concatenate([dummy, eq.xc, eq.xd, eq.inputs]),
                 dynamics=[Expression(0.0)], output=eq.update,
             )
         )
         update.set_name("discrete_update")
         sampler = builder.AddSystem(ZeroOrderHold(eq.period, len(eq.xd)))
         sampler.set_name("sampler")
-        mux = builder.AddSystem(Multiplexer([len(eq.signals) + len(eq.xc), len(eq.xd)]))
+        mux = builder.AddSystem(Multiplexer([len(eq.signals) + len(eq.xc), len(eq.xd)] + ([nu] if nu else [])))
         builder.Connect(plant.get_output_port(0), mux.get_input_port(0))
         builder.Connect(sampler.get_output_port(), mux.get_input_port(1))
         builder.Connect(mux.get_output_port(0), update.get_input_port(0))
         builder.Connect(update.get_output_port(0), sampler.get_input_port())
+    if nu:
+        # one exported input feeds the plant (beside the held discrete state) and the discrete update
+        from pydrake.systems.primitives import PassThrough
+
+        through = builder.AddSystem(PassThrough(nu))
+        through.set_name("inputs")
+        builder.ExportInput(through.get_input_port(), "inputs")
+        if sampler is not None:
+            builder.Connect(through.get_output_port(), mux.get_input_port(2))
+            plant_in = builder.AddSystem(Multiplexer([len(eq.xd), nu]))
+            builder.Connect(sampler.get_output_port(), plant_in.get_input_port(0))
+            builder.Connect(through.get_output_port(), plant_in.get_input_port(1))
+            builder.Connect(plant_in.get_output_port(0), plant.get_input_port(0))
+        else:
+            builder.Connect(through.get_output_port(), plant.get_input_port(0))
+    elif sampler is not None:
         builder.Connect(sampler.get_output_port(), plant.get_input_port(0))
     builder.ExportOutput(plant.get_output_port(0), "signals")
     diagram = builder.Build()

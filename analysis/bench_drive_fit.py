@@ -1,0 +1,115 @@
+"""Replay of ``kind: drakecreep`` runs: compiled fast path vs leaf systems, and a recovery example.
+
+1. Speed-up: :func:`drakecreep.gap.drake_replay.replay_drakecreep` with ``backend="compiled"`` against
+   ``backend="leaf"`` on the same measured run (an out-and-back reference with an external force), for the
+   presets ``paper`` and ``rigid_axis`` and the test rig of ``tests/gap/test_drive_fit.py``. Both are
+   timed in this process, CPU time (``time.process_time``: the machine is shared, wall time is not
+   comparable between runs) and wall time; the agreement of the two is printed beside.
+2. Recovery: runs simulated by the test rig with a known change (Coulomb level +30 %, a 2 um lead error,
+   nothing), two training and two held-out runs, noise 2 N on ``u``: what ``diagnose_drive`` finds.
+
+Run: ``python analysis/bench_drive_fit.py [--duration S] [--skip-speed] [--skip-recovery]``
+"""
+
+import argparse
+import dataclasses
+import time
+
+import numpy as np
+
+from drakecreep.gap.drake_replay import replay_drakecreep
+from drakecreep.gap.drive_fit import diagnose_drive
+from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
+from drakecreep.gap.truth import out_and_back
+from drakecreep.model.nut_table import friction_levels
+from drakecreep.params import LoadCase, preset, with_value
+
+
+def test_rig():
+    """The rig of tests/gap/test_drive_fit.py."""
+    rig = preset("paper")
+    for path, value in (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
+                        ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
+                        ("motor.current_loop_time_constant", 0.0)):
+        rig = with_value(rig, path, value)
+    return rig
+
+
+def blank_run(params, n, label="run", speed=0.02, f_ext=True):
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=params, controller=ControllerMeta(kind="drakecreep"))
+    t = np.arange(n) * 1e-3
+    half = n * 1e-3 / 2
+    x_ref = out_and_back(speed, 0.0, n=n, dt=1e-3, leg=0.4 * half, starts=(0.05 * half, 1.05 * half))
+    force = 30.0 * np.sin(2 * np.pi * 7.0 * t) if f_ext else None
+    return MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(n), meta=meta, f_ext=force, label=label)
+
+
+def timed(fn):
+    c, w = time.process_time(), time.perf_counter()
+    out = fn()
+    return out, time.process_time() - c, time.perf_counter() - w
+
+
+def speed(duration):
+    from drakecreep.sim.simulation import target_accuracy
+
+    n = int(round(duration / 1e-3))
+    print(f"replay of a {duration:g} s run (out-and-back at 20 mm/s, f_ext 30 N at 7 Hz), CPU s / wall s, after a "
+          "warm-up replay of each backend; |dx|, |du|: compiled vs leaf at the params' accuracy, and the compiled "
+          "replay vs itself at 1/100 of that accuracy (the integration error both carry):")
+    print(f"{'params':12s} {'compiled':>16s} {'leaf':>16s} {'CPU ratio':>9s} {'|dx| m':>9s} {'|du| N':>7s} "
+          f"{'int. |dx| m':>11s} {'int. |du| N':>11s}")
+    for name, params in (("test rig", test_rig()), ("paper", preset("paper")), ("rigid_axis", preset("rigid_axis"))):
+        for backend in ("compiled", "leaf"):
+            replay_drakecreep(blank_run(params, 60), backend=backend)
+        run = blank_run(params, n)
+        fast, cf, wf = timed(lambda: replay_drakecreep(run))
+        slow, cs, ws = timed(lambda: replay_drakecreep(run, backend="leaf"))
+        tight = replay_drakecreep(run, with_value(params, "simulation.accuracy", target_accuracy(params) / 100))
+        dx = max(np.max(np.abs(fast.x_motor - slow.x_motor)), np.max(np.abs(fast.x_table - slow.x_table)))
+        du = np.max(np.abs(fast.u - slow.u))
+        ix = max(np.max(np.abs(fast.x_motor - tight.x_motor)), np.max(np.abs(fast.x_table - tight.x_table)))
+        iu = np.max(np.abs(fast.u - tight.u))
+        print(f"{name:12s} {cf:6.2f} / {wf:6.2f} {cs:6.2f} / {ws:6.2f} {cs / cf:9.1f} {dx:9.2e} {du:7.3g} "
+              f"{ix:11.2e} {iu:11.3g}", flush=True)
+
+
+def recovery():
+    rig = test_rig()
+    fc = friction_levels(rig, LoadCase())[0]
+    cases = {
+        "Coulomb +30 %": with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * fc),
+        "lead error 2 um": with_value(rig, "disturbance.lead_error_amplitude", 2e-6),
+        "null": rig,
+    }
+    for seed, (label, truth) in enumerate(cases.items()):
+        runs = []
+        for i, v in enumerate((0.02, 0.03, 0.025, 0.035)):
+            blank = dataclasses.replace(blank_run(rig, 500, f"r{i}", v, f_ext=False))
+            x_ref = out_and_back(v, 0.0, n=500, dt=1e-3, leg=0.2, starts=(0.03, 0.26))
+            blank = dataclasses.replace(blank, x_ref=x_ref, x_motor=x_ref)
+            sim = replay_drakecreep(blank, truth)
+            noise = np.random.default_rng(1000 + 10 * seed + i).normal(0.0, 2.0, 500)
+            runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=sim.u + noise, x_table=sim.x_table))
+        result, cpu, wall = timed(lambda: diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
+                                                         effects=("lead_error", "force_ripple", "stribeck")))
+        print(f"\n== truth: {label} (seal_force {truth.table.seal_force:.4g} N, lead error "
+              f"{truth.disturbance.lead_error_amplitude * 1e6:g} um); {result.simulations} replays, "
+              f"{cpu:.1f} s CPU, {wall:.1f} s wall")
+        print("\n".join(result.summary))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--duration", type=float, default=0.5, help="simulated seconds of the speed run (default 0.5)")
+    ap.add_argument("--skip-speed", action="store_true")
+    ap.add_argument("--skip-recovery", action="store_true")
+    args = ap.parse_args()
+    if not args.skip_speed:
+        speed(args.duration)
+    if not args.skip_recovery:
+        recovery()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,670 @@
+"""The gap of the project's own Drake model on runs of its own controller (``controller: {kind: drakecreep}``).
+
+Runs whose metadata declares the project's PI cascade and a params file (``MeasuredMeta.params``) are
+replayed through the drive diagram of that file (:func:`drakecreep.gap.drake_replay.replay_drakecreep`, its
+compiled fast path) and the params file itself is identified and augmented, so the answer is a
+:class:`~drakecreep.params.DriveParams` YAML that ``drakecreep simulate --params``, ``margins --params`` and
+``report --params`` take::
+
+    result = diagnose_drive(train, test, uncertain=("table.seal_force", "friction.viscous"))
+    print("\\n".join(result.summary))
+    result.save_params("augmented.yaml")
+    json_ready = result.to_json()
+
+Signature (what the ``diagnose`` CLI calls for ``kind: drakecreep`` runs)::
+
+    diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0,
+                   max_nfev=8, progress=False) -> DriveDiagnosis
+
+Steps:
+
+1. **Output-error fit** of the ``DriveParams`` fields named in ``uncertain`` (:data:`FITTABLE`: friction
+   levels, Stribeck velocity and ratio, viscous, LuGre sigma0/sigma1, axial stiffness and damping of the
+   nut and bearing, nut friction) on the training runs with :func:`scipy.optimize.least_squares`: the
+   residual is the drive force ``u_gain u`` of each training run minus its closed-loop replay, divided by
+   the spread of the measured force. Each field is fitted as ``lo + (v0 - lo) exp(theta)`` (``lo`` its
+   lower bound, ``v0`` the params file's value), so it stays in range. 95 % confidence intervals from the
+   Jacobian at the optimum, ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance, inflated by
+   ``(1 + rho) / (1 - rho)`` for the residual's lag-1 autocorrelation ``rho`` (closed-loop residuals are
+   not white); a warning names every pair whose estimates correlate above :data:`SEPARABILITY` (not
+   separable from these runs) and every field whose interval spans more than a factor 10.
+   The diagram is recompiled for every evaluation: compiling it takes about 0.03 s, against 0.1-1.1 s CPU to
+   replay a 0.5 s run (test rig to ``paper`` preset, ``analysis/bench_drive_fit.py``), so symbolic parameters
+   (``SymbolicVectorSystem(parameter=...)``) would save a few per cent.
+2. **Candidate effects that are parts of the Drake model** (:data:`EFFECTS`): lead error (amplitude fitted,
+   period a harmonic of the lead), force ripple at a fixed frequency (frequency from the peaks of the
+   training residual's spectrum), Stribeck weakening (static ratio and Stribeck velocity fitted), the
+   friction law switched (coulomb, stribeck, lugre, gms), the nut's friction moved between the table and
+   the screw. What ``DriveParams`` cannot express is never ranked (:data:`NOT_IN_MODEL`).
+3. **Claims on held-out runs only**: each candidate, fitted on the training runs, is replayed with fixed
+   values on the held-out runs; its per-run decrease of the force error (points of %) must exceed
+   ``t_(1-alpha, n-1)`` standard errors of those paired differences
+   (:func:`drakecreep.gap.drake_diagnosis.paired_gain`: the threshold is the held-out runs' own spread,
+   ``alpha`` = :data:`drakecreep.gap.claims.ALPHA`), and :func:`drakecreep.gap.claims.replay_test` must pass
+   with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
+   changes when the uncertain fields are refitted with one training run left out (as
+   :func:`drakecreep.gap.claims.replay_null`), and a majority of the runs improve. Without that null (one
+   training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are
+   added greedily, best first, each tested again on top of what is already claimed.
+4. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
+   claimed effects' amplitudes (a missing effect biases them and widens their intervals); ``fitted`` and
+   ``test_errors`` are those of the final model.
+
+Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time as _time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import stats
+from scipy.optimize import least_squares
+
+from drakecreep.errors import InputError
+from drakecreep.gap.claims import ALPHA, replay_test
+from drakecreep.gap.drake_diagnosis import paired_gain
+from drakecreep.gap.drake_replay import check_replayable, drake_replay_errors, replay_drakecreep, replay_params
+from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
+
+__all__ = [
+    "FITTABLE",
+    "DEFAULT_UNCERTAIN",
+    "EFFECTS",
+    "NOT_IN_MODEL",
+    "SEPARABILITY",
+    "MIN_SAMPLES",
+    "MIN_DURATION",
+    "FittedParameter",
+    "EffectResult",
+    "DriveDiagnosis",
+    "diagnose_drive",
+    "fit_drive",
+]
+
+#: DriveParams fields the output-error fit may take as uncertain.
+FITTABLE = (
+    "table.seal_force", "table.guide_friction_coefficient", "nut.preload_torque", "nut.load_friction_coefficient",
+    "friction.viscous", "friction.static_ratio", "friction.stribeck_velocity", "friction.bristle_stiffness",
+    "friction.bristle_damping", "nut.axial_stiffness", "nut.axial_damping", "screw.bearing_stiffness",
+    "screw.bearing_damping",
+)
+#: Default uncertain fields: the friction level of the guides, the nut's preload drag, the viscous friction.
+DEFAULT_UNCERTAIN = ("table.seal_force", "nut.preload_torque", "friction.viscous")
+#: Lower bound of each fitted field (the field's own range: ``static_ratio >= 1``, the rest >= 0).
+_LOWER = {"friction.static_ratio": 1.0}
+#: Estimates whose correlation exceeds this are reported as not separable.
+SEPARABILITY = 0.95
+#: Shortest run accepted (samples and seconds): the position loop needs a few periods to show anything.
+MIN_SAMPLES = 50
+MIN_DURATION = 0.1
+#: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
+_STEP = 0.1
+_BOUND = 4.0
+#: Lead-error periods tried: the lead divided by these harmonics.
+LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
+
+#: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
+_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude",), "force_ripple": ("disturbance.force_ripple",)}
+#: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
+EFFECTS = {
+    "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude, period lead/k)",
+    "force_ripple": "force ripple on the table at a fixed frequency (disturbance.force_ripple, ripple_frequency)",
+    "stribeck": "velocity weakening: the Stribeck law with fitted friction.static_ratio and stribeck_velocity",
+    "law_coulomb": "friction law switched to coulomb (same levels)",
+    "law_stribeck": "friction law switched to stribeck (same levels and shape)",
+    "law_lugre": "friction law switched to lugre (same levels and shape)",
+    "law_gms": "friction law switched to gms (same levels and shape)",
+    "nut_friction_side": "the nut's friction moved between the table and the screw (friction.nut_friction_on)",
+}
+#: Effects of issue 16 that DriveParams cannot express: never ranked, with the reason.
+NOT_IN_MODEL = {
+    "asymmetric_friction": "DriveParams has one friction level for both directions",
+    "position_friction": "no position-dependent friction field in DriveParams",
+    "load_friction": "load dependence is fixed by the load case (nut.load_friction_coefficient is fittable as uncertain)",
+    "cogging": "no motor cogging field in DriveParams",
+    "backlash": "no lost-motion field in DriveParams",
+    "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
+    "control_delay": "no computation-delay field in ControllerParams",
+    "quantization": "the sensor resolutions are declared in the run metadata (replayed as declared), not fitted",
+    "friction_drift": "no time-dependent friction field in DriveParams",
+    "drive_gain": "u_gain is declared in the run metadata, not a DriveParams field",
+}
+
+
+@dataclass(frozen=True)
+class FittedParameter:
+    """One fitted DriveParams field: estimate, 95 % interval, params-file value, SI unit."""
+
+    path: str
+    value: float
+    lower: float
+    upper: float
+    prior: float
+    unit: str
+
+    def contains(self, value):
+        """Whether ``value`` lies in the 95 % interval."""
+        return self.lower <= value <= self.upper
+
+
+@dataclass(frozen=True)
+class EffectResult:
+    """A candidate effect fitted on the training runs and replayed, fixed, on the held-out runs.
+
+    ``values``: the DriveParams fields it sets; ``train_gain``: relative decrease of the training force SSE;
+    ``gain``, ``standard_error``, ``threshold``: held-out force-error decrease [points of %] and the bar
+    it must clear; ``replay``: :func:`drakecreep.gap.claims.replay_test`; ``claimed``, ``reason``.
+    """
+
+    name: str
+    values: dict
+    train_gain: float
+    test_errors: dict
+    gain: float
+    standard_error: float
+    threshold: float
+    replay: dict
+    passes: bool
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class DriveDiagnosis:
+    """Result of :func:`diagnose_drive`.
+
+    Attributes
+    ----------
+    prior, params : DriveParams
+        The run's params file and the augmented one (fitted values + claimed effects).
+    fitted : tuple of FittedParameter
+        Of the final (augmented) model.
+    warnings : tuple of str
+        Parameters not separable or poorly determined by the training runs.
+    prior_test_errors, nominal_test_errors, test_errors : dict
+        Held-out run label -> replay errors [%] (:func:`drakecreep.gap.drake_replay.drake_replay_errors`) of
+        the params file, of the fitted one and of the augmented one.
+    candidates : tuple of EffectResult
+        Best held-out gain first.
+    claimed : tuple of str
+    not_ranked : dict
+    replay_null : float or None
+        Largest relative change of the pooled held-out force-error energy when the uncertain fields are
+        refitted with one training run left out: the shrink a claim must beat (None: not available, and
+        then nothing is claimed).
+    simulations : int
+        Closed-loop replays run.
+    seconds : float
+    """
+
+    prior: DriveParams
+    params: DriveParams
+    fitted: tuple
+    warnings: tuple
+    prior_test_errors: dict
+    nominal_test_errors: dict
+    candidates: tuple
+    claimed: tuple
+    test_errors: dict
+    not_ranked: dict = field(default_factory=lambda: dict(NOT_IN_MODEL))
+    replay_null: float | None = None
+    simulations: int = 0
+    seconds: float = 0.0
+
+    @property
+    def summary(self):
+        """Lines of text (units labelled)."""
+        def rms(errs):
+            return math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))
+
+        lines = [f"held-out force error: params file {rms(self.prior_test_errors):.3f} %, "
+                 f"fitted {rms(self.nominal_test_errors):.3f} %"
+                 + ("" if self.replay_null is None else
+                    f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
+        for f in self.fitted:
+            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {f.lower:.4g} .. {f.upper:.4g}; "
+                         f"params file {f.prior:.4g})")
+        lines += [f"  warning: {w}" for w in self.warnings]
+        for c in self.candidates:
+            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f})"
+                         f"{'  passes' if c.passes else ''}: {c.reason}")
+            if c.passes:
+                lines.append("    fitted " + ", ".join(
+                    f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"
+                    for k, v in c.values.items()))
+        if self.claimed:
+            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
+        else:
+            lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
+        return lines
+
+    def save_params(self, path):
+        """Write the augmented :class:`DriveParams` as YAML (:func:`drakecreep.params.save_params`)."""
+        save_params(self.params, path)
+        return Path(path)
+
+    def to_json(self):
+        """A JSON-ready dict (plain types, SI values, errors in %)."""
+        from drakecreep.files import to_jsonable
+        from drakecreep.params import params_to_dict
+
+        return to_jsonable({
+            "kind": "drakecreep.drive_diagnosis",
+            "fitted": [dataclasses.asdict(f) for f in self.fitted],
+            "warnings": list(self.warnings),
+            "prior_test_errors": self.prior_test_errors,
+            "nominal_test_errors": self.nominal_test_errors,
+            "candidates": [{k: v for k, v in dataclasses.asdict(c).items()} for c in self.candidates],
+            "claimed": list(self.claimed),
+            "test_errors": self.test_errors,
+            "replay_null": self.replay_null,
+            "not_ranked": dict(self.not_ranked),
+            "params": params_to_dict(self.params),
+            "simulations": self.simulations,
+            "seconds": self.seconds,
+        })
+
+
+# --------------------------------------------------------------------------- checks (before any work)
+
+def _check_inputs(train, test, uncertain, effects, load_case):
+    train, test = list(train), list(test)
+    if not train:
+        raise InputError("train", 0, ">= 1 training run")
+    if len(test) < 2:
+        raise InputError("test", len(test), ">= 2 held-out runs (the claim threshold is their spread)")
+    prior = None
+    for r in train + test:
+        ctrl = r.meta.controller
+        if ctrl is None or ctrl.kind != "drakecreep":
+            raise InputError("controller.kind", None if ctrl is None else ctrl.kind,
+                             "drakecreep (the project's cascade; p_p_cascade runs go to the EMPS diagnosis)")
+        check_replayable(r)
+        duration = float(r.t[-1] - r.t[0])
+        if r.n < MIN_SAMPLES or duration < MIN_DURATION:
+            raise InputError("t", f"run {r.label}: {r.n} samples over {duration:.3g} s",
+                             f">= {MIN_SAMPLES} samples and >= {MIN_DURATION:g} s per run")
+        if prior is None:
+            prior = r.meta.params
+        elif r.meta.params != prior:
+            raise InputError("params", f"run {r.label}", "the same params file for every run")
+        replay_params(r, prior)  # the declared sensor resolutions fit the params' lead
+    prior.load_case(load_case)
+    uncertain = tuple(uncertain)
+    for path in uncertain:
+        if path not in FITTABLE:
+            raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
+        if get_value(prior, path) <= _LOWER.get(path, 0.0):
+            raise InputError("uncertain", path, f"a field whose params value is above {_LOWER.get(path, 0.0):g}")
+    if len(set(uncertain)) != len(uncertain):
+        raise InputError("uncertain", uncertain, "distinct fields")
+    names = tuple(EFFECTS) if effects is None else tuple(effects)
+    for n in names:
+        if n not in EFFECTS:
+            raise InputError("effects", n, NOT_IN_MODEL.get(n, "one of " + ", ".join(EFFECTS)))
+    return train, test, prior, uncertain, names
+
+
+# --------------------------------------------------------------------------- replay and residuals
+
+class _Replayer:
+    """Closed-loop replays of a fixed set of runs, counting them."""
+
+    def __init__(self, load_case, say):
+        self.load_case, self.count, self.say = load_case, 0, say
+
+    def __call__(self, runs, params):
+        self.count += len(runs)
+        return [replay_drakecreep(r, params, load_case=self.load_case) for r in runs]
+
+    def errors(self, runs, params):
+        return {r.label: drake_replay_errors(s) for r, s in zip(runs, self(runs, params))}
+
+
+def _residual(runs, sims, scale):
+    return np.concatenate([(r.force - s.force) / scale for r, s in zip(runs, sims)])
+
+
+def _force_scale(runs):
+    f = np.concatenate([r.force for r in runs])
+    return float(np.std(f)) or 1.0
+
+
+def _lag1(r):
+    r = r - r.mean()
+    d = float(r @ r)
+    return float(r[1:] @ r[:-1]) / d if d > 0 else 0.0
+
+
+# --------------------------------------------------------------------------- output-error fit
+
+def _with(params, values):
+    for path, v in values.items():
+        params = with_value(params, path, float(v))
+    return params
+
+
+def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None):
+    """Output-error least squares of the DriveParams fields ``paths`` on ``runs``.
+
+    Parameters
+    ----------
+    runs : sequence of MeasuredRun
+    prior : DriveParams
+        Starting values (and the fields not fitted).
+    paths : sequence of str
+        Fields of :data:`FITTABLE`.
+    replayer : callable
+        ``replayer(runs, params) -> [DrakeReplayResult]``.
+    max_nfev : int
+        Residual evaluations of ``least_squares`` (each simulates every run).
+
+    Returns
+    -------
+    params : DriveParams
+    fitted : tuple of FittedParameter
+        Of the final (augmented) model.
+    warnings : tuple of str
+    sse : float
+        Final sum of squared (scaled) residuals.
+    """
+    scale = _force_scale(runs)
+    if not paths:
+        r = _residual(runs, replayer(runs, prior), scale)
+        return prior, (), (), float(r @ r)
+    v0 = np.array([get_value(prior, p) for p in paths])
+    lo = np.array([_LOWER.get(p, 0.0) for p in paths])
+
+    def values(theta):
+        return dict(zip(paths, lo + (v0 - lo) * np.exp(theta)))
+
+    cache = {}
+
+    def residual(theta):
+        key = tuple(np.round(theta, 12))
+        if key not in cache:
+            cache[key] = _residual(runs, replayer(runs, _with(prior, values(theta))), scale)
+        return cache[key]
+
+    def jacobian(theta):
+        # central differences with a fixed step of _STEP in log(value - lower bound): the adaptive integrator
+        # and the counting sensors make the residual a slightly rough function of the values (a step near
+        # machine precision would amplify that), and a one-sided step of a few % leaves a curvature error
+        # that differs between fields of very different force contributions
+        cols = []
+        for i in range(theta.size):
+            step = np.zeros(theta.size)
+            step[i] = _STEP
+            hi, lo_ = np.minimum(theta + step, _BOUND), np.maximum(theta - step, -_BOUND)
+            cols.append((residual(hi) - residual(lo_)) / (hi[i] - lo_[i]))
+        return np.column_stack(cols)
+
+    sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, _BOUND), max_nfev=max_nfev,
+                        x_scale=1.0, xtol=1e-3, ftol=1e-4)
+    J, r = sol.jac, sol.fun
+    m, n = r.size, len(paths)
+    s2 = float(r @ r) / max(m - n, 1)
+    rho = min(max(_lag1(r), 0.0), 0.99)
+    try:
+        cov = np.linalg.inv(J.T @ J) * s2 * (1 + rho) / (1 - rho)
+    except np.linalg.LinAlgError:
+        cov = np.full((n, n), np.inf)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    z = stats.norm.ppf(0.975)
+    fitted, warnings = [], []
+    for i, p in enumerate(paths):
+        lo_i = lo[i] + (v0[i] - lo[i]) * math.exp(max(sol.x[i] - z * sd[i], -700))
+        hi_i = lo[i] + (v0[i] - lo[i]) * math.exp(min(sol.x[i] + z * sd[i], 700))
+        val = lo[i] + (v0[i] - lo[i]) * math.exp(sol.x[i])
+        fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
+        if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
+            warnings.append(f"{p} is poorly determined by these runs (95 % interval {lo_i:.3g} .. {hi_i:.3g})")
+    if n > 1 and np.all(np.isfinite(cov)):
+        corr = cov / np.outer(sd, sd)
+        for i in range(n):
+            for j in range(i + 1, n):
+                if abs(corr[i, j]) > SEPARABILITY:
+                    warnings.append(f"{paths[i]} and {paths[j]} are not separable from these runs (estimates "
+                                    f"correlated {corr[i, j]:+.3f}): only a combination of them is identified")
+    return _with(prior, values(sol.x)), tuple(fitted), tuple(warnings), float(r @ r)
+
+
+# --------------------------------------------------------------------------- candidate effects
+
+def _screen(runs, base, amp_path, trial, fixed, replayer, r0, scale):
+    """One replay at a trial amplitude: the residual's slope in the amplitude and the linear optimum.
+
+    Returns ``(amplitude, predicted_sse, state)``; ``state`` continues in :func:`_refine`.
+    """
+    params = _with(base, fixed)
+    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: trial})), scale)
+    d = (r0 - r_a) / trial  # the residual decreases by d per unit amplitude (first order)
+    dd = float(d @ d)
+    if dd == 0.0:
+        return 0.0, float(r0 @ r0), None
+    a = float(np.clip((r0 @ d) / dd, 0.0, 50 * trial))
+    r_lin = r0 - a * d
+    return a, float(r_lin @ r_lin), (params, trial, r_a)
+
+
+def _refine(runs, amp_path, a, state, replayer, r0, scale):
+    """Replay at the screened amplitude and take one secant step; ``(amplitude, sse)`` (measured, not predicted)."""
+    if state is None or a == 0.0:
+        return 0.0, float(r0 @ r0)
+    params, trial, r_t = state
+    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: a})), scale)
+    if abs(a - trial) > 1e-3 * trial:
+        d = (r_t - r_a) / (a - trial)
+        if float(d @ d) > 0:
+            a2 = float(np.clip(a + (r_a @ d) / float(d @ d), 0.0, 50 * trial))
+            r_2 = _residual(runs, replayer(runs, _with(params, {amp_path: a2})), scale)
+            if float(r_2 @ r_2) < float(r_a @ r_a):
+                return a2, float(r_2 @ r_2)
+    return a, float(r_a @ r_a)
+
+
+def _amplitude_effect(runs, base, amp_path, grid_path, grid, trial, replayer, base_sims, scale):
+    """Screen every grid value with one replay, refine the best: ``(values, sse)``."""
+    r0 = _residual(runs, base_sims, scale)
+    best = None
+    for g in grid:
+        a, sse, state = _screen(runs, base, amp_path, trial, {grid_path: g}, replayer, r0, scale)
+        if best is None or sse < best[1]:
+            best = (g, sse, a, state)
+    if best is None:
+        return {}, float(r0 @ r0)
+    g, _, a, state = best
+    a, sse = _refine(runs, amp_path, a, state, replayer, r0, scale)
+    return {grid_path: g, amp_path: a}, sse
+
+
+def _ripple_frequencies(runs, sims, k=2):
+    """The ``k`` largest peaks of the training force residual's spectrum between 1 and 300 Hz."""
+    n = min(r.n for r in runs)
+    dt = runs[0].dt
+    power = 0.0
+    for r, s in zip(runs, sims):
+        e = (r.force - s.force)[:n]
+        power = power + np.abs(np.fft.rfft((e - e.mean()) * np.hanning(n))) ** 2
+    f = np.fft.rfftfreq(n, dt)
+    ok = np.flatnonzero((f >= 1.0) & (f <= min(300.0, 0.45 / dt)))
+    peaks = [i for i in ok if power[i] >= power[max(i - 1, 0)] and power[i] >= power[min(i + 1, f.size - 1)]]
+    peaks.sort(key=lambda i: -power[i])
+    return [float(f[i]) for i in peaks[:k]]
+
+
+def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
+    """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain)``."""
+    scale = _force_scale(runs)
+    lead = base.screw.lead
+    if name == "lead_error":
+        values, sse = _amplitude_effect(runs, base, "disturbance.lead_error_amplitude", "disturbance.lead_error_period",
+                                        [lead / k for k in LEAD_HARMONICS], 1e-6, replayer, base_sims, scale)
+    elif name == "force_ripple":
+        values, sse = _amplitude_effect(runs, base, "disturbance.force_ripple", "disturbance.ripple_frequency",
+                                        _ripple_frequencies(runs, base_sims), 0.1 * scale, replayer, base_sims,
+                                        scale)
+        if not values:
+            return {}, 0.0
+    elif name == "stribeck":
+        start = base if base.friction.law != "coulomb" else with_value(base, "friction.law", "stribeck")
+        paths = ("friction.static_ratio", "friction.stribeck_velocity")
+        if start.friction.static_ratio <= 1.0:
+            start = with_value(start, "friction.static_ratio", 1.2)
+        fitted_params, _, _, sse = fit_drive(runs, start, paths, replayer, max_nfev=min(max_nfev, 4))
+        values = {p: get_value(fitted_params, p) for p in paths}
+        if start.friction.law != base.friction.law:
+            values["friction.law"] = start.friction.law
+    elif name.startswith("law_"):
+        law = name[4:]
+        if law == base.friction.law:
+            return None, 0.0
+        values = {"friction.law": law}
+        r = _residual(runs, replayer(runs, _with(base, values)), scale)
+        sse = float(r @ r)
+    elif name == "nut_friction_side":
+        values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
+        r = _residual(runs, replayer(runs, _with(base, values)), scale)
+        sse = float(r @ r)
+    else:  # pragma: no cover - names are checked up front
+        raise InputError("effects", name, "one of " + ", ".join(EFFECTS))
+    return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0
+
+
+def _with_any(params, values):
+    for path, v in values.items():
+        params = with_value(params, path, v)
+    return params
+
+
+def _energy(errors, labels):
+    return [errors[k]["force"] ** 2 for k in labels]
+
+
+def _replay_null(train, test, params, uncertain, replayer, nominal_errors):
+    """Run-to-run variation of the held-out replay: refit the uncertain fields with each training run left out.
+
+    Returns the largest relative change of the pooled held-out force-error energy (the shrink an effect must
+    beat, as :func:`drakecreep.gap.claims.replay_null`), or ``None`` when it cannot be computed (one training
+    run, or nothing fitted).
+    """
+    if len(train) < 2 or not uncertain:
+        return None
+    labels = list(nominal_errors)
+    e_nom = float(np.sum(_energy(nominal_errors, labels)))
+    changes = []
+    for i in range(len(train)):
+        rest = train[:i] + train[i + 1:]
+        refit = fit_drive(rest, params, uncertain, replayer, max_nfev=4)[0]
+        e = float(np.sum(_energy(replayer.errors(test, refit), labels)))
+        changes.append(abs(1.0 - e / e_nom) if e_nom > 0 else 0.0)
+    return float(max(changes))
+
+
+def _held_out(name, values, train_gain, test, current, current_errors, replayer, null):
+    """Replay the candidate on the held-out runs and decide whether it passes."""
+    errs = replayer.errors(test, _with_any(current, values))
+    gain, se = paired_gain(current_errors, errs)
+    n = len(test)
+    bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
+    labels = list(current_errors)
+    rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
+    ok = bool(null is not None and train_gain > 0 and gain > bar and rt["passes"])
+    reason = ("passes" if ok else
+              "no gain on the training runs" if train_gain <= 0 else
+              f"held-out gain {gain:+.3f} <= {bar:.3f} (t quantile x standard error of {n} runs)" if gain <= bar else
+              f"pooled shrink {100 * rt['shrink']:.1f} % (run-to-run null {100 * rt['threshold']:.1f} %), "
+              f"{rt['runs_better']}/{n} runs better" if not rt["passes"] else
+              "provisional: no run-to-run null (needs >= 2 training runs and a fitted field)")
+    return EffectResult(name=name, values=dict(values), train_gain=float(train_gain), test_errors=errs, gain=gain,
+                        standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason)
+
+
+def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0, max_nfev=8,
+                   progress=False):
+    """Identify and augment the run's params file on ``kind: drakecreep`` runs (see the module docstring).
+
+    Parameters
+    ----------
+    train, test : sequence of drakecreep.gap.measured.MeasuredRun
+        Fitting on ``train`` only; ``test`` (at least 2 runs) is replayed with fixed values.
+    uncertain : sequence of str
+        DriveParams fields to fit (:data:`FITTABLE`); empty: keep the params file's values.
+    effects : sequence of str, optional
+        Candidates (:data:`EFFECTS`); default all.
+    load_case : int
+        Load case of the params file the runs were taken under (0 = unloaded).
+    max_nfev : int
+        Least-squares evaluations of the nominal fit.
+    progress : bool or callable
+        ``True`` prints a line per step to stderr; a callable receives the lines.
+
+    Returns
+    -------
+    DriveDiagnosis
+
+    Raises
+    ------
+    InputError
+        Before any simulation: fewer than 1 training or 2 held-out runs, a run of another controller
+        kind, without params, with sensor resolutions that do not fit the lead, shorter than
+        :data:`MIN_SAMPLES` samples or :data:`MIN_DURATION` s, runs with different params, an unknown
+        field or effect.
+    """
+    import sys
+
+    t0 = _time.perf_counter()
+    train, test, prior, uncertain, names = _check_inputs(train, test, uncertain, effects, load_case)
+    say = progress if callable(progress) else (
+        (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None))
+    replay = _Replayer(load_case, say)
+    prior_errors = replay.errors(test, prior)
+    params, fitted, warnings, sse0 = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev)
+    nominal_errors = replay.errors(test, params)
+    say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
+    null = _replay_null(train, test, params, uncertain, replay, nominal_errors) if names else None
+    if names:
+        say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %"))
+    base_sims = replay(train, params)
+    candidates = []
+    for name in names:
+        if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):
+            continue  # already fitted as uncertain
+        values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev)
+        if values is None:
+            continue
+        if not values:
+            candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, "nothing to fit"))
+            continue
+        candidates.append(_held_out(name, values, train_gain, test, params, nominal_errors, replay, null))
+        c = candidates[-1]
+        say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f})")
+    candidates.sort(key=lambda c: -c.gain)
+    claimed, current, current_errors = [], params, nominal_errors
+    for c in candidates:
+        if not c.passes:
+            continue
+        again = c if not claimed else _held_out(c.name, c.values, c.train_gain, test, current, current_errors, replay,
+                                                null)
+        if again.passes:
+            claimed.append(c.name)
+            current, current_errors = _with_any(current, c.values), again.test_errors
+            say(f"claimed {c.name}")
+    if claimed and uncertain:
+        # the uncertain fields again, on the augmented model: a missing effect biases them and widens their
+        # intervals (its residual is autocorrelated), so the values kept are the ones fitted with it in place
+        # jointly with the claimed effects' amplitudes (fixed, they would carry the bias of the first fit)
+        amplitudes = tuple(p for name in claimed for p in _AMPLITUDES.get(name, ())
+                           if get_value(current, p) > 0)
+        current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
+        fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
+        current_errors = replay.errors(test, current)
+        say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)}")
+    return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
+                          prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
+                          candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
+                          replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0)
