@@ -17,7 +17,7 @@ parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
 
 import sys
 
-from drakecreep.cli._common import positive_float, print_json
+from drakecreep.cli._common import print_json
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import load_runs, pick  # noqa: F401 (re-exported: the library side)
 
@@ -35,17 +35,17 @@ def add_parser(subparsers):
                    "(default: even indices; parts of one split run: 0, 1, 4, 5, ...)")
     p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of "
                    "one split run: 2, 3, 6, 7, ...)")
-    p.add_argument("--screw-lead", type=positive_float, default=2.5, metavar="MM",
-                   help="screw lead [mm] (default 2.5; used by the rigid where-analysis of kind drakecreep runs only)")
-    p.add_argument("--motor-period", type=positive_float, metavar="MM",
-                   help="table travel per motor revolution [mm] (kind drakecreep runs only; default: the lead)")
+    p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
+                   "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous)")
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, position_friction, position_ripple, time_ripple, "
-                   "thermal_drift, axial_mode, control_delay)")
+                   "thermal_drift, axial_mode, control_delay; kind drakecreep runs: lead_error, force_ripple, "
+                   "stribeck, law_coulomb, ...)")
     p.add_argument("--score", metavar="FILE", help="after the diagnosis, replay the augmented model (parameters "
                    "fixed) on this file")
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
-                   "augmented_model.yaml here")
+                   "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
+                   "report --params, diagnosis.json, summary.txt)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p
@@ -80,6 +80,9 @@ def run(args):
         check_replayable(r)
     if own:
         return _run_drakecreep_kind(args, train, test, score_runs)
+    if args.uncertain:
+        raise InputError("--uncertain", args.uncertain, "only for runs of controller kind drakecreep "
+                         "(p_p_cascade runs fit viscous, Coulomb and offset)")
     if len(test) < 2:
         raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
                          "at least two held-out runs (the claim threshold is their run-to-run spread; "
@@ -168,60 +171,44 @@ def _residuals(diag, run):
 def _run_drakecreep_kind(args, train, test, score_runs):
     """Runs of ``controller: {kind: drakecreep}`` (the project's own PI-cascade diagram and params file).
 
-    ---- BRANCH FOR kind: drakecreep ----
-    The identification and augmentation of ``DriveParams`` through the project's diagram lives in
-    ``drakecreep.gap.drive_fit`` (its own work item). When that module exists, its ``diagnose_drive(train, test,
-    ...)`` is called; otherwise the previous behaviour: the rigid inverse-dynamics ranking of
-    :mod:`drakecreep.gap.diagnosis`, then the held-out runs replayed through the params file's diagram.
+    :func:`drakecreep.gap.drive_fit.diagnose_drive`: the uncertain ``DriveParams`` fields fitted by output error
+    through the compiled diagram, candidate effects of the Drake model ranked and claimed on the held-out runs;
+    with ``--out`` the augmented params file (``augmented_params.yaml``, for ``simulate/margins/report
+    --params``), ``diagnosis.json`` and ``summary.txt``, the manifest last; ``--score`` replays the augmented
+    params, fixed, on the runs of another file.
     """
-    import importlib.util
+    import json
+
+    from drakecreep.files import OutputSet
+    from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+    from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.params import save_params
 
     say = _say(args)
-    if importlib.util.find_spec("drakecreep.gap.drive_fit") is not None:
-        from drakecreep.gap.drive_fit import diagnose_drive
-
-        result = diagnose_drive(train, test, progress=say, out=args.out, score=score_runs)
-        if args.json:
-            from drakecreep.files import to_jsonable
-
-            print_json(to_jsonable(result.to_json() if hasattr(result, "to_json") else result))
-        elif hasattr(result, "summary"):
-            print("\n".join(result.summary()))
-        return 0
-    # ---- previous behaviour (until drive_fit exists) ----
-    from pathlib import Path
-
-    from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
-    from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-    from drakecreep.report.gap_report import to_json_dict, write_report
-
-    cfg = DiagnosisConfig(screw_lead=args.screw_lead * 1e-3,
-                          motor_period=None if args.motor_period is None else args.motor_period * 1e-3,
-                          progress=not args.quiet)
-    result = diagnose(train, test, cfg, replay=False)
-    say(f"closed-loop replay of {len(test)} held-out run(s) through the project's diagram")
-    errors = {r.label: drake_replay_errors(replay_drakecreep(r)) for r in test}
-    result["drake_replay"] = errors
-    result["summary"].append("Held-out replay through the drakecreep diagram of the params file, errors in % "
-                             "of ||y||: " + "; ".join(f"{k}: position {e['position']:.3g}, force {e['force']:.3g}"
-                                                      for k, e in errors.items()))
-    result["data"] = str(args.data)
-    result["train_runs"] = [r.label for r in train]
-    result["test_runs"] = [r.label for r in test]
+    kwargs = {}
+    if args.uncertain:
+        kwargs["uncertain"] = tuple(x.strip() for x in args.uncertain.split(",") if x.strip())
+    if getattr(args, "effects", None):
+        kwargs["effects"] = tuple(x.strip() for x in args.effects.split(",") if x.strip())
+    result = diagnose_drive(train, test, progress=not args.quiet, **kwargs)
+    payload = result.to_json()
+    lines = list(result.summary)
     if score_runs:
-        say(f"scoring the fixed diagnosis on {args.score}")
-        result["scored"] = score_fixed(result, score_runs)
-        result["scored"]["data"] = str(args.score)
+        say(f"replaying the augmented params, fixed, on {args.score}")
+        scored = {r.label: drake_replay_errors(replay_drakecreep(r, params=result.params)) for r in score_runs}
+        payload["scored"] = {"data": str(args.score), "errors_percent": scored}
+        lines.append(f"Scored on {args.score} (parameters fixed), errors in % of ||y||: " + "; ".join(
+            f"{k}: position {e['position']:.3g}, force {e['force']:.3g}" for k, e in scored.items()))
+    payload.update(data=str(args.data), train_runs=[r.label for r in train], test_runs=[r.label for r in test])
     if args.out:
-        html_path, json_path = write_report(result, args.out)
-        if score_runs:
-            sc = dict(result["scored"])
-            sc.update({"nominal": result["nominal"], "claimed": result["claimed"], "ranking": [],
-                       "unexplained_share": sc["unexplained_share"]})
-            write_report(sc, Path(args.out) / "scored", title=f"Fixed diagnosis scored on {args.score}")
-        say(f"wrote {html_path} and {json_path}")
+        with OutputSet(args.out, "manifest.json") as out:
+            out.write("augmented_params.yaml", lambda tmp: save_params(result.params, tmp))
+            out.write_text("diagnosis.json", json.dumps(payload, indent=2) + "\n")
+            out.write_text("summary.txt", "\n".join(lines) + "\n")
+            out.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed)})
+        say(f"wrote {out.dir}/augmented_params.yaml, diagnosis.json, summary.txt")
     if args.json:
-        print_json(to_json_dict(result))
+        print_json(payload)
     else:
-        print("\n".join(result["summary"]))
+        print("\n".join(lines))
     return 0

@@ -1,34 +1,47 @@
 """``drakecreep diagnose`` on runs whose controller is the project's own cascade (kind: drakecreep)."""
 
 import dataclasses
-import os
+import json
 
 import numpy as np
 import pytest
 
 from drakecreep import cli
-from drakecreep.gap.benchmark import out_and_back
 from drakecreep.gap.drake_replay import replay_drakecreep
 from drakecreep.gap.measured import ControllerMeta, MeasuredData, MeasuredMeta, MeasuredRun, save_measured
-from drakecreep.params import preset, save_params  # noqa: F401
+from drakecreep.gap.truth import out_and_back
+from drakecreep.params import load_params, preset, with_value
 
 N = 1200
 
 
+def _fast_rig():
+    """The paper preset made quick to replay (as tests/gap/test_drive_fit.py): Stribeck regularised at
+    0.1 mm/s, the nut's friction on the table, an ideal current loop."""
+    rig = preset("paper")
+    for path, value in (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
+                        ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
+                        ("motor.current_loop_time_constant", 0.0)):
+        rig = with_value(rig, path, value)
+    return rig
+
+
 @pytest.fixture(scope="module")
 def own_csv(tmp_path_factory):
-    """Four out-and-back runs simulated by the project's diagram (rigid_axis preset) from their references."""
+    """Four out-and-back runs simulated by the project's diagram from their references, with a 2 um lead
+    error the params file lacks, saved as CSV + metadata YAML (the params file beside them)."""
     folder = tmp_path_factory.mktemp("own")
-    p = preset("rigid_axis")
-    save_params(p, folder / "rig.yaml")
-    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=p, controller=ControllerMeta(kind="drakecreep"))
-    t = np.arange(N) * 1e-3
+    rig = _fast_rig()
+    truth = with_value(rig, "disturbance.lead_error_amplitude", 2e-6)
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=rig, controller=ControllerMeta(kind="drakecreep"))
+    n = 500
+    t = np.arange(n) * 1e-3
     runs = []
     for i, v in enumerate((0.02, 0.03, 0.025, 0.035)):
-        x_ref = out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6))
-        blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(N), meta=meta, label=f"r{i}")
-        sim = replay_drakecreep(blank)
-        noise = np.random.default_rng(i).normal(0.0, 2.0, N)
+        x_ref = out_and_back(v, 0.0, n=n, dt=1e-3, leg=0.2, starts=(0.03, 0.26))
+        blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(n), meta=meta, label=f"r{i}")
+        sim = replay_drakecreep(blank, truth)
+        noise = np.random.default_rng(7 + i).normal(0.0, 2.0, n)
         runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=sim.u + noise, x_table=sim.x_table))
     path = folder / "own.csv"
     _, yaml_path = save_measured(MeasuredData(runs=tuple(runs), meta=meta), path)
@@ -48,14 +61,35 @@ def blank_csv(tmp_path_factory):
     return folder / "blank.csv", yaml_path
 
 
-@pytest.mark.slow
-@pytest.mark.skipif(not os.environ.get("DRAKECREEP_SLOW"),
-                    reason="about 5 minutes on 2 shared cores (leaf-system replays); set DRAKECREEP_SLOW=1")
-def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, capsys):
+def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path, capsys):
     path, _ = own_csv
-    assert cli.main(["diagnose", str(path)]) == 0
-    out = capsys.readouterr().out
-    assert "drakecreep diagram" in out
+    out = tmp_path / "diag"
+    code = cli.main(["-q", "diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3",
+                     "--uncertain", "table.seal_force", "--effects", "lead_error,force_ripple",
+                     "--out", str(out), "--json"])
+    assert code == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["kind"] == "drakecreep.drive_diagnosis"
+    assert result["train_runs"] == ["r0", "r1"] and result["test_runs"] == ["r2", "r3"]
+    assert result["claimed"] == ["lead_error"]  # the withheld effect, and nothing else
+    augmented = load_params(out / "augmented_params.yaml")
+    assert augmented.disturbance.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert set(manifest["files"]) == {"augmented_params.yaml", "diagnosis.json", "summary.txt"}
+
+
+def test_uncertain_is_refused_for_p_p_cascade_runs(capsys):
+    assert cli.main(["diagnose", "estimation", "--uncertain", "table.seal_force"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--uncertain" in err[0]
+
+
+def test_unknown_uncertain_field_is_one_line_exit_2(own_csv, capsys):
+    path, _ = own_csv
+    assert cli.main(["diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3",
+                     "--uncertain", "table.colour"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "table.colour" in err[0]
 
 
 def test_diagnose_without_params_for_kind_drakecreep_is_one_line_exit_2(blank_csv, tmp_path, capsys):
