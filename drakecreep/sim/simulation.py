@@ -462,7 +462,8 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None):
     bounds = (v_max, v_max * 2.0 * math.pi / params.screw.lead)
 
     start = time.perf_counter()
-    simulator = make_simulator(root, context, sim, accuracy, integrator=info["integrator"])
+    other = {} if info["integrator"] == sim.integrator else dict(integrator=info["integrator"])
+    simulator = make_simulator(root, context, sim, accuracy, **other)
     guard = _guard(simulator, root, read_speeds, bounds, wall_limit)
     status = "ok"
     try:
