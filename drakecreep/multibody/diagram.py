@@ -262,7 +262,8 @@ def loaded_equilibrium(drive, applied, torque_map, fixed, torque=0.0, context=No
     raise RuntimeError(f"loaded equilibrium not reached: residual {residual:.3g} after {max_iterations} steps")
 
 
-def build_multibody_diagram(params, scenario, options=None, *, continuous=None, ideal_sensors=False):
+def build_multibody_diagram(params, scenario, options=None, *, continuous=None, ideal_sensors=False,
+                            open_loop=False):
     """Wire the multibody feed drive for ``scenario`` from ``params``: the two-mass diagram's loop on the plant.
 
     Parameters
@@ -274,6 +275,10 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
         Force the continuous (True) or sampled (False) controller; default ``params.controller.sampled``.
     ideal_sensors : bool
         Unquantized encoder and scale.
+    open_loop : bool
+        The mechanics alone (for linearization, :mod:`drakecreep.multibody.linear`): no reference,
+        controller or sensors; input port ``torque_command`` (N m, into the torque limit and current
+        loop); first output ``plant_outputs`` = ``[motor angle, motor speed, table position, table speed]``.
 
     Returns
     -------
@@ -333,11 +338,17 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
     t = idx["table"]
     table = select("table", [(t["qx"], 1.0), (nq + t["vx"], 1.0)])
     motor = select("motor", [(idx["motor_q"], 1.0), (nq + idx["motor_v"], 1.0)])
-    add("reference", FeedReference(scenario.feed, params.simulation.acceleration_time, x_ref0))
-    add("controller", CascadeController(gains, params.screw.lead, force_limit(params), initial_force=torque0 / ratio,
-                                        initial_angle=theta_counted))
-    add("encoder", MotorEncoder(0 if ideal_sensors else params.sensors.encoder_counts_per_rev))
-    add("scale", LinearScale(0.0 if ideal_sensors else params.sensors.scale_resolution))
+    if open_loop:
+        outputs = add("plant_outputs", Multiplexer([2, 2]))
+        builder.Connect(motor.get_output_port(), outputs.get_input_port(0))
+        builder.Connect(table.get_output_port(), outputs.get_input_port(1))
+        builder.ExportOutput(outputs.get_output_port(0), "plant_outputs")
+    else:
+        add("reference", FeedReference(scenario.feed, params.simulation.acceleration_time, x_ref0))
+        add("controller", CascadeController(gains, params.screw.lead, force_limit(params),
+                                            initial_force=torque0 / ratio, initial_angle=theta_counted))
+        add("encoder", MotorEncoder(0 if ideal_sensors else params.sensors.encoder_counts_per_rev))
+        add("scale", LinearScale(0.0 if ideal_sensors else params.sensors.scale_resolution))
     limit = add("torque_limit", Saturation([-params.motor.peak_torque], [params.motor.peak_torque]))
     torque_out = limit.get_output_port()
     tau_c = params.motor.current_loop_time_constant
@@ -376,6 +387,15 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
     builder.Connect(to_forces.get_output_port(), total.get_input_port(0))
     builder.Connect(load_source.get_output_port(), total.get_input_port(1))
     builder.Connect(total.get_output_port(), plant.get_applied_generalized_force_input_port())
+
+    if open_loop:
+        builder.ExportInput(limit.get_input_port(), "torque_command")
+        diagram = builder.Build()
+        diagram.set_name("multibody_feed_drive_plant")
+        drive.diagram = diagram
+        return MultibodyFeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=(),
+                                  drive=drive, options=options, q0=q0, equilibrium_residual=residual,
+                                  initial_torque=torque0)
 
     reaction = add("screw", _ReactionForce(idx["nut_joint"]))
     builder.Connect(plant.get_reaction_forces_output_port(), reaction.get_input_port())
