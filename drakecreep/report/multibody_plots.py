@@ -108,9 +108,6 @@ def plot_mode_shapes(drive, result, path, num_modes=4, context=None, scale=0.08)
     scale : float
         Largest drawn displacement as a share of the screw length.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     plant = drive.plant
@@ -172,9 +169,6 @@ def _box(ax, center, size, colour, alpha=0.35):
 
 def plot_mechanism(drive, path):
     """A static 3-D picture of the rig's bodies from the geometry of ``drive`` (mm)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     rig, params = drive.rig, drive.params
