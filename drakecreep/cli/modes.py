@@ -27,6 +27,9 @@ def add_parser(subparsers):
                    help="table position in mm (default 0: the nut at screw.nut_start_distance)")
     p.add_argument("--modes", type=int, default=10, metavar="K", help="flexible modes to list (default 10)")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.add_argument("--out", metavar="DIR",
+                   help="also write modes.png (side and top views of the first four mode shapes) and "
+                        "mechanism.png (the rig in 3-D) into DIR")
     p.set_defaults(func=run)
     return p
 
@@ -43,13 +46,31 @@ def run(args):
         raise InputError("--table-position", args.table_position,
                          f"in ({-start:g}, {length - start:g}) mm (the nut stays on the screw)")
     x = args.table_position * 1e-3
+    if args.out:
+        from drakecreep.files import check_output_dir
+
+        check_output_dir(args.out)
     drive = build_multibody(params, n_segments=args.segments, rigid_joints=args.rigid_joints, table_position=x)
-    result = modal_analysis(drive, num_modes=args.modes)
+    context = drive.diagram.CreateDefaultContext()
+    result = modal_analysis(drive, num_modes=args.modes, context=context)
+    written = []
+    if args.out:
+        from pathlib import Path
+
+        from drakecreep.report.multibody_plots import plot_mechanism, plot_mode_shapes
+
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        written = [plot_mode_shapes(drive, result, out / "modes.png", num_modes=min(4, args.modes),
+                                    context=drive.plant.GetMyContextFromRoot(context)),
+                   plot_mechanism(drive, out / "mechanism.png")]
     two_mass = two_mass_axial_frequency(params, x)
     if args.json:
         out = result.to_dict()
         out["table_position_mm"] = args.table_position
         out["two_mass_axial_frequency_Hz"] = two_mass
+        if written:
+            out["figures"] = [str(p) for p in written]
         print_json(out)
         return 0
     source = args.params or f"preset {args.preset}"
@@ -61,6 +82,8 @@ def run(args):
         share = 100.0 * m.shares[m.label]
         flag = f"yes: {two_mass:.2f} Hz" if m.two_mass else "no"
         print(f"{i:>4}  {m.frequency:>9.2f}  {m.damping_ratio:>7.4f}  {m.label:<16}  {share:>4.0f}%  {flag}")
+    if written:
+        print("wrote " + ", ".join(str(p) for p in written))
     if any(m.damping_ratio > 1.0 for m in result.modes):
         print("zeta > 1: the modal (proportional) damping estimate does not hold there; Table 1's damping "
               "columns are suspect (see docs/multibody.md)")

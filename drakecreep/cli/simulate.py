@@ -26,6 +26,13 @@ def add_parser(subparsers):
     p.add_argument("--duration", type=positive_float, default=5.0, metavar="S", help="simulated time in s (default 5)")
     p.add_argument("--controller", choices=("sampled", "continuous"), help="controller variant (default: parameters)")
     p.add_argument("--backend", choices=("compiled", "leaf"), help="compiled symbolic fast path or Python leaf systems")
+    p.add_argument("--model", choices=("two_mass", "multibody"), default="two_mass",
+                   help="mechanics: the two-mass model (default) or the paper's rig in a Drake MultibodyPlant "
+                        "(same controller, sensors, friction and load case; docs/multibody.md)")
+    p.add_argument("--segments", type=int, metavar="N",
+                   help="--model multibody: screw segments (default 6)")
+    p.add_argument("--rigid-joints", action="store_true",
+                   help="--model multibody: make the fixed joints of Tables 1-2 rigid")
     p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
     p.add_argument("--max-wall", type=positive_float, metavar="S",
                    help="stop the run after S seconds of computing (what was computed is saved)")
@@ -59,6 +66,26 @@ def run(args):
             f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window",
         )
     scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
+    multibody = None
+    if args.model == "multibody":
+        from drakecreep.multibody.diagram import DEFAULT_SEGMENTS, MultibodyOptions
+
+        if args.segments is not None and not 2 <= args.segments <= 400:
+            raise InputError("--segments", args.segments, "an integer in [2, 400]")
+        if args.backend is not None:
+            raise InputError("--backend", args.backend, "not given with --model multibody (Drake's systems run directly)")
+        if args.uncertainty is not None:
+            raise InputError("--uncertainty", args.uncertainty, "not given with --model multibody")
+        segments = DEFAULT_SEGMENTS if args.segments is None else args.segments
+        multibody = MultibodyOptions(n_segments=segments, rigid_joints=args.rigid_joints)
+        travel, segment = abs(feed) * args.duration, params.screw.length / segments
+        if travel > segment * (1.0 + 1e-9):
+            raise InputError("--duration", args.duration,
+                             f"<= {segment / abs(feed):g} s at {args.feed:g} mm/s (the multibody nut stays on one "
+                             f"screw segment of {segment * 1e3:g} mm)")
+    elif args.segments is not None or args.rigid_joints:
+        raise InputError("--segments/--rigid-joints", args.segments if args.segments is not None else True,
+                         "only with --model multibody")
     spec = None
     if args.uncertainty is not None:
         from drakecreep.cli.uncertainty import spec_from_args
@@ -69,7 +96,8 @@ def run(args):
             raise InputError("--seed", args.seed, "an integer >= 0")
         spec = spec_from_args(args)
     check_output_dir(args.out)  # before the run, not after it
-    result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall)
+    result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall, model=args.model,
+                      multibody=multibody)
     extra = {}
     if not args.no_plot and len(result.time) > 1:
         from drakecreep.report.plots import plot_feed
@@ -110,8 +138,12 @@ def run(args):
 
 def _print_text(result, paths):
     s = result.summary()
+    model = ""
+    if s.get("model") == "multibody":
+        joints = "rigid fixed joints" if s["rigid_joints"] else "fixed joints of Tables 1-2"
+        model = f", multibody model ({s['n_segments']} screw segments, {joints})"
     print(f"feed {s['feed_mm_s']:g} mm/s, load case {s['load_case']}, {s['friction_law']} friction, "
-          f"{s['controller']} cascade: {s['sim_time_s']:g} s simulated in {s['wall_time_s']:.2f} s")
+          f"{s['controller']} cascade{model}: {s['sim_time_s']:g} s simulated in {s['wall_time_s']:.2f} s")
     if result.metrics is not None:
         rows = [
             ("metrics window", f"{s['window_start_s']:g}-{s['window_end_s']:g} s"),

@@ -133,6 +133,8 @@ class ModalResult:
 def _plant_context(drive, context):
     if context is None:
         context = drive.diagram.CreateDefaultContext()
+    if drive.diagram is None:  # a plant still being wired into a larger diagram: its own context
+        return context
     try:
         drive.diagram.ValidateContext(context)
     except RuntimeError:

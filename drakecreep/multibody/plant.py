@@ -105,6 +105,8 @@ class MultibodyDrive:
     joints : dict
         Bushing name -> ``{"force_stiffness", "torque_stiffness", "force_damping", "torque_damping"}``
         (lists of 3, N/m, N m/rad, N s/m, N m s/rad, in the bushing's axes = world axes).
+    home : dict
+        Body name -> position (m, world) of its origin (centre of mass) in the undeformed rig.
     """
 
     diagram: object
@@ -116,6 +118,7 @@ class MultibodyDrive:
     table_position: float
     groups: dict = field(default_factory=dict)
     joints: dict = field(default_factory=dict)
+    home: dict = field(default_factory=dict)
 
     @property
     def segment_length(self):
@@ -140,7 +143,8 @@ def _cylinder_x(mass, r_out, r_in, length, extra_ixx=0.0):
     return SpatialInertia.MakeFromCentralInertia(mass, np.zeros(3), RotationalInertia(ixx, iyy, iyy))
 
 
-def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.0, rig=None):
+def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.0, rig=None, builder=None,
+                    rigid_twist_factor=RIGID_TWIST_FACTOR):
     """Build the multibody feed drive of ``params`` (continuous-time ``MultibodyPlant`` in a diagram).
 
     Parameters
@@ -155,6 +159,13 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         Table position x (m); the nut is ``screw.nut_start_distance + x`` from the thrust bearing.
     rig : RigGeometry, optional
         Geometry and masses the paper does not give; defaults to :class:`RigGeometry`'s assumptions.
+    rigid_twist_factor : float
+        With ``rigid_joints``: the nut's spin spring in units of the screw-nut axial stiffness seen through
+        the lead (:data:`RIGID_TWIST_FACTOR`, >= 1); its share of the axial chain's compliance is
+        ``1 / factor`` of the nut's. Its mode (~6e5 rad/s at 1e6) sets the step of an explicit integrator.
+    builder : DiagramBuilder, optional
+        Add the plant to this builder (the caller wires and builds the diagram; ``drive.diagram`` is then
+        None). Default: a diagram of the plant alone.
 
     Returns
     -------
@@ -164,6 +175,9 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         raise InputError("n_segments", n_segments, "an integer in [2, 400]")
     if not isinstance(rigid_joints, bool):
         raise InputError("rigid_joints", rigid_joints, "true or false")
+    if isinstance(rigid_twist_factor, bool) or not isinstance(rigid_twist_factor, (int, float)) \
+            or not 1.0 <= rigid_twist_factor <= 1e12:
+        raise InputError("rigid_twist_factor", rigid_twist_factor, "a number in [1, 1e12]")
     rig = RigGeometry() if rig is None else rig
     screw, nut, table = params.screw, params.nut, params.table
     a_nut = screw.nut_start_distance + float(table_position)
@@ -175,7 +189,8 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         raise InputError("rig.nut_seat_mass", rig.nut_seat_mass, f"< table.mass ({table.mass} kg)")
     jd = paper_joints()
 
-    builder = DiagramBuilder()
+    own_builder = builder is None
+    builder = DiagramBuilder() if own_builder else builder
     plant = builder.AddSystem(MultibodyPlant(0.0))
     plant.set_name("plant")
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -params.loads.gravity])
@@ -305,7 +320,7 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
     ratio = screw.lead / (2.0 * math.pi)
     if rigid_joints:
         k_force, c_force = [sn.kt, sn.kn, sn.kn], [sn.ct, sn.cn, sn.cn]
-        k_torque = [RIGID_TWIST_FACTOR * sn.kt * ratio**2, tilt, tilt]
+        k_torque = [float(rigid_twist_factor) * sn.kt * ratio**2, tilt, tilt]
         c_torque = [0.0, tilt_c, tilt_c]
     else:
         flange = jd["nut-nut seat"]
@@ -323,5 +338,6 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
             k_torque, c_torque, k_force, c_force)
 
     plant.Finalize()
-    drive.diagram = builder.Build()
+    drive.home = home
+    drive.diagram = builder.Build() if own_builder else None
     return drive

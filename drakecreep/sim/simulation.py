@@ -49,7 +49,7 @@ from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "target_accuracy", "FIXED_STEP",
-           "ACCURACY_BY_LAW", "MAX_SAMPLES",
+           "ACCURACY_BY_LAW", "MAX_SAMPLES", "MODELS",
            "MAX_TABLE_SPEED", "MIN_STEP"]
 
 #: integrators without error control: they step at ``max_step``
@@ -70,6 +70,10 @@ GUARD_EVERY = 64
 
 #: default integrator target accuracy per friction law (``simulation.accuracy: 0``); see the module notes
 ACCURACY_BY_LAW = {"lugre": 1e-4, "stribeck": 1e-5, "coulomb": 1e-5, "gms": 1e-5}
+
+#: mechanics a run can simulate: the two-mass diagram (:mod:`drakecreep.model.diagram`) or the paper's
+#: rig in a MultibodyPlant (:mod:`drakecreep.multibody.diagram`)
+MODELS = ("two_mass", "multibody")
 
 #: tightest accuracy the automatic convergence check goes to
 _ACCURACY_FLOOR = 1e-9
@@ -200,19 +204,21 @@ def _unit_tag(unit):
     return unit.replace(" ", "").replace("/", "_per_").replace("^", "")
 
 
-def make_simulator(system, context, sim, accuracy=None):
+def make_simulator(system, context, sim, accuracy=None, integrator=None):
     """A Drake ``Simulator`` configured from :class:`~drakecreep.params.SimulationParams`.
 
     ``accuracy`` (the target accuracy) defaults to ``sim.accuracy``; pass :func:`target_accuracy` when
-    ``sim.accuracy`` may be 0 (the friction law's default).
+    ``sim.accuracy`` may be 0 (the friction law's default). ``integrator`` (a Drake integrator name)
+    defaults to ``sim.integrator``.
     """
     accuracy = sim.accuracy if accuracy is None else accuracy
-    if sim.integrator not in FIXED_STEP and not accuracy > 0:
+    name = sim.integrator if integrator is None else integrator
+    if name not in FIXED_STEP and not accuracy > 0:
         raise InputError("simulation.accuracy", accuracy, "> 0 (0 is resolved per friction law by target_accuracy)")
     simulator = Simulator(system, context)
-    integrator = ResetIntegratorFromFlags(simulator, sim.integrator, sim.max_step)
+    integrator = ResetIntegratorFromFlags(simulator, name, sim.max_step)
     integrator.set_maximum_step_size(sim.max_step)
-    if sim.integrator not in FIXED_STEP:
+    if name not in FIXED_STEP:
         integrator.set_target_accuracy(accuracy)
         integrator.set_requested_minimum_step_size(min(MIN_STEP, sim.max_step))
         integrator.set_throw_on_minimum_step_size_violation(True)
@@ -255,7 +261,7 @@ def _guard(simulator, root, read_speeds, bounds, wall_limit):
     return report
 
 
-def simulate(params, scenario, *, backend=None, wall_limit=None):
+def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass", multibody=None):
     """Simulate ``scenario`` on the drive described by ``params``, with a convergence check.
 
     Parameters
@@ -263,9 +269,17 @@ def simulate(params, scenario, *, backend=None, wall_limit=None):
     params : drakecreep.params.DriveParams
     scenario : drakecreep.scenario.Scenario
     backend : {"compiled", "leaf"}, optional
-        Default ``params.simulation.backend``.
+        Default ``params.simulation.backend`` (two-mass model only; the multibody model runs Drake's
+        systems directly).
     wall_limit : float, optional
         Stop after this many seconds of computing (the result says so in ``status``).
+    model : {"two_mass", "multibody"}
+        The mechanics (:data:`MODELS`): the two-mass diagram, or the paper's rig in a MultibodyPlant
+        with the same controller, sensors, friction laws and load case
+        (:func:`drakecreep.multibody.diagram.build_multibody_diagram`).
+    multibody : drakecreep.multibody.diagram.MultibodyOptions, optional
+        Segments, rigid joints, friction on/off and the integrator of the multibody model (its
+        defaults when None).
 
     Returns
     -------
@@ -282,6 +296,10 @@ def simulate(params, scenario, *, backend=None, wall_limit=None):
                                    or not wall_limit > 0):
         raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
     sim = params.simulation
+    if model not in MODELS:
+        raise InputError("model", model, " or ".join(MODELS))
+    if model == "two_mass" and multibody is not None:
+        raise InputError("multibody", multibody, "None with model two_mass")
     backend = backend or sim.backend
     if backend not in ("compiled", "leaf"):
         raise InputError("backend", backend, "compiled or leaf")
@@ -295,9 +313,10 @@ def simulate(params, scenario, *, backend=None, wall_limit=None):
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration)
     accuracy = target_accuracy(params)
-    built = _build(params, scenario, backend)
+    built = _build(params, scenario, backend) if model == "two_mass" else _build_multibody(params, scenario, multibody)
     result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit)
-    check = sim.convergence_check and sim.integrator not in FIXED_STEP and result.ok and result.metrics is not None
+    check = sim.convergence_check and built[5]["integrator"] not in FIXED_STEP and result.ok \
+        and result.metrics is not None
     if not check:
         result.stats.update(accuracy=accuracy)
         return result
@@ -353,8 +372,9 @@ def _window_metrics(result, keep):
 def _build(params, scenario, backend):
     """The diagram with its loggers, built once for the run and its convergence check.
 
-    Returns ``(feed_drive, root, loggers, init, read_speeds)``: ``init(context)`` sets the compiled path's
-    initial state, ``read_speeds(context)`` the table and motor speeds the divergence guard watches.
+    Returns ``(feed_drive, root, loggers, init, read_speeds, info)``: ``init(context)`` sets the compiled
+    path's initial state, ``read_speeds(context)`` the table and motor speeds the divergence guard watches,
+    ``info`` the backend and integrator names (and what else goes into the result's ``stats``).
     """
     sim = params.simulation
     feed_drive = build_diagram(params, scenario)
@@ -369,15 +389,7 @@ def _build(params, scenario, backend):
         loggers = {"all": (logger, list(range(len(feed_drive.signals))))}
     else:
         system = builder.AddSystem(feed_drive.diagram)
-        loggers = {}
-        for i, (_, (sys_name, port_name, index), _) in enumerate(feed_drive.signals):
-            key = f"{sys_name}.{port_name}"
-            if key not in loggers:
-                port = system.GetOutputPort(key)
-                sink = builder.AddSystem(VectorLogSink(port.size(), sim.log_period))
-                builder.Connect(port, sink.get_input_port())
-                loggers[key] = (sink, [])
-            loggers[key][1].append((i, index))
+        loggers = _log_ports(builder, system, feed_drive, sim.log_period)
     root = builder.Build()
     names = feed_drive.signal_names
     init = None
@@ -401,15 +413,53 @@ def _build(params, scenario, backend):
             m_ctx = feed_drive.diagram.GetSubsystemContext(motor, diagram_context)
             return (float(table.GetOutputPort("table_state").Eval(t_ctx)[1]),
                     float(motor.GetOutputPort("motor_state").Eval(m_ctx)[1]))
-    return feed_drive, root, loggers, init, read_speeds
+    return feed_drive, root, loggers, init, read_speeds, dict(backend=backend, integrator=sim.integrator)
+
+
+def _log_ports(builder, system, feed_drive, log_period):
+    """One ``VectorLogSink`` per exported port of the recorded signals: ``{key: (sink, [(signal, index)])}``."""
+    loggers = {}
+    for i, (_, (sys_name, port_name, index), _) in enumerate(feed_drive.signals):
+        key = f"{sys_name}.{port_name}"
+        if key not in loggers:
+            port = system.GetOutputPort(key)
+            sink = builder.AddSystem(VectorLogSink(port.size(), log_period))
+            builder.Connect(port, sink.get_input_port())
+            loggers[key] = (sink, [])
+        loggers[key][1].append((i, index))
+    return loggers
+
+
+def _build_multibody(params, scenario, options):
+    """:func:`_build` for the multibody model: its diagram with loggers on the exported signal ports."""
+    from drakecreep.multibody.diagram import MultibodyOptions, build_multibody_diagram
+
+    options = MultibodyOptions() if options is None else options
+    feed_drive = build_multibody_diagram(params, scenario, options)
+    builder = DiagramBuilder()
+    system = builder.AddSystem(feed_drive.diagram)
+    loggers = _log_ports(builder, system, feed_drive, params.simulation.log_period)
+    root = builder.Build()
+
+    def init(context):
+        feed_drive.set_initial_state(root.GetMutableSubsystemContext(system, context))
+
+    table, motor = system.GetOutputPort("table.table_state"), system.GetOutputPort("motor.motor_state")
+
+    def read_speeds(context):
+        sub = root.GetSubsystemContext(system, context)
+        return float(table.Eval(sub)[1]), float(motor.Eval(sub)[1])
+
+    info = dict(backend="multibody", integrator=options.integrator, model="multibody",
+                n_segments=options.n_segments, rigid_joints=options.rigid_joints, friction=options.friction)
+    return feed_drive, root, loggers, init, read_speeds, info
 
 
 def _run(params, scenario, built, accuracy, until, wall_limit=None):
     """One simulation from t = 0 to ``until`` at target ``accuracy`` on a diagram from :func:`_build`, watched
     by the divergence guard."""
     sim = params.simulation
-    feed_drive, root, loggers, init, read_speeds = built
-    backend = "compiled" if init is not None else "leaf"
+    feed_drive, root, loggers, init, read_speeds, info = built
     units = feed_drive.signal_units()
     context = root.CreateDefaultContext()
     if init is not None:
@@ -418,7 +468,8 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None):
     bounds = (v_max, v_max * 2.0 * math.pi / params.screw.lead)
 
     start = time.perf_counter()
-    simulator = make_simulator(root, context, sim, accuracy)
+    other = {} if info["integrator"] == sim.integrator else dict(integrator=info["integrator"])
+    simulator = make_simulator(root, context, sim, accuracy, **other)
     guard = _guard(simulator, root, read_speeds, bounds, wall_limit)
     status = "ok"
     try:
@@ -465,8 +516,7 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None):
         )
     integrator = simulator.get_integrator()
     stats = dict(
-        backend=backend,
-        integrator=sim.integrator,
+        **info,
         steps=int(integrator.get_num_steps_taken()),
         derivative_evaluations=int(integrator.get_num_derivative_evaluations()),
     )

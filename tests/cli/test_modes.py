@@ -35,3 +35,9 @@ def test_modes_bad_arguments_one_line_exit_2(argv, fragment, capsys):
         code = exit_.code
     err = capsys.readouterr().err
     assert code == 2 and fragment in err and len(err.strip().splitlines()) == 1
+
+
+def test_modes_out_writes_the_figures(tmp_path, capsys):
+    assert main(["modes", "--segments", "4", "--modes", "4", "--out", str(tmp_path)]) == 0
+    assert "modes.png" in capsys.readouterr().out
+    assert (tmp_path / "modes.png").stat().st_size > 10_000 and (tmp_path / "mechanism.png").exists()

@@ -1,0 +1,107 @@
+"""Benchmark: a 5 s creep run of the multibody model against the two-mass compiled path, same run.
+
+Scenario: paper preset, load case 3, LuGre, 0.1 mm/s (stick-slip in the two-mass model), 5 s, the
+convergence check off in both (it costs each model its own share; timed here is one run). Prints the
+CPU time of this process for each run (the ratio is taken on it: on a shared machine wall time
+measures the neighbours), its wall time, its integrator steps and derivative evaluations, the ratio to the
+two-mass compiled run, and where one derivative evaluation of the multibody diagram spends its time
+(the plant with its inputs, and each Python leaf system's output alone). Issue 17's target: 20x.
+
+    python analysis/bench_multibody.py [--feed 0.1] [--duration 5] [--configs full6 rigid6 rigid4 rigid3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from drakecreep.multibody.diagram import MultibodyOptions, build_multibody_diagram
+from drakecreep.params import preset, with_value
+from drakecreep.scenario import Scenario
+from drakecreep.sim.simulation import simulate
+
+__all__ = ["CONFIGS", "profile", "main"]
+
+#: name -> multibody options
+CONFIGS = {
+    "full6": MultibodyOptions(n_segments=6),
+    "full4": MultibodyOptions(n_segments=4),
+    "rigid6": MultibodyOptions(n_segments=6, rigid_joints=True),
+    "rigid4": MultibodyOptions(n_segments=4, rigid_joints=True),
+    "rigid3": MultibodyOptions(n_segments=3, rigid_joints=True),
+    "rigid4_rk3": MultibodyOptions(n_segments=4, rigid_joints=True, integrator="runge_kutta3"),
+    "rigid3_rk3": MultibodyOptions(n_segments=3, rigid_joints=True, integrator="runge_kutta3"),
+}
+
+
+def timed(params, scenario, **kwargs):
+    """``simulate`` and the CPU time of this process it took (s): the machine may be shared, wall time is not
+    a fair ratio there."""
+    start = time.process_time()
+    result = simulate(params, scenario, **kwargs)
+    return result, time.process_time() - start
+
+
+def profile(params, scenario, options, repeats=500):
+    """Microseconds per evaluation: the whole diagram's derivatives, then each leaf's output port alone."""
+    fd = build_multibody_diagram(params, scenario, options)
+    d = fd.diagram
+    ctx = d.CreateDefaultContext()
+    fd.set_initial_state(ctx)
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    der = d.AllocateTimeDerivatives()
+    out = {}
+    start = time.perf_counter()
+    for _ in range(repeats):
+        ctx.SetContinuousState(x)  # invalidates every cache entry that depends on the state
+        d.CalcTimeDerivatives(ctx, der)
+    out["diagram derivatives"] = (time.perf_counter() - start) / repeats * 1e6
+    for name in ("controller", "guide_friction", "nut_friction", "encoder", "scale", "reference"):
+        if name not in fd.systems:
+            continue
+        system = fd.systems[name]
+        sub = system.GetMyContextFromRoot(ctx)
+        port = system.get_output_port(0)
+        start = time.perf_counter()
+        for _ in range(repeats):
+            ctx.SetContinuousState(x)
+            port.Eval(sub)
+        out[f"{name} output (with its inputs)"] = (time.perf_counter() - start) / repeats * 1e6
+    out["states"] = len(x)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--feed", type=float, default=0.1, help="mm/s (default 0.1)")
+    ap.add_argument("--duration", type=float, default=5.0, help="s (default 5)")
+    ap.add_argument("--configs", nargs="+", default=["full6", "rigid4", "rigid3_rk3"], choices=sorted(CONFIGS))
+    args = ap.parse_args(argv)
+    params = with_value(preset("paper"), "simulation.convergence_check", False)
+    scenario = Scenario(feed=args.feed * 1e-3, load_case=3, duration=args.duration)
+    base, base_cpu = timed(params, scenario)
+    m = base.metrics
+    print(f"two-mass compiled: {base_cpu:.2f} s CPU ({base.wall_time:.2f} s wall), {base.stats['steps']} steps, "
+          f"{base.stats['derivative_evaluations']} derivative evaluations; creep {m.creep}, "
+          f"fluctuation {m.max_fluctuation * 1e3:.4f} mm/s", flush=True)
+    print("| configuration | states | CPU (s) | wall (s) | ratio (CPU) | steps | derivative evals | us / eval | creep "
+          "| fluctuation (mm/s) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    for name in args.configs:
+        options = CONFIGS[name]
+        r, cpu = timed(params, scenario, model="multibody", multibody=options)
+        prof = profile(params, scenario, options, repeats=200)
+        creep = r.metrics.creep if r.metrics else None
+        fluct = f"{r.metrics.max_fluctuation * 1e3:.4f}" if r.metrics else "-"
+        evals = r.stats["derivative_evaluations"]
+        print(f"| {name} ({options.integrator}) | {prof['states']} | {cpu:.1f} | {r.wall_time:.1f} | {cpu / base_cpu:.0f}x "
+              f"| {r.stats['steps']} | {evals} | {prof['diagram derivatives']:.0f} | {creep} | {fluct} |", flush=True)
+        print("    per evaluation (us): " + ", ".join(f"{k} {v:.0f}" for k, v in prof.items() if k != "states"),
+              flush=True)
+        if not r.ok:
+            print(f"    status: {r.status}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
