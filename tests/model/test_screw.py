@@ -69,7 +69,7 @@ def test_two_mass_natural_frequency_without_friction(paper):
     x0[-2] = 1e-6  # table displaced 1 um: stretches the screw
     ctx.SetContinuousState(x0)
     sim = Simulator(d, ctx)
-    sim.get_mutable_integrator().set_target_accuracy(1e-9)
+    sim.get_mutable_integrator().set_target_accuracy(1e-7)  # the frequency, not the amplitude, is checked
     sim.AdvanceTo(0.5)
     v = log.FindLog(ctx).data()[1]
     spectrum = np.abs(np.fft.rfft(v * np.hanning(len(v)), n=8 * len(v)))

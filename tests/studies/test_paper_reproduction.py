@@ -1,3 +1,5 @@
+import os
+
 import pytest
 
 from drakecreep.errors import InputError
@@ -48,6 +50,11 @@ def test_uncalibrated_paper_preset_is_far_too_smooth():
     assert all(r["ours_mm_s"] < 0.01 * r["experiment_mm_s"] for r in rows)
 
 
+@pytest.mark.slow
+@pytest.mark.skipif(not os.environ.get("DRAKECREEP_SLOW"),
+                    reason="refits paper_calibrated (~100 s); the default suite checks the stored amplitudes against "
+                           "the current model in test_predicted_rows_beat_the_papers_worst_error (calibration rows "
+                           "within 1 %); set DRAKECREEP_SLOW=1")
 def test_calibration_is_deterministic_and_gives_the_stored_preset():
     # paper_calibrated is the paper preset (nut's drag on the screw, one-sample delay) plus the two fitted
     # amplitudes: refitting from the paper preset must give the stored values
