@@ -287,6 +287,14 @@ def _drake_figures(diagnosis, residuals=None):
         ax.axvline(0, color="k", lw=0.8)
         ax.set_yticks(y, [r.name + (" (screened out)" if r.screened_out else "") for r in ranked])
         ax.set_xlabel("held-out force error decrease [points of %]")
+        # one wild screen score must not squash the others: clip the axis to the closed-loop gains' scale
+        # (at least +-5 points) and write the clipped values at the edge
+        span = max(5.0, 3.0 * np.nanmax(np.abs(np.r_[cl, se, 0.0])))
+        ax.set_xlim(-span, span)
+        for yi, v in zip(y, sc):
+            if np.isfinite(v) and abs(v) > span:
+                ax.text(np.sign(v) * span * 0.98, yi - 0.2, f"{v:+.3g}", va="center", fontsize=7,
+                        ha="left" if v < 0 else "right")
         ax.legend(fontsize=8, loc="lower right")
         figs.append((_fig_png(fig), "Which effect: held-out gain against the nominal model, per candidate "
                                     "(green: passes the claim threshold)"))
@@ -315,6 +323,20 @@ def _drake_figures(diagnosis, residuals=None):
     return figs
 
 
+
+#: SI unit of a MeasuredAxis parameter -> (factor, unit at the edge): mm/s, mm, N/um in the report
+_EDGE_UNITS = {"m/s": (1e3, "mm/s"), "m": (1e3, "mm"), "N/m": (1e-6, "N/um")}
+
+
+def _edge(name, value):
+    """``(value, unit)`` of MeasuredAxis parameter ``name`` in the report's units (mm/s, mm, N/um; else SI)."""
+    from drakecreep.model.axis import AXIS_UNITS
+
+    unit = AXIS_UNITS[name]
+    factor, shown = _EDGE_UNITS.get(unit, (1.0, unit))
+    return value * factor, shown
+
+
 def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real gap diagnosis (Drake model)",
                        outset=None, **extra):
     """Write ``diagnosis.html`` and ``diagnosis.json`` of a typed Drake diagnosis into ``out_dir``.
@@ -336,7 +358,6 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         ``(html_path, json_path)``.
     """
     from drakecreep.files import OutputSet
-    from drakecreep.model.axis import AXIS_UNITS
     from drakecreep.report.html import escape, figure, page, table
 
     own = outset is None
@@ -358,7 +379,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  "(the screen). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
     parts.append(table(["parameter", "value", "95 % half-width", "unit"],
-                       [[n, f"{nom.parameters[n]:.5g}", f"{nom.ci95.get(n, float('nan')):.3g}", AXIS_UNITS[n]]
+                       [[n, f"{_edge(n, nom.parameters[n])[0]:.5g}",
+                         f"{_edge(n, nom.ci95.get(n, float('nan')))[0]:.3g}", _edge(n, 0.0)[1]]
                         for n in nom.fitted]))
     if nom.warnings:
         parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in nom.warnings) + "</ul>")
@@ -372,14 +394,15 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
         names = DRAKE_EFFECTS[r.name].parameters if r.name in DRAKE_EFFECTS else ()
-        params = "; ".join(f"{n} = {r.fit.parameters[n]:.4g} {AXIS_UNITS[n]}" for n in names)
+        params = "; ".join("{} = {:.4g} {}".format(n, *_edge(n, r.fit.parameters[n])) for n in names)
         if r.name == "control_delay":
             params = f"delay = {r.fit.delay:.3g} samples"
         rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f} ± {k * r.standard_error:.3f}",
-                     "yes" if r.passes else "no", params])
+                     ("yes" if r.passes else "no") + ("" if r.name in diagnosis.claimed or not r.passes
+                                                      else " (not kept by the greedy step)"), params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
     parts.append(table(["effect", "inverse-dynamics gain [points of %]", "closed-loop held-out force error [%]",
-                        "closed-loop gain [points of %]", "passes", "fitted parameters"], rows))
+                        "closed-loop gain [points of %]", "passes alone", "fitted parameters"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = ("position", "velocity", "acceleration", "force")
     rows = [[lab] + [f"{diagnosis.nominal_test_errors[lab][s]:.4g} → {diagnosis.test_errors[lab][s]:.4g}"
