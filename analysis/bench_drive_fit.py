@@ -8,16 +8,19 @@
 2. Recovery: runs simulated by the test rig with a known change (Coulomb level +30 %, a 2 um lead error,
    nothing), two training and two held-out runs, noise 2 N on ``u``: what ``diagnose_drive`` finds.
 
-Run: ``python analysis/bench_drive_fit.py [--duration S] [--skip-speed] [--skip-recovery]``
+3. Coverage (``--coverage N``): the Coulomb case with N noise realisations (seeds 5000 + 10 k, never used by
+   the tests): how often the 95 % interval of the fitted level contains the truth, and the error in units of
+   the stated standard deviation (a calibrated interval: ~95 %, errors of spread ~1).
+
+Run: ``python analysis/bench_drive_fit.py [--duration S] [--skip-speed] [--skip-recovery] [--coverage N]``
 """
 
 import argparse
-import dataclasses
 import time
 
 import numpy as np
 
-from drakecreep.gap.drake_replay import replay_drakecreep
+from drakecreep.gap.drake_replay import quick_replay_params, replay_drakecreep, simulated_runs
 from drakecreep.gap.drive_fit import diagnose_drive
 from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
 from drakecreep.gap.truth import out_and_back
@@ -26,13 +29,8 @@ from drakecreep.params import LoadCase, preset, with_value
 
 
 def test_rig():
-    """The rig of tests/gap/test_drive_fit.py."""
-    rig = preset("paper")
-    for path, value in (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
-                        ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
-                        ("motor.current_loop_time_constant", 0.0)):
-        rig = with_value(rig, path, value)
-    return rig
+    """The rig of tests/gap/test_drive_fit.py: the paper preset quick to replay."""
+    return quick_replay_params(preset("paper"))
 
 
 def blank_run(params, n, label="run", speed=0.02, f_ext=True):
@@ -83,14 +81,7 @@ def recovery():
         "null": rig,
     }
     for seed, (label, truth) in enumerate(cases.items()):
-        runs = []
-        for i, v in enumerate((0.02, 0.03, 0.025, 0.035)):
-            blank = dataclasses.replace(blank_run(rig, 500, f"r{i}", v, f_ext=False))
-            x_ref = out_and_back(v, 0.0, n=500, dt=1e-3, leg=0.2, starts=(0.03, 0.26))
-            blank = dataclasses.replace(blank, x_ref=x_ref, x_motor=x_ref)
-            sim = replay_drakecreep(blank, truth)
-            noise = np.random.default_rng(1000 + 10 * seed + i).normal(0.0, 2.0, 500)
-            runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=sim.u + noise, x_table=sim.x_table))
+        runs = simulated_runs(truth, (0.02, 0.03, 0.025, 0.035), declared=rig, n=500, noise=2.0, seed=1000 + 10 * seed)
         result, cpu, wall = timed(lambda: diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
                                                          effects=("lead_error", "force_ripple", "stribeck")))
         print(f"\n== truth: {label} (seal_force {truth.table.seal_force:.4g} N, lead error "
@@ -99,12 +90,35 @@ def recovery():
         print("\n".join(result.summary))
 
 
+def coverage(count):
+    rig = test_rig()
+    fc = friction_levels(rig, LoadCase())[0]
+    truth = with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * fc)
+    true = truth.table.seal_force
+    inside, z = 0, []
+    for k in range(count):
+        runs = simulated_runs(truth, (0.02, 0.03, 0.025, 0.035), declared=rig, n=500, noise=2.0, seed=5000 + 10 * k)
+        result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=())
+        (seal,) = result.fitted
+        half = (seal.upper - seal.lower) / 2
+        inside += seal.contains(true)
+        z.append((seal.value - true) / (half / 1.96))
+        print(f"seed {5000 + 10 * k}: {seal.value:.4f} N [{seal.lower:.4f}, {seal.upper:.4f}], truth {true:.4f} N, "
+              f"error {z[-1]:+.2f} sd", flush=True)
+    print(f"coverage of the 95 % interval: {inside}/{count}; error / stated sd: mean {np.mean(z):+.2f}, "
+          f"spread {np.std(z, ddof=1):.2f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=0.5, help="simulated seconds of the speed run (default 0.5)")
     ap.add_argument("--skip-speed", action="store_true")
     ap.add_argument("--skip-recovery", action="store_true")
+    ap.add_argument("--coverage", type=int, default=0, help="noise realisations of the interval coverage check")
     args = ap.parse_args()
+    if args.coverage:
+        coverage(args.coverage)
+        return
     if not args.skip_speed:
         speed(args.duration)
     if not args.skip_recovery:

@@ -20,8 +20,9 @@ The front door (each name is imported from its subpackage on first use, so ``imp
 ``run_sweep``                 parameter sweeps, serial / processes / Dask (:mod:`drakecreep.sim.sweep`)
 ``analyze_loops``             linearized velocity and position loops, margins (:mod:`drakecreep.servo.loops`)
 ``critical_speed``            the paper's eq. 11 (:mod:`drakecreep.paper.creep`)
-``load_measured``, ``diagnose``  measured runs and the sim-to-real gap diagnosis (:mod:`drakecreep.gap`)
-``diagnose_drake``            the gap diagnosis on the Drake replay model (what ``drakecreep diagnose`` runs)
+``load_measured``             measured runs in any units with their metadata (:mod:`drakecreep.gap.measured`)
+``diagnose``                  the sim-to-real gap diagnosis on the Drake replay model, what ``drakecreep
+                              diagnose`` runs (:func:`drakecreep.gap.drake_diagnosis.diagnose_drake`)
 ============================  ==============================================================
 """
 
@@ -29,7 +30,7 @@ import importlib
 
 __version__ = "0.1.0"
 
-#: public name -> module that defines it
+#: public name -> module that defines it, or (module, name there)
 _API = {
     "preset": "drakecreep.params",
     "load_params": "drakecreep.params",
@@ -46,18 +47,18 @@ _API = {
     "analyze_loops": "drakecreep.servo.loops",
     "critical_speed": "drakecreep.paper.creep",
     "load_measured": "drakecreep.gap.measured",
-    "diagnose": "drakecreep.gap.diagnosis",
-    "diagnose_drake": "drakecreep.gap.drake_diagnosis",
+    "diagnose": ("drakecreep.gap.drake_diagnosis", "diagnose_drake"),
 }
 
 __all__ = ["__version__", *_API]
 
 
 def __getattr__(name):
-    module = _API.get(name)
-    if module is None:
+    where = _API.get(name)
+    if where is None:
         raise AttributeError(f"module 'drakecreep' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
+    module, attribute = where if isinstance(where, tuple) else (where, name)
+    value = getattr(importlib.import_module(module), attribute)
     globals()[name] = value
     return value
 

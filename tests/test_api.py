@@ -19,3 +19,10 @@ def test_first_lines_of_a_user(paper):
     drive = dc.lumped(dc.preset("paper"), 3)
     assert 1e6 < drive.stiffness < 1e9 and drive.mass > 40
     assert dc.Scenario(feed=1e-4, load_case=3, duration=0.5).feed == 1e-4
+
+
+def test_diagnose_is_the_drake_model_diagnosis():
+    """One name per thing: the front door's ``diagnose`` is what ``drakecreep diagnose`` runs."""
+    from drakecreep.gap.drake_diagnosis import diagnose_drake
+
+    assert dc.diagnose is diagnose_drake

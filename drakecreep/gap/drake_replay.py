@@ -51,6 +51,9 @@ __all__ = [
     "replay_drakecreep",
     "replay_params",
     "check_replayable",
+    "QUICK_REPLAY_SETTINGS",
+    "quick_replay_params",
+    "simulated_runs",
 ]
 
 
@@ -674,3 +677,75 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     force = u * run.u_gain + f_ext
     return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
                              wall_time=_time.perf_counter() - start)
+
+
+#: ``(path, value)`` settings that make a params file quick to replay, for studies and tests that generate
+#: many runs of the project's controller: a Stribeck law regularised at 0.1 mm/s (no LuGre bristle state),
+#: accuracy 1e-4, the nut's friction on the table (no second friction state on the screw) and an ideal
+#: current loop (no 0.1 ms lag to resolve). The rig is then no longer the paper's; use it for the gap
+#: machinery, not for creep verdicts.
+QUICK_REPLAY_SETTINGS = (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
+                         ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
+                         ("motor.current_loop_time_constant", 0.0))
+
+
+def quick_replay_params(params):
+    """``params`` with :data:`QUICK_REPLAY_SETTINGS` applied (a new :class:`~drakecreep.params.DriveParams`)."""
+    from drakecreep.params import with_value
+
+    for path, value in QUICK_REPLAY_SETTINGS:
+        params = with_value(params, path, value)
+    return params
+
+
+def simulated_runs(truth, speeds, *, declared=None, n=500, dt=1e-3, noise=0.0, seed=0, leg=0.2,
+                   starts=(0.03, 0.26), f_ext=None, label="r"):
+    """Runs of the project's controller as a measurement of the rig ``truth`` would record them.
+
+    Each run is an out-and-back reference (:func:`drakecreep.gap.truth.out_and_back`) at one of ``speeds``,
+    replayed through ``truth``'s diagram (:func:`replay_drakecreep`), with white noise of standard deviation
+    ``noise`` [N] added to ``u``; the metadata declare ``kind: drakecreep`` and the params file ``declared``
+    (default ``truth``): what the user's model says the rig is.
+
+    Parameters
+    ----------
+    truth, declared : drakecreep.params.DriveParams
+    speeds : sequence of float
+        Reference speed of each run [m/s].
+    n : int
+        Samples per run.
+    dt : float
+        Sample time [s].
+    noise : float
+        Standard deviation of the noise on ``u`` [N].
+    seed : int
+        Seeds the noise: run ``i``'s generator is ``numpy.random.default_rng(seed + i)``.
+    leg, starts : float, tuple of float
+        Duration of each leg and its start times [s] (:func:`~drakecreep.gap.truth.out_and_back`).
+    f_ext : array_like, optional
+        Known external force on the table, the same for every run [N].
+    label : str
+        Run labels are ``label + index``.
+
+    Returns
+    -------
+    list of drakecreep.gap.measured.MeasuredRun
+    """
+    import dataclasses
+
+    from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
+    from drakecreep.gap.truth import out_and_back
+
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=truth if declared is None else declared,
+                        controller=ControllerMeta(kind="drakecreep"))
+    t = np.arange(n) * dt
+    force = None if f_ext is None else np.asarray(f_ext, dtype=float)
+    runs = []
+    for i, v in enumerate(speeds):
+        x_ref = out_and_back(v, 0.0, n=n, dt=dt, leg=leg, starts=starts)
+        blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(n), meta=meta, f_ext=force,
+                            label=f"{label}{i}")
+        sim = replay_drakecreep(blank, truth)
+        u = sim.u + (np.random.default_rng(seed + i).normal(0.0, noise, n) if noise > 0 else 0.0)
+        runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=u, x_table=sim.x_table))
+    return runs

@@ -1,13 +1,12 @@
 """``drakecreep diagnose`` on runs whose controller is the project's own cascade (kind: drakecreep)."""
 
-import dataclasses
 import json
 
 import numpy as np
 import pytest
 
 from drakecreep import cli
-from drakecreep.gap.drake_replay import replay_drakecreep
+from drakecreep.gap.drake_replay import quick_replay_params, simulated_runs
 from drakecreep.gap.measured import ControllerMeta, MeasuredData, MeasuredMeta, MeasuredRun, save_measured
 from drakecreep.gap.truth import out_and_back
 from drakecreep.params import load_params, preset, with_value
@@ -15,34 +14,15 @@ from drakecreep.params import load_params, preset, with_value
 N = 1200
 
 
-def _fast_rig():
-    """The paper preset made quick to replay (as tests/gap/test_drive_fit.py): Stribeck regularised at
-    0.1 mm/s, the nut's friction on the table, an ideal current loop."""
-    rig = preset("paper")
-    for path, value in (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
-                        ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
-                        ("motor.current_loop_time_constant", 0.0)):
-        rig = with_value(rig, path, value)
-    return rig
-
-
 @pytest.fixture(scope="module")
 def own_csv(tmp_path_factory):
     """Four out-and-back runs simulated by the project's diagram from their references, with a 2 um lead
     error the params file lacks, saved as CSV + metadata YAML (the params file beside them)."""
     folder = tmp_path_factory.mktemp("own")
-    rig = _fast_rig()
+    rig = quick_replay_params(preset("paper"))
     truth = with_value(rig, "disturbance.lead_error_amplitude", 2e-6)
-    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=rig, controller=ControllerMeta(kind="drakecreep"))
-    n = 500
-    t = np.arange(n) * 1e-3
-    runs = []
-    for i, v in enumerate((0.02, 0.03, 0.025, 0.035)):
-        x_ref = out_and_back(v, 0.0, n=n, dt=1e-3, leg=0.2, starts=(0.03, 0.26))
-        blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(n), meta=meta, label=f"r{i}")
-        sim = replay_drakecreep(blank, truth)
-        noise = np.random.default_rng(7 + i).normal(0.0, 2.0, n)
-        runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=sim.u + noise, x_table=sim.x_table))
+    runs = simulated_runs(truth, (0.02, 0.03, 0.025, 0.035), declared=rig, n=500, noise=2.0, seed=7)
+    meta = runs[0].meta
     path = folder / "own.csv"
     _, yaml_path = save_measured(MeasuredData(runs=tuple(runs), meta=meta), path)
     return path, yaml_path

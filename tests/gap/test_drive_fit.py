@@ -6,7 +6,6 @@ with a Stribeck law (regularised at 0.1 mm/s), the nut's friction on the table a
 loop, so that a 0.5 s run replays in well under a second.
 """
 
-import dataclasses
 import json
 
 import numpy as np
@@ -15,7 +14,7 @@ import pytest
 from drakecreep import cli
 from drakecreep.errors import InputError
 from drakecreep.gap import drive_fit
-from drakecreep.gap.drake_replay import replay_drakecreep
+from drakecreep.gap.drake_replay import quick_replay_params, simulated_runs
 from drakecreep.gap.drive_fit import DriveDiagnosis, diagnose_drive
 from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
 from drakecreep.gap.truth import out_and_back
@@ -28,30 +27,12 @@ CANDIDATES = ("lead_error", "force_ripple", "stribeck")
 NOISE = 2.0  # N, white, on u
 
 
-def _rig():
-    rig = preset("paper")
-    for path, value in (("friction.law", "stribeck"), ("friction.regularization_velocity", 1e-4),
-                        ("simulation.accuracy", 1e-4), ("friction.nut_friction_on", "table"),
-                        ("motor.current_loop_time_constant", 0.0)):
-        rig = with_value(rig, path, value)
-    return rig
-
-
-RIG = _rig()
+RIG = quick_replay_params(preset("paper"))
 COULOMB = friction_levels(RIG, LoadCase())[0]
 
 
 def _runs(truth, seed=0):
-    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=RIG, controller=ControllerMeta(kind="drakecreep"))
-    t = np.arange(N) * 1e-3
-    runs = []
-    for i, v in enumerate(SPEEDS):
-        x_ref = out_and_back(v, 0.0, n=N, dt=1e-3, leg=0.2, starts=(0.03, 0.26))
-        blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(N), meta=meta, label=f"r{i}")
-        sim = replay_drakecreep(blank, truth)
-        noise = np.random.default_rng(100 * seed + i).normal(0.0, NOISE, N)
-        runs.append(dataclasses.replace(blank, x_motor=sim.x_motor, u=sim.u + noise, x_table=sim.x_table))
-    return runs
+    return simulated_runs(truth, SPEEDS, declared=RIG, n=N, noise=NOISE, seed=100 * seed)
 
 
 @pytest.fixture(scope="module")
