@@ -15,9 +15,10 @@ diagnosis.html, diagnosis.json and augmented_model.yaml; ``--score FILE`` replay
 parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
 """
 
+import os
 import sys
 
-from drakecreep.cli._common import print_json
+from drakecreep.cli._common import print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import load_runs, pick  # noqa: F401 (re-exported: the library side)
 
@@ -46,6 +47,9 @@ def add_parser(subparsers):
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
                    "report --params, diagnosis.json, summary.txt)")
+    p.add_argument("--workers", type=workers, metavar="N",
+                   help=f"processes for the candidates' closed-loop fits (kind p_p_cascade; default: all cores, "
+                        f"{os.cpu_count()}; 1 fits them one after another in this process)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p
@@ -127,7 +131,8 @@ def _run_drake(args, train, test, score_runs, effects=None):
             say(f"ranking written to {path}")
 
     say(f"{len(train)} training, {len(test)} held-out runs; identifying the nominal axis")
-    diag = diagnose_drake(train, test, effects, progress=say, on_ranking=keep_ranking)
+    diag = diagnose_drake(train, test, effects, progress=say, on_ranking=keep_ranking,
+                          workers=args.workers or os.cpu_count() or 1)
     model = diag.model
     if score_runs:
         say(f"replaying the augmented model on {args.score} (parameters fixed)")

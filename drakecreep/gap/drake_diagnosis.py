@@ -149,8 +149,18 @@ def load_model(path):
     return dict(params), bool(data.get("flexible", False)), float(data.get("delay_samples", 0.0))
 
 
+def _closed_loop_fit(name, train, test, nominal, max_nfev, start):
+    """Closed-loop fit of one candidate against ``nominal`` (a process pool's job: module level, picklable)."""
+    if name == "control_delay":
+        return fit_delay(train, test, nominal, start=start)
+    # the two-mass replay is the costly one (its mode sets the sub-steps): rank the mode with the nominal
+    # friction fixed (2 parameters, not 5); the greedy step refits the friction with it if it passes
+    refit = () if name == "axial_mode" else NOMINAL_PARAMETERS
+    return fit_effect(name, train, test, nominal, max_nfev=max_nfev, starts=(start,) if start else None, refit=refit)
+
+
 def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=None, screen=True,
-                   screen_k_se=1.0, on_nominal=None, on_ranking=None):
+                   screen_k_se=1.0, on_nominal=None, on_ranking=None, workers=1):
     """Diagnose the gap of the Drake replay model (see the module docstring).
 
     Parameters
@@ -177,6 +187,10 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
         Called with ``(nominal, nominal_test_errors)`` once the nominal model is identified, and with
         ``(nominal, nominal_test_errors, ranking)`` once every candidate is ranked, before the greedy
         augmentation (the CLI writes the ranking there, so a late failure keeps it).
+    workers : int
+        Processes for the closed-loop fits of the candidates that pass the screen (they are independent;
+        ``spawn`` processes, each imports Drake once, a few seconds). 1 fits them one after another in this
+        process. The result does not depend on it.
 
     Returns
     -------
@@ -191,35 +205,49 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
         if n != "control_delay" and n not in DRAKE_EFFECTS:
             why = NOT_RANKED.get(n, "one of " + ", ".join(tuple(DRAKE_EFFECTS) + ("control_delay",)))
             raise InputError("effects", n, why)
+    if not isinstance(workers, int) or workers < 1:
+        raise InputError("workers", workers, "an integer >= 1")
     say = progress or (lambda line: None)
     nominal = identify(train, NOMINAL_PARAMETERS, max_nfev=max_nfev)
     nom_test, _ = score_parameters(test, nominal.parameters)
     say(f"nominal identified ({nominal.n_evaluations} replays)")
     if on_nominal is not None:
         on_nominal(nominal, nom_test)
-    ranking = []
+    ranking, jobs = [], []
     for n in names:
         if n == "control_delay":
             sc = ScreenResult("control_delay", {}, *(float("nan"),) * 3, float("nan"), float("nan"), True)
-            fit = fit_delay(train, test, nominal, start=screen_delay(train, nominal.parameters))
-        else:
-            sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=screen_k_se) if screen \
-                else None
-            if sc is not None and not sc.passes:
-                ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
-                                            screen=sc, effect=n))
-                say(f"{n}: screened out (held-out inverse-dynamics gain {sc.gain:+.3f} +- "
-                    f"{k_se * sc.standard_error:.3f} points of %)")
-                continue
-            starts = (sc.start,) if sc is not None and sc.start else None
-            # the two-mass replay is the costly one (its mode sets the sub-steps): rank the mode with the nominal
-            # friction fixed (2 parameters, not 5); the greedy step refits the friction with it if it passes
-            refit = () if n == "axial_mode" else NOMINAL_PARAMETERS
-            fit = fit_effect(n, train, test, nominal, max_nfev=max_nfev, starts=starts, refit=refit)
+            jobs.append((n, sc, screen_delay(train, nominal.parameters)))
+            continue
+        sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=screen_k_se) if screen else None
+        if sc is not None and not sc.passes:
+            ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
+                                        screen=sc, effect=n))
+            say(f"{n}: screened out (held-out inverse-dynamics gain {sc.gain:+.3f} +- "
+                f"{k_se * sc.standard_error:.3f} points of %)")
+            continue
+        jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
+
+    def ranked(n, sc, fit):
         gain, se = paired_gain(nom_test, fit.test_errors)
-        ranking.append(RankedEffect(fit=fit, gain=gain, standard_error=se, passes=gain > k_se * se, screen=sc,
-                                    effect=n))
         say(f"{n}: held-out gain {gain:+.3f} +- {k_se * se:.3f} points of %")
+        return RankedEffect(fit=fit, gain=gain, standard_error=se, passes=gain > k_se * se, screen=sc, effect=n)
+
+    if workers == 1 or len(jobs) < 2:
+        for n, sc, start in jobs:
+            ranking.append(ranked(n, sc, _closed_loop_fit(n, train, test, nominal, max_nfev, start)))
+    else:
+        import concurrent.futures as cf
+        import multiprocessing
+
+        with cf.ProcessPoolExecutor(min(workers, len(jobs)), mp_context=multiprocessing.get_context("spawn")) as pool:
+            futures = {pool.submit(_closed_loop_fit, n, train, test, nominal, max_nfev, start): (n, sc)
+                       for n, sc, start in jobs}
+            done = {}
+            for future in cf.as_completed(futures):
+                n, sc = futures[future]
+                done[n] = ranked(n, sc, future.result())
+        ranking += [done[n] for n, _, _ in jobs]
     ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
     if on_ranking is not None:
         on_ranking(nominal, nom_test, tuple(ranking))

@@ -40,8 +40,20 @@ def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
     assert any("claimed: asymmetric_friction" in line for line in diag.summary())
 
 
+def test_candidates_fitted_in_worker_processes_give_the_same_diagnosis(runs):
+    kwargs = dict(effects=("asymmetric_friction", "control_delay"), max_nfev=3)
+    serial = diagnose_drake(runs[:2], runs[2:], **kwargs)
+    pooled = diagnose_drake(runs[:2], runs[2:], workers=2, **kwargs)
+    assert [r.name for r in pooled.ranking] == [r.name for r in serial.ranking]
+    assert [r.gain for r in pooled.ranking] == pytest.approx([r.gain for r in serial.ranking], rel=1e-9, abs=1e-12)
+    assert pooled.claimed == serial.claimed
+    assert pooled.model["parameters"] == pytest.approx(serial.model["parameters"], rel=1e-9)
+
+
 def test_bad_requests(runs):
     with pytest.raises(InputError, match="effects"):
         diagnose_drake(runs[:2], runs[2:], effects=("backlash",))
     with pytest.raises(InputError, match="runs"):
         diagnose_drake(runs[:2], runs[2:3])
+    with pytest.raises(InputError, match="workers"):
+        diagnose_drake(runs[:2], runs[2:], effects=("stribeck",), workers=0)
