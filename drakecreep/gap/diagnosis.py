@@ -40,6 +40,7 @@ from drakecreep.gap.effects import (
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, regressor
 from drakecreep.gap.replay import RigidModel
+from drakecreep.gap.runs import split_cycles  # noqa: F401 (moved to gap.runs; kept importable here)
 from drakecreep.gap import claims as claims_mod
 from drakecreep.gap.claims import identifiable
 from drakecreep.gap.residuals import (
@@ -123,37 +124,6 @@ class DiagnosisConfig:
 def _log(cfg, msg):
     if cfg.progress:
         print(f"[diagnose] {msg}", file=sys.stderr, flush=True)
-
-
-def split_cycles(run, cycles_per_run=1):
-    """Split a run at every second change of direction of the reference (one out-and-back cycle per part).
-
-    Parameters
-    ----------
-    run : drakecreep.gap.measured.MeasuredRun
-    cycles_per_run : int
-        Cycles per part.
-
-    Returns
-    -------
-    list of MeasuredRun
-        Labelled ``<label>#<i>``.
-    """
-    import dataclasses
-
-    v = np.gradient(run.x_ref, run.dt)
-    eps = 0.01 * np.max(np.abs(v))
-    s = np.sign(v) * (np.abs(v) > eps)
-    nz = np.flatnonzero(s)
-    flips = nz[1:][np.diff(s[nz]) != 0]
-    cuts = [0] + [int(c) for c in flips[1::2 * cycles_per_run]] + [run.n]
-    parts = []
-    for i, (a, b) in enumerate(zip(cuts[:-1], cuts[1:])):
-        if b - a < 200:
-            continue
-        part = run.slice(a, b)
-        parts.append(dataclasses.replace(part, label=f"{run.label}#{len(parts)}"))
-    return parts
 
 
 @dataclass

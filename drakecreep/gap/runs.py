@@ -3,29 +3,54 @@
 (Library side of ``drakecreep diagnose``: the CLI only parses arguments.)
 """
 
+import dataclasses
 from pathlib import Path
+
+import numpy as np
 
 from drakecreep.errors import InputError
 
-__all__ = ["load_runs", "pick", "split_half_cycles"]
+__all__ = ["load_runs", "pick", "split_half_cycles", "split_cycles"]
+
+
+def _reversals(run):
+    """Sample indices where the reference changes direction (speeds below 1 % of the largest are standstill)."""
+    v = np.gradient(run.x_ref, run.dt)
+    s = np.sign(v) * (np.abs(v) > 0.01 * np.max(np.abs(v)))
+    nz = np.flatnonzero(s)
+    return [int(c) for c in nz[1:][np.diff(s[nz]) != 0]]
+
+
+def _cut(run, cuts, min_samples, sep):
+    parts = []
+    for a, b in zip(cuts[:-1], cuts[1:]):
+        if b - a >= min_samples:
+            parts.append(dataclasses.replace(run.slice(a, b), label=f"{run.label}{sep}{len(parts)}"))
+    return parts
 
 
 def split_half_cycles(run, min_samples=500):
     """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``), at least ``min_samples`` long."""
-    import dataclasses
+    return _cut(run, [0] + _reversals(run) + [run.n], min_samples, "@")
 
-    import numpy as np
 
-    v = np.gradient(run.x_ref, run.dt)
-    s = np.sign(v) * (np.abs(v) > 0.01 * np.max(np.abs(v)))
-    nz = np.flatnonzero(s)
-    flips = nz[1:][np.diff(s[nz]) != 0]
-    cuts = [0] + [int(c) for c in flips] + [run.n]
-    parts = []
-    for a, b in zip(cuts[:-1], cuts[1:]):
-        if b - a >= min_samples:
-            parts.append(dataclasses.replace(run.slice(a, b), label=f"{run.label}@{len(parts)}"))
-    return parts
+def split_cycles(run, cycles_per_run=1, min_samples=200):
+    """Split a run at every second change of direction of the reference (one out-and-back cycle per part).
+
+    Parameters
+    ----------
+    run : drakecreep.gap.measured.MeasuredRun
+    cycles_per_run : int
+        Cycles per part.
+    min_samples : int
+        Shorter parts are dropped.
+
+    Returns
+    -------
+    list of MeasuredRun
+        Labelled ``<label>#<i>``.
+    """
+    return _cut(run, [0] + _reversals(run)[1::2 * cycles_per_run] + [run.n], min_samples, "#")
 
 
 def load_runs(data, meta=None, split=True):
@@ -46,7 +71,6 @@ def load_runs(data, meta=None, split=True):
     -------
     list of drakecreep.gap.measured.MeasuredRun
     """
-    from drakecreep.gap.diagnosis import split_cycles
     from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
     if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):

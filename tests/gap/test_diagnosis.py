@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed, split_cycles
+from drakecreep.gap.diagnosis import DiagnosisConfig, diagnose, score_fixed
+from drakecreep.gap.runs import split_cycles
 from drakecreep.gap.effects import EffectContext, get_effect, synthesize_run
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import out_and_back
@@ -24,16 +25,6 @@ def _runs(terms, seed=0):
         runs.append(synthesize_run(T, out_and_back(v, 0.02 + 0.01 * i), META, MODEL, terms,
                                    force_noise=noise, label=f"r{i}"))
     return runs[0::2], runs[1::2]
-
-
-def test_split_cycles_cuts_every_second_reversal():
-    x = np.concatenate([out_and_back(0.05, 0.0)] * 3)
-    t = np.arange(x.size) * 1e-3
-    run = MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.zeros(x.size), meta=META, label="three")
-    parts = split_cycles(run)
-    assert len(parts) == 3
-    assert [p.label for p in parts] == ["three#0", "three#1", "three#2"]
-    assert sum(p.n for p in parts) == run.n
 
 
 def test_a_hidden_asymmetric_friction_is_found_ranked_and_shrinks_the_gap():

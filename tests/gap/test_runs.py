@@ -1,0 +1,34 @@
+"""drakecreep.gap.runs: cutting a measured run at the reversals of its reference."""
+
+import numpy as np
+
+from drakecreep.gap.measured import EMPS_CONTROLLER, MeasuredMeta, MeasuredRun
+from drakecreep.gap.runs import split_cycles, split_half_cycles
+from drakecreep.gap.truth import out_and_back
+
+META = MeasuredMeta(u_units="V", u_gain=35.15, controller=EMPS_CONTROLLER)
+
+
+def _three_cycles():
+    x = np.concatenate([out_and_back(0.05, 0.0)] * 3)
+    t = np.arange(x.size) * 1e-3
+    return MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.zeros(x.size), meta=META, label="three")
+
+
+def test_split_cycles_cuts_every_second_reversal():
+    run = _three_cycles()
+    parts = split_cycles(run)
+    assert len(parts) == 3
+    assert [p.label for p in parts] == ["three#0", "three#1", "three#2"]
+    assert sum(p.n for p in parts) == run.n
+
+
+def test_split_half_cycles_cuts_every_reversal():
+    run = _three_cycles()
+    parts = split_half_cycles(run)
+    assert [p.label for p in parts] == [f"three@{i}" for i in range(6)]
+    assert sum(p.n for p in parts) == run.n
+    for p in parts:  # each part moves one way (up to the creeping start of the next leg, below 1 % of the speed)
+        dx = np.diff(p.x_ref)
+        forward, backward = dx[dx > 0].sum(), -dx[dx < 0].sum()
+        assert min(forward, backward) < 0.01 * max(forward, backward)
