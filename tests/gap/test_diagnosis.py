@@ -6,7 +6,7 @@ from drakecreep.gap.runs import split_cycles
 from drakecreep.gap.effects import EffectContext, get_effect, synthesize_run
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import out_and_back
-from drakecreep.gap.measured import EMPS_CONTROLLER, MeasuredMeta, MeasuredRun, SensorMeta, load_emps
+from drakecreep.gap.measured import EMPS_CONTROLLER, MeasuredMeta, SensorMeta, load_emps
 from drakecreep.gap.replay import RigidModel
 
 META = MeasuredMeta(u_units="V", u_gain=35.15, controller=EMPS_CONTROLLER, sensors=SensorMeta(encoder_resolution=5e-8))
