@@ -524,11 +524,11 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
         if law == base.friction.law:
             return None, 0.0
         values = {"friction.law": law}
-        r = _residual(runs, replayer(runs, _with(base, values)), scale)
+        r = _residual(runs, replayer(runs, _with_any(base, values)), scale)
         sse = float(r @ r)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
-        r = _residual(runs, replayer(runs, _with(base, values)), scale)
+        r = _residual(runs, replayer(runs, _with_any(base, values)), scale)
         sse = float(r @ r)
     else:  # pragma: no cover - names are checked up front
         raise InputError("effects", name, "one of " + ", ".join(EFFECTS))

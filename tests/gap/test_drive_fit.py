@@ -92,6 +92,16 @@ def test_null_dataset_makes_no_claim():
     assert result.params.disturbance == RIG.disturbance
 
 
+def test_switch_candidates_find_the_nut_drag_on_the_screw():
+    """The friction-law and nut-side candidates set a word, not a number (they once failed on it)."""
+    truth = with_value(RIG, "friction.nut_friction_on", "screw")
+    runs = simulated_runs(truth, SPEEDS + (0.022, 0.032), declared=RIG, n=N, noise=NOISE, seed=900)
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
+                            effects=("nut_friction_side", "law_coulomb"))
+    assert result.claimed == ("nut_friction_side",)
+    assert result.params.friction.nut_friction_on == "screw" and result.params.friction.law == RIG.friction.law
+
+
 def test_levels_acting_at_the_same_place_are_reported_not_separable():
     """Seal drag and nut preload drag both add to the one Coulomb level on the table in this rig."""
     runs = _runs(RIG, seed=4)
