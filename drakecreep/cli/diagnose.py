@@ -48,8 +48,9 @@ def add_parser(subparsers):
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
                    "report --params, diagnosis.json, summary.txt)")
     p.add_argument("--workers", type=workers, metavar="N",
-                   help=f"processes for the candidates' closed-loop fits (kind p_p_cascade; default: all cores, "
-                        f"{os.cpu_count()}; 1 fits them one after another in this process)")
+                   help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits; drakecreep: "
+                        f"the runs and Jacobian columns; default: all cores, {os.cpu_count()}; 1: all in this "
+                        "process)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p
@@ -195,7 +196,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         kwargs["uncertain"] = tuple(x.strip() for x in args.uncertain.split(",") if x.strip())
     if getattr(args, "effects", None):
         kwargs["effects"] = tuple(x.strip() for x in args.effects.split(",") if x.strip())
-    result = diagnose_drive(train, test, progress=not args.quiet, **kwargs)
+    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers or os.cpu_count() or 1, **kwargs)
     payload = result.to_json()
     lines = list(result.summary)
     if score_runs:

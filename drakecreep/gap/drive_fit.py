@@ -311,15 +311,33 @@ def _check_inputs(train, test, uncertain, effects, load_case):
 
 # --------------------------------------------------------------------------- replay and residuals
 
-class _Replayer:
-    """Closed-loop replays of a fixed set of runs, counting them."""
+def _replay_one(run, params, load_case):
+    """One closed-loop replay (a process pool's job: module level, picklable)."""
+    return replay_drakecreep(run, params, load_case=load_case)
 
-    def __init__(self, load_case, say):
-        self.load_case, self.count, self.say = load_case, 0, say
+
+class _Replayer:
+    """Closed-loop replays of a fixed set of runs, counting them; over a process pool when given one."""
+
+    def __init__(self, load_case, say, pool=None):
+        self.load_case, self.count, self.say, self.pool = load_case, 0, say, pool
 
     def __call__(self, runs, params):
-        self.count += len(runs)
-        return [replay_drakecreep(r, params, load_case=self.load_case) for r in runs]
+        return self.many([(runs, params)])[0]
+
+    def many(self, jobs):
+        """Replays of several ``(runs, params)`` at once (in parallel over a pool): a list of lists of results."""
+        tasks = [(r, params) for runs, params in jobs for r in runs]
+        self.count += len(tasks)
+        if self.pool is None or len(tasks) < 2:
+            flat = [replay_drakecreep(r, params, load_case=self.load_case) for r, params in tasks]
+        else:
+            flat = list(self.pool.map(_replay_one, *zip(*tasks), [self.load_case] * len(tasks)))
+        out, k = [], 0
+        for runs, _ in jobs:
+            out.append(flat[k: k + len(runs)])
+            k += len(runs)
+        return out
 
     def errors(self, runs, params):
         return {r.label: drake_replay_errors(s) for r, s in zip(runs, self(runs, params))}
@@ -395,13 +413,23 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None):
         # and the counting sensors make the residual a slightly rough function of the values (a step near
         # machine precision would amplify that), and a one-sided step of a few % leaves a curvature error
         # that differs between fields of very different force contributions
-        cols = []
+        points = []
         for i in range(theta.size):
             step = np.zeros(theta.size)
             step[i] = _STEP
-            hi, lo_ = np.minimum(theta + step, _BOUND), np.maximum(theta - step, -_BOUND)
-            cols.append((residual(hi) - residual(lo_)) / (hi[i] - lo_[i]))
-        return np.column_stack(cols)
+            points.append((np.minimum(theta + step, _BOUND), np.maximum(theta - step, -_BOUND)))
+        many = getattr(replayer, "many", None)
+        if many is not None:  # every column's replays at once (in parallel when the replayer has a pool)
+            todo = {}
+            for hi, lo_ in points:
+                for t in (hi, lo_):
+                    key = tuple(np.round(t, 12))
+                    if key not in cache:
+                        todo[key] = t
+            keys = list(todo)
+            for key, sims in zip(keys, many([(runs, _with(prior, values(todo[k]))) for k in keys])):
+                cache[key] = _residual(runs, sims, scale)
+        return np.column_stack([(residual(hi) - residual(lo_)) / (hi[i] - lo_[i]) for i, (hi, lo_) in enumerate(points)])
 
     sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, _BOUND), max_nfev=max_nfev,
                         x_scale=1.0, xtol=1e-3, ftol=1e-4)
@@ -585,7 +613,7 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
 
 
 def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0, max_nfev=8,
-                   progress=False):
+                   progress=False, workers=1):
     """Identify and augment the run's params file on ``kind: drakecreep`` runs (see the module docstring).
 
     Parameters
@@ -602,6 +630,10 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         Least-squares evaluations of the nominal fit.
     progress : bool or callable
         ``True`` prints a line per step to stderr; a callable receives the lines.
+    workers : int
+        Processes for the replays (the runs of one evaluation, and every column of a Jacobian, are independent;
+        ``spawn`` processes, each imports Drake once, a few seconds). 1 replays in this process. The result
+        does not depend on it.
 
     Returns
     -------
@@ -619,9 +651,22 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
 
     t0 = _time.perf_counter()
     train, test, prior, uncertain, names = _check_inputs(train, test, uncertain, effects, load_case)
+    if not isinstance(workers, int) or workers < 1:
+        raise InputError("workers", workers, "an integer >= 1")
     say = progress if callable(progress) else (
         (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None))
-    replay = _Replayer(load_case, say)
+    if workers == 1:
+        return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case, say),
+                               say, t0)
+    import concurrent.futures as cf
+    import multiprocessing
+
+    with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev,
+                               _Replayer(load_case, say, pool), say, t0)
+
+
+def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0):
     prior_errors = replay.errors(test, prior)
     params, fitted, warnings, sse0 = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev)
     nominal_errors = replay.errors(test, params)

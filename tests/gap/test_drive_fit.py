@@ -102,6 +102,18 @@ def test_switch_candidates_find_the_nut_drag_on_the_screw():
     assert result.params.friction.nut_friction_on == "screw" and result.params.friction.law == RIG.friction.law
 
 
+def test_replays_in_worker_processes_give_the_same_diagnosis():
+    runs = _runs(RIG, seed=3)
+    kwargs = dict(uncertain=("table.seal_force",), effects=("law_coulomb",), max_nfev=2)
+    serial = diagnose_drive(runs[:2], runs[2:], **kwargs)
+    pooled = diagnose_drive(runs[:2], runs[2:], workers=2, **kwargs)
+    assert pooled.fitted == serial.fitted and pooled.claimed == serial.claimed
+    assert pooled.simulations == serial.simulations
+    assert [c.gain for c in pooled.candidates] == [c.gain for c in serial.candidates]
+    with pytest.raises(InputError, match="workers"):
+        diagnose_drive(runs[:2], runs[2:], workers=0, **kwargs)
+
+
 def test_levels_acting_at_the_same_place_are_reported_not_separable():
     """Seal drag and nut preload drag both add to the one Coulomb level on the table in this rig."""
     runs = _runs(RIG, seed=4)
