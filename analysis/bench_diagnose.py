@@ -53,10 +53,10 @@ def main():
     if not args.skip_emps:
         emps(args.validate, args.workers)
     if args.paper_rig:
-        paper_rig()
+        paper_rig(args.workers)
 
 
-def paper_rig():
+def paper_rig(workers=1):
     from drakecreep.gap.drake_replay import simulated_runs
     from drakecreep.gap.drive_fit import diagnose_drive
     from drakecreep.params import preset, with_value
@@ -70,11 +70,12 @@ def paper_rig():
     print(f"paper rig: 6 runs of 1.5 s simulated in {time.perf_counter() - start:.1f} s wall, "
           f"{time.process_time() - cpu:.1f} s CPU")
     start, cpu = time.perf_counter(), time.process_time()
-    diag = diagnose_drive(runs[0::2], runs[1::2], progress=lambda line: print(
+    diag = diagnose_drive(runs[0::2], runs[1::2], workers=workers, progress=lambda line: print(
         f"  [{time.perf_counter() - start:5.0f} s] {line}", flush=True))
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     print("\n".join(diag.summary))
-    print(f"paper-rig diagnosis (6 runs, kind drakecreep): {wall:.1f} s wall, {cpu:.1f} s CPU (target 120 s on 2 cores)")
+    print(f"paper-rig diagnosis (6 runs, kind drakecreep, {workers} worker(s)): {wall:.1f} s wall, {cpu:.1f} s CPU "
+          "of this process (target 120 s on 2 cores)")
 
 
 def emps(validate, workers=1):

@@ -33,6 +33,7 @@ from drakecreep.errors import InputError
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import ScreenResult, screen_delay, screen_effect
+from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "paired_gain", "load_model", "NOMINAL_PARAMETERS"]
@@ -97,6 +98,9 @@ class DrakeDiagnosis:
     not_ranked : dict
         Effects that are never ranked, with the reason.
     seconds : float
+    where : dict
+        What the augmented model still does not explain on the held-out runs, and where
+        (:func:`drakecreep.gap.where.where_gap`): regimes, frequency bands, residual-input independence, screw side.
     """
 
     nominal: object
@@ -108,6 +112,7 @@ class DrakeDiagnosis:
     not_ranked: dict = field(default_factory=lambda: dict(NOT_RANKED))
     seconds: float = 0.0
     k_se: float = 2.0
+    where: dict = field(default_factory=dict)
 
     def summary(self):
         """Lines of text."""
@@ -125,6 +130,8 @@ class DrakeDiagnosis:
             lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the run-to-run spread)")
+        if self.where:
+            lines += where_lines(self.where)
         return lines
 
     def save_model(self, path):
@@ -270,5 +277,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
             if r.name != "control_delay":
                 fitted += [p for p in DRAKE_EFFECTS[r.name].parameters if p not in fitted]
             model = {"parameters": dict(fit.parameters), "flexible": fit.flexible, "delay": fit.delay}
+    where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])
     return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
-                          model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se)
+                          model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se,
+                          where=where)

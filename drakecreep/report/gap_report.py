@@ -253,6 +253,7 @@ def drake_to_json_dict(diagnosis, **extra):
         "held_out_force_error_percent": {"nominal": _rms_force(diagnosis.nominal_test_errors),
                                          "augmented": _rms_force(diagnosis.test_errors)},
         "not_ranked": diagnosis.not_ranked,
+        "unexplained": diagnosis.where,
         "k_se": diagnosis.k_se,
         "seconds": diagnosis.seconds,
         "summary": diagnosis.summary(),
@@ -414,6 +415,26 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         rows = [[lab] + [f"{scored['nominal'][lab][s]:.4g} → {scored['augmented'][lab][s]:.4g}" for s in sig]
                 for lab in scored["augmented"]]
         parts.append(table(["run"] + [f"{s} error [%] nominal → augmented" for s in sig], rows))
+    where = diagnosis.where
+    if where:
+        parts.append("<h2>Unexplained: where the augmented model's held-out residual lies</h2>")
+        parts.append(f"<p>Measured minus replayed force, {where['force_rms_N']:.3g} N rms over the held-out runs.</p>")
+        parts.append(table(["regime", "share of the residual energy [%]", "share of the time [%]", "rms [N]"],
+                           [[k.replace("_", " "), f"{100 * v['energy_share']:.1f}", f"{100 * v['time_share']:.1f}",
+                             f"{v['rms']:.3g}"] for k, v in where["regimes"].items()]))
+        parts.append(table(["frequency band [Hz]", "share of the residual energy [%]", "rms [N]"],
+                           [[f"{b['lo_Hz']:g}-{b['hi_Hz']:.0f}", f"{100 * b['share']:.1f}", f"{b['rms']:.3g}"]
+                            for b in where["bands"]["bands"]]))
+        rows = [[name, "yes" if r["independent"] else "no", f"{r['max_abs']:.3f}", f"{r['band']:.3f}",
+                 str(r["lag_of_max"]), r["run"]] for name, r in where["independence"].items()]
+        if rows:
+            parts.append("<p>Residual-input independence (cross-correlation over ±25 samples against a 99 % "
+                         "family-wise band; a residual correlated with an input is a model error, not noise):</p>")
+            parts.append(table(["input", "independent", "largest |r|", "band", "at lag [samples]", "worst run"], rows))
+        if where["split"]:
+            parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
+                               [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]
+                                for lab, v in where["split"].items()]))
     parts.append("<h2>Never ranked</h2>")
     parts.append(table(["effect", "why"], [[n, why] for n, why in diagnosis.not_ranked.items()]))
     for png, caption in _drake_figures(diagnosis, residuals):

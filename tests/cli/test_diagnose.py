@@ -50,6 +50,8 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert {"diagnosis.html", "diagnosis.json", "augmented_model.yaml", "ranking.json"} <= set(manifest["files"])
     html = (out / "diagnosis.html").read_text()
     assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
+    assert "Unexplained: where" in html and "Residual-input independence" in html
+    assert {"regimes", "bands", "independence", "split"} <= set(data["unexplained"])
     params, flexible, delay = load_model(out / "augmented_model.yaml")
     assert abs(params["viscous_asym"] + 40.0) < 10.0 and not flexible and delay == 0.0
     # --score replays the augmented model, fixed, on the whole runs of another file

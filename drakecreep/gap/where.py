@@ -1,0 +1,98 @@
+"""Where the gap of the Drake replay model lies: its held-out residual by regime, frequency band, input, screw side.
+
+:func:`where_gap` replays the held-out runs through the (augmented) Drake model with every parameter fixed and
+decomposes what it still does not explain, measured force minus replayed force, with the functions of
+:mod:`drakecreep.gap.residuals`:
+
+* ``regimes``: share of the residual energy and of the time in each regime (dwell, stick, reversal,
+  acceleration, constant speed);
+* ``bands``: share of the residual energy per frequency band (Welch PSD over the runs), and its peak;
+* ``independence``: the residual-input independence test of system identification (cross-correlation of the
+  residual with the reference speed and the known external force, with a 99 % family-wise band): a residual
+  correlated with an input is a model error, not noise;
+* ``split``: for runs with a linear scale (``x_table``), the position gap before or after the screw.
+
+``diagnose_drake`` stores it as :attr:`~drakecreep.gap.drake_diagnosis.DrakeDiagnosis.where` ("unexplained":
+what is left after the claimed effects, and where).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakecreep.gap.drake_replay import make_replay
+from drakecreep.gap.residuals import classify_regimes, frequency_bands, independence, motor_table_split, regime_shares
+
+__all__ = ["where_gap", "where_lines"]
+
+
+def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
+    """Decompose the closed-loop replay residual of ``runs`` under a fixed model.
+
+    Parameters
+    ----------
+    runs : sequence of drakecreep.gap.measured.MeasuredRun
+        Held-out runs (p_p_cascade).
+    parameters : dict
+        Axis parameters of the model (:data:`drakecreep.model.axis.AXIS_PARAMETERS`, SI).
+    flexible : bool
+        Two-mass axis.
+    delay : float
+        Computation delay [samples].
+    lags : int
+        Largest lag of the independence test [samples].
+
+    Returns
+    -------
+    dict
+        ``regimes`` (:func:`~drakecreep.gap.residuals.regime_shares` over all runs), ``bands``
+        (:func:`~drakecreep.gap.residuals.frequency_bands`), ``independence`` (per input: ``max_abs``, ``band``,
+        ``lag_of_max`` [samples], ``independent``, worst over the runs), ``split`` (per run with a scale), and
+        ``force_rms_N`` of the residual.
+    """
+    residuals, labels, dts = [], [], []
+    indep, split = {}, {}
+    for run in runs:
+        sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters)
+        e = run.force - sim.force
+        residuals.append(e)
+        v = np.gradient(run.x_motor, run.dt)
+        labels.append(classify_regimes(run.t, run.x_ref, v))
+        dts.append(run.dt)
+        inputs = {"reference speed": np.gradient(run.x_ref, run.dt)}
+        if run.f_ext is not None and np.any(run.f_ext):
+            inputs["external force"] = run.f_ext
+        if e.size >= 4 * lags:
+            for name, res in independence(e, inputs, lags=lags).items():
+                keep = indep.get(name)
+                if keep is None or res["max_abs"] / res["band"] > keep["max_abs"] / keep["band"]:
+                    indep[name] = {"max_abs": res["max_abs"], "band": res["band"], "lag_of_max": res["lag_of_max"],
+                                   "independent": res["independent"] and (keep is None or keep["independent"]),
+                                   "run": run.label}
+                elif not res["independent"]:
+                    keep["independent"] = False
+        if run.x_table is not None:
+            split[run.label] = motor_table_split(run.x_motor, run.x_table, sim.x_motor,
+                                                 sim.x_table if flexible else None)
+    flat = np.concatenate(residuals)
+    return {"regimes": regime_shares(flat, np.concatenate(labels)), "bands": frequency_bands(residuals, dts[0]),
+            "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2)))}
+
+
+def where_lines(where):
+    """Lines of text (edge units: N, Hz, %)."""
+    reg = sorted(where["regimes"].items(), key=lambda kv: -kv[1]["energy_share"])
+    lines = [f"unexplained: held-out force residual {where['force_rms_N']:.3g} N rms; by regime "
+             + ", ".join(f"{k.replace('_', ' ')} {100 * v['energy_share']:.0f} % of the energy in "
+                         f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] > 0)]
+    b = where["bands"]
+    lines.append("  by frequency: " + ", ".join(f"{r['lo_Hz']:g}-{r['hi_Hz']:.0f} Hz {100 * r['share']:.0f} %"
+                                                for r in b["bands"]) + f" (peak {b['peak_hz']:.3g} Hz)")
+    for name, r in where["independence"].items():
+        verdict = "independent" if r["independent"] else \
+            f"CORRELATED (|r| {r['max_abs']:.2f} > band {r['band']:.2f} at lag {r['lag_of_max']} samples, run {r['run']})"
+        lines.append(f"  residual vs {name}: {verdict}")
+    for label, s in where["split"].items():
+        lines.append(f"  {label}: position gap {s['where']} (motor {1e6 * s['motor_rms_m']:.3g} um rms, "
+                     f"transmission {1e6 * s['transmission_rms_m']:.3g} um rms)")
+    return lines

@@ -1,0 +1,49 @@
+"""drakecreep.gap.where: what a fixed Drake model leaves unexplained on held-out runs, and where."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.idim import PUBLISHED_IDIM
+from drakecreep.gap.measured import load_emps
+from drakecreep.gap.where import where_gap, where_lines
+
+TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=4.0, viscous_asym=-40.0)
+NOISE = 0.5  # N on the force
+
+
+@pytest.fixture(scope="module")
+def runs():
+    full = load_emps("estimation").runs[0]
+    out = []
+    for seed, a in enumerate((6000, 9000, 12000)):
+        run = full.slice(a, a + 1000)
+        res = DrakeReplay(run).simulate(TRUTH)
+        u = res.u + np.random.default_rng(50 + seed).normal(0.0, NOISE / run.u_gain, res.u.size)
+        out.append(dataclasses.replace(run, x_motor=res.x_motor, x_table=res.x_motor + 1e-3, u=u, label=f"w{a}"))
+    return out
+
+
+def test_the_true_model_leaves_noise_and_the_missing_asymmetry_leaves_a_slow_gap(runs):
+    right = where_gap(runs, TRUTH)
+    wrong = where_gap(runs, dict(TRUTH, coulomb_asym=0.0, viscous_asym=0.0))
+    for w in (right, wrong):
+        assert sum(v["energy_share"] for v in w["regimes"].values()) == pytest.approx(1.0)
+        assert sum(v["time_share"] for v in w["regimes"].values()) == pytest.approx(1.0)
+        assert sum(b["share"] for b in w["bands"]["bands"]) == pytest.approx(1.0, abs=1e-6)
+    # the true model leaves the noise (0.5 N; the replay's own sampling adds a little), the wrong one more
+    assert right["force_rms_N"] < 1.5 * NOISE < wrong["force_rms_N"]
+    # white noise spreads over the bands in proportion to their width; the friction error is slow
+    low = lambda w: w["bands"]["bands"][0]["share"] + w["bands"]["bands"][1]["share"]  # noqa: E731
+    assert low(right) < 0.1 < low(wrong)
+    assert right["independence"]["reference speed"]["independent"]
+
+
+def test_a_scale_that_reads_the_motor_puts_the_gap_before_the_screw(runs):
+    w = where_gap(runs, dict(TRUTH, coulomb_asym=0.0, viscous_asym=0.0))
+    assert set(w["split"]) == {r.label for r in runs}
+    assert all(s["where"] == "before the screw" for s in w["split"].values())
+    text = "\n".join(where_lines(w))
+    assert "unexplained" in text and "Hz" in text and "before the screw" in text
