@@ -97,3 +97,46 @@ def test_travel_beyond_one_segment_is_refused(paper):
     with pytest.raises(InputError) as err:
         build_multibody_diagram(paper, Scenario(feed=0.1, duration=5.0), MultibodyOptions(n_segments=6))
     assert err.value.field == "duration"
+
+
+@pytest.mark.parametrize("options", [MultibodyOptions(n_segments=3, rigid_joints=True), MultibodyOptions(n_segments=4)],
+                         ids=["rigid3", "full4"])
+def test_compiled_loop_gives_the_leaf_equations(paper, options):
+    """The loop compiled into SymbolicVectorSystems (the default backend) has the leaf systems' equations: at a
+    random state and time in the start-up ramp the time derivatives, the controller's discrete update and the
+    recorded signals agree to 1e-9 relative."""
+    from drakecreep.sim.compiled import compile_diagram
+
+    scenario = Scenario(feed=0.2e-3, load_case=3, duration=1.0)
+    leaf = build_multibody_diagram(paper, scenario, options)
+    comp = build_multibody_diagram(paper, scenario, options, compiler=compile_diagram)
+    assert comp.compiled is not None and "controller" not in comp.systems
+    contexts = []
+    for fd in (leaf, comp):
+        ctx = fd.diagram.CreateDefaultContext()
+        fd.set_initial_state(ctx)
+        contexts.append(ctx)
+    x0 = contexts[0].get_continuous_state_vector().CopyToVector()
+    # the same state at t = 0: the compiled loop holds one constant extra state (its discrete update system's)
+    np.testing.assert_array_equal(contexts[1].get_continuous_state_vector().CopyToVector()[:-1], x0)
+    rng = np.random.default_rng(17)
+    nx = len(x0)
+    x = x0 + 1e-5 * rng.standard_normal(nx)  # a few um / mrad around the loaded equilibrium, mm/s speeds
+    x[-3:] = x0[-3:] + [0.05, 2e-6, -3e-6]  # current loop torque (N m), the two LuGre bristle states (m)
+    xd = contexts[0].get_discrete_state_vector().CopyToVector()
+    xd = xd + 1e-3 * np.abs(xd).max() * rng.standard_normal(len(xd))
+    for ctx, extra in zip(contexts, ([], [0.0])):
+        ctx.SetTime(0.031)
+        ctx.SetContinuousState(np.concatenate([x, extra]))
+        ctx.get_mutable_discrete_state_vector().SetFromVector(xd)
+    dl = leaf.diagram.EvalTimeDerivatives(contexts[0]).CopyToVector()
+    dc = comp.diagram.EvalTimeDerivatives(contexts[1]).CopyToVector()
+    assert dc[-1] == 0.0
+    np.testing.assert_allclose(dc[:-1], dl, rtol=1e-9, atol=1e-9 * np.max(np.abs(dl)))
+    ul = leaf.diagram.EvalUniquePeriodicDiscreteUpdate(contexts[0]).get_vector(0).CopyToVector()
+    uc = comp.diagram.EvalUniquePeriodicDiscreteUpdate(contexts[1]).get_vector(0).CopyToVector()
+    np.testing.assert_allclose(uc, ul, rtol=1e-9, atol=1e-12)
+    for _, (system, port, index), _ in leaf.signals:
+        a = leaf.diagram.GetOutputPort(f"{system}.{port}").Eval(contexts[0])[index]
+        b = comp.diagram.GetOutputPort(f"{system}.{port}").Eval(contexts[1])[index]
+        assert b == pytest.approx(a, rel=1e-9, abs=1e-12), f"{system}.{port}[{index}]"
