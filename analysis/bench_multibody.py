@@ -37,6 +37,8 @@ CONFIGS = {
     "rigid3": MultibodyOptions(n_segments=3, rigid_joints=True),
     "rigid4_rk3": MultibodyOptions(n_segments=4, rigid_joints=True, integrator="runge_kutta3"),
     "rigid3_rk3": MultibodyOptions(n_segments=3, rigid_joints=True, integrator="runge_kutta3"),
+    "rigid3_axial": MultibodyOptions(n_segments=3, rigid_joints=True, screw_bending=False),
+    "rigid6_axial": MultibodyOptions(n_segments=6, rigid_joints=True, screw_bending=False),
 }
 
 

@@ -63,6 +63,7 @@ from pydrake.systems.primitives import (
 from drakecreep.errors import InputError
 from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.model.diagram import SIGNALS, FeedDrive
+from drakecreep.model.disturbances import LoadRipple
 from drakecreep.model.nut_friction import NutFriction, nut_friction_levels
 from drakecreep.model.nut_table import table_friction_levels
 from drakecreep.model.reference import FeedReference
@@ -105,6 +106,11 @@ class MultibodyOptions:
         paper preset (load case 3, 0.2 mm/s, rigid joints, N = 3): RK3 stick-slips as the two-mass model
         does (0.230 vs 0.231 mm/s, 71 vs 72 cycles) where velocity-implicit Euler at 1e-4 slides smoothly:
         its numerical damping can hide stick-slip; keep the convergence check on with it.
+    screw_bending : bool
+        False: the screw segments only slide along and turn about the screw axis (no bending, shear or
+        sag; :func:`drakecreep.multibody.build_multibody`). Removes the screw's bending modes, lateral
+        motions that do not couple to the feed, and makes a run cheaper (fewer degrees of freedom, a
+        lower stiffest mode). Measured: docs/multibody.md ("Benchmark").
     """
 
     n_segments: int = DEFAULT_SEGMENTS
@@ -112,17 +118,20 @@ class MultibodyOptions:
     friction: bool = True
     rigid_twist_factor: float = 1e3
     integrator: str = ""
+    screw_bending: bool = True
 
     def __post_init__(self):
         if isinstance(self.n_segments, bool) or not isinstance(self.n_segments, int) \
                 or not 2 <= self.n_segments <= 400:
             raise InputError("multibody.n_segments", self.n_segments, "an integer in [2, 400]")
-        for name in ("rigid_joints", "friction"):
+        for name in ("rigid_joints", "friction", "screw_bending"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"multibody.{name}", getattr(self, name), "true or false")
         if isinstance(self.rigid_twist_factor, bool) or not isinstance(self.rigid_twist_factor, (int, float)) \
                 or not 1.0 <= self.rigid_twist_factor <= 1e12:
             raise InputError("multibody.rigid_twist_factor", self.rigid_twist_factor, "a number in [1, 1e12]")
+        if not self.screw_bending and not self.rigid_joints:
+            raise InputError("multibody.screw_bending", self.screw_bending, "true unless rigid_joints is true")
         if self.integrator == "":
             object.__setattr__(self, "integrator", "runge_kutta3" if self.rigid_joints else "velocity_implicit_euler")
         if self.integrator not in INTEGRATORS:
@@ -178,7 +187,7 @@ class _ReactionForce(LeafSystem):
 def _indices(drive):
     """Position and velocity indices of the coordinates the loop reads and drives."""
     plant = drive.plant
-    seg = plant.GetJointByName("screw_0_free")
+    seg = plant.GetJointByName("screw_0_free" if drive.screw_bending else "screw_0_spin")  # rotation about x first
     nut = plant.GetJointByName("screw_nut")
     if drive.rigid_joints:
         slide = plant.GetJointByName("table_slide")
@@ -192,9 +201,10 @@ def _indices(drive):
 
 
 def _applied_map(drive, idx):
-    """``nv x 3`` map of ``[motor torque (N m), guide friction (N), nut joint torque (N m)]`` to generalized forces."""
+    """``nv x 4`` map of ``[motor torque (N m), guide friction (N), nut joint torque (N m), force ripple (N)]`` to
+    generalized forces (the ripple along +x at the table's centre of mass)."""
     nv = drive.plant.num_velocities()
-    gain = np.zeros((nv, 3))
+    gain = np.zeros((nv, 4))
     gain[idx["motor_v"], 0] = 1.0
     t = idx["table"]
     gain[t["vx"], 1] = -1.0
@@ -203,6 +213,7 @@ def _applied_map(drive, idx):
         dz = drive.rig.slider_height - drive.home["table"][2]
         gain[t["wy"], 1] = -dz
     gain[idx["nut_v"], 2] = 1.0
+    gain[t["vx"], 3] = 1.0
     return gain
 
 
@@ -321,7 +332,8 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
 
     builder = DiagramBuilder()
     drive = build_multibody(params, n_segments=options.n_segments, rigid_joints=options.rigid_joints,
-                            table_position=0.0, builder=builder, rigid_twist_factor=options.rigid_twist_factor)
+                            table_position=0.0, builder=builder, rigid_twist_factor=options.rigid_twist_factor,
+                            screw_bending=options.screw_bending)
     plant = drive.plant
     idx = _indices(drive)
     nq, nv = plant.num_positions(), plant.num_velocities()
@@ -418,6 +430,10 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
     (system, port): output port}`` of the recorded signals, or with ``open_loop`` the key
     ``"torque_command_in"`` (the torque limit's input) instead of the signals.
     """
+    if params.disturbance.lead_error_amplitude > 0.0:
+        raise InputError("disturbance.lead_error_amplitude", params.disturbance.lead_error_amplitude,
+                         "0 with the multibody model (its ScrewJoint has an exact lead; the lead error is a "
+                         "two-mass model effect)")
     s = {}
 
     def put(name, system):
@@ -440,7 +456,7 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         torque_out = lag.get_output_port()
 
     # friction: the guides on the table, the nut on the screw (the two-mass split of the levels)
-    mux = put("applied_inputs", Multiplexer([1, 1, 1]))
+    mux = put("applied_inputs", Multiplexer([1, 1, 1, 1]))
     zero = None
     if options.friction:
         fc, fs = table_friction_levels(params, load)
@@ -460,6 +476,15 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         zero = zero or put("no_friction", ConstantVectorSource([0.0]))
         builder.Connect(zero.get_output_port(), mux.get_input_port(2))
     builder.Connect(torque_out, mux.get_input_port(0))
+    d = params.disturbance
+    amplitude = d.force_ripple + d.load_ripple * abs(load.fx)
+    if amplitude > 0.0:
+        # the two-mass model's force ripple (model.disturbances.LoadRipple), on the table along x
+        ripple = put("load_ripple", LoadRipple(amplitude, d.ripple_frequency))
+        builder.Connect(ripple.get_output_port(0), mux.get_input_port(3))
+    else:
+        zero = zero or put("no_friction", ConstantVectorSource([0.0]))
+        builder.Connect(zero.get_output_port(), mux.get_input_port(3))
     ports = {"applied": mux.get_output_port()}
     if open_loop:
         ports["torque_command_in"] = limit.get_input_port()
