@@ -105,7 +105,11 @@ class MultibodyOptions:
         (eigenvalues to ~2.6e6 1/s) would hold an explicit integrator to steps of ~1 us. Measured on the
         paper preset (load case 3, 0.2 mm/s, rigid joints, N = 3): RK3 stick-slips as the two-mass model
         does (0.230 vs 0.231 mm/s, 71 vs 72 cycles) where velocity-implicit Euler at 1e-4 slides smoothly:
-        its numerical damping can hide stick-slip; keep the convergence check on with it.
+        its numerical damping can hide stick-slip; keep the convergence check on with it. On the rigid-joint
+        model (N = 3, axial screw) the check catches it: the 1e-4 run's check at 1e-5 disagrees, the rerun at
+        1e-5 stick-slips (0.228 mm/s, 71 cycles, RK3 0.230) and passes at 1e-6; with
+        ``simulation.max_step`` 2e-5 s it stick-slips at 1e-4 already (0.2295 mm/s). A smooth verdict of an
+        implicit integrator is safest checked with a small ``max_step`` too (docs/multibody.md).
     screw_bending : bool
         False: the screw segments only slide along and turn about the screw axis (no bending, shear or
         sag; :func:`drakecreep.multibody.build_multibody`). Removes the screw's bending modes, lateral
