@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from drakecreep.multibody.diagram import MultibodyOptions
 from drakecreep.params import with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
@@ -40,18 +39,12 @@ from drakecreep.studies.table_fluctuation import (
     leave_one_out,
     predict,
 )
+from multibody_vs_two_mass import BOUNDARY_MODELS  # analysis/ is sys.path[0] when run as a script
 
 __all__ = ["MODELS", "HYPOTHESES", "model_responses", "main"]
 
-#: name -> simulate() keyword arguments
-MODELS = {
-    "two_mass": {},
-    "rigid3_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=3, rigid_joints=True,
-                                                                        screw_bending=False)),
-    "rigid6_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=6, rigid_joints=True,
-                                                                        screw_bending=False)),
-    "full4": dict(model="multibody", multibody=MultibodyOptions(n_segments=4)),
-}
+#: name -> simulate() keyword arguments (the creep-boundary comparison's models)
+MODELS = BOUNDARY_MODELS
 
 #: the hypotheses both models can carry (no lead error)
 _CARRIED = ("force_ripple", "grating", "quantization")
