@@ -7,7 +7,12 @@ measures the neighbours), its wall time, its integrator steps and derivative eva
 two-mass compiled run, and where one derivative evaluation of the multibody diagram spends its time
 (the plant with its inputs, and each Python leaf system's output alone). Issue 17's target: 20x.
 
+The multibody runs use the compiled loop (``simulate(..., backend="compiled")``: controller, sensors and
+friction laws as ``SymbolicVectorSystem``s around Drake's MultibodyPlant) unless ``--backends`` also names
+``leaf`` (the Python leaf systems: the same equations, the run before the loop was compiled).
+
     python analysis/bench_multibody.py [--feed 0.1] [--duration 5] [--configs full6 rigid6 rigid4 rigid3]
+        [--backends compiled leaf]
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ import time
 from drakecreep.multibody.diagram import MultibodyOptions, build_multibody_diagram
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
+from drakecreep.sim.compiled import compile_diagram
 from drakecreep.sim.simulation import simulate
 
 __all__ = ["CONFIGS", "profile", "main"]
@@ -31,6 +37,8 @@ CONFIGS = {
     "rigid3": MultibodyOptions(n_segments=3, rigid_joints=True),
     "rigid4_rk3": MultibodyOptions(n_segments=4, rigid_joints=True, integrator="runge_kutta3"),
     "rigid3_rk3": MultibodyOptions(n_segments=3, rigid_joints=True, integrator="runge_kutta3"),
+    "rigid3_axial": MultibodyOptions(n_segments=3, rigid_joints=True, screw_bending=False),
+    "rigid6_axial": MultibodyOptions(n_segments=6, rigid_joints=True, screw_bending=False),
 }
 
 
@@ -42,9 +50,10 @@ def timed(params, scenario, **kwargs):
     return result, time.process_time() - start
 
 
-def profile(params, scenario, options, repeats=500):
-    """Microseconds per evaluation: the whole diagram's derivatives, then each leaf's output port alone."""
-    fd = build_multibody_diagram(params, scenario, options)
+def profile(params, scenario, options, repeats=500, backend="compiled"):
+    """Microseconds per evaluation: the whole diagram's derivatives, the plant alone, then each leaf's output port alone."""
+    fd = build_multibody_diagram(params, scenario, options,
+                                 compiler=compile_diagram if backend == "compiled" else None)
     d = fd.diagram
     ctx = d.CreateDefaultContext()
     fd.set_initial_state(ctx)
@@ -56,7 +65,16 @@ def profile(params, scenario, options, repeats=500):
         ctx.SetContinuousState(x)  # invalidates every cache entry that depends on the state
         d.CalcTimeDerivatives(ctx, der)
     out["diagram derivatives"] = (time.perf_counter() - start) / repeats * 1e6
-    for name in ("controller", "guide_friction", "nut_friction", "encoder", "scale", "reference"):
+    plant = fd.drive.plant
+    pc = plant.GetMyMutableContextFromRoot(ctx)
+    xp = plant.GetPositionsAndVelocities(pc)
+    pder = plant.AllocateTimeDerivatives()
+    start = time.perf_counter()
+    for _ in range(repeats):
+        plant.SetPositionsAndVelocities(pc, xp)  # the plant's own state only: its inputs stay cached
+        plant.CalcTimeDerivatives(pc, pder)
+    out["plant alone"] = (time.perf_counter() - start) / repeats * 1e6
+    for name in ("controls", "controller", "guide_friction", "nut_friction", "encoder", "scale", "reference"):
         if name not in fd.systems:
             continue
         system = fd.systems[name]
@@ -76,6 +94,7 @@ def main(argv=None):
     ap.add_argument("--feed", type=float, default=0.1, help="mm/s (default 0.1)")
     ap.add_argument("--duration", type=float, default=5.0, help="s (default 5)")
     ap.add_argument("--configs", nargs="+", default=["full6", "rigid4", "rigid3_rk3"], choices=sorted(CONFIGS))
+    ap.add_argument("--backends", nargs="+", default=["compiled"], choices=["compiled", "leaf"])
     args = ap.parse_args(argv)
     params = with_value(preset("paper"), "simulation.convergence_check", False)
     scenario = Scenario(feed=args.feed * 1e-3, load_case=3, duration=args.duration)
@@ -87,14 +106,14 @@ def main(argv=None):
     print("| configuration | states | CPU (s) | wall (s) | ratio (CPU) | steps | derivative evals | us / eval | creep "
           "| fluctuation (mm/s) |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-    for name in args.configs:
+    for name, backend in ((n, b) for n in args.configs for b in args.backends):
         options = CONFIGS[name]
-        r, cpu = timed(params, scenario, model="multibody", multibody=options)
-        prof = profile(params, scenario, options, repeats=200)
+        r, cpu = timed(params, scenario, model="multibody", multibody=options, backend=backend)
+        prof = profile(params, scenario, options, repeats=200, backend=backend)
         creep = r.metrics.creep if r.metrics else None
         fluct = f"{r.metrics.max_fluctuation * 1e3:.4f}" if r.metrics else "-"
         evals = r.stats["derivative_evaluations"]
-        print(f"| {name} ({options.integrator}) | {prof['states']} | {cpu:.1f} | {r.wall_time:.1f} | {cpu / base_cpu:.0f}x "
+        print(f"| {name} ({options.integrator}, {backend}) | {prof['states']} | {cpu:.1f} | {r.wall_time:.1f} | {cpu / base_cpu:.0f}x "
               f"| {r.stats['steps']} | {evals} | {prof['diagram derivatives']:.0f} | {creep} | {fluct} |", flush=True)
         print("    per evaluation (us): " + ", ".join(f"{k} {v:.0f}" for k, v in prof.items() if k != "states"),
               flush=True)

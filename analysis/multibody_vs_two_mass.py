@@ -12,9 +12,18 @@
    dense frequency response, python-control's polynomial method overflows at this model order). Also the
    closed loop's least stable pole.
 
+3. ``--boundary``: the creep boundary, convergence-checked. Each model of ``--models`` (:data:`BOUNDARY_MODELS`)
+   at each feed of ``--feeds`` (ascending), ``--duration`` s (2 s, metrics from 1 s: as
+   :func:`drakecreep.studies.paper_reproduction.simulated_creep_boundary`), with the convergence check on. A
+   verdict counts only when converged; the boundary is bracketed by the highest converged creeping feed
+   and the lowest converged sliding feed above it. ``--wall-limit`` stops a run after that many seconds
+   (reported as such, not as a verdict). Rows go to ``boundary.json`` as they come.
+
 Writes ``comparison.json`` to ``--out`` (default ``out/multibody_vs_two_mass``).
 
     python analysis/multibody_vs_two_mass.py [--feeds 0.1 0.5 1 2] [--duration 3] [--segments 6] [--skip-creep]
+    python analysis/multibody_vs_two_mass.py --boundary --feeds 0.18 0.2 0.22 0.24 0.26 --duration 2 \
+        --models two_mass rigid3_axial [--wall-limit 1200]
 """
 
 from __future__ import annotations
@@ -36,7 +45,21 @@ from drakecreep.servo.linearize import linearize_plant
 from drakecreep.servo.loops import loop_margins, loop_transfer
 from drakecreep.sim.simulation import simulate
 
-__all__ = ["creep_rows", "margin_rows", "main"]
+__all__ = ["creep_rows", "margin_rows", "boundary_rows", "bracket", "BOUNDARY_MODELS", "main"]
+
+#: models of the creep-boundary comparison: name -> simulate() keyword arguments
+BOUNDARY_MODELS = {
+    "two_mass": {},
+    "rigid3_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=3, rigid_joints=True,
+                                                                        screw_bending=False)),
+    "rigid6_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=6, rigid_joints=True,
+                                                                        screw_bending=False)),
+    "rigid3": dict(model="multibody", multibody=MultibodyOptions(n_segments=3, rigid_joints=True)),
+    "rigid3_axial_vie": dict(model="multibody", multibody=MultibodyOptions(
+        n_segments=3, rigid_joints=True, screw_bending=False, integrator="velocity_implicit_euler")),
+    "full6": dict(model="multibody", multibody=MultibodyOptions(n_segments=6)),
+    "full4": dict(model="multibody", multibody=MultibodyOptions(n_segments=4)),
+}
 
 #: modes faster than this (rad/s) are residualized in the multibody plant before forming the loops
 CUTOFF = 1e5
@@ -60,6 +83,57 @@ def creep_rows(params, feeds_mm_s, duration, models):
             rows.append(row)
             print(_creep_line(row), flush=True)
     return rows
+
+
+def boundary_rows(params, feeds_mm_s, duration, models, wall_limit=None, out=None):
+    """One row per (model, feed), convergence check on; written to ``out`` (a JSON path) after each run."""
+    rows = []
+    for name in models:
+        for feed in sorted(feeds_mm_s):
+            scenario = Scenario(feed=feed * 1e-3, load_case=3, duration=duration)
+            start = time.process_time()
+            r = simulate(params, scenario, wall_limit=wall_limit, **BOUNDARY_MODELS[name])
+            row = dict(feed_mm_s=feed, model=name, status=r.status, wall_s=r.wall_time,
+                       cpu_s=time.process_time() - start, accuracy=r.stats.get("accuracy"),
+                       check_accuracy=r.stats.get("convergence_check_accuracy"),
+                       check_runs=r.stats.get("convergence_runs"),
+                       check_change_mm_s=r.stats.get("convergence_fluctuation_change_mm_s"))
+            m = r.metrics
+            if m is not None:
+                row.update(creep=bool(m.creep), max_fluctuation_mm_s=m.max_fluctuation * 1e3,
+                           fluctuation_rate_percent=m.fluctuation_rate * 100, cycles=int(m.stick_slip_cycles),
+                           converged=m.converged)
+            rows.append(row)
+            print(_boundary_line(row), flush=True)
+            if out is not None:
+                Path(out).write_text(json.dumps(rows, indent=1, default=str))
+    return rows
+
+
+def bracket(rows, model):
+    """``(highest converged creeping feed, lowest converged sliding feed above it)`` of ``model`` (mm/s; None
+    when missing), and the feeds whose verdict was not converged or not reached."""
+    mine = [r for r in rows if r["model"] == model]
+    ok = [r for r in mine if r.get("converged") and r["status"] == "ok"]
+    creeping = [r["feed_mm_s"] for r in ok if r["creep"]]
+    hi = max(creeping) if creeping else None
+    sliding = [r["feed_mm_s"] for r in ok if not r["creep"] and (hi is None or r["feed_mm_s"] > hi)]
+    lo = min(sliding) if sliding else None
+    open_ = [r["feed_mm_s"] for r in mine if not (r.get("converged") and r["status"] == "ok")]
+    return hi, lo, open_
+
+
+def _boundary_line(row):
+    head = f"| {row['model']} | {row['feed_mm_s']:g} |"
+    if "creep" not in row:
+        return f"{head} - | - | - | - | {row['status']} | {row['cpu_s']:.0f} |"
+    verdict = "creeps" if row["creep"] else "slides"
+    if not row["converged"]:
+        verdict = f"not converged (read {verdict})"
+    status = "" if row["status"] == "ok" else row["status"]
+    return (f"{head} {verdict} | {row['max_fluctuation_mm_s']:.4f} | {row['cycles']} | {row['accuracy']:g} / "
+            f"{row['check_accuracy']:g}, {row['check_runs']} check(s), change {row['check_change_mm_s']:.4f} mm/s "
+            f"| {status} | {row['cpu_s']:.0f} |")
 
 
 def _creep_line(row):
@@ -127,8 +201,33 @@ def main(argv=None):
     ap.add_argument("--skip-margins", action="store_true")
     ap.add_argument("--no-check", action="store_true",
                     help="convergence check off in both models (faster; the verdicts are then unchecked)")
+    ap.add_argument("--boundary", action="store_true", help="the convergence-checked creep boundary (only)")
+    ap.add_argument("--models", nargs="+", default=["two_mass", "rigid3_axial"], choices=sorted(BOUNDARY_MODELS))
+    ap.add_argument("--wall-limit", type=float, default=None, help="s per run (--boundary)")
+    ap.add_argument("--max-step", type=float, default=None,
+                    help="s: simulation.max_step of every run (--boundary; default the preset's 1 ms). The "
+                         "implicit integrators' numerical damping at large steps can hide stick-slip and pass the "
+                         "convergence check (docs/multibody.md)")
     ap.add_argument("--out", default="out/multibody_vs_two_mass")
     args = ap.parse_args(argv)
+    if args.boundary:
+        params = preset("paper")
+        if args.max_step is not None:
+            params = with_value(params, "simulation.max_step", args.max_step)
+            print(f"simulation.max_step = {args.max_step:g} s")
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        print(f"Creep boundary, paper preset, {params.friction.law}, load case 3, {args.duration:g} s runs, metrics "
+              f"from {params.simulation.steady_start:g} s, convergence check on")
+        print("| model | feed (mm/s) | verdict | max fluctuation (mm/s) | cycles | accuracy / check, runs, change "
+              "| status | CPU (s) |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+        rows = boundary_rows(params, args.feeds, args.duration, args.models, args.wall_limit, out / "boundary.json")
+        for name in args.models:
+            hi, lo, open_ = bracket(rows, name)
+            print(f"{name}: highest creeping feed {hi} mm/s, lowest sliding feed above it {lo} mm/s"
+                  + (f"; not converged / not finished at {open_} mm/s" if open_ else ""))
+        return 0
     params = preset("paper")
     if args.no_check:
         params = with_value(params, "simulation.convergence_check", False)

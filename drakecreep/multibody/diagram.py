@@ -63,6 +63,7 @@ from pydrake.systems.primitives import (
 from drakecreep.errors import InputError
 from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.model.diagram import SIGNALS, FeedDrive
+from drakecreep.model.disturbances import LoadRipple
 from drakecreep.model.nut_friction import NutFriction, nut_friction_levels
 from drakecreep.model.nut_table import table_friction_levels
 from drakecreep.model.reference import FeedReference
@@ -104,7 +105,16 @@ class MultibodyOptions:
         (eigenvalues to ~2.6e6 1/s) would hold an explicit integrator to steps of ~1 us. Measured on the
         paper preset (load case 3, 0.2 mm/s, rigid joints, N = 3): RK3 stick-slips as the two-mass model
         does (0.230 vs 0.231 mm/s, 71 vs 72 cycles) where velocity-implicit Euler at 1e-4 slides smoothly:
-        its numerical damping can hide stick-slip; keep the convergence check on with it.
+        its numerical damping can hide stick-slip; keep the convergence check on with it. On the rigid-joint
+        model (N = 3, axial screw) the check catches it: the 1e-4 run's check at 1e-5 disagrees, the rerun at
+        1e-5 stick-slips (0.228 mm/s, 71 cycles, RK3 0.230) and passes at 1e-6; with
+        ``simulation.max_step`` 2e-5 s it stick-slips at 1e-4 already (0.2295 mm/s). A smooth verdict of an
+        implicit integrator is safest checked with a small ``max_step`` too (docs/multibody.md).
+    screw_bending : bool
+        False: the screw segments only slide along and turn about the screw axis (no bending, shear or
+        sag; :func:`drakecreep.multibody.build_multibody`). Removes the screw's bending modes, lateral
+        motions that do not couple to the feed, and makes a run cheaper (fewer degrees of freedom, a
+        lower stiffest mode). Measured: docs/multibody.md ("Benchmark").
     """
 
     n_segments: int = DEFAULT_SEGMENTS
@@ -112,17 +122,20 @@ class MultibodyOptions:
     friction: bool = True
     rigid_twist_factor: float = 1e3
     integrator: str = ""
+    screw_bending: bool = True
 
     def __post_init__(self):
         if isinstance(self.n_segments, bool) or not isinstance(self.n_segments, int) \
                 or not 2 <= self.n_segments <= 400:
             raise InputError("multibody.n_segments", self.n_segments, "an integer in [2, 400]")
-        for name in ("rigid_joints", "friction"):
+        for name in ("rigid_joints", "friction", "screw_bending"):
             if not isinstance(getattr(self, name), bool):
                 raise InputError(f"multibody.{name}", getattr(self, name), "true or false")
         if isinstance(self.rigid_twist_factor, bool) or not isinstance(self.rigid_twist_factor, (int, float)) \
                 or not 1.0 <= self.rigid_twist_factor <= 1e12:
             raise InputError("multibody.rigid_twist_factor", self.rigid_twist_factor, "a number in [1, 1e12]")
+        if not self.screw_bending and not self.rigid_joints:
+            raise InputError("multibody.screw_bending", self.screw_bending, "true unless rigid_joints is true")
         if self.integrator == "":
             object.__setattr__(self, "integrator", "runge_kutta3" if self.rigid_joints else "velocity_implicit_euler")
         if self.integrator not in INTEGRATORS:
@@ -135,7 +148,8 @@ class MultibodyFeedDrive(FeedDrive):
 
     Extra attributes: ``drive`` (the :class:`~drakecreep.multibody.plant.MultibodyDrive`), ``options``,
     ``q0`` (plant positions at the loaded equilibrium), ``equilibrium_residual`` (N or N m),
-    ``initial_torque`` (N m, held by the current loop at t = 0).
+    ``initial_torque`` (N m, held by the current loop at t = 0), ``compiled`` (the
+    :class:`~drakecreep.sim.compiled.CompiledDrive` of the loop when it was compiled, else None).
     """
 
     drive: object = None
@@ -143,9 +157,13 @@ class MultibodyFeedDrive(FeedDrive):
     q0: np.ndarray = None
     equilibrium_residual: float = 0.0
     initial_torque: float = 0.0
+    compiled: object = None
 
     def set_initial_state(self, context):
         """Set the current loop's torque in ``context`` (the diagram's); the plant's positions are its defaults."""
+        if self.compiled is not None:
+            self.compiled.set_initial_state(self.diagram.GetMutableSubsystemContext(self.compiled.diagram, context))
+            return
         if "current_loop" in self.systems:
             lag = self.systems["current_loop"]
             lag.set_initial_output_value(self.diagram.GetMutableSubsystemContext(lag, context),
@@ -173,7 +191,7 @@ class _ReactionForce(LeafSystem):
 def _indices(drive):
     """Position and velocity indices of the coordinates the loop reads and drives."""
     plant = drive.plant
-    seg = plant.GetJointByName("screw_0_free")
+    seg = plant.GetJointByName("screw_0_free" if drive.screw_bending else "screw_0_spin")  # rotation about x first
     nut = plant.GetJointByName("screw_nut")
     if drive.rigid_joints:
         slide = plant.GetJointByName("table_slide")
@@ -187,9 +205,10 @@ def _indices(drive):
 
 
 def _applied_map(drive, idx):
-    """``nv x 3`` map of ``[motor torque (N m), guide friction (N), nut joint torque (N m)]`` to generalized forces."""
+    """``nv x 4`` map of ``[motor torque (N m), guide friction (N), nut joint torque (N m), force ripple (N)]`` to
+    generalized forces (the ripple along +x at the table's centre of mass)."""
     nv = drive.plant.num_velocities()
-    gain = np.zeros((nv, 3))
+    gain = np.zeros((nv, 4))
     gain[idx["motor_v"], 0] = 1.0
     t = idx["table"]
     gain[t["vx"], 1] = -1.0
@@ -198,6 +217,7 @@ def _applied_map(drive, idx):
         dz = drive.rig.slider_height - drive.home["table"][2]
         gain[t["wy"], 1] = -dz
     gain[idx["nut_v"], 2] = 1.0
+    gain[t["vx"], 3] = 1.0
     return gain
 
 
@@ -268,7 +288,7 @@ def loaded_equilibrium(drive, applied, torque_map, fixed, torque=0.0, context=No
 
 
 def build_multibody_diagram(params, scenario, options=None, *, continuous=None, ideal_sensors=False,
-                            open_loop=False):
+                            open_loop=False, compiler=None):
     """Wire the multibody feed drive for ``scenario`` from ``params``: the two-mass diagram's loop on the plant.
 
     Parameters
@@ -284,6 +304,12 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
         The mechanics alone (for linearization, :mod:`drakecreep.multibody.linear`): no reference,
         controller or sensors; input port ``torque_command`` (N m, into the torque limit and current
         loop); first output ``plant_outputs`` = ``[motor angle, motor speed, table position, table speed]``.
+    compiler : callable, optional
+        :func:`drakecreep.sim.compiled.compile_diagram` (passed in: ``multibody`` may not import ``sim``).
+        When given, every system of the loop but the plant (reference, controller, sensors, torque limit,
+        current loop, the friction laws) is compiled into ``SymbolicVectorSystem``s, so the only system
+        evaluated in Python during a run is the reaction-force reader at the log's samples; the same
+        equations (``tests/multibody/test_diagram.py`` compares the derivatives). Ignored with ``open_loop``.
 
     Returns
     -------
@@ -310,7 +336,8 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
 
     builder = DiagramBuilder()
     drive = build_multibody(params, n_segments=options.n_segments, rigid_joints=options.rigid_joints,
-                            table_position=0.0, builder=builder, rigid_twist_factor=options.rigid_twist_factor)
+                            table_position=0.0, builder=builder, rigid_twist_factor=options.rigid_twist_factor,
+                            screw_bending=options.screw_bending)
     plant = drive.plant
     idx = _indices(drive)
     nq, nv = plant.num_positions(), plant.num_velocities()
@@ -326,9 +353,9 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
 
     s = {}
 
-    def add(name, system):
+    def add(name, system, into=builder):
         system.set_name(name)
-        s[name] = builder.AddSystem(system)
+        s[name] = into.AddSystem(system)
         return s[name]
 
     def select(name, rows):
@@ -341,83 +368,141 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
         return sys
 
     t = idx["table"]
-    table = select("table", [(t["qx"], 1.0), (nq + t["vx"], 1.0)])
-    motor = select("motor", [(idx["motor_q"], 1.0), (nq + idx["motor_v"], 1.0)])
+    # the coordinates the loop reads: motor [angle, speed], table [x, v], the screw relative to the nut
+    # [-(ScrewJoint angle), -(its speed)] (+theta of the screw feeds +x)
+    rows = {"motor": [(idx["motor_q"], 1.0), (nq + idx["motor_v"], 1.0)],
+            "table": [(t["qx"], 1.0), (nq + t["vx"], 1.0)],
+            "nut_motion": [(idx["nut_q"], -1.0), (nq + idx["nut_v"], -1.0)]}
+    table = select("table", rows["table"])
+    motor = select("motor", rows["motor"])
+    setup = dict(params=params, scenario=scenario, gains=gains, load=load, ideal_sensors=ideal_sensors,
+                 theta_counted=theta_counted, x_ref0=x_ref0, torque0=torque0, options=options)
+    compiled = None
+    if open_loop or compiler is None:
+        coords = {"motor": motor.get_output_port(), "table": table.get_output_port(),
+                  "nut_motion": (lambda: select("nut_motion", rows["nut_motion"]).get_output_port())}
+        ports = _add_controls(builder, add, coords, open_loop=open_loop, **setup)
+        applied = ports.pop("applied")
+    else:
+        compiled, applied, ports = _compiled_controls(builder, add, select, rows, setup, compiler)
+
     if open_loop:
         outputs = add("plant_outputs", Multiplexer([2, 2]))
         builder.Connect(motor.get_output_port(), outputs.get_input_port(0))
         builder.Connect(table.get_output_port(), outputs.get_input_port(1))
         builder.ExportOutput(outputs.get_output_port(0), "plant_outputs")
-    else:
-        add("reference", FeedReference(scenario.feed, params.simulation.acceleration_time, x_ref0))
-        add("controller", CascadeController(gains, params.screw.lead, force_limit(params),
-                                            initial_force=torque0 / ratio, initial_angle=theta_counted))
-        add("encoder", MotorEncoder(0 if ideal_sensors else params.sensors.encoder_counts_per_rev))
-        add("scale", LinearScale(0.0 if ideal_sensors else params.sensors.scale_resolution))
-    limit = add("torque_limit", Saturation([-params.motor.peak_torque], [params.motor.peak_torque]))
-    torque_out = limit.get_output_port()
-    tau_c = params.motor.current_loop_time_constant
-    if tau_c > 0:
-        lag = add("current_loop", FirstOrderLowPassFilter(tau_c, 1))
-        builder.Connect(limit.get_output_port(), lag.get_input_port())
-        torque_out = lag.get_output_port()
-
-    # friction: the guides on the table, the nut on the screw (the two-mass split of the levels)
-    mux = add("applied_inputs", Multiplexer([1, 1, 1]))
-    zero = None
-    if options.friction:
-        fc, fs = table_friction_levels(params, load)
-        guide = add("guide_friction", NutFriction(params.friction, fc, fs, 2.0 * math.pi))
-        builder.Connect(table.get_output_port(), guide.GetInputPort("motor_state"))
-        builder.Connect(guide.GetOutputPort("friction_torque"), mux.get_input_port(1))
-        fc_n, fs_n = nut_friction_levels(params, load)
-    else:
-        fc_n = 0.0
-        zero = add("no_friction", ConstantVectorSource([0.0]))
-        builder.Connect(zero.get_output_port(), mux.get_input_port(1))
-    if fc_n > 0.0:
-        # the screw's rotation relative to the nut: -(ScrewJoint angle), since +theta of the screw feeds +x
-        rel = select("nut_motion", [(idx["nut_q"], -1.0), (nq + idx["nut_v"], -1.0)])
-        nut = add("nut_friction", NutFriction(params.friction, fc_n, fs_n, params.screw.lead))
-        builder.Connect(rel.get_output_port(), nut.GetInputPort("motor_state"))
-        builder.Connect(nut.GetOutputPort("friction_torque"), mux.get_input_port(2))
-    else:
-        zero = zero or add("no_friction", ConstantVectorSource([0.0]))
-        builder.Connect(zero.get_output_port(), mux.get_input_port(2))
-    builder.Connect(torque_out, mux.get_input_port(0))
     to_forces = add("applied_forces", MatrixGain(_applied_map(drive, idx)))
-    builder.Connect(mux.get_output_port(), to_forces.get_input_port())
+    builder.Connect(applied, to_forces.get_input_port())
     load_source = add("load_case", ConstantVectorSource(loads))
     total = add("generalized_forces", Adder(2, nv))
     builder.Connect(to_forces.get_output_port(), total.get_input_port(0))
     builder.Connect(load_source.get_output_port(), total.get_input_port(1))
     builder.Connect(total.get_output_port(), plant.get_applied_generalized_force_input_port())
 
+    extra = dict(drive=drive, options=options, q0=q0, equilibrium_residual=residual, initial_torque=torque0,
+                 compiled=compiled)
     if open_loop:
-        builder.ExportInput(limit.get_input_port(), "torque_command")
+        builder.ExportInput(ports["torque_command_in"], "torque_command")
         diagram = builder.Build()
         diagram.set_name("multibody_feed_drive_plant")
         drive.diagram = diagram
-        return MultibodyFeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=(),
-                                  drive=drive, options=options, q0=q0, equilibrium_residual=residual,
-                                  initial_torque=torque0)
+        return MultibodyFeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=(), **extra)
 
     reaction = add("screw", _ReactionForce(idx["nut_joint"]))
     builder.Connect(plant.get_reaction_forces_output_port(), reaction.get_input_port())
+    exports = {("motor", "motor_state"): motor.get_output_port(), ("table", "table_state"): table.get_output_port(),
+               ("screw", "axial_force"): reaction.get_output_port(0)}
+    exports.update(ports)
+    for (system, port), out in exports.items():
+        builder.ExportOutput(out, f"{system}.{port}")
+    signals = SIGNALS
+    if ("nut_friction", "friction_force") in exports:
+        signals = signals + (("nut_friction_force", ("nut_friction", "friction_force", 0), "N"),)
+    diagram = builder.Build()
+    diagram.set_name("multibody_feed_drive")
+    drive.diagram = diagram
+    return MultibodyFeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals, **extra)
+
+
+def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_sensors, theta_counted, x_ref0,
+                  torque0, options, open_loop=False):
+    """Add everything of the loop but the plant: reference, controller, sensors, torque limit, current loop, friction.
+
+    ``coords``: output ports ``motor`` and ``table`` (``[position, speed]``) and ``nut_motion`` (a callable
+    giving the port of the screw's motion relative to the nut, asked for only when the nut has friction).
+    Returns ``{"applied": port of [motor torque (N m), guide friction (N), nut joint torque (N m)],
+    (system, port): output port}`` of the recorded signals, or with ``open_loop`` the key
+    ``"torque_command_in"`` (the torque limit's input) instead of the signals.
+    """
+    if params.disturbance.lead_error_amplitude > 0.0:
+        raise InputError("disturbance.lead_error_amplitude", params.disturbance.lead_error_amplitude,
+                         "0 with the multibody model (its ScrewJoint has an exact lead; the lead error is a "
+                         "two-mass model effect)")
+    s = {}
+
+    def put(name, system):
+        s[name] = add(name, system, builder)
+        return s[name]
+
+    ratio = params.screw.lead / (2.0 * math.pi)
+    if not open_loop:
+        put("reference", FeedReference(scenario.feed, params.simulation.acceleration_time, x_ref0))
+        put("controller", CascadeController(gains, params.screw.lead, force_limit(params),
+                                            initial_force=torque0 / ratio, initial_angle=theta_counted))
+        put("encoder", MotorEncoder(0 if ideal_sensors else params.sensors.encoder_counts_per_rev))
+        put("scale", LinearScale(0.0 if ideal_sensors else params.sensors.scale_resolution))
+    limit = put("torque_limit", Saturation([-params.motor.peak_torque], [params.motor.peak_torque]))
+    torque_out = limit.get_output_port()
+    tau_c = params.motor.current_loop_time_constant
+    if tau_c > 0:
+        lag = put("current_loop", FirstOrderLowPassFilter(tau_c, 1))
+        builder.Connect(limit.get_output_port(), lag.get_input_port())
+        torque_out = lag.get_output_port()
+
+    # friction: the guides on the table, the nut on the screw (the two-mass split of the levels)
+    mux = put("applied_inputs", Multiplexer([1, 1, 1, 1]))
+    zero = None
+    if options.friction:
+        fc, fs = table_friction_levels(params, load)
+        guide = put("guide_friction", NutFriction(params.friction, fc, fs, 2.0 * math.pi))
+        builder.Connect(coords["table"], guide.GetInputPort("motor_state"))
+        builder.Connect(guide.GetOutputPort("friction_torque"), mux.get_input_port(1))
+        fc_n, fs_n = nut_friction_levels(params, load)
+    else:
+        fc_n = 0.0
+        zero = put("no_friction", ConstantVectorSource([0.0]))
+        builder.Connect(zero.get_output_port(), mux.get_input_port(1))
+    if fc_n > 0.0:
+        nut = put("nut_friction", NutFriction(params.friction, fc_n, fs_n, params.screw.lead))
+        builder.Connect(coords["nut_motion"](), nut.GetInputPort("motor_state"))
+        builder.Connect(nut.GetOutputPort("friction_torque"), mux.get_input_port(2))
+    else:
+        zero = zero or put("no_friction", ConstantVectorSource([0.0]))
+        builder.Connect(zero.get_output_port(), mux.get_input_port(2))
+    builder.Connect(torque_out, mux.get_input_port(0))
+    d = params.disturbance
+    amplitude = d.force_ripple + d.load_ripple * abs(load.fx)
+    if amplitude > 0.0:
+        # the two-mass model's force ripple (model.disturbances.LoadRipple), on the table along x
+        ripple = put("load_ripple", LoadRipple(amplitude, d.ripple_frequency))
+        builder.Connect(ripple.get_output_port(0), mux.get_input_port(3))
+    else:
+        zero = zero or put("no_friction", ConstantVectorSource([0.0]))
+        builder.Connect(zero.get_output_port(), mux.get_input_port(3))
+    ports = {"applied": mux.get_output_port()}
+    if open_loop:
+        ports["torque_command_in"] = limit.get_input_port()
+        return ports
 
     c = builder.Connect
     c(s["reference"].get_output_port(0), s["controller"].GetInputPort("reference"))
     c(s["encoder"].GetOutputPort("motor_measured"), s["controller"].GetInputPort("motor_measured"))
     c(s["scale"].GetOutputPort("table_position_measured"), s["controller"].GetInputPort("table_position_measured"))
     c(s["controller"].GetOutputPort("torque_command"), limit.get_input_port())
-    c(motor.get_output_port(), s["encoder"].GetInputPort("motor_state"))
-    c(table.get_output_port(), s["scale"].GetInputPort("table_state"))
-
-    exports = {
+    c(coords["motor"], s["encoder"].GetInputPort("motor_state"))
+    c(coords["table"], s["scale"].GetInputPort("table_state"))
+    ports.update({
         ("reference", "reference"): s["reference"].get_output_port(0),
-        ("motor", "motor_state"): motor.get_output_port(),
-        ("table", "table_state"): table.get_output_port(),
-        ("screw", "axial_force"): reaction.get_output_port(0),
         ("table", "friction_force"): (s["guide_friction"].GetOutputPort("friction_force")
                                       if "guide_friction" in s else zero.get_output_port()),
         ("motor", "motor_torque"): torque_out,
@@ -425,16 +510,84 @@ def build_multibody_diagram(params, scenario, options=None, *, continuous=None, 
         ("controller", "controller_signals"): s["controller"].GetOutputPort("controller_signals"),
         ("encoder", "motor_measured"): s["encoder"].GetOutputPort("motor_measured"),
         ("scale", "table_position_measured"): s["scale"].GetOutputPort("table_position_measured"),
-    }
-    for (system, port), out in exports.items():
-        builder.ExportOutput(out, f"{system}.{port}")
-    signals = SIGNALS
+    })
     if "nut_friction" in s:
-        builder.ExportOutput(s["nut_friction"].GetOutputPort("friction_force"), "nut_friction.friction_force")
-        signals = signals + (("nut_friction_force", ("nut_friction", "friction_force", 0), "N"),)
-    diagram = builder.Build()
-    diagram.set_name("multibody_feed_drive")
-    drive.diagram = diagram
-    return MultibodyFeedDrive(diagram=diagram, systems=s, params=params, scenario=scenario, signals=signals,
-                              drive=drive, options=options, q0=q0, equilibrium_residual=residual,
-                              initial_torque=torque0)
+        ports[("nut_friction", "friction_force")] = s["nut_friction"].GetOutputPort("friction_force")
+    return ports
+
+
+@dataclass
+class _Controls:
+    """The loop's systems alone, in the form :func:`drakecreep.sim.compiled.compile_diagram` takes."""
+
+    diagram: object
+    signals: tuple
+
+    @property
+    def signal_names(self):
+        return [name for name, _, _ in self.signals]
+
+
+#: name of the placeholder source of the plant coordinates in the loop's own diagram
+_COORDINATES = "plant_coordinates"
+
+
+def _compiled_controls(builder, add, select, rows, setup, compiler):
+    """The loop's systems compiled by ``compiler`` (:func:`drakecreep.sim.compiled.compile_diagram`), wired to the plant.
+
+    The same systems as the leaf path (:func:`_add_controls`) are built into a diagram of their own whose
+    plant coordinates come from a ``ConstantVectorSource`` placeholder; that diagram is compiled with the
+    placeholder as its input. In ``builder``: plant state -> ``MatrixGain`` (the six coordinates) ->
+    compiled loop -> ``MatrixGain`` selections of the applied inputs and of each recorded signal port.
+
+    Returns ``(compiled, applied port, {(system, port): output port})``.
+    """
+    inner = DiagramBuilder()
+    source = inner.AddSystem(ConstantVectorSource(np.zeros(6)))
+    source.set_name(_COORDINATES)
+    split = {}
+    for k, name in enumerate(("motor", "table", "nut_motion")):
+        gain = np.zeros((2, 6))
+        gain[0, 2 * k], gain[1, 2 * k + 1] = 1.0, 1.0
+        split[name] = inner.AddSystem(MatrixGain(gain))
+        split[name].set_name(f"{name}_coordinates")
+        inner.Connect(source.get_output_port(), split[name].get_input_port())
+    local = {}
+
+    def add_inner(name, system, into):
+        system.set_name(name)
+        local[name] = into.AddSystem(system)
+        return local[name]
+
+    coords = {"motor": split["motor"].get_output_port(), "table": split["table"].get_output_port(),
+              "nut_motion": lambda: split["nut_motion"].get_output_port()}
+    ports = _add_controls(inner, add_inner, coords, **setup)
+    ports[("applied", "inputs")] = ports.pop("applied")
+    signals, sizes = [], {}
+    for (system, port), out in ports.items():
+        inner.ExportOutput(out, f"{system}.{port}")
+        sizes[(system, port)] = out.size()
+        signals.extend((f"{system}.{port}[{i}]", (system, port, i), "") for i in range(out.size()))
+    controls = _Controls(diagram=inner.Build(), signals=tuple(signals))
+    compiled = compiler(controls, inputs=(_COORDINATES,))
+    if "current_loop" in local:
+        # the current loop starts holding the equilibrium torque (set in a context, not a default)
+        ctx = controls.diagram.CreateDefaultContext()
+        lag = local["current_loop"]
+        lag.set_initial_output_value(controls.diagram.GetMutableSubsystemContext(lag, ctx), [setup["torque0"]])
+        compiled.equations.xc0 = ctx.get_continuous_state_vector().CopyToVector()
+
+    loop = add("controls", compiled.diagram)
+    coordinates = select(_COORDINATES, rows["motor"] + rows["table"] + rows["nut_motion"])
+    builder.Connect(coordinates.get_output_port(), loop.get_input_port(0))
+    width = loop.get_output_port(0).size()
+    out, start = {}, 0
+    for key, n in sizes.items():
+        gain = np.zeros((n, width))
+        gain[:, start:start + n] = np.eye(n)
+        pick = add(f"{key[0]}.{key[1]}", MatrixGain(gain))
+        builder.Connect(loop.get_output_port(0), pick.get_input_port())
+        out[key] = pick.get_output_port()
+        start += n
+    applied = out.pop(("applied", "inputs"))
+    return compiled, applied, out

@@ -72,7 +72,7 @@ def linearize_multibody_plant(params, scenario, options=None):
     fc_n, fs_n = nut_friction_levels(params, load) if options.friction else (0.0, 0.0)
     f_guide = float(law.steady_state_force(v, fc, fs)) if fc > 0 else 0.0
     f_nut = float(law.steady_state_force(v, fc_n, fs_n)) if fc_n > 0 else 0.0
-    applied = _load_forces(drive, idx, load) + amap @ np.array([0.0, f_guide, f_nut * ratio])
+    applied = _load_forces(drive, idx, load) + amap @ np.array([0.0, f_guide, f_nut * ratio, 0.0])
 
     context = diagram.CreateDefaultContext()
     pc = plant.GetMyMutableContextFromRoot(context)

@@ -48,6 +48,9 @@ from pydrake.multibody.tree import (
     FixedOffsetFrame,
     LinearBushingRollPitchYaw,
     PrismaticJoint,
+    PrismaticSpring,
+    RevoluteJoint,
+    RevoluteSpring,
     RotationalInertia,
     RpyFloatingJoint,
     ScrewJoint,
@@ -107,6 +110,8 @@ class MultibodyDrive:
         (lists of 3, N/m, N m/rad, N s/m, N m s/rad, in the bushing's axes = world axes).
     home : dict
         Body name -> position (m, world) of its origin (centre of mass) in the undeformed rig.
+    screw_bending : bool
+        False when the screw segments only slide along and turn about x (:func:`build_multibody`).
     """
 
     diagram: object
@@ -119,6 +124,7 @@ class MultibodyDrive:
     groups: dict = field(default_factory=dict)
     joints: dict = field(default_factory=dict)
     home: dict = field(default_factory=dict)
+    screw_bending: bool = True
 
     @property
     def segment_length(self):
@@ -144,7 +150,7 @@ def _cylinder_x(mass, r_out, r_in, length, extra_ixx=0.0):
 
 
 def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.0, rig=None, builder=None,
-                    rigid_twist_factor=RIGID_TWIST_FACTOR):
+                    rigid_twist_factor=RIGID_TWIST_FACTOR, screw_bending=True):
     """Build the multibody feed drive of ``params`` (continuous-time ``MultibodyPlant`` in a diagram).
 
     Parameters
@@ -163,6 +169,17 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         With ``rigid_joints``: the nut's spin spring in units of the screw-nut axial stiffness seen through
         the lead (:data:`RIGID_TWIST_FACTOR`, >= 1); its share of the axial chain's compliance is
         ``1 / factor`` of the nut's. Its mode (~6e5 rad/s at 1e6) sets the step of an explicit integrator.
+    screw_bending : bool
+        False (with ``rigid_joints`` only): each screw segment moves only along and about the screw's axis,
+        relative to the segment before it (a ``PrismaticJoint`` to a massless carrier, then a
+        ``RevoluteJoint``; 2 instead of 6 degrees of freedom). The shaft sections become a
+        ``PrismaticSpring`` (``EA/l``) and a ``RevoluteSpring`` (``GJ/l``) on those coordinates, the thrust
+        bearing a ``PrismaticSpring`` with joint damping on the first segment, the motor's drag joint damping:
+        the same axial and torsion forces as the bushings, at a fraction of their cost (a
+        ``LinearBushingRollPitchYaw`` costs ~10 us per evaluation). No bending, shear or lateral sag: the
+        screw's bending modes (from ~100 Hz, lateral, not coupled to the feed's axial motion) are gone.
+        For closed-loop runs of the axial dynamics (creep); ``tests/multibody/test_modes.py`` and
+        ``tests/multibody/test_diagram.py`` check the axial mode and a stick-slip run against the full screw.
     builder : DiagramBuilder, optional
         Add the plant to this builder (the caller wires and builds the diagram; ``drive.diagram`` is then
         None). Default: a diagram of the plant alone.
@@ -175,6 +192,11 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         raise InputError("n_segments", n_segments, "an integer in [2, 400]")
     if not isinstance(rigid_joints, bool):
         raise InputError("rigid_joints", rigid_joints, "true or false")
+    if not isinstance(screw_bending, bool):
+        raise InputError("screw_bending", screw_bending, "true or false")
+    if not screw_bending and not rigid_joints:
+        raise InputError("screw_bending", screw_bending, "true with the fixed joints of Tables 1-2 (false needs "
+                         "rigid_joints: the axial screw hangs on the world)")
     if isinstance(rigid_twist_factor, bool) or not isinstance(rigid_twist_factor, (int, float)) \
             or not 1.0 <= rigid_twist_factor <= 1e12:
         raise InputError("rigid_twist_factor", rigid_twist_factor, "a number in [1, 1e12]")
@@ -195,7 +217,8 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
     plant.set_name("plant")
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, -params.loads.gravity])
     drive = MultibodyDrive(diagram=None, plant=plant, params=params, rig=rig, n_segments=n_segments,
-                           rigid_joints=rigid_joints, table_position=float(table_position))
+                           rigid_joints=rigid_joints, table_position=float(table_position),
+                           screw_bending=screw_bending)
     world = plant.world_frame()
     home = {}
 
@@ -204,6 +227,23 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
         frame = plant.AddFrame(FixedOffsetFrame(f"{name}_home", world, RigidTransform(np.asarray(p, float))))
         plant.AddJoint(RpyFloatingJoint(f"{name}_free", frame, body.body_frame()))
         drive.groups[name] = group
+        home[name] = np.asarray(p, float)
+        return body
+
+    def axial_segment(i, inertia, p, previous):
+        """Segment ``i`` sliding along and turning about x relative to the one before (the world for i = 0):
+        ``PrismaticJoint`` to a massless carrier, ``RevoluteJoint`` on it; the shaft springs act on them."""
+        name = f"screw_{i}"
+        body = plant.AddRigidBody(name, inertia)
+        carrier = plant.AddRigidBody(f"{name}_carrier", SpatialInertia.Zero())
+        if previous is None:
+            parent = plant.AddFrame(FixedOffsetFrame(f"{name}_home", world, RigidTransform(np.asarray(p, float))))
+        else:
+            parent = plant.AddFrame(FixedOffsetFrame(f"{name}_home", previous.body_frame(),
+                                                     RigidTransform(np.asarray(p, float) - home[previous.name()])))
+        plant.AddJoint(PrismaticJoint(f"{name}_slide", parent, carrier.body_frame(), [1.0, 0.0, 0.0]))
+        plant.AddJoint(RevoluteJoint(f"{name}_spin", carrier.body_frame(), body.body_frame(), [1.0, 0.0, 0.0]))
+        drive.groups[name] = BodyGroup.SCREW
         home[name] = np.asarray(p, float)
         return body
 
@@ -237,13 +277,25 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
     segments = []
     for i in range(n):
         inertia = _cylinder_x(m_seg, r_nom, 0.0, seg, extra_ixx=rotor if i == 0 else 0.0)
-        segments.append(free_body(f"screw_{i}", BodyGroup.SCREW, inertia, [(i + 0.5) * seg, 0.0, 0.0]))
+        p_seg = [(i + 0.5) * seg, 0.0, 0.0]
+        if screw_bending:
+            segments.append(free_body(f"screw_{i}", BodyGroup.SCREW, inertia, p_seg))
+        else:
+            segments.append(axial_segment(i, inertia, p_seg, segments[-1] if segments else None))
     k_seg_force = [e_mod * area / seg, kappa * g_mod * area / seg, kappa * g_mod * area / seg]
     k_seg_torque = [g_mod * 2.0 * second_moment / seg, e_mod * second_moment / seg, e_mod * second_moment / seg]
     for i in range(n - 1):
         p = [(i + 1) * seg, 0.0, 0.0]
-        bushing(f"shaft_{i}", frame_at(segments[i], p, "right"), frame_at(segments[i + 1], p, "left"),
-                k_seg_torque, [0.0] * 3, k_seg_force, [0.0] * 3)
+        if screw_bending:
+            bushing(f"shaft_{i}", frame_at(segments[i], p, "right"), frame_at(segments[i + 1], p, "left"),
+                    k_seg_torque, [0.0] * 3, k_seg_force, [0.0] * 3)
+        else:
+            # the same shaft section on the chain's relative coordinates (exactly the bushing's axial and
+            # torsion terms; its shear and bending terms act on motions this screw does not have)
+            plant.AddForceElement(PrismaticSpring(plant.GetJointByName(f"screw_{i + 1}_slide"), 0.0, k_seg_force[0]))
+            plant.AddForceElement(RevoluteSpring(plant.GetJointByName(f"screw_{i + 1}_spin"), 0.0, k_seg_torque[0]))
+            drive.joints[f"shaft_{i}"] = dict(torque_stiffness=[k_seg_torque[0], 0.0, 0.0], torque_damping=[0.0] * 3,
+                                              force_stiffness=[k_seg_force[0], 0.0, 0.0], force_damping=[0.0] * 3)
 
     # ------------------------------------------------------------------ bearings and their seats
     # axial values from the parameters (the two-mass chain's), radial ones from Table 6
@@ -272,6 +324,18 @@ def build_multibody(params, n_segments=12, rigid_joints=False, table_position=0.
             bushing(f"base-bearing_seat_{side}", frame_at(None, p_face, f"seat_{side}"),
                     frame_at(seat, p_face, "face"), kt_, ct_, kf_, cf_)
             base = frame_at(seat, [x_b, 0.0, 0.0], "bearing")
+        if not screw_bending and side == 0:
+            # the thrust bearing on the first segment's coordinates (absolute: its carrier slides on the world,
+            # and does not turn): axial spring and damper, the motor's viscous drag on the rotation
+            slide, spin = plant.GetJointByName("screw_0_slide"), plant.GetJointByName("screw_0_spin")
+            plant.AddForceElement(PrismaticSpring(slide, 0.0, k_ax))
+            slide.set_default_damping(c_ax)
+            spin.set_default_damping(params.motor.viscous_damping)
+            drive.joints["bearing_0"] = dict(torque_stiffness=[0.0] * 3, torque_damping=[params.motor.viscous_damping, 0, 0],
+                                             force_stiffness=[k_ax, 0.0, 0.0], force_damping=[c_ax, 0.0, 0.0])
+            continue
+        if not screw_bending and not axial:
+            continue  # the floating bearing's radial support acts on motions this screw does not have
         bushing(f"bearing_{side}", base, frame_at(shaft_body, [x_b, 0.0, 0.0], end),
                 [0.0] * 3, [params.motor.viscous_damping if side == 0 else 0.0, 0.0, 0.0],
                 [k_ax if axial else 0.0, k_rad, k_rad], [c_ax if axial else 0.0, c_rad, c_rad])

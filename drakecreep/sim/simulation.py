@@ -269,8 +269,9 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     params : drakecreep.params.DriveParams
     scenario : drakecreep.scenario.Scenario
     backend : {"compiled", "leaf"}, optional
-        Default ``params.simulation.backend`` (two-mass model only; the multibody model runs Drake's
-        systems directly).
+        Default ``params.simulation.backend``. With the multibody model: ``compiled`` compiles the loop
+        around the MultibodyPlant (controller, sensors, friction laws; the plant stays Drake's),
+        ``leaf`` runs the leaf systems.
     wall_limit : float, optional
         Stop after this many seconds of computing (the result says so in ``status``).
     model : {"two_mass", "multibody"}
@@ -313,7 +314,8 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration)
     accuracy = target_accuracy(params)
-    built = _build(params, scenario, backend) if model == "two_mass" else _build_multibody(params, scenario, multibody)
+    built = (_build(params, scenario, backend) if model == "two_mass"
+             else _build_multibody(params, scenario, multibody, backend))
     result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit)
     check = sim.convergence_check and built[5]["integrator"] not in FIXED_STEP and result.ok \
         and result.metrics is not None
@@ -430,12 +432,14 @@ def _log_ports(builder, system, feed_drive, log_period):
     return loggers
 
 
-def _build_multibody(params, scenario, options):
-    """:func:`_build` for the multibody model: its diagram with loggers on the exported signal ports."""
+def _build_multibody(params, scenario, options, backend="compiled"):
+    """:func:`_build` for the multibody model: its diagram with loggers on the exported signal ports (the loop
+    compiled with ``backend == "compiled"``, the plant always Drake's own)."""
     from drakecreep.multibody.diagram import MultibodyOptions, build_multibody_diagram
 
     options = MultibodyOptions() if options is None else options
-    feed_drive = build_multibody_diagram(params, scenario, options)
+    feed_drive = build_multibody_diagram(params, scenario, options,
+                                         compiler=compile_diagram if backend == "compiled" else None)
     builder = DiagramBuilder()
     system = builder.AddSystem(feed_drive.diagram)
     loggers = _log_ports(builder, system, feed_drive, params.simulation.log_period)
@@ -450,7 +454,7 @@ def _build_multibody(params, scenario, options):
         sub = root.GetSubsystemContext(system, context)
         return float(table.Eval(sub)[1]), float(motor.Eval(sub)[1])
 
-    info = dict(backend="multibody", integrator=options.integrator, model="multibody",
+    info = dict(backend=f"multibody {backend}", integrator=options.integrator, model="multibody",
                 n_segments=options.n_segments, rigid_joints=options.rigid_joints, friction=options.friction)
     return feed_drive, root, loggers, init, read_speeds, info
 

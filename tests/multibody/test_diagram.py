@@ -97,3 +97,95 @@ def test_travel_beyond_one_segment_is_refused(paper):
     with pytest.raises(InputError) as err:
         build_multibody_diagram(paper, Scenario(feed=0.1, duration=5.0), MultibodyOptions(n_segments=6))
     assert err.value.field == "duration"
+
+
+@pytest.mark.parametrize("options", [MultibodyOptions(n_segments=3, rigid_joints=True), MultibodyOptions(n_segments=4)],
+                         ids=["rigid3", "full4"])
+def test_compiled_loop_gives_the_leaf_equations(paper, options):
+    """The loop compiled into SymbolicVectorSystems (the default backend) has the leaf systems' equations: at a
+    random state and time in the start-up ramp the time derivatives, the controller's discrete update and the
+    recorded signals agree to 1e-9 relative."""
+    from drakecreep.sim.compiled import compile_diagram
+
+    scenario = Scenario(feed=0.2e-3, load_case=3, duration=1.0)
+    leaf = build_multibody_diagram(paper, scenario, options)
+    comp = build_multibody_diagram(paper, scenario, options, compiler=compile_diagram)
+    assert comp.compiled is not None and "controller" not in comp.systems
+    contexts = []
+    for fd in (leaf, comp):
+        ctx = fd.diagram.CreateDefaultContext()
+        fd.set_initial_state(ctx)
+        contexts.append(ctx)
+    x0 = contexts[0].get_continuous_state_vector().CopyToVector()
+    # the same state at t = 0: the compiled loop holds one constant extra state (its discrete update system's)
+    np.testing.assert_array_equal(contexts[1].get_continuous_state_vector().CopyToVector()[:-1], x0)
+    rng = np.random.default_rng(17)
+    nx = len(x0)
+    x = x0 + 1e-5 * rng.standard_normal(nx)  # a few um / mrad around the loaded equilibrium, mm/s speeds
+    x[-3:] = x0[-3:] + [0.05, 2e-6, -3e-6]  # current loop torque (N m), the two LuGre bristle states (m)
+    xd = contexts[0].get_discrete_state_vector().CopyToVector()
+    xd = xd + 1e-3 * np.abs(xd).max() * rng.standard_normal(len(xd))
+    for ctx, extra in zip(contexts, ([], [0.0])):
+        ctx.SetTime(0.031)
+        ctx.SetContinuousState(np.concatenate([x, extra]))
+        ctx.get_mutable_discrete_state_vector().SetFromVector(xd)
+    dl = leaf.diagram.EvalTimeDerivatives(contexts[0]).CopyToVector()
+    dc = comp.diagram.EvalTimeDerivatives(contexts[1]).CopyToVector()
+    assert dc[-1] == 0.0
+    np.testing.assert_allclose(dc[:-1], dl, rtol=1e-9, atol=1e-9 * np.max(np.abs(dl)))
+    ul = leaf.diagram.EvalUniquePeriodicDiscreteUpdate(contexts[0]).get_vector(0).CopyToVector()
+    uc = comp.diagram.EvalUniquePeriodicDiscreteUpdate(contexts[1]).get_vector(0).CopyToVector()
+    np.testing.assert_allclose(uc, ul, rtol=1e-9, atol=1e-12)
+    for _, (system, port, index), _ in leaf.signals:
+        a = leaf.diagram.GetOutputPort(f"{system}.{port}").Eval(contexts[0])[index]
+        b = comp.diagram.GetOutputPort(f"{system}.{port}").Eval(contexts[1])[index]
+        assert b == pytest.approx(a, rel=1e-9, abs=1e-12), f"{system}.{port}[{index}]"
+
+
+def test_axial_screw_stick_slips_as_the_full_screw(paper):
+    """At 0.1 mm/s (load case 3, LuGre, rigid joints, N = 3) the model stick-slips; with the screw reduced to its
+    axial and torsion motion (``screw_bending=False``) the table speed follows the full screw's within 1 % of
+    the feed through the first stick-slip cycles (0.2 s), and both creep. (Stick-slip amplifies differences:
+    the two traces part by 1 % of the feed at 0.25 s; the verdict and the amplitude over 5 s are compared in
+    analysis/bench_multibody.py.)"""
+    params = _short(paper, 0.1)
+    scenario = Scenario(feed=0.1e-3, load_case=3, duration=0.2)
+    runs = [simulate(params, scenario, model="multibody",
+                     multibody=MultibodyOptions(n_segments=3, rigid_joints=True, screw_bending=bending))
+            for bending in (True, False)]
+    assert all(r.ok and r.metrics.creep and r.metrics.stick_slip_cycles >= 2 for r in runs)
+    v_full, v_axial = (r.signals["table_speed"] for r in runs)
+    assert np.max(np.abs(v_full)) > 2e-4  # slips at twice the feed and more: there is something to follow
+    assert np.max(np.abs(v_axial - v_full)) < 0.01 * 1e-4
+
+
+def test_axial_screw_option_needs_rigid_joints():
+    with pytest.raises(InputError) as err:
+        MultibodyOptions(screw_bending=False)
+    assert err.value.field == "multibody.screw_bending"
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["leaf", "compiled"])
+def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
+    """``disturbance.force_ripple`` (Tables 8-9's force ripple, :class:`LoadRipple`) adds
+    ``-A sin(2 pi f t)`` to the table's x force and nothing else; the lead error is refused."""
+    from drakecreep.multibody.diagram import _indices
+    from drakecreep.sim.compiled import compile_diagram
+
+    scenario = Scenario(feed=1e-3, load_case=3, duration=0.5)
+    options = MultibodyOptions(n_segments=3, rigid_joints=True)
+    rippled = with_value(with_value(paper, "disturbance.force_ripple", 2.0), "disturbance.ripple_frequency", 5.0)
+    forces = []
+    for params in (paper, rippled):
+        fd = build_multibody_diagram(params, scenario, options, compiler=compile_diagram if compiled else None)
+        ctx = fd.diagram.CreateDefaultContext()
+        fd.set_initial_state(ctx)
+        ctx.SetTime(0.03)
+        plant = fd.drive.plant
+        forces.append(plant.get_applied_generalized_force_input_port().Eval(plant.GetMyContextFromRoot(ctx)))
+    expected = np.zeros_like(forces[0])
+    expected[_indices(fd.drive)["table"]["vx"]] = -2.0 * math.sin(2.0 * math.pi * 5.0 * 0.03)
+    np.testing.assert_allclose(forces[1] - forces[0], expected, atol=1e-12)
+    with pytest.raises(InputError) as err:
+        build_multibody_diagram(with_value(paper, "disturbance.lead_error_amplitude", 1e-6), scenario, options)
+    assert err.value.field == "disturbance.lead_error_amplitude"

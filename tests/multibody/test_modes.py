@@ -138,3 +138,28 @@ def test_bad_input_names_the_field(paper):
         RigGeometry(table_thickness=-1.0)
     with pytest.raises(InputError, match="num_modes"):
         modal_analysis(build_multibody(paper, n_segments=2), num_modes=0)
+
+
+@pytest.mark.parametrize("n", [3, 6])
+def test_axial_screw_keeps_the_axial_and_torsion_modes(paper, n):
+    """``screw_bending=False`` (segments only slide along and turn about x, shaft springs on the chain's
+    coordinates) removes the bending modes and changes none of the axial chain's: the axial mode within 1e-6,
+    the screw's axial and torsion modes within 1 %, and the stiffest mode is no longer a bending one."""
+    full = modal_analysis(build_multibody(paper, n_segments=n, rigid_joints=True, rigid_twist_factor=1e3), num_modes=60)
+    axial = modal_analysis(build_multibody(paper, n_segments=n, rigid_joints=True, rigid_twist_factor=1e3,
+                                           screw_bending=False), num_modes=60)
+    assert axial.axial_mode().frequency == pytest.approx(full.axial_mode().frequency, rel=1e-6)
+    assert not any(m.label == "screw bending" for m in axial.modes)
+    for label in ("screw axial", "torsion"):
+        a = [m.frequency for m in axial.modes if m.label == label]
+        f = [m.frequency for m in full.modes if m.label == label]
+        assert a and len(a) == len(f)
+        np.testing.assert_allclose(a, f, rtol=0.01)
+    assert full.modes[-1].label == "screw bending"
+    assert axial.modes[-1].frequency < full.modes[-1].frequency
+
+
+def test_axial_screw_needs_rigid_joints(paper):
+    with pytest.raises(InputError) as err:
+        build_multibody(paper, n_segments=3, screw_bending=False)
+    assert err.value.field == "screw_bending"
