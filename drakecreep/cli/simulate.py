@@ -33,6 +33,9 @@ def add_parser(subparsers):
                    help="--model multibody: screw segments (default 6)")
     p.add_argument("--rigid-joints", action="store_true",
                    help="--model multibody: make the fixed joints of Tables 1-2 rigid")
+    p.add_argument("--axial-screw", action="store_true",
+                   help="--model multibody with --rigid-joints: screw segments only slide and turn about the axis "
+                        "(no bending; the cheap configuration for creep runs, docs/multibody.md)")
     p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
     p.add_argument("--max-wall", type=positive_float, metavar="S",
                    help="stop the run after S seconds of computing (what was computed is saved)")
@@ -72,19 +75,20 @@ def run(args):
 
         if args.segments is not None and not 2 <= args.segments <= 400:
             raise InputError("--segments", args.segments, "an integer in [2, 400]")
-        if args.backend is not None:
-            raise InputError("--backend", args.backend, "not given with --model multibody (Drake's systems run directly)")
         if args.uncertainty is not None:
             raise InputError("--uncertainty", args.uncertainty, "not given with --model multibody")
         segments = DEFAULT_SEGMENTS if args.segments is None else args.segments
-        multibody = MultibodyOptions(n_segments=segments, rigid_joints=args.rigid_joints)
+        if args.axial_screw and not args.rigid_joints:
+            raise InputError("--axial-screw", True, "only with --rigid-joints (the screw's bending carries the joints)")
+        multibody = MultibodyOptions(n_segments=segments, rigid_joints=args.rigid_joints,
+                                     screw_bending=not args.axial_screw)
         travel, segment = abs(feed) * args.duration, params.screw.length / segments
         if travel > segment * (1.0 + 1e-9):
             raise InputError("--duration", args.duration,
                              f"<= {segment / abs(feed):g} s at {args.feed:g} mm/s (the multibody nut stays on one "
                              f"screw segment of {segment * 1e3:g} mm)")
-    elif args.segments is not None or args.rigid_joints:
-        raise InputError("--segments/--rigid-joints", args.segments if args.segments is not None else True,
+    elif args.segments is not None or args.rigid_joints or args.axial_screw:
+        raise InputError("--segments/--rigid-joints/--axial-screw", args.segments if args.segments is not None else True,
                          "only with --model multibody")
     spec = None
     if args.uncertainty is not None:

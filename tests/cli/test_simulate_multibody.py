@@ -13,7 +13,7 @@ def test_simulate_multibody_json(paper, tmp_path, capsys):
     save_params(params, tmp_path / "short.yaml")
     out = tmp_path / "run"
     code = main(["simulate", "--params", str(tmp_path / "short.yaml"), "--model", "multibody", "--segments", "3",
-                 "--rigid-joints", "--feed", "1", "--duration", "0.3", "--no-plot", "--json", "--out", str(out)])
+                 "--rigid-joints", "--axial-screw", "--backend", "compiled", "--feed", "1", "--duration", "0.3", "--no-plot", "--json", "--out", str(out)])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["model"] == "multibody" and summary["n_segments"] == 3 and summary["rigid_joints"] is True
@@ -26,7 +26,8 @@ def test_simulate_multibody_json(paper, tmp_path, capsys):
     (["simulate", "--model", "multibody", "--segments", "1"], "--segments"),
     (["simulate", "--segments", "4"], "--segments"),
     (["simulate", "--rigid-joints"], "--rigid-joints"),
-    (["simulate", "--model", "multibody", "--backend", "leaf"], "--backend"),
+    (["simulate", "--model", "multibody", "--axial-screw"], "--axial-screw"),
+    (["simulate", "--axial-screw"], "--axial-screw"),
     (["simulate", "--model", "multibody", "--feed", "50", "--duration", "5"], "--duration"),
     (["simulate", "--model", "four_mass"], "--model"),
 ])
