@@ -25,6 +25,8 @@ def add_parser(subparsers):
     p.add_argument("--n-ool", type=count, default=6,
                    help="datasets per out-of-library and per no-candidate effect and kind (default 6)")
     p.add_argument("--samples", type=count, default=3000, help="samples per run at 1 kHz (default 3000)")
+    p.add_argument("--effects", help="comma-separated candidates of the diagnosis (default: all; a subset is for "
+                                     "quick checks: the reported figures use all)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
@@ -43,9 +45,18 @@ def run(args):
         if k not in BENCHMARK_KINDS:
             raise InputError("--kinds", k, "p_p_cascade (the drakecreep kind's product diagnosis, diagnose_drive, "
                                            "is not benchmarked yet)")
+    effects = None
+    if args.effects is not None:
+        from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+        effects = tuple(e.strip() for e in args.effects.split(",") if e.strip())
+        allowed = tuple(DRAKE_EFFECTS) + ("control_delay",)
+        for e in effects or ("",):
+            if e not in allowed:
+                raise InputError("--effects", e, "comma-separated names of " + ", ".join(allowed))
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
-                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples)
+                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects)
     if args.json:
         print_json(res)
         return 0
