@@ -437,8 +437,8 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
     diagnosed; the others are only counted (``low_snr_skipped``), and no further candidate of an effect is
     generated once it has enough. Nulls, no-candidate and out-of-library datasets are all diagnosed. Every
-    dataset is generated first (cheap), then the selected ones are diagnosed round-robin over the effects, so
-    that a run cut short still covers every effect.
+    dataset is generated first (cheap), then the selected ones are diagnosed round-robin over the effects
+    (two nulls per round, first), so that a run cut short still covers every effect.
 
     Parameters
     ----------
@@ -479,11 +479,14 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
                     skipped[name] = skipped.get(name, 0) + 1
                     continue
             kept.setdefault(key, []).append(ds)
-    order = sorted(((i, j, ds) for j, dss in enumerate(kept.values()) for i, ds in enumerate(dss)), key=lambda x: x[:2])
+    order = [ds for _, _, ds in sorted(((_round(ds, i), _slot_rank(ds.withheld), ds) for dss in kept.values()
+                                          for i, ds in enumerate(dss)), key=lambda x: x[:2])]
     rows, failed = [], []
-    for n, (_, _, ds) in enumerate(order, 1):
+    for n, ds in enumerate(order, 1):
+        t_ds = time.perf_counter()
+        inner = (lambda line, t=t_ds: say(f"    {time.perf_counter() - t:5.0f} s  {line}")) if progress else None
         try:
-            row = evaluate(ds, effects=effects, audit=audit)
+            row = evaluate(ds, effects=effects, audit=audit, progress=inner)
         except Exception as err:  # noqa: BLE001 - one failing dataset is reported, the benchmark goes on
             failed.append({"seed": ds.seed, "withheld": list(ds.withheld), "error": f"{type(err).__name__}: {err}"})
             say(f"{n}/{len(order)} seed {ds.seed}: FAILED {type(err).__name__}: {err}")
@@ -498,6 +501,27 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
     short = {f"{k}/{e}": len(kept.get((k, (e,)), [])) for k in kinds for e in T.LIBRARY_EFFECTS
              if len(kept.get((k, (e,)), [])) < n_per_effect}
     return {"scores": score_rows(rows), "datasets": rows, "failed": failed, "low_snr_skipped": skipped, "short": short}
+
+
+def _slot_rank(withheld):
+    """Order of the effects within a round: the null first, then the library effects with the no-candidate and
+    out-of-library effects spread among them (a run cut short still covers every kind of answer)."""
+    if not withheld:
+        return 0
+    lib = [(e,) for e in T.LIBRARY_EFFECTS]
+    other = [(e,) for e in T.NO_CANDIDATE + T.OUT_OF_LIBRARY]
+    seq = []
+    for k, w in enumerate(lib):
+        seq.append(w)
+        if k % 3 == 1 and other:
+            seq.append(other.pop(0))
+    seq += other
+    return 1 + seq.index(tuple(withheld))
+
+
+def _round(ds, i):
+    """Round of the ``i``-th dataset of its effect: two nulls per round."""
+    return i // 2 if not ds.withheld else i
 
 
 def _fmt(x):
