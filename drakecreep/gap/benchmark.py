@@ -380,7 +380,9 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6):
            "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
            "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
            "test_force_nominal": rms(res.nominal_test_errors), "test_force_claimed": rms(res.test_errors),
-           "diagnosis_seconds": res.seconds, "truth": {k: v for k, v in ds.truth.effects.items()}}
+           "diagnosis_seconds": res.seconds, "truth": {k: v for k, v in ds.truth.effects.items()},
+           "claimed_model": {"parameters": {k: float(v) for k, v in res.model["parameters"].items()},
+                             "flexible": bool(res.model["flexible"]), "delay": float(res.model["delay"])}}
     if audit:
         t1 = time.perf_counter()
         nom = res.nominal
