@@ -122,7 +122,7 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     (motor order 1) is claimed as position_ripple and shrinks the audit replay (runs the diagnosis never saw) as
     much as the true effect's fit (it is that fit); a null claims nothing. The rates over all candidates are
     the benchmark's business (docs/gap_benchmark.md); this checks the mechanism. Measured: SNR 4.0, audit force
-    error 20.4 -> 12.1 %, 22 s + 7 s on the loaded machine."""
+    error 20.4 -> 12.1 %; 10.5 s for both (22 s + 7 s under a load of 5 on 2 cores)."""
     from drakecreep.gap.benchmark import evaluate
 
     ds = _dataset(DEV_SEEDS + 2200, ("cogging",), {"cogging": {"amplitude_N": 10.0, "order": 1, "phase": 0.5, "h2": 0.0}})
