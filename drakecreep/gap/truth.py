@@ -30,14 +30,22 @@ diagnosis model's exact per-sample rigid step or its ``sign`` friction.
 
 Withheld effects
 ----------------
-* in the library (:data:`LIBRARY_EFFECTS`): a strong Stribeck drop, asymmetric friction, position-dependent
-  friction (a smooth ``tanh`` ramp, not the library's knots), a lead error with harmonics (kinematic: the
-  nut follows the screw angle with a periodic error, so it acts through the table's inertia and the
-  spring; it shows on the scale), cogging with harmonics (motor side), an extra structural mode (a
-  payload on a spring, 10-120 Hz), a control delay of 1-3 samples, load-dependent nut friction;
-* outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a bearing defect (a
-  force periodic in screw angle at a *non-integer* order 2.3-3.7) and a force ripple at a fixed time
-  frequency (6-25 Hz, e.g. a pump).
+The right answer of each withheld effect is decided by the benchmark (:mod:`drakecreep.gap.benchmark`, which
+maps them onto the candidates of the diagnosis); this module only simulates them.
+
+* with a candidate in the Drake diagnosis's library (:data:`LIBRARY_EFFECTS`): a strong Stribeck drop,
+  asymmetric friction, position-dependent friction (a smooth ``tanh`` ramp, not the library's periodic
+  level), a lead error with harmonics (kinematic: the nut follows the screw angle with a periodic error, so
+  it acts through the table's inertia and the spring; it shows on the scale), cogging with harmonics (motor
+  side), an extra structural mode (a payload on a spring, 10-120 Hz), a control delay of 1-3 samples, a
+  bearing defect (a force periodic in screw angle at a *non-integer* order 2.3-3.7: periodic in position,
+  with a period that is not a divisor of the lead) and a force ripple at a fixed time frequency (6-25 Hz,
+  e.g. a pump);
+* without a candidate (:data:`NO_CANDIDATE`): load-dependent nut friction (``mu |F_axial|``);
+* outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a **cable carrier**, a
+  conservative force of the table position (linear and quadratic about a neutral position, the same in
+  both directions of motion: not friction, not periodic), and a **drive-gain saturation**, the drive force
+  ``F_k tanh(F_cmd / F_k)`` instead of the commanded ``F_cmd`` (the recorded ``u`` is the command).
 
 Cross-tests (``tests/gap/test_truth.py``, with the measured differences and the tolerances):
 
@@ -63,6 +71,7 @@ from drakecreep.gap.measured import ControllerMeta, EMPS_CONTROLLER, MeasuredMet
 
 __all__ = [
     "LIBRARY_EFFECTS",
+    "NO_CANDIDATE",
     "OUT_OF_LIBRARY",
     "WITHHELD",
     "CONTROLLER_KINDS",
@@ -80,12 +89,14 @@ __all__ = [
     "make_runs",
 ]
 
-#: Withheld effects the diagnosis library has a candidate for (names as in :mod:`drakecreep.gap.effects`).
+#: Withheld effects the Drake diagnosis has a candidate for (the benchmark maps each onto its candidate).
 LIBRARY_EFFECTS = ("stribeck", "asymmetric_friction", "position_friction", "lead_error", "cogging",
-                   "structural_mode", "control_delay", "load_friction")
-#: Withheld effects without a library candidate (the answer must be "unexplained").
-OUT_OF_LIBRARY = ("bearing_defect", "time_ripple")
-WITHHELD = LIBRARY_EFFECTS + OUT_OF_LIBRARY
+                   "structural_mode", "control_delay", "bearing_defect", "time_ripple")
+#: Withheld effects whose kind the diagnosis knows but never ranks (no candidate in its replay axis).
+NO_CANDIDATE = ("load_friction",)
+#: Withheld effects outside the diagnosis's library (the answer must be "unexplained").
+OUT_OF_LIBRARY = ("cable_carrier", "drive_saturation")
+WITHHELD = LIBRARY_EFFECTS + NO_CANDIDATE + OUT_OF_LIBRARY
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 AXES = ("flexible", "rigid")
 
@@ -208,6 +219,14 @@ def draw_truth(rng, kind, axis, withheld=()):
         elif h == "time_ripple":
             p[h] = {"amplitude_N": rng.uniform(2.0, 6.0), "freq_Hz": rng.uniform(6.0, 25.0),
                     "phase": rng.uniform(0, 2 * np.pi)}
+        elif h == "cable_carrier":
+            # assumption (no rig data): a 0.1-0.3 m travel carrier pulls 8-25 N at 0.1 m from its neutral point
+            p[h] = {"stiffness_N_m": rng.uniform(80.0, 250.0) * sgn(), "quadratic_N": rng.uniform(2.0, 6.0) * sgn(),
+                    "neutral_m": rng.uniform(0.0, 0.15)}
+        elif h == "drive_saturation":
+            # assumption: the drive's force constant falls off above F_k (tanh), F_k 60-160 N (a few times the
+            # friction level of these axes, so the larger accelerations and speeds reach it)
+            p[h] = {"knee_N": rng.uniform(60.0, 160.0)}
     tr.effects = p
     return tr
 
@@ -338,6 +357,11 @@ def _columns(jobs):
         for k_ in ("amplitude_N", "freq_Hz", "phase"):
             put("tr_" + k_, one(e.get(k_, 0.0)))
         put("delay", one(eff.get("control_delay", {}).get("delay_samples", 0)))
+        e = eff.get("cable_carrier", {})
+        put("cc_k", one(e.get("stiffness_N_m", 0.0)))
+        put("cc_q", one(e.get("quadratic_N", 0.0)))
+        put("cc_x0", one(e.get("neutral_m", 0.0)))
+        put("knee", one(eff.get("drive_saturation", {}).get("knee_N", 0.0)))
     return {k: np.array(v) for k, v in cols.items()}
 
 
@@ -371,6 +395,9 @@ def simulate_batch(jobs):
     pp = p["pp"] > 0.5
     mp_safe = np.where(p["mp"] > 0, p["mp"], 1.0)
     has_le = bool(np.any(p["le_amplitude_m"] != 0))
+    has_knee = bool(np.any(p["knee"] > 0))
+    knee_safe = np.where(p["knee"] > 0, p["knee"], 1.0)
+    has_cc = bool(np.any(p["cc_k"] != 0) or np.any(p["cc_q"] != 0))
     w_lead = 2 * np.pi / p["lead"]
     v_eps = 1e-4
 
@@ -427,7 +454,10 @@ def simulate_batch(jobs):
             ring[tick % (dmax + 1)] = out
             applied = ring[(tick - dticks) % (dmax + 1), cols] if dmax else out
             tick += 1
-            cmd = p["gain"] * applied + pulses[:, kk] + noise[:, kk]
+            drive = p["gain"] * applied
+            if has_knee:
+                drive = np.where(p["knee"] > 0, p["knee"] * np.tanh(drive / knee_safe), drive)
+            cmd = drive + pulses[:, kk] + noise[:, kk]
             for i in range(sub):
                 t = (kk + (j * sub + i) / SUBSTEPS) * DT
                 f_app = f_app + (cmd - f_app) * lagc
@@ -456,7 +486,11 @@ def simulate_batch(jobs):
                 z = z_new
                 ft = p["sigma0"] * z + p["sigma1"] * dz + p["Fv_t"] * (1 + sg * p["beta"]) * v2
                 fp = p["kpl"] * (x2 - xp) + p["cpl"] * (v2 - vp)
-                a2 = (fk - ft - fp) / p["m2"]
+                fcc = 0.0
+                if has_cc:  # conservative: the same force of position in both directions of motion
+                    d = x2 - p["cc_x0"]
+                    fcc = p["cc_k"] * d + p["cc_q"] * (d / 0.1) ** 2
+                a2 = (fk - ft - fp - fcc) / p["m2"]
                 v1 = v1 + h * a1
                 v2 = v2 + h * a2
                 x1 = x1 + h * v1

@@ -6,14 +6,17 @@ from drakecreep import cli
 
 
 def test_gap_benchmark_json_on_one_short_null(capsys):
-    assert cli.main(["gap-benchmark", "--seeds", "dev", "--kinds", "drakecreep", "--n-per-effect", "0",
+    """One short null through the product diagnosis (one candidate, to stay fast)."""
+    assert cli.main(["gap-benchmark", "--seeds", "dev", "--n-per-effect", "0", "--effects", "position_ripple",
                      "--n-null", "1", "--n-ool", "0", "--samples", "900", "--json"]) == 0
     captured = capsys.readouterr()
     data = json.loads(captured.out)
     assert data["scores"]["n_datasets"] == 1
     row = data["datasets"][0]
-    assert row["category"] == "null" and row["kind"] == "drakecreep" and row["claimed"] == []
-    assert "[gap-benchmark] 1 seed" in captured.err
+    assert row["category"] == "null" and row["kind"] == "p_p_cascade" and row["claimed"] == []
+    assert [r["effect"] for r in row["ranking"]] == ["position_ripple"]
+    assert row["audit"]["nominal"]["force_rms"] > 0
+    assert "[gap-benchmark] 1/1 seed" in captured.err
 
 
 @pytest.mark.parametrize("argv, needle", [(["--n-null", "-1"], "must be >= 0"),
@@ -29,3 +32,12 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
     assert cli.main(["gap-benchmark", "--samples", "10"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--samples" in err
+
+
+@pytest.mark.parametrize("argv, needle", [(["--kinds", "drakecreep"], "diagnose_drive"),
+                                          (["--effects", "gremlins"], "--effects"),
+                                          (["--effects", "lead_error"], "--effects")])
+def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv, needle):
+    assert cli.main(["gap-benchmark"] + argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and needle in err

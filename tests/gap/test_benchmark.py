@@ -1,27 +1,62 @@
+import ast
+import pathlib
+
 import numpy as np
 import pytest
 
+from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
-from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs, design, out_and_back, score_rows
+from drakecreep.gap.benchmark import (DEV_SEEDS, EXPECTED, HELDOUT_SEEDS, benchmark_specs, design, out_and_back,
+                                      run_benchmark, score_rows)
 
 
-def test_specs_cover_every_effect_kind_and_axis_and_keep_seed_sets_apart():
+def test_specs_cover_every_effect_and_axis_and_keep_seed_sets_apart():
     specs = benchmark_specs(HELDOUT_SEEDS, n_per_effect=4, tries=2, n_null=3, n_ool=2)
     seeds = [s[0] for s in specs]
     assert len(set(seeds)) == len(seeds)
     dev = {s[0] for s in benchmark_specs(DEV_SEEDS, n_per_effect=10, tries=3, n_null=10, n_ool=10)}
     assert not dev & set(seeds)
-    for kind in T.CONTROLLER_KINDS:
-        for e in T.LIBRARY_EFFECTS:
-            mine = [s for s in specs if s[1] == (e,) and s[2] == kind]
-            assert len(mine) == 8 and {s[3] for s in mine} == set(T.AXES)
-        assert sum(1 for s in specs if s[1] == () and s[2] == kind) == 3
-        assert sum(1 for s in specs if s[1] == ("time_ripple",) and s[2] == kind) == 2
+    assert {s[2] for s in specs} == {"p_p_cascade"}
+    for e in T.LIBRARY_EFFECTS:
+        mine = [s for s in specs if s[1] == (e,)]
+        assert len(mine) == 8 and {s[3] for s in mine} == set(T.AXES)
+    assert sum(1 for s in specs if s[1] == ()) == 3
+    for e in T.OUT_OF_LIBRARY + T.NO_CANDIDATE:
+        assert sum(1 for s in specs if s[1] == (e,)) == 2
+
+
+def test_every_library_effect_has_an_expected_drake_candidate():
+    from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
+
+    assert set(EXPECTED) == set(T.LIBRARY_EFFECTS)
+    assert set(EXPECTED.values()) <= set(DRAKE_EFFECTS) | {"control_delay"}
+    # the effects the benchmark expects "no claim" for are really outside the ranked candidates
+    assert "load_dependent_friction" in NOT_RANKED and "drive_gain_nonlinearity" in NOT_RANKED
+    assert not (set(T.OUT_OF_LIBRARY) | set(T.NO_CANDIDATE)) & set(DRAKE_EFFECTS)
+
+
+def test_the_benchmark_does_not_use_the_former_rigid_diagnosis():
+    src = pathlib.Path(__file__).parents[2] / "drakecreep" / "gap" / "benchmark.py"
+    names = set()
+    for node in ast.walk(ast.parse(src.read_text())):
+        if isinstance(node, ast.ImportFrom):
+            names.add(node.module)
+        elif isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+    assert not names & {"drakecreep.gap.diagnosis", "drakecreep.gap.effects", "drakecreep.gap.replay",
+                        "drakecreep.gap.claims"}
+    assert "drakecreep.gap.drake_diagnosis" in names
+
+
+def test_the_drakecreep_kind_is_refused_before_any_work():
+    with pytest.raises(InputError, match="diagnose_drive"):
+        run_benchmark(seed=DEV_SEEDS, kinds=("drakecreep",), n_per_effect=0, n_null=1, n_ool=0)
 
 
 def test_design_cycles_through_slots():
-    got = [design(i)[0] for i in range(12)]
-    assert got[:8] == [(e,) for e in T.LIBRARY_EFFECTS] and got[10:] == [(), ()]
+    n = len(T.LIBRARY_EFFECTS) + len(T.NO_CANDIDATE) + len(T.OUT_OF_LIBRARY)
+    got = [design(i)[0] for i in range(n + 2)]
+    assert got[: len(T.LIBRARY_EFFECTS)] == [(e,) for e in T.LIBRARY_EFFECTS] and got[n:] == [(), ()]
 
 
 def test_out_and_back_returns_home():
@@ -30,22 +65,72 @@ def test_out_and_back_returns_home():
     assert np.max(np.gradient(x, 1e-3)) == pytest.approx(0.05, rel=1e-3)
 
 
-def _row(w, snr, claimed, kind="p_p_cascade", shrink=None, true=None, worse=False):
-    cat = "null" if not w else ("out_of_library" if w[0] in T.OUT_OF_LIBRARY else "library")
-    return {"withheld": w, "category": cat, "kind": kind, "axis": "rigid", "snr": snr, "claimed": claimed,
-            "audit_shrink": shrink, "true_shrink": true, "worse": worse, "provisional": []}
+def _row(w, snr, claimed, shrink=None, true=None, worse=False, axis="rigid"):
+    w = list(w)
+    if not w:
+        cat = "null"
+    elif w[0] in T.LIBRARY_EFFECTS:
+        cat = "library"
+    else:
+        cat = "no_candidate" if w[0] in T.NO_CANDIDATE else "out_of_library"
+    return {"withheld": w, "expected": EXPECTED.get(w[0]) if w else None, "category": cat, "kind": "p_p_cascade",
+            "axis": axis, "snr": snr, "claimed": claimed, "audit_shrink": shrink, "true_shrink": true, "worse": worse}
 
 
 def test_score_rows():
-    rows = [_row(["cogging"], 5.0, ["cogging"], shrink=0.8, true=0.9),
-            _row(["stribeck"], 4.0, ["load_friction"], shrink=-0.1, true=0.5, worse=True),
+    rows = [_row(["cogging"], 5.0, ["position_ripple"], shrink=0.8, true=0.9),
+            _row(["stribeck"], 4.0, ["thermal_drift"], shrink=-0.1, true=0.5, worse=True, axis="flexible"),
             _row(["stribeck"], 1.0, []),
             _row([], 0.0, []), _row([], 0.0, ["stribeck"]),
-            _row(["time_ripple"], 4.0, [])]
+            _row(["cable_carrier"], 4.0, []), _row(["drive_saturation"], 2.0, ["position_friction"]),
+            _row(["load_friction"], 6.0, [])]
     s = score_rows(rows)
     assert s["top1_snr3"] == {"rate": 0.5, "n": 2}
+    assert s["top1_all"] == {"rate": pytest.approx(1 / 3), "n": 3}
     assert s["claims_on_nulls"] == {"rate": 0.5, "n": 2}
-    assert s["out_of_library_unexplained"] == {"rate": 1.0, "n": 1}
+    assert s["out_of_library_unexplained"] == {"rate": 0.5, "n": 2}
+    assert s["no_candidate_unclaimed"] == {"rate": 1.0, "n": 1}
     assert s["median_relative_shrink_snr3"] == pytest.approx(0.5 * (0.8 / 0.9 - 0.2))
-    assert s["claims_making_audit_worse"] == 1 and s["n_claims"] == 3
-    assert s["per_effect"]["stribeck"]["n"] == 2 and s["per_effect"]["stribeck"]["n_snr3"] == 1
+    assert s["claims_making_audit_worse"] == 1 and s["n_claims"] == 4
+    assert s["wrong_claims"] == 3  # thermal_drift for stribeck, a null's claim, an out-of-library claim
+    assert s["per_effect"]["stribeck"]["n"] == 2 and s["per_effect"]["stribeck"]["n_scored"] == 1
+    assert s["per_effect"]["cogging"]["expected"] == "position_ripple"
+    assert s["per_axis"]["flexible"]["top1_snr3"] == {"rate": 0.0, "n": 1}
+
+
+def _dataset(seed, withheld, effects, n=1000):
+    """A short development dataset whose withheld effect has the given parameters (not drawn)."""
+    from drakecreep.gap.benchmark import N_TEST, N_TRAIN, Dataset, snr
+
+    rng = np.random.default_rng(seed)
+    tr = T.draw_truth(rng, "p_p_cascade", "rigid", withheld)
+    tr.effects.update(effects)
+    refs, pulses, _ = T.draw_profiles(rng, 10, n=n)
+    drift, noise = T.noise_draws(tr, 10, n, rng)
+    sim, twin = T.simulate_batch([(tr, refs, pulses, drift, noise, True), (tr, refs, pulses, drift, noise, False)])
+    runs = T.make_runs(tr, refs, pulses, sim)
+    i, j = N_TRAIN, N_TRAIN + N_TEST
+    ds = Dataset(seed=seed, withheld=withheld, truth=tr, train=runs[:i], test=runs[i:j], audit=runs[j:])
+    if withheld:
+        ds.twin_train = T.make_runs(tr, refs[:i], pulses[:i], {k: v[:i] for k, v in twin.items()})
+        ds.snr = snr(ds.train, ds.twin_train)
+    return ds
+
+
+def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
+    """Through the product diagnosis with one candidate (position_ripple) on 1 s runs: a 10 N cogging force
+    (motor order 1) is claimed as position_ripple and shrinks the audit replay (runs the diagnosis never saw) as
+    much as the true effect's fit (it is that fit); a null claims nothing. The rates over all candidates are
+    the benchmark's business (docs/gap_benchmark.md); this checks the mechanism. Measured: SNR 4.0, audit force
+    error 20.4 -> 12.1 %; 10.5 s for both (22 s + 7 s under a load of 5 on 2 cores)."""
+    from drakecreep.gap.benchmark import evaluate
+
+    ds = _dataset(DEV_SEEDS + 2200, ("cogging",), {"cogging": {"amplitude_N": 10.0, "order": 1, "phase": 0.5, "h2": 0.0}})
+    assert ds.snr >= 3
+    row = evaluate(ds, effects=("position_ripple",))
+    assert row["expected"] == "position_ripple" and row["claimed"] == ["position_ripple"]
+    assert row["audit_shrink"] > 0.3 and not row["worse"]
+    assert row["true_shrink"] == pytest.approx(row["audit_shrink"])
+    null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
+    assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
+    assert null["audit"]["claimed"] == null["audit"]["nominal"]

@@ -122,3 +122,38 @@ def test_limit_case_agrees_with_the_drake_diagram():
     ef = sim["u"][0, 100:] - f[100:]
     assert np.sqrt(np.mean(ef ** 2)) < 0.06 * np.sqrt(np.mean(f[100:] ** 2))
     assert abs(sim["u"][0, 500:].mean() - f[500:].mean()) < 0.01 * abs(f[500:].mean())
+
+
+def _clean_pair(withheld, effects, speed=0.02, n=1500):
+    """One run with and without ``withheld`` (no noise, drift or pulses); drive force [N] and table position."""
+    tr = T.draw_truth(np.random.default_rng(11), "p_p_cascade", "rigid", withheld)
+    tr.effects.update(effects)
+    refs = T.out_and_back(speed, 0.05, n=n, leg=0.6, starts=(0.1, 0.8))[None, :]
+    zero = np.zeros_like(refs)
+    a, b = T.simulate_batch([(tr, refs, zero, np.ones(1), zero, True), (tr, refs, zero, np.ones(1), zero, False)])
+    return tr, a["u"][0] * T.GTAU, b["u"][0] * T.GTAU, a["x_table"][0], np.gradient(refs[0], T.DT)
+
+
+def test_cable_carrier_is_a_force_of_position_the_same_in_both_directions():
+    """The drive force it adds (with minus without) follows k d + q (d / 0.1)^2, d = x - x_n, on the way out and
+    back alike (not friction: no sign change with the direction)."""
+    cc = {"stiffness_N_m": 200.0, "quadratic_N": 4.0, "neutral_m": 0.06}
+    tr, f, f0, x, v = _clean_pair(("cable_carrier",), {"cable_carrier": cc})
+    cruise = np.abs(v) > 0.9 * 0.02
+    d = x - cc["neutral_m"]
+    model = cc["stiffness_N_m"] * d + cc["quadratic_N"] * (d / 0.1) ** 2
+    for leg in (v > 0, v < 0):
+        m = cruise & leg
+        err = (f - f0)[m] - model[m]
+        assert np.sqrt(np.mean(err ** 2)) < 0.1 * np.sqrt(np.mean(model[m] ** 2))
+
+
+def test_drive_saturation_applies_less_than_the_recorded_command():
+    """With a knee F_k the applied force is F_k tanh(F_cmd / F_k): the recorded command must exceed the
+    effect-free one so that the applied force matches it."""
+    tr, f, f0, x, v = _clean_pair(("drive_saturation",), {"drive_saturation": {"knee_N": 40.0}}, speed=0.1)
+    big = np.abs(f0) > 20.0
+    assert big.sum() > 100
+    assert np.mean(np.abs(f[big])) > 1.1 * np.mean(np.abs(f0[big]))
+    applied = 40.0 * np.tanh(f / 40.0)
+    assert np.sqrt(np.mean((applied - f0)[big] ** 2)) < 0.2 * np.sqrt(np.mean((f - f0)[big] ** 2))
