@@ -30,7 +30,7 @@ from numba import njit
 
 from drakecreep.sim.simulation import target_accuracy
 from drakecreep.sim.baseline import BaselineModel
-from drakecreep.params import preset, with_value
+from drakecreep.params import preset
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
 from drakecreep.sim.sweep import grid, run_sweep

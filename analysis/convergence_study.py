@@ -5,7 +5,7 @@ convergence check off (this measures the raw integrator). 3 s runs, metrics over
 Run: python analysis/convergence_study.py stribeck 0.5,0.6,1.0 3
      python analysis/convergence_study.py lugre 0.05,0.1,0.5 3
 """
-import sys, time
+import sys
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate

@@ -7,7 +7,6 @@ external force in N; units in the header) and its metadata ``emps_segment.yaml``
     python analysis/make_example_dataset.py
 """
 
-from pathlib import Path
 
 import numpy as np
 import yaml

@@ -1,6 +1,5 @@
 """The atomic writer and output sets under faults: a SIGKILL during a write, a failing writer, a full disk."""
 
-import json
 import os
 import signal
 import subprocess

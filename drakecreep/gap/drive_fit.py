@@ -43,7 +43,7 @@ Steps:
    ``alpha`` = :data:`drakecreep.gap.claims.ALPHA`), and :func:`drakecreep.gap.claims.replay_test` must pass
    with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
    changes when the uncertain fields are refitted with one training run left out (as
-   :func:`drakecreep.gap.claims.replay_null`), and a majority of the runs improve. Without that null (one
+   :func:`_replay_null`), and a majority of the runs improve. Without that null (one
    training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are
    added greedily, best first, each tested again on top of what is already claimed.
 4. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
@@ -577,7 +577,7 @@ def _replay_null(train, test, params, uncertain, replayer, nominal_errors):
     """Run-to-run variation of the held-out replay: refit the uncertain fields with each training run left out.
 
     Returns the largest relative change of the pooled held-out force-error energy (the shrink an effect must
-    beat, as :func:`drakecreep.gap.claims.replay_null`), or ``None`` when it cannot be computed (one training
+    beat, as :func:`_replay_null`), or ``None`` when it cannot be computed (one training
     run, or nothing fitted).
     """
     if len(train) < 2 or not uncertain:

@@ -1,4 +1,9 @@
-"""Closed-loop replay of a rigid axis under the measured run's sampled controller.
+"""Closed-loop replay of a rigid axis under the measured run's sampled controller: the exact reference stepper.
+
+Not the diagnosis model (that is the Drake replay, :mod:`drakecreep.gap.drake_replay`): this stepper
+replays the published EMPS IDIM model for its reference errors (:mod:`drakecreep.gap.emps`) and is the
+independent cross-check of the Drake replay (``tests/gap/test_drake_replay.py``) and of the benchmark's
+truth simulator (``tests/gap/test_truth.py``). The former rigid diagnosis built on it was retired.
 
 Plant (the IDIM model, :mod:`drakecreep.gap.idim`)::
 
@@ -12,7 +17,7 @@ changes the motion is a first-order exponential (``Fv > 0``) or a parabola (``Fv
 finds the instant where ``v`` reaches 0, and there applies the stick rule of Coulomb friction with
 static level ``Fc``: the axis stays at rest while ``|F - offset| <= Fc`` and otherwise leaves in the
 direction of ``F - offset``. No regularized ``sign`` is involved, so there is no smoothing width to
-choose and no stiff step near zero speed; ``tests/test_replay.py`` checks the stepper against
+choose and no stiff step near zero speed; ``tests/gap/test_replay.py`` checks the stepper against
 :func:`scipy.integrate.solve_ivp` with a narrow ``tanh`` sign.
 
 Errors are ``100 * ||y - y_sim|| / ||y||`` over all samples (:func:`replay_errors`). Measured
@@ -184,7 +189,7 @@ class SampledPPController:
 
     ``u = kp kv (x_ref - q) - kv dq``, with ``dq`` the first difference of the position filtered by
     ``position_filter`` taps, saturated, and applied after ``delay`` samples (the queue starts with
-    the recorded outputs). Shared by :func:`replay` and :func:`drakecreep.gap.effects.replay_with_effects`.
+    the recorded outputs). Used by :func:`replay`.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """Where the sim-to-real gap lies: residuals decomposed by time regime, order, operating map; whiteness.
 
 Inputs are plain arrays on a uniform time grid: the measured run and the closed-loop replay of a model
-(:func:`drakecreep.gap.effects.replay_with_effects`), or an inverse-dynamics residual. Functions:
+(:func:`drakecreep.gap.where.where_gap` replays the Drake model), or an inverse-dynamics residual. Functions:
 
 * :func:`classify_regimes`: every sample is ``dwell``, ``stick``, ``reversal``, ``acceleration`` or
   ``constant_speed`` (from the reference motion and the measured speed);

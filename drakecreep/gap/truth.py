@@ -3,7 +3,7 @@
 Why a second implementation of the equations
 --------------------------------------------
 The gap diagnosis is scored on data whose answer is known. If those data came from the model under test
-(the rigid replay of :mod:`drakecreep.gap.replay` / :mod:`drakecreep.gap.effects`, or the Drake diagram
+(the former rigid replay of :mod:`drakecreep.gap.replay`, or the Drake diagram
 the diagnosis will replay through), every modelling shortcut of that model would be invisible: the truth
 would share its integrator, its friction law and its sensor model, and a benchmark could not tell a good
 diagnosis from one that only recognises its own equations. This module is therefore written separately
