@@ -84,7 +84,7 @@ def where_lines(where):
     reg = sorted(where["regimes"].items(), key=lambda kv: -kv[1]["energy_share"])
     lines = [f"unexplained: held-out force residual {where['force_rms_N']:.3g} N rms; by regime "
              + ", ".join(f"{k.replace('_', ' ')} {100 * v['energy_share']:.0f} % of the energy in "
-                         f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] > 0)]
+                         f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] >= 0.005)]
     b = where["bands"]
     lines.append("  by frequency: " + ", ".join(f"{r['lo_Hz']:g}-{r['hi_Hz']:.0f} Hz {100 * r['share']:.0f} %"
                                                 for r in b["bands"]) + f" (peak {b['peak_hz']:.3g} Hz)")
