@@ -73,7 +73,7 @@ def paper_rig(workers=1):
     diag = diagnose_drive(runs[0::2], runs[1::2], workers=workers, progress=lambda line: print(
         f"  [{time.perf_counter() - start:5.0f} s] {line}", flush=True))
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
-    print("\n".join(diag.summary))
+    print("\n".join(diag.summary()))
     print(f"paper-rig diagnosis (6 runs, kind drakecreep, {workers} worker(s)): {wall:.1f} s wall, {cpu:.1f} s CPU "
           "of this process (target 120 s on 2 cores)")
 

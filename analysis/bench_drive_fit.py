@@ -87,7 +87,7 @@ def recovery():
         print(f"\n== truth: {label} (seal_force {truth.table.seal_force:.4g} N, lead error "
               f"{truth.disturbance.lead_error_amplitude * 1e6:g} um); {result.simulations} replays, "
               f"{cpu:.1f} s CPU, {wall:.1f} s wall")
-        print("\n".join(result.summary))
+        print("\n".join(result.summary()))
 
 
 def coverage(count):

@@ -198,7 +198,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         kwargs["effects"] = tuple(x.strip() for x in args.effects.split(",") if x.strip())
     result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers or os.cpu_count() or 1, **kwargs)
     payload = result.to_json()
-    lines = list(result.summary)
+    lines = list(result.summary())
     if score_runs:
         say(f"replaying the augmented params, fixed, on {args.score}")
         scored = {r.label: drake_replay_errors(replay_drakecreep(r, params=result.params)) for r in score_runs}

@@ -7,7 +7,7 @@ compiled fast path) and the params file itself is identified and augmented, so t
 ``report --params`` take::
 
     result = diagnose_drive(train, test, uncertain=("table.seal_force", "friction.viscous"))
-    print("\\n".join(result.summary))
+    print("\\n".join(result.summary()))
     result.save_params("augmented.yaml")
     json_ready = result.to_json()
 
@@ -215,7 +215,6 @@ class DriveDiagnosis:
     simulations: int = 0
     seconds: float = 0.0
 
-    @property
     def summary(self):
         """Lines of text (units labelled)."""
         def rms(errs):
