@@ -72,11 +72,15 @@ def speed(duration):
               f"{ix:11.2e} {iu:11.3g}", flush=True)
 
 
+def coulomb_truth(rig):
+    """``rig`` with the guides' Coulomb level raised by 30 % of the rig's whole Coulomb force."""
+    return with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * friction_levels(rig, LoadCase())[0])
+
+
 def recovery():
     rig = test_rig()
-    fc = friction_levels(rig, LoadCase())[0]
     cases = {
-        "Coulomb +30 %": with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * fc),
+        "Coulomb +30 %": coulomb_truth(rig),
         "lead error 2 um": with_value(rig, "disturbance.lead_error_amplitude", 2e-6),
         "null": rig,
     }
@@ -92,8 +96,7 @@ def recovery():
 
 def coverage(count):
     rig = test_rig()
-    fc = friction_levels(rig, LoadCase())[0]
-    truth = with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * fc)
+    truth = coulomb_truth(rig)
     true = truth.table.seal_force
     inside, z = 0, []
     for k in range(count):

@@ -47,7 +47,7 @@ def add_parser(subparsers):
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
                    "report --params, diagnosis.json, summary.txt)")
-    p.add_argument("--workers", type=workers, metavar="N",
+    p.add_argument("--workers", type=workers, metavar="N", default=os.cpu_count() or 1,
                    help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits; drakecreep: "
                         f"the runs and Jacobian columns; default: all cores, {os.cpu_count()}; 1: all in this "
                         "process)")
@@ -99,12 +99,17 @@ def run(args):
     if getattr(args, "effects", None):
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 
-        effects = tuple(e.strip() for e in args.effects.split(",") if e.strip())
+        effects = _names(args.effects)
         for e in effects:
             if e != "control_delay" and e not in DRAKE_EFFECTS:
                 raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
                     tuple(DRAKE_EFFECTS) + ("control_delay",))))
     return _run_drake(args, train, test, score_runs, effects)
+
+
+def _names(text):
+    """A comma-separated option value as a tuple of names."""
+    return tuple(x.strip() for x in text.split(",") if x.strip())
 
 
 def _say(args):
@@ -133,7 +138,7 @@ def _run_drake(args, train, test, score_runs, effects=None):
 
     say(f"{len(train)} training, {len(test)} held-out runs; identifying the nominal axis")
     diag = diagnose_drake(train, test, effects, progress=say, on_ranking=keep_ranking,
-                          workers=args.workers or os.cpu_count() or 1)
+                          workers=args.workers)
     model = diag.model
     if score_runs:
         say(f"replaying the augmented model on {args.score} (parameters fixed)")
@@ -188,15 +193,14 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     from drakecreep.files import OutputSet
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import diagnose_drive
-    from drakecreep.params import save_params
 
     say = _say(args)
     kwargs = {}
     if args.uncertain:
-        kwargs["uncertain"] = tuple(x.strip() for x in args.uncertain.split(",") if x.strip())
+        kwargs["uncertain"] = _names(args.uncertain)
     if getattr(args, "effects", None):
-        kwargs["effects"] = tuple(x.strip() for x in args.effects.split(",") if x.strip())
-    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers or os.cpu_count() or 1, **kwargs)
+        kwargs["effects"] = _names(args.effects)
+    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, **kwargs)
     payload = result.to_json()
     lines = list(result.summary())
     if score_runs:
@@ -208,7 +212,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     payload.update(data=str(args.data), train_runs=[r.label for r in train], test_runs=[r.label for r in test])
     if args.out:
         with OutputSet(args.out, "manifest.json") as out:
-            out.write("augmented_params.yaml", lambda tmp: save_params(result.params, tmp))
+            out.write("augmented_params.yaml", result.save_params)
             out.write_text("diagnosis.json", json.dumps(payload, indent=2) + "\n")
             out.write_text("summary.txt", "\n".join(lines) + "\n")
             out.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed)})

@@ -50,6 +50,7 @@ import numpy as np
 
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
+from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.truth import out_and_back
 
 __all__ = [
@@ -308,8 +309,7 @@ def true_effect_fit(result, ds, max_nfev=6):
     :func:`drakecreep.gap.drake_effects.fit_effect` on the training runs from the screen's start); otherwise
     (screened out, or not among the candidates) the same call made here. None without an expected label.
     """
-    from drakecreep.gap.drake_diagnosis import NOMINAL_PARAMETERS
-    from drakecreep.gap.drake_effects import fit_delay, fit_effect
+    from drakecreep.gap.drake_diagnosis import fit_candidate
     from drakecreep.gap.screen import screen_delay
 
     label = ds.expected
@@ -320,10 +320,10 @@ def true_effect_fit(result, ds, max_nfev=6):
     if r is not None and r.fit is not None:
         return r.fit
     if label == "control_delay":
-        return fit_delay(ds.train, ds.test, result.nominal, start=screen_delay(ds.train, result.nominal.parameters))
-    start = r.screen.start if r is not None and r.screen is not None and r.screen.start else None
-    return fit_effect(label, ds.train, ds.test, result.nominal, max_nfev=max_nfev,
-                      starts=(start,) if start else None, refit=() if label == "axial_mode" else NOMINAL_PARAMETERS)
+        start = screen_delay(ds.train, result.nominal.parameters)
+    else:
+        start = r.screen.start if r is not None and r.screen is not None and r.screen.start else None
+    return fit_candidate(label, ds.train, ds.test, result.nominal, max_nfev, start)
 
 
 def audit_replay(runs, models):
@@ -374,12 +374,12 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6):
                 "screened_out": bool(r.screened_out),
                 "screen_gain": None if r.screen is None or r.screen.name in ("axial_mode", "control_delay")
                 else float(r.screen.gain)} for r in res.ranking]
-    rms = lambda errs: float(math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()])))  # noqa: E731
     row = {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
            "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed,
            "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
            "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
-           "test_force_nominal": rms(res.nominal_test_errors), "test_force_claimed": rms(res.test_errors),
+           "test_force_nominal": rms_force_error(res.nominal_test_errors),
+           "test_force_claimed": rms_force_error(res.test_errors),
            "diagnosis_seconds": res.seconds, "truth": {k: v for k, v in ds.truth.effects.items()},
            "claimed_model": {"parameters": {k: float(v) for k, v in res.model["parameters"].items()},
                              "flexible": bool(res.model["flexible"]), "delay": float(res.model["delay"])}}

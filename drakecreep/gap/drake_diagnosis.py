@@ -31,12 +31,14 @@ import yaml
 
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
+from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import ScreenResult, screen_delay, screen_effect
 from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
-__all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "paired_gain", "load_model", "NOMINAL_PARAMETERS"]
+__all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "fit_candidate", "paired_gain", "load_model",
+           "NOMINAL_PARAMETERS"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
 
@@ -116,8 +118,7 @@ class DrakeDiagnosis:
 
     def summary(self):
         """Lines of text."""
-        rms = lambda errs: math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-        lines = [f"nominal held-out force error {rms(self.nominal_test_errors):.3f} %"]
+        lines = [f"nominal held-out force error {rms_force_error(self.nominal_test_errors):.3f} %"]
         for r in self.ranking:
             if r.screened_out:
                 sc = r.screen
@@ -127,7 +128,8 @@ class DrakeDiagnosis:
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, gain {r.gain:+.3f} "
                          f"+- {self.k_se * r.standard_error:.3f}{'  passes' if r.passes else ''}")
         if self.claimed:
-            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
+            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error "
+                         f"{rms_force_error(self.test_errors):.3f} %")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the run-to-run spread)")
         if self.where:
@@ -156,8 +158,10 @@ def load_model(path):
     return dict(params), bool(data.get("flexible", False)), float(data.get("delay_samples", 0.0))
 
 
-def _closed_loop_fit(name, train, test, nominal, max_nfev, start):
-    """Closed-loop fit of one candidate against ``nominal`` (a process pool's job: module level, picklable)."""
+def fit_candidate(name, train, test, nominal, max_nfev, start):
+    """Closed-loop fit of candidate ``name`` (or ``"control_delay"``) on ``train`` against ``nominal``, replayed
+    fixed on ``test``, from ``start`` (the screen's best start, or None): an
+    :class:`~drakecreep.gap.drake_effects.EffectFit`. Module level, so a process pool can run it."""
     if name == "control_delay":
         return fit_delay(train, test, nominal, start=start)
     # the two-mass replay is the costly one (its mode sets the sub-steps): rank the mode with the nominal
@@ -242,13 +246,13 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
 
     if workers == 1 or len(jobs) < 2:
         for n, sc, start in jobs:
-            ranking.append(ranked(n, sc, _closed_loop_fit(n, train, test, nominal, max_nfev, start)))
+            ranking.append(ranked(n, sc, fit_candidate(n, train, test, nominal, max_nfev, start)))
     else:
         import concurrent.futures as cf
         import multiprocessing
 
         with cf.ProcessPoolExecutor(min(workers, len(jobs)), mp_context=multiprocessing.get_context("spawn")) as pool:
-            futures = {pool.submit(_closed_loop_fit, n, train, test, nominal, max_nfev, start): (n, sc)
+            futures = {pool.submit(fit_candidate, n, train, test, nominal, max_nfev, start): (n, sc)
                        for n, sc, start in jobs}
             done = {}
             for future in cf.as_completed(futures):

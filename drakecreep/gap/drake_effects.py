@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
+from drakecreep.gap.drake_replay import drake_replay_errors, make_replay, rms_force_error
 from drakecreep.gap.identify import identify
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
@@ -126,11 +126,6 @@ class EffectFit:
     seconds: float
 
 
-def _rms(values):
-    values = list(values)
-    return float(math.sqrt(sum(v * v for v in values) / len(values))) if values else float("nan")
-
-
 def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=None):
     """Replay ``runs`` with FIXED parameters: ``({label: errors}, rms force error [%])`` (no fitting)."""
     replays = replays or [make_replay(r, flexible=flexible, delay=delay, free=()) for r in runs]
@@ -138,7 +133,7 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
     for i, rep in enumerate(replays):
         label = rep.run.label if rep.run.label not in errors else f"{rep.run.label}#{i}"
         errors[label] = drake_replay_errors(rep.simulate(parameters))
-    return errors, _rms(e["force"] for e in errors.values())
+    return errors, rms_force_error(errors)
 
 
 def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0, prominent=False):
@@ -246,7 +241,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
                        bounds=bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:
             best = idf
-    train_rms = _rms(e["force"] for e in best.train_errors.values())
+    train_rms = rms_force_error(best.train_errors)
     test_errors, test_rms = score_parameters(test, best.parameters, flexible=flexible, delay=nominal.delay)
     return EffectFit(name=effect.name, parameters=best.parameters, identified=best, delay=nominal.delay,
                      flexible=flexible, train_force_error=train_rms, test_force_error=test_rms,

@@ -47,6 +47,7 @@ __all__ = [
     "DrakeReplayResult",
     "drake_replay",
     "drake_replay_errors",
+    "rms_force_error",
     "axis_from_idim",
     "replay_drakecreep",
     "replay_params",
@@ -550,6 +551,12 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     if run.x_table is not None:
         out["table_position"] = relative_error(run.x_table, result.x_table)
     return out
+
+
+def rms_force_error(errors):
+    """RMS over runs of the force error [%] of ``{label: errors}`` (:func:`drake_replay_errors`); NaN if empty."""
+    values = [e["force"] for e in errors.values()]
+    return float(math.sqrt(sum(v * v for v in values) / len(values))) if values else float("nan")
 
 
 def replay_params(run, params=None, quantize=True):

@@ -14,7 +14,7 @@ compiled fast path) and the params file itself is identified and augmented, so t
 Signature (what the ``diagnose`` CLI calls for ``kind: drakecreep`` runs)::
 
     diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0,
-                   max_nfev=8, progress=False) -> DriveDiagnosis
+                   max_nfev=8, progress=False, workers=1) -> DriveDiagnosis
 
 Steps:
 
@@ -42,8 +42,8 @@ Steps:
    (:func:`drakecreep.gap.drake_diagnosis.paired_gain`: the threshold is the held-out runs' own spread,
    ``alpha`` = :data:`drakecreep.gap.claims.ALPHA`), and :func:`drakecreep.gap.claims.replay_test` must pass
    with the run-to-run null as threshold: the pooled held-out force-error energy shrinks by more than it
-   changes when the uncertain fields are refitted with one training run left out (as
-   :func:`_replay_null`), and a majority of the runs improve. Without that null (one
+   changes when the uncertain fields are refitted with one training run left out, and a majority of the runs
+   improve. Without that null (one
    training run, or no uncertain field) candidates are ranked but never claimed. Passing candidates are
    added greedily, best first, each tested again on top of what is already claimed.
 4. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
@@ -68,7 +68,8 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, replay_test
 from drakecreep.gap.drake_diagnosis import paired_gain
-from drakecreep.gap.drake_replay import check_replayable, drake_replay_errors, replay_drakecreep, replay_params
+from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
+                                         rms_force_error)
 from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 
 __all__ = [
@@ -217,11 +218,8 @@ class DriveDiagnosis:
 
     def summary(self):
         """Lines of text (units labelled)."""
-        def rms(errs):
-            return math.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))
-
-        lines = [f"held-out force error: params file {rms(self.prior_test_errors):.3f} %, "
-                 f"fitted {rms(self.nominal_test_errors):.3f} %"
+        lines = [f"held-out force error: params file {rms_force_error(self.prior_test_errors):.3f} %, "
+                 f"fitted {rms_force_error(self.nominal_test_errors):.3f} %"
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
@@ -236,7 +234,8 @@ class DriveDiagnosis:
                     f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"
                     for k, v in c.values.items()))
         if self.claimed:
-            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error {rms(self.test_errors):.3f} %")
+            lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error "
+                         f"{rms_force_error(self.test_errors):.3f} %")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
         return lines
@@ -318,8 +317,8 @@ def _replay_one(run, params, load_case):
 class _Replayer:
     """Closed-loop replays of a fixed set of runs, counting them; over a process pool when given one."""
 
-    def __init__(self, load_case, say, pool=None):
-        self.load_case, self.count, self.say, self.pool = load_case, 0, say, pool
+    def __init__(self, load_case, pool=None):
+        self.load_case, self.count, self.pool = load_case, 0, pool
 
     def __call__(self, runs, params):
         return self.many([(runs, params)])[0]
@@ -360,8 +359,9 @@ def _lag1(r):
 # --------------------------------------------------------------------------- output-error fit
 
 def _with(params, values):
+    """``params`` with ``values`` (path -> number or word) set; NumPy scalars become Python numbers."""
     for path, v in values.items():
-        params = with_value(params, path, float(v))
+        params = with_value(params, path, v.item() if isinstance(v, np.generic) else v)
     return params
 
 
@@ -551,21 +551,15 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
         if law == base.friction.law:
             return None, 0.0
         values = {"friction.law": law}
-        r = _residual(runs, replayer(runs, _with_any(base, values)), scale)
+        r = _residual(runs, replayer(runs, _with(base, values)), scale)
         sse = float(r @ r)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
-        r = _residual(runs, replayer(runs, _with_any(base, values)), scale)
+        r = _residual(runs, replayer(runs, _with(base, values)), scale)
         sse = float(r @ r)
     else:  # pragma: no cover - names are checked up front
         raise InputError("effects", name, "one of " + ", ".join(EFFECTS))
     return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0
-
-
-def _with_any(params, values):
-    for path, v in values.items():
-        params = with_value(params, path, v)
-    return params
 
 
 def _energy(errors, labels):
@@ -576,8 +570,7 @@ def _replay_null(train, test, params, uncertain, replayer, nominal_errors):
     """Run-to-run variation of the held-out replay: refit the uncertain fields with each training run left out.
 
     Returns the largest relative change of the pooled held-out force-error energy (the shrink an effect must
-    beat, as :func:`_replay_null`), or ``None`` when it cannot be computed (one training
-    run, or nothing fitted).
+    beat), or ``None`` when it cannot be computed (one training run, or nothing fitted).
     """
     if len(train) < 2 or not uncertain:
         return None
@@ -594,7 +587,7 @@ def _replay_null(train, test, params, uncertain, replayer, nominal_errors):
 
 def _held_out(name, values, train_gain, test, current, current_errors, replayer, null):
     """Replay the candidate on the held-out runs and decide whether it passes."""
-    errs = replayer.errors(test, _with_any(current, values))
+    errs = replayer.errors(test, _with(current, values))
     gain, se = paired_gain(current_errors, errs)
     n = len(test)
     bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
@@ -655,14 +648,14 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     say = progress if callable(progress) else (
         (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None))
     if workers == 1:
-        return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case, say),
+        return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case),
                                say, t0)
     import concurrent.futures as cf
     import multiprocessing
 
     with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev,
-                               _Replayer(load_case, say, pool), say, t0)
+                               _Replayer(load_case, pool), say, t0)
 
 
 def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0):
@@ -696,7 +689,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                                                 null)
         if again.passes:
             claimed.append(c.name)
-            current, current_errors = _with_any(current, c.values), again.test_errors
+            current, current_errors = _with(current, c.values), again.test_errors
             say(f"claimed {c.name}")
     if claimed and uncertain:
         # the uncertain fields again, on the augmented model: a missing effect biases them and widens their

@@ -8,13 +8,9 @@ import json
 import numpy as np
 
 from drakecreep.files import to_jsonable
+from drakecreep.gap.drake_replay import rms_force_error
 
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
-
-
-def _rms_force(errors):
-    vals = [e["force"] for e in errors.values()]
-    return float(np.sqrt(np.mean(np.square(vals)))) if vals else float("nan")
 
 
 def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
@@ -41,7 +37,7 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
     shown = ("mass",) + tuple(n for n in nominal.fitted if n != "mass")
     return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in shown},
                                     "ci95": nominal.ci95, "warnings": list(nominal.warnings),
-                                    "held_out_force_error_percent": _rms_force(nominal_test_errors),
+                                    "held_out_force_error_percent": rms_force_error(nominal_test_errors),
                                     "held_out_errors": nominal_test_errors},
                         "ranking": rows})
 
@@ -55,8 +51,8 @@ def drake_to_json_dict(diagnosis, **extra):
         "claimed": list(diagnosis.claimed),
         "model": diagnosis.model,
         "held_out_errors": diagnosis.test_errors,
-        "held_out_force_error_percent": {"nominal": _rms_force(diagnosis.nominal_test_errors),
-                                         "augmented": _rms_force(diagnosis.test_errors)},
+        "held_out_force_error_percent": {"nominal": rms_force_error(diagnosis.nominal_test_errors),
+                                         "augmented": rms_force_error(diagnosis.test_errors)},
         "not_ranked": diagnosis.not_ranked,
         "unexplained": diagnosis.where,
         "k_se": diagnosis.k_se,
