@@ -178,3 +178,31 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
     with pytest.raises(InputError) as err:
         diagnose_drive([_blank("x", params=other)], good[1:])
     assert err.value.field == "params"
+
+
+def test_leave_one_out_step_is_close_to_the_refit():
+    """The run-to-run null's refits are one Gauss-Newton step from the nominal fit (``_Fit.without``): on a
+    residual linear in the values (as friction levels nearly are), that step lands on the refit."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(3)
+    paths = ("table.seal_force", "friction.viscous")
+    basis = [rng.normal(size=(2, 300)) for _ in range(3)]
+    truth = np.array([6.0, 250.0])
+
+    def force(k, values):
+        return values[0] * basis[k][0] + 0.01 * values[1] * basis[k][1]
+
+    runs = [SimpleNamespace(k=k, n=300, force=force(k, truth) + rng.normal(scale=0.5, size=300)) for k in range(3)]
+
+    def replayer(rs, params):
+        values = [drive_fit.get_value(params, p) for p in paths]
+        return [SimpleNamespace(force=force(r.k, values)) for r in rs]
+
+    *_, fit = drive_fit.fit_drive(runs, RIG, paths, replayer, max_nfev=20, details=True)
+    for i in range(3):
+        refit = drive_fit.fit_drive(runs[:i] + runs[i + 1:], RIG, paths, replayer, max_nfev=20)[0]
+        step = fit.without(i)
+        for p in paths:
+            a, b = drive_fit.get_value(refit, p), drive_fit.get_value(step, p)
+            assert abs(a - b) <= 2e-3 * abs(a), (i, p, a, b)
