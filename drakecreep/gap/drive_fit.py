@@ -498,13 +498,12 @@ class _Fit:
 
 # --------------------------------------------------------------------------- candidate effects
 
-def _screen(runs, base, amp_path, trial, fixed, replayer, r0, scale):
-    """One replay at a trial amplitude: the residual's slope in the amplitude and the linear optimum.
+def _screen(params, trial, r_a, r0):
+    """The residual ``r_a`` of one replay of ``params`` at a trial amplitude: its slope in the amplitude and the
+    linear optimum.
 
     Returns ``(amplitude, predicted_sse, state)``; ``state`` continues in :func:`_refine`.
     """
-    params = _with(base, fixed)
-    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: trial})), scale)
     d = (r0 - r_a) / trial  # the residual decreases by d per unit amplitude (first order)
     dd = float(d @ d)
     if dd == 0.0:
@@ -534,8 +533,12 @@ def _amplitude_effect(runs, base, amp_path, grid_path, grid, trial, replayer, ba
     """Screen every grid value with one replay, refine the best: ``(values, sse)``."""
     r0 = _residual(runs, base_sims, scale)
     best = None
-    for g in grid:
-        a, sse, state = _screen(runs, base, amp_path, trial, {grid_path: g}, replayer, r0, scale)
+    at = [_with(base, {grid_path: g}) for g in grid]
+    jobs = [(runs, _with(params, {amp_path: trial})) for params in at]
+    many = getattr(replayer, "many", None)  # every grid value's replays at once (in parallel over a pool)
+    sims = many(jobs) if many is not None else [replayer(*job) for job in jobs]
+    for g, params, s in zip(grid, at, sims):
+        a, sse, state = _screen(params, trial, _residual(runs, s, scale), r0)
         if best is None or sse < best[1]:
             best = (g, sse, a, state)
     if best is None:
