@@ -50,6 +50,8 @@ __all__ = ["creep_rows", "margin_rows", "boundary_rows", "bracket", "BOUNDARY_MO
 #: models of the creep-boundary comparison: name -> simulate() keyword arguments
 BOUNDARY_MODELS = {
     "two_mass": {},
+    "rigid2_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=2, rigid_joints=True,
+                                                                        screw_bending=False)),
     "rigid3_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=3, rigid_joints=True,
                                                                         screw_bending=False)),
     "rigid6_axial": dict(model="multibody", multibody=MultibodyOptions(n_segments=6, rigid_joints=True,

@@ -12,7 +12,7 @@ from drakecreep.params import field_unit, preset, with_value
 from drakecreep.files import write_atomic
 from drakecreep.sim.sweep import SCENARIO_FIELDS
 
-__all__ = ["plot_feed", "zoom_window", "plot_stability_map", "axis_label", "column_label"]
+__all__ = ["plot_feed", "feed_title", "zoom_window", "plot_stability_map", "axis_label", "column_label"]
 
 
 def zoom_window(result, span=None):
@@ -78,18 +78,7 @@ def plot_feed(result, path):
     ax.set_xlabel("time (s)")
     ax.set_title("reference travel minus travel", fontsize=9)
     ax.legend(loc="lower right", fontsize=8, ncol=2)
-    title = (
-        f"feed {sc.feed * 1e3:g} mm/s, load case {sc.load_case}, {p.friction.law} friction, "
-        f"{'sampled' if p.controller.sampled else 'continuous'} cascade"
-    )
-    if m is not None:
-        title += (
-            f"\nmax fluctuation {m.max_fluctuation * 1e3:.3g} mm/s ({m.fluctuation_rate * 100:.3g} %), "
-            f"stick {m.stick_fraction * 100:.1f} %, {m.stick_slip_cycles} stick-slip cycles"
-        )
-    if not result.ok:
-        title += f"\n{result.status}"
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(feed_title(result), fontsize=10)
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
@@ -97,6 +86,27 @@ def plot_feed(result, path):
 
 #: metric column suffix -> unit shown on a plot
 _SUFFIX_UNITS = {"_percent": "%", "_mm_s": "mm/s", "_um": "um", "_Hz": "Hz", "_N": "N", "_s": "s"}
+
+
+def feed_title(result):
+    """The title of :func:`plot_feed`: the run's scenario and model, its metrics, its status when it failed."""
+    p, sc, m = result.params, result.scenario, result.metrics
+    title = (
+        f"feed {sc.feed * 1e3:g} mm/s, load case {sc.load_case}, {p.friction.law} friction, "
+        f"{'sampled' if p.controller.sampled else 'continuous'} cascade"
+    )
+    stats = result.stats or {}
+    if stats.get("model") == "multibody":
+        title += (f", multibody model (N = {stats.get('n_segments')}, "
+                  f"{'rigid' if stats.get('rigid_joints') else 'Tables 1-2'} fixed joints)")
+    if m is not None:
+        title += (
+            f"\nmax fluctuation {m.max_fluctuation * 1e3:.3g} mm/s ({m.fluctuation_rate * 100:.3g} %), "
+            f"stick {m.stick_fraction * 100:.1f} %, {m.stick_slip_cycles} stick-slip cycles"
+        )
+    if not result.ok:
+        title += f"\n{result.status}"
+    return title
 
 
 def column_label(column):
