@@ -12,12 +12,14 @@ Run (about 2-3 min per dataset on one core)::
     PYTHONPATH=. nohup python analysis/bench_gap_benchmark.py --seeds heldout --n-per-effect 3 --n-null 6 \\
         --n-ool 3 --json heldout.json > heldout.txt 2> heldout.err &
     PYTHONPATH=. python analysis/bench_gap_benchmark.py --score heldout.json
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --resume heldout.json --json heldout2.json  # go on
 """
 
 import argparse
 import json
 import time
 
+from drakecreep.files import write_text
 from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, run_benchmark, score_rows
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
@@ -79,6 +81,8 @@ def main():
     ap.add_argument("--tries", type=float, default=4.0, help="candidates per library effect / --n-per-effect")
     ap.add_argument("--json", help="write scores and rows to this file (after every dataset)")
     ap.add_argument("--score", help="only print the scores of a JSON file written by this script")
+    ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
+                                     "not diagnosed again")
     args = ap.parse_args()
     if args.score:
         with open(args.score) as fh:
@@ -87,24 +91,30 @@ def main():
         report(data)
         return
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
+    done = []
+    if args.resume:
+        with open(args.resume) as fh:
+            earlier = json.load(fh)
+        if earlier.get("seed") != seed:
+            raise SystemExit(f"--resume: {args.resume} has seeds from {earlier.get('seed')}; this run's are from {seed}")
+        done = earlier["datasets"]
     t0 = time.perf_counter()
 
     def write(row, rows):
         if args.json:
-            with open(args.json, "w") as fh:
-                json.dump({"seeds": args.seeds, "seed": seed, "complete": False, "datasets": rows}, fh, indent=1,
-                          default=str)
+            write_text(args.json, json.dumps({"seeds": args.seeds, "seed": seed, "complete": False,
+                                              "datasets": rows}, indent=1, default=str))
 
     res = run_benchmark(seed=seed, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
-                        progress=True, tries=args.tries, on_row=write)
+                        progress=True, tries=args.tries, on_row=write, done=done)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, p_p_cascade, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "
           f"effects short of {args.n_per_effect} datasets with SNR >= 3: {res['short'] or 'none'}")
     report(res)
     if args.json:
-        with open(args.json, "w") as fh:
-            json.dump(dict(res, seeds=args.seeds, seed=seed, complete=True), fh, indent=1, default=str)
+        write_text(args.json, json.dumps(dict(res, seeds=args.seeds, seed=seed, complete=True), indent=1,
+                                         default=str))
 
 
 if __name__ == "__main__":

@@ -433,7 +433,8 @@ def benchmark_specs(seed, kinds=BENCHMARK_KINDS, n_per_effect=10, tries=4.0, n_n
 
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
-                  audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None):
+                  audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
+                  done=()):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -446,6 +447,9 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
     ----------
     on_row : callable, optional
         Called with ``(row, rows_so_far)`` after each dataset (e.g. to write a JSON file as rows come).
+    done : sequence of dict
+        Rows of an earlier, interrupted run with the same settings (resume): their datasets (by seed) are not
+        diagnosed again, the rows are kept in their place.
 
     Returns
     -------
@@ -484,7 +488,12 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
     order = [ds for _, _, ds in sorted(((_round(ds, i), _slot_rank(ds.withheld), ds) for dss in kept.values()
                                           for i, ds in enumerate(dss)), key=lambda x: x[:2])]
     rows, failed = [], []
+    earlier = {int(r["seed"]): r for r in done}
     for n, ds in enumerate(order, 1):
+        if ds.seed in earlier:
+            rows.append(earlier[ds.seed])
+            say(f"{n}/{len(order)} seed {ds.seed}: diagnosed in the earlier run")
+            continue
         t_ds = time.perf_counter()
         inner = (lambda line, t=t_ds: say(f"    {time.perf_counter() - t:5.0f} s  {line}")) if progress else None
         try:

@@ -134,3 +134,26 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
     assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
     assert null["audit"]["claimed"] == null["audit"]["nominal"]
+
+
+def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkeypatch):
+    from drakecreep.gap import benchmark
+
+    seen = []
+
+    def fake_evaluate(ds, **kwargs):
+        seen.append(ds.seed)
+        return {"seed": ds.seed, "withheld": list(ds.withheld), "claimed": [], "seconds": 0.0}
+
+    monkeypatch.setattr(benchmark, "evaluate", fake_evaluate)
+    monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
+    first = run_benchmark(seed=DEV_SEEDS, n_per_effect=0, n_null=3, n_ool=0, n_no_candidate=0, audit=False,
+                          n_samples=300)
+    assert len(first["datasets"]) == 3 and len(seen) == 3
+    earlier = [dict(first["datasets"][0], marker="earlier")]
+    seen.clear()
+    again = run_benchmark(seed=DEV_SEEDS, n_per_effect=0, n_null=3, n_ool=0, n_no_candidate=0, audit=False,
+                          n_samples=300, done=earlier)
+    assert earlier[0]["seed"] not in seen and len(seen) == 2
+    assert [r["seed"] for r in again["datasets"]] == [r["seed"] for r in first["datasets"]]
+    assert again["datasets"][0]["marker"] == "earlier"
