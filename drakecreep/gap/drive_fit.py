@@ -381,7 +381,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=8, base=None, details=False
         Residual evaluations of ``least_squares`` (each simulates every run).
     details : bool
         Also return a :class:`_Fit` (the solution in the fitted coordinates, the Jacobian and residual at it,
-        the rows of each run), for :func:`_leave_one_out`.
+        the rows of each run), for the leave-one-out refits (:meth:`_Fit.without`).
 
     Returns
     -------
