@@ -362,3 +362,26 @@ def test_full_disk_is_one_line_exit_1(monkeypatch, capsys):
 def test_too_long_a_path_is_bad_input(capsys):
     code, _, err = _run(["emps", "--data", "9" * 400], capsys)
     _one_line_exit_2(code, err, "File name too long")
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["simulate", "--params", ""], "--params"),
+    (["simulate", "--out", ""], "--out"),
+    (["simulate", "--out", "  "], "--out"),
+    (["params", "--check", ""], "--check"),
+    (["report", "--out", ""], "--out"),
+    (["diagnose", ""], "DATA"),
+    (["diagnose", "estimation", "--effects", ""], "--effects"),
+    (["diagnose", "estimation", "--train", ""], "--train"),
+    (["reproduce-paper", "--calibrate", ""], "--calibrate"),
+    (["emps", "--data", ""], "--data"),
+    (["tune", "--write", ""], "--write"),
+    (["sweep", ""], "SPEC.yaml"),
+])
+def test_empty_values_are_refused_not_read_as_absent(argv, fragment, tmp_path, capsys, monkeypatch):
+    # "" used to mean "not given": the default preset ran, the outputs landed in the working folder, every
+    # effect was diagnosed; a shell variable left unset must not silently change what runs
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _run(argv, capsys, timeout=10)
+    _one_line_exit_2(code, err, fragment + ": got ''" if "  " not in argv else fragment)
+    assert list(tmp_path.iterdir()) == []
