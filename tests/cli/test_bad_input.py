@@ -266,6 +266,7 @@ def test_bad_mat_files(mangle, tmp_path, capsys):
     ["report", "--out", "{file}"],
     ["diagnose", "estimation", "--out", "{file}"],
     ["sweep", "{spec}", "--out", "{file}", "--workers", "1"],
+    ["uncertainty", "--samples", "2", "--feeds", "0.1", "--duration", "1.2", "--workers", "1", "--out", "{file}"],
 ])
 def test_output_folder_is_checked_before_the_work(argv, tmp_path, capsys):
     afile = tmp_path / "afile"
@@ -338,6 +339,17 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["modal", "{tmp}/u16.csv"], "UTF-8"),
     (["modal", "/dev/zero"], "regular file"),
     (["sweep", "{tmp}/spec.yaml", "--max-cases", "0"], "--max-cases"),
+    (["uncertainty", "--samples", "99999999999"], "--samples: got 99999999999; allowed: at most 20000 rigs"),
+    (["uncertainty", "--feeds", "0.1,,0.2"], "no empty item"),
+    (["uncertainty", "--feeds", "0.1,"], "no empty item"),
+    (["uncertainty", "--load-cases", "1,,2"], "no empty item"),
+    (["uncertainty", "--feeds", "0.1,0.1"], "distinct values"),
+    (["uncertainty", "--load-cases", "2,2"], "distinct values"),
+    (["simulate", "--out", "{tmp}/s", "--uncertainty", "99999999999"], "--uncertainty: got 99999999999"),
+    (["simulate", "--out", "{tmp}/s", "--seed", "3"], "--seed: got 3; allowed: only with --uncertainty"),
+    (["simulate", "--out", "{tmp}/s", "--spec", "{tmp}/spec.yaml"], "--spec"),
+    (["compensate", "--out", "{tmp}/c", "--feeds", "0.1,,1"], "no empty item"),
+    (["compensate", "--out", "{tmp}/c", "--load-cases", "3,3"], "each once"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
