@@ -397,3 +397,17 @@ def test_empty_values_are_refused_not_read_as_absent(argv, fragment, tmp_path, c
     code, _, err = _run(argv, capsys, timeout=10)
     _one_line_exit_2(code, err, fragment + ": got ''" if "  " not in argv else fragment)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("target", ["{tmp}", "{tmp}/afile/p.yaml", "/proc/no/such/p.yaml"])
+def test_tune_write_target_is_checked_before_the_tuning(target, tmp_path, capsys, monkeypatch):
+    import drakecreep.servo.tuning as tuning
+
+    def started(*args, **kwargs):
+        raise AssertionError("the tuning started before --write was checked")
+
+    monkeypatch.setattr(tuning, "tune", started)
+    (tmp_path / "afile").write_text("keep me\n")
+    code, _, err = _run(["tune", "--write", target.format(tmp=tmp_path)], capsys)
+    _one_line_exit_2(code, err, "--write")
+    assert (tmp_path / "afile").read_text() == "keep me\n"
