@@ -350,6 +350,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["simulate", "--out", "{tmp}/s", "--spec", "{tmp}/spec.yaml"], "--spec"),
     (["compensate", "--out", "{tmp}/c", "--feeds", "0.1,,1"], "no empty item"),
     (["compensate", "--out", "{tmp}/c", "--load-cases", "3,3"], "each once"),
+    (["uncertainty", "--workers", "99999"], "--workers: '99999' must be <= 256"),
+    (["sweep", "{tmp}/spec.yaml", "--workers", "100000"], "--workers: '100000' must be <= 256"),
+    (["diagnose", "estimation", "--workers", "257"], "--workers: '257' must be <= 256"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
