@@ -154,6 +154,8 @@ SPECS = {
     "base_set_int_key": ("base: {set: {3: 4}}\naxes:\n  table.mass: [30, 40]\n", "base.set"),
     "bomb": (_bomb(), "aliases"),
     "bomb_as_axis": ("axes:\n  table.mass: &m [30, 40]\n" + _bomb_in_value().replace("x0:", "junk:"), "junk"),
+    "grid_with_n": ("axes:\n  table.mass: [30, 40]\nsample: {mode: grid, n: 3}\n", "sample"),
+    "grid_with_seed": ("axes:\n  table.mass: [30, 40]\nsample: {seed: 3}\n", "sample"),
     "scenario_bad": ("scenario: {feed: fast}\naxes:\n  table.mass: [30]\n", "feed"),
 }
 
