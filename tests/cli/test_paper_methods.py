@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+import math
 
 import numpy as np
 import pytest
@@ -115,3 +116,24 @@ def test_modal_options_name_themselves(kind, options, field, tmp_path, capsys):
     assert cli.main(["modal", str(path)] + options) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith(f"drakecreep modal: error: {field}")
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["--stiffness", "1e-300"], "--stiffness"),  # these printed inf / 1e+148 with a RuntimeWarning, exit 0
+    (["--stiffness", "1e300", "--mass", "1e-300"], "--stiffness"),
+    (["--mass", "1e-300"], "--mass"),
+    (["--damping", "1e300"], "--damping"),
+    (["--fs", "1e308", "--fd", "1e308"], "--fs"),
+    (["--feed", "1e300"], "--feed"),
+])
+def test_critical_refuses_overflowing_values(argv, field, capsys):
+    assert cli.main(["critical", "--json"] + argv) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert captured.out == "" and err.count("\n") == 0 and err.startswith(f"drakecreep critical: error: {field}: got")
+
+
+def test_critical_at_the_bounds_is_finite(capsys):
+    assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-20", "--damping", "0"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert math.isfinite(out["natural_frequency_Hz"]) and math.isfinite(out["zeta"])
