@@ -41,6 +41,7 @@ __all__ = [
     "check_input_file",
     "resolve_reference",
     "check_output_dir",
+    "check_output_file",
     "OutputSet",
     "read_manifest",
 ]
@@ -230,6 +231,27 @@ def check_output_dir(path, field="--out"):
         raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise InputError(field, str(path), "a writable folder")
+    return path
+
+
+def check_output_file(path, field="--out"):
+    """Check, before any work, that a file can be written (atomically) at ``path``; its folder is created if needed.
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` if ``path`` is an existing folder, or a file cannot be created in its folder.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(field, str(path), "a file name (this is an existing folder)")
+    folder = check_output_dir(path.parent, field)
+    try:  # what write_atomic will do: a temporary file beside the target
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.stem}.", suffix=".check")
+    except OSError as err:
+        raise InputError(field, str(path), f"a file in a writable folder ({err.strerror})") from None
+    os.close(fd)
+    os.unlink(tmp)
     return path
 
 

@@ -15,12 +15,11 @@ import re
 import typing
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
 
 import yaml
 
 from drakecreep.errors import InputError, short_repr
-from drakecreep.files import MAX_INPUT_BYTES, read_input_text
+from drakecreep.files import MAX_INPUT_BYTES, read_input_text, write_text
 
 __all__ = [
     "MotorParams",
@@ -586,7 +585,7 @@ def load_params(path):
 
 def save_params(params, path):
     """Write ``params`` to ``path`` as YAML (SI units); :func:`load_params` reads it back identically."""
-    Path(path).write_text(yaml.safe_dump(params_to_dict(params), sort_keys=False))
+    write_text(path, yaml.safe_dump(params_to_dict(params), sort_keys=False))  # atomically: all or the old file
 
 
 PRESETS = ("paper", "paper_calibrated", "rigid_axis", "paper_catalogue")

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from drakecreep.errors import InputError
-from drakecreep.files import (OutputSet, check_output_dir, read_input_text, read_manifest, resolve_reference,
+from drakecreep.files import (OutputSet, check_output_dir, check_output_file, read_input_text, read_manifest, resolve_reference,
                               write_atomic, write_text)
 
 _ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -144,3 +144,13 @@ def test_output_dir_checks(tmp_path):
         with pytest.raises(InputError, match="--out"):
             check_output_dir(bad)
     assert check_output_dir(tmp_path / "new" / "dir").is_dir()
+
+
+def test_output_file_checks(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    for bad, why in ((tmp_path, "existing folder"), (tmp_path / "afile" / "p.yaml", "existing file"),
+                     ("/proc/no/such/p.yaml", "--write")):
+        with pytest.raises(InputError, match=why):
+            check_output_file(bad, "--write")
+    assert check_output_file(tmp_path / "new" / "p.yaml", "--write") == tmp_path / "new" / "p.yaml"
+    assert sorted(p.name for p in (tmp_path / "new").iterdir()) == []  # the probe file is gone, nothing written

@@ -46,6 +46,21 @@ def test_yaml_round_trip_is_identical(tmp_path, paper):
     assert load_params(path) == paper
 
 
+def test_save_params_is_atomic(tmp_path, paper, monkeypatch):
+    import drakecreep.files
+
+    path = tmp_path / "p.yaml"
+    path.write_text("old\n")
+
+    def fail(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(drakecreep.files.os, "replace", fail)
+    with pytest.raises(OSError):
+        save_params(paper, path)
+    assert path.read_text() == "old\n" and [p.name for p in tmp_path.iterdir()] == ["p.yaml"]
+
+
 def test_exponent_without_sign_is_a_float(tmp_path):
     path = tmp_path / "p.yaml"
     path.write_text("nut: {axial_stiffness: 4.2e7}\n")

@@ -146,6 +146,7 @@ def main(argv=None):
     debug = getattr(args, "debug", False) or args.verbose > 1
     prefix = f"drakecreep {args.command}"
     try:
+        _check_no_empty_values(parser, args)
         return int(args.func(args) or 0)
     except DrakecreepError as err:
         _debug_traceback(debug)
@@ -181,6 +182,25 @@ def main(argv=None):
                 os.environ.pop("TQDM_DISABLE", None)
             else:
                 os.environ["TQDM_DISABLE"] = saved
+
+
+def _check_no_empty_values(parser, args):
+    """Refuse an option or argument given as an empty (or blank) string before the command runs.
+
+    Every command reads ``""`` as "not given" (``--params ""`` ran the default preset, ``--out ""`` wrote into
+    the working folder, ``--effects ""`` ran every effect): a shell variable left unset must not silently
+    change what runs.
+    """
+    from drakecreep.errors import InputError
+
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    for action in commands.choices[args.command]._actions:
+        value = getattr(args, action.dest, None)
+        values = value if isinstance(value, list) else [value]
+        for v in values:
+            if isinstance(v, str) and not v.strip():
+                name = max(action.option_strings, key=len) if action.option_strings else action.metavar or action.dest
+                raise InputError(name, v, "a non-empty value (leave the option out for its default)")
 
 
 #: errors of a path given by the user (exit 2); other OSErrors (a full disk, I/O errors) exit 1

@@ -8,7 +8,7 @@ from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 from drakecreep.params import PRESETS, load_params, preset, with_value
 
-__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers", "count"]
+__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers", "count", "MAX_WORKERS"]
 
 
 def number(text):
@@ -54,19 +54,25 @@ def print_json(obj):
     print(json.dumps(to_jsonable(obj)))
 
 
-def _integer_at_least(text, minimum):
+#: most worker processes of one command (``--workers 99999`` started a process per queued case)
+MAX_WORKERS = 256
+
+
+def _integer_at_least(text, minimum, maximum=None):
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
     if value < minimum:
         raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
+    if maximum is not None and value > maximum:
+        raise argparse.ArgumentTypeError(f"{text!r} must be <= {maximum}")
     return value
 
 
 def workers(text):
-    """argparse type: a number of worker processes, an integer >= 1."""
-    return _integer_at_least(text, 1)
+    """argparse type: a number of worker processes, an integer in [1, :data:`MAX_WORKERS`]."""
+    return _integer_at_least(text, 1, MAX_WORKERS)
 
 
 def count(text):

@@ -42,12 +42,17 @@ def add_parser(subparsers):
 
 
 def _list(text, option, kind, check, allowed):
+    items = [x.strip() for x in text.split(",")]
+    if not all(items):  # "1,,2" or "1,": an item lost, not a shorter list
+        raise InputError(option, text, allowed + " (no empty item)")
     try:
-        values = [kind(x) for x in text.split(",") if x.strip()]
+        values = [kind(x) for x in items]
     except ValueError:
         raise InputError(option, text, allowed) from None
-    if not values or not all(check(v) for v in values):
+    if not all(check(v) for v in values):
         raise InputError(option, text, allowed)
+    if len(set(values)) != len(values):
+        raise InputError(option, text, allowed + ", each once")
     return values
 
 

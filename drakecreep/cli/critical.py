@@ -12,9 +12,10 @@ overridden for a what-if. Units at this edge: stiffness N/µm, speeds mm/s, ever
 import dataclasses
 import math
 
-from drakecreep.cli._common import add_params_options, params_from_args, print_json
+from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, print_json
 from drakecreep.errors import InputError
 from drakecreep.model.lumped import lumped
+from drakecreep.params import ABSURD
 from drakecreep.paper import creep
 
 __all__ = ["add_parser", "run"]
@@ -62,8 +63,10 @@ def _drive(args):
         value = getattr(args, option)
         if value is None:
             continue
-        if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
-            raise InputError("--" + option, value, "a finite number >= 0" if zero_ok else "a finite number > 0")
+        # the bounds of a parameter file's fields (params.ABSURD): 1e300 or 1e-300 overflowed to inf results
+        lo, hi = 1.0 / ABSURD / unit, min(ABSURD / unit, 1e5 if option == "mass" else math.inf)
+        if not (math.isfinite(value) and ((value == 0 and zero_ok) or lo <= value <= hi)):
+            raise InputError("--" + option, value, f"{'0 or ' if zero_ok else ''}a number in [{lo:g}, {hi:g}]")
         changes[field] = value * unit
     drive = dataclasses.replace(drive, **changes)
     if drive.breakaway < drive.coulomb:
@@ -77,6 +80,7 @@ def run(args):
     """Compute and print the creep boundary."""
     if not (math.isfinite(args.feed) and args.feed > 0):
         raise InputError("--feed", args.feed, "a finite speed > 0 in mm/s")
+    feed_from_mm_s(args.feed)  # the range of every command (1e300 mm/s overflowed the friction law)
     d, source, law_name, nut_on = _drive(args)
     # the lumped mass carries the friction the model applies to the table (drakecreep.model.lumped)
     friction_on_mass = ("guides only (the ball nut's drag acts on the screw, motor side of the spring)"

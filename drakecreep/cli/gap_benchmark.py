@@ -32,13 +32,23 @@ def add_parser(subparsers):
     return p
 
 
+#: largest --n-per-effect / --n-null / --n-ool (datasets of minutes each)
+MAX_DATASETS = 1000
+#: longest run of --samples (1000 s at 1 kHz)
+MAX_SAMPLES = 1_000_000
+
+
 def run(args):
     """Run and print the scores (each dataset takes minutes: ``diagnose_drake`` fits every candidate)."""
     from drakecreep.errors import InputError
     from drakecreep.gap.benchmark import BENCHMARK_KINDS, DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
 
-    if args.samples < 600:
-        raise InputError("--samples", args.samples, "at least 600 samples per run")
+    if not 600 <= args.samples <= MAX_SAMPLES:
+        raise InputError("--samples", args.samples, f"an integer in [600, {MAX_SAMPLES}] samples per run (1 kHz)")
+    for option in ("--n-per-effect", "--n-null", "--n-ool"):
+        n = getattr(args, option[2:].replace("-", "_"))
+        if n > MAX_DATASETS:  # each dataset is minutes of fitting: 999999999 never ended
+            raise InputError(option, n, f"an integer in [0, {MAX_DATASETS}]")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
     for k in args.kinds:

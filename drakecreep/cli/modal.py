@@ -84,7 +84,14 @@ def run(args):
         raise InputError("--mass", args.mass, "> 0 kg")
     if args.exp_tau is not None and not (math.isfinite(args.exp_tau) and args.exp_tau > 0):
         raise InputError("--exp-tau", args.exp_tau, "> 0 s")
+    if args.pulse_width is not None and not (math.isfinite(args.pulse_width) and args.pulse_width > 0):
+        raise InputError("--pulse-width", args.pulse_width, "> 0 s")  # -1 was reported as a bad frequency band
+    for option, value in (("--fmin", args.fmin), ("--fmax", args.fmax)):
+        if value is not None and not math.isfinite(value):
+            raise InputError(option, value, "a finite frequency in Hz")
     header, data = _read_csv(args.file)
+    if header == _FRF_COLUMNS and args.pulse_width is not None:
+        raise InputError("--pulse-width", args.pulse_width, "only with a t,force,response file (this one is an FRF)")
     band = None
     if args.fmin is not None or args.fmax is not None:
         band = (args.fmin, args.fmax)

@@ -46,7 +46,7 @@ def add_parser(subparsers):
     p.add_argument("--uncertainty", type=int, metavar="N",
                    help="also run N plausible rigs (the preset's assumed values sampled over their ranges, "
                         "drakecreep uncertainty) at this feed and load, and say in what share of them it creeps")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="seed of the --uncertainty rig sample (default 0)")
+    p.add_argument("--seed", type=int, metavar="S", help="seed of the --uncertainty rig sample (default 0)")
     p.add_argument("--spec", metavar="FILE",
                    help="uncertainty spec for --uncertainty (default: the preset's; needed with --params)")
     p.set_defaults(func=run)
@@ -94,13 +94,19 @@ def run(args):
                          "only with --model multibody")
     spec = None
     if args.uncertainty is not None:
-        from drakecreep.cli.uncertainty import spec_from_args
+        from drakecreep.cli.uncertainty import check_study, spec_from_args
 
+        args.seed = 0 if args.seed is None else args.seed
         if args.uncertainty < 1:
             raise InputError("--uncertainty", args.uncertainty, "a number of rigs >= 1")
-        if args.seed < 0:
-            raise InputError("--seed", args.seed, "an integer >= 0")
+        try:  # before the run, not after it
+            check_study(params, args.uncertainty, [feed], [args.load_case], seed=args.seed, duration=args.duration)
+        except InputError as err:
+            raise InputError("--uncertainty" if err.field == "--samples" else err.field, err.value, err.allowed) from None
         spec = spec_from_args(args)
+    elif args.spec is not None or args.seed is not None:
+        raise InputError("--spec" if args.spec is not None else "--seed", args.spec or args.seed,
+                         "only with --uncertainty N (the rig sample it describes)")
     check_output_dir(args.out)  # before the run, not after it
     result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall, model=args.model,
                       multibody=multibody)

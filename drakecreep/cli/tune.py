@@ -42,6 +42,10 @@ def run(args):
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
+    if args.write:  # before the tuning, not after it
+        from drakecreep.files import check_output_file
+
+        check_output_file(args.write, "--write")
     try:
         result = tune(params, scenario, args.bandwidth, args.phase_margin)
     except InputError as err:

@@ -5,31 +5,47 @@ import os
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, positive_float, print_json, workers
 from drakecreep.errors import InputError
 
-__all__ = ["add_parser", "run", "run_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
+__all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
 
 #: feeds (mm/s) of the default study: the paper's creep range and above
 DEFAULT_FEEDS_MM_S = (0.05, 0.1, 0.2, 0.5, 1.0)
 
 
+def _items(text, option, allowed):
+    """The comma-separated items of an option's value; an empty item (``1,,2``, ``1,``) is an error."""
+    items = [v.strip() for v in text.split(",")]
+    if not all(items):
+        raise InputError(option, text, allowed + " (no empty item)")
+    return items
+
+
+def _distinct(values, option, text):
+    if len(set(values)) != len(values):
+        raise InputError(option, text, "distinct values (each is a column of the study)")
+    return values
+
+
 def _feeds(text):
+    allowed = "comma-separated feeds in mm/s, e.g. 0.05,0.1,0.2"
+    items = _items(text, "--feeds", allowed)
     try:
-        values = [float(v) for v in text.split(",") if v.strip()]
+        values = [float(v) for v in items]
     except ValueError:
-        raise InputError("--feeds", text, "comma-separated feeds in mm/s, e.g. 0.05,0.1,0.2") from None
-    if not values:
-        raise InputError("--feeds", text, "comma-separated feeds in mm/s, e.g. 0.05,0.1,0.2")
-    return [feed_from_mm_s(v, "--feeds") for v in values]
+        raise InputError("--feeds", text, allowed) from None
+    return _distinct([feed_from_mm_s(v, "--feeds") for v in values], "--feeds", text)
 
 
 def _load_cases(text, params):
+    n = len(params.loads.cases)
+    allowed = f"comma-separated integers in 0..{n} (0 = unloaded)"
+    items = _items(text, "--load-cases", allowed)
     try:
-        values = [int(v) for v in text.split(",") if v.strip()]
+        values = [int(v) for v in items]
     except ValueError:
         raise InputError("--load-cases", text, "comma-separated load case numbers, e.g. 1,2,3") from None
-    n = len(params.loads.cases)
-    if not values or any(not 0 <= v <= n for v in values):
-        raise InputError("--load-cases", text, f"comma-separated integers in 0..{n} (0 = unloaded)")
-    return values
+    if any(not 0 <= v <= n for v in values):
+        raise InputError("--load-cases", text, allowed)
+    return _distinct(values, "--load-cases", text)
 
 
 def add_parser(subparsers):
@@ -76,19 +92,33 @@ def spec_from_args(args):
     return uncertainty_spec(args.preset)
 
 
+def check_study(params, samples, feeds, load_cases, *, seed=0, duration=3.0, out=None):
+    """Everything :func:`run_study` needs, checked before the first simulation (and ``out`` created)."""
+    from drakecreep.files import check_output_dir
+    from drakecreep.sim.sweep import MAX_CASES
+
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise InputError("--samples", samples, "an integer >= 1")
+    per_rig = max(1, len(feeds) * len(load_cases))
+    if samples * per_rig > MAX_CASES:  # the rig sample alone would not fit in memory (1e11 rigs: 15 TiB)
+        raise InputError("--samples", samples, f"at most {MAX_CASES // per_rig} rigs ({MAX_CASES} simulations "
+                                               f"of {len(feeds)} feed(s) x {len(load_cases)} load case(s))")
+    if seed < 0:
+        raise InputError("--seed", seed, "an integer >= 0")
+    if params.simulation.steady_start >= duration:
+        raise InputError("--duration", duration,
+                         f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window")
+    if out is not None:
+        check_output_dir(out)
+
+
 def run_study(params, spec, samples, feeds, load_cases, *, seed=0, duration=3.0, n_workers=None, scheduler=None,
               out=None, progress=True):
     """Validate, run :func:`drakecreep.studies.uncertainty.run_uncertainty`, write its tables; return the result."""
     from drakecreep.files import write_atomic, write_json
     from drakecreep.studies.uncertainty import run_uncertainty
 
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
-        raise InputError("--samples", samples, "an integer >= 1")
-    if seed < 0:
-        raise InputError("--seed", seed, "an integer >= 0")
-    if params.simulation.steady_start >= duration:
-        raise InputError("--duration", duration,
-                         f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window")
+    check_study(params, samples, feeds, load_cases, seed=seed, duration=duration, out=out)
     if scheduler:
         executor = "dask"
     elif n_workers == 1:

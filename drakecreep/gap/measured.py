@@ -49,6 +49,8 @@ from drakecreep.gap.formats import read_signals
 
 __all__ = [
     "U_UNITS",
+    "MIN_U_GAIN",
+    "MAX_U_GAIN",
     "COLUMNS",
     "CONTROLLER_KINDS",
     "ControllerMeta",
@@ -79,6 +81,9 @@ COLUMNS = {
     "run": (None, False),
 }
 _ARRAYS = ("t", "x_ref", "x_motor", "x_table", "u", "f_ext")
+#: Range of ``u_gain`` [N per unit of u]: drives span about 1e-3 to 1e5 N/A or N/V; outside these bounds the
+#: forces overflow or vanish in the identification
+MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
 #: Controller kinds of the metadata schema.
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
@@ -236,6 +241,8 @@ class MeasuredMeta:
         if self.u_units not in U_UNITS:
             raise InputError("u_units", self.u_units, "one of " + ", ".join(U_UNITS))
         gain = _finite("u_gain", self.u_gain, 0.0, True)
+        if not MIN_U_GAIN <= gain <= MAX_U_GAIN:  # 1e300 overflowed the identification (axis.damping = inf)
+            raise InputError("u_gain", self.u_gain, f"a gain in [{MIN_U_GAIN:g}, {MAX_U_GAIN:g}] N per {self.u_units}")
         if self.u_units == "N" and gain != 1.0:
             raise InputError("u_gain", self.u_gain, "1 when u_units is N (u is already a force)")
         object.__setattr__(self, "u_gain", gain)
@@ -262,12 +269,13 @@ def _check_time(t, rtol, where="t"):
     bad = np.flatnonzero(dt <= 0)
     if bad.size:
         k = bad[0]
-        raise InputError(where, f"t[{k + 1}] = {t[k + 1]!r} after t[{k}] = {t[k]!r}", "strictly increasing time")
+        raise InputError(where, f"t[{k + 1}] = {float(t[k + 1])!r} after t[{k}] = {float(t[k])!r}",
+                         "strictly increasing time")
     step = float(np.median(dt))
     dev = np.abs(dt - step) / step
     k = int(np.argmax(dev))
     if dev[k] > rtol:
-        raise InputError(where, f"step {dt[k]!r} s at sample {k} (median step {step!r} s)",
+        raise InputError(where, f"step {float(dt[k])!r} s at sample {k} (median step {step!r} s)",
                          f"uniform sampling within a relative tolerance of {rtol:g}")
     return step
 

@@ -823,7 +823,8 @@ def load_spec(path, max_cases=MAX_CASES):
         raise InputError("axes", axes, "a non-empty mapping path -> values")
     sample = data.get("sample") or {"mode": "grid"}
     if not isinstance(sample, dict) or sample.get("mode", "grid") not in ("grid", "random") \
-            or set(sample) - {"mode", "n", "seed"}:
+            or set(sample) - {"mode", "n", "seed"} \
+            or (sample.get("mode", "grid") == "grid" and set(sample) - {"mode"}):  # n of a grid was ignored
         raise InputError("sample", sample, "{mode: grid} or {mode: random, n: N, seed: S}")
     if sample.get("mode", "grid") == "grid":
         expanded = {p: (_range(p, v, max_cases) if isinstance(v, dict) else v) for p, v in axes.items()}

@@ -5,6 +5,7 @@ with a Markdown/CSV/PNG report (:func:`write_report`).
 """
 
 from drakecreep.errors import InputError
+from drakecreep.files import write_atomic, write_text
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
@@ -249,13 +250,18 @@ def write_report(out_dir, rows, critical=None, robust=None, params_name="paper")
     paths = dict(csv=out / "compensation.csv", markdown=out / "summary.md", json=out / "rows.json",
                  plot=out / "comparison.png")
     keys = list(dict.fromkeys(k for r in rows + (robust or []) for k in r))
-    with paths["csv"].open("w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=keys + ["study"])
-        writer.writeheader()
-        for study, group in (("grid", rows), ("robustness", robust or [])):
-            for r in group:
-                writer.writerow(dict(r, study=study))
-    paths["markdown"].write_text(summary_markdown(rows, critical, robust, params_name))
-    paths["json"].write_text(json.dumps(dict(rows=rows, critical=critical, robustness=robust), indent=2) + "\n")
-    plot_comparison(rows, paths["plot"], f"Friction compensation against none ({params_name})")
+
+    def write_csv(tmp):
+        with open(tmp, "w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=keys + ["study"])
+            writer.writeheader()
+            for study, group in (("grid", rows), ("robustness", robust or [])):
+                for r in group:
+                    writer.writerow(dict(r, study=study))
+
+    # every file atomically: a failure (a full disk, a kill) leaves the previous file whole
+    write_atomic(paths["csv"], write_csv)
+    write_text(paths["markdown"], summary_markdown(rows, critical, robust, params_name))
+    write_text(paths["json"], json.dumps(dict(rows=rows, critical=critical, robustness=robust), indent=2) + "\n")
+    write_atomic(paths["plot"], lambda tmp: plot_comparison(rows, tmp, f"Friction compensation against none ({params_name})"))
     return paths

@@ -154,6 +154,8 @@ SPECS = {
     "base_set_int_key": ("base: {set: {3: 4}}\naxes:\n  table.mass: [30, 40]\n", "base.set"),
     "bomb": (_bomb(), "aliases"),
     "bomb_as_axis": ("axes:\n  table.mass: &m [30, 40]\n" + _bomb_in_value().replace("x0:", "junk:"), "junk"),
+    "grid_with_n": ("axes:\n  table.mass: [30, 40]\nsample: {mode: grid, n: 3}\n", "sample"),
+    "grid_with_seed": ("axes:\n  table.mass: [30, 40]\nsample: {seed: 3}\n", "sample"),
     "scenario_bad": ("scenario: {feed: fast}\naxes:\n  table.mass: [30]\n", "feed"),
 }
 
@@ -266,6 +268,7 @@ def test_bad_mat_files(mangle, tmp_path, capsys):
     ["report", "--out", "{file}"],
     ["diagnose", "estimation", "--out", "{file}"],
     ["sweep", "{spec}", "--out", "{file}", "--workers", "1"],
+    ["uncertainty", "--samples", "2", "--feeds", "0.1", "--duration", "1.2", "--workers", "1", "--out", "{file}"],
 ])
 def test_output_folder_is_checked_before_the_work(argv, tmp_path, capsys):
     afile = tmp_path / "afile"
@@ -338,6 +341,20 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["modal", "{tmp}/u16.csv"], "UTF-8"),
     (["modal", "/dev/zero"], "regular file"),
     (["sweep", "{tmp}/spec.yaml", "--max-cases", "0"], "--max-cases"),
+    (["uncertainty", "--samples", "99999999999"], "--samples: got 99999999999; allowed: at most 20000 rigs"),
+    (["uncertainty", "--feeds", "0.1,,0.2"], "no empty item"),
+    (["uncertainty", "--feeds", "0.1,"], "no empty item"),
+    (["uncertainty", "--load-cases", "1,,2"], "no empty item"),
+    (["uncertainty", "--feeds", "0.1,0.1"], "distinct values"),
+    (["uncertainty", "--load-cases", "2,2"], "distinct values"),
+    (["simulate", "--out", "{tmp}/s", "--uncertainty", "99999999999"], "--uncertainty: got 99999999999"),
+    (["simulate", "--out", "{tmp}/s", "--seed", "3"], "--seed: got 3; allowed: only with --uncertainty"),
+    (["simulate", "--out", "{tmp}/s", "--spec", "{tmp}/spec.yaml"], "--spec"),
+    (["compensate", "--out", "{tmp}/c", "--feeds", "0.1,,1"], "no empty item"),
+    (["compensate", "--out", "{tmp}/c", "--load-cases", "3,3"], "each once"),
+    (["uncertainty", "--workers", "99999"], "--workers: '99999' must be <= 256"),
+    (["sweep", "{tmp}/spec.yaml", "--workers", "100000"], "--workers: '100000' must be <= 256"),
+    (["diagnose", "estimation", "--workers", "257"], "--workers: '257' must be <= 256"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
@@ -362,3 +379,40 @@ def test_full_disk_is_one_line_exit_1(monkeypatch, capsys):
 def test_too_long_a_path_is_bad_input(capsys):
     code, _, err = _run(["emps", "--data", "9" * 400], capsys)
     _one_line_exit_2(code, err, "File name too long")
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["simulate", "--params", ""], "--params"),
+    (["simulate", "--out", ""], "--out"),
+    (["simulate", "--out", "  "], "--out"),
+    (["params", "--check", ""], "--check"),
+    (["report", "--out", ""], "--out"),
+    (["diagnose", ""], "DATA"),
+    (["diagnose", "estimation", "--effects", ""], "--effects"),
+    (["diagnose", "estimation", "--train", ""], "--train"),
+    (["reproduce-paper", "--calibrate", ""], "--calibrate"),
+    (["emps", "--data", ""], "--data"),
+    (["tune", "--write", ""], "--write"),
+    (["sweep", ""], "SPEC.yaml"),
+])
+def test_empty_values_are_refused_not_read_as_absent(argv, fragment, tmp_path, capsys, monkeypatch):
+    # "" used to mean "not given": the default preset ran, the outputs landed in the working folder, every
+    # effect was diagnosed; a shell variable left unset must not silently change what runs
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _run(argv, capsys, timeout=10)
+    _one_line_exit_2(code, err, fragment + ": got ''" if "  " not in argv else fragment)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("target", ["{tmp}", "{tmp}/afile/p.yaml", "/proc/no/such/p.yaml"])
+def test_tune_write_target_is_checked_before_the_tuning(target, tmp_path, capsys, monkeypatch):
+    import drakecreep.servo.tuning as tuning
+
+    def started(*args, **kwargs):
+        raise AssertionError("the tuning started before --write was checked")
+
+    monkeypatch.setattr(tuning, "tune", started)
+    (tmp_path / "afile").write_text("keep me\n")
+    code, _, err = _run(["tune", "--write", target.format(tmp=tmp_path)], capsys)
+    _one_line_exit_2(code, err, "--write")
+    assert (tmp_path / "afile").read_text() == "keep me\n"

@@ -41,3 +41,19 @@ def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv
     assert cli.main(["gap-benchmark"] + argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and needle in err
+
+
+@pytest.mark.parametrize("argv, field", [(["--n-per-effect", "999999999"], "--n-per-effect"),
+                                         (["--n-null", "5000"], "--n-null"),
+                                         (["--n-ool", "99999"], "--n-ool"),
+                                         (["--samples", "99999999999"], "--samples")])
+def test_gap_benchmark_refuses_sizes_that_never_end_before_starting(capsys, monkeypatch, argv, field):
+    import drakecreep.gap.benchmark as benchmark
+
+    def started(**kwargs):
+        raise AssertionError("the benchmark started")
+
+    monkeypatch.setattr(benchmark, "run_benchmark", started)
+    assert cli.main(["gap-benchmark"] + argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and err.startswith(f"drakecreep gap-benchmark: error: {field}: got ")

@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+import math
 
 import numpy as np
 import pytest
@@ -93,3 +94,46 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     assert cli.main(["modal", str(path)]) == 2
     assert "f_Hz,re,im" in capsys.readouterr().err
     assert cli.main(["modal", str(tmp_path / "missing.csv")]) == 2
+
+
+@pytest.mark.parametrize("kind, options, field", [
+    ("time", ["--pulse-width", "-1"], "--pulse-width: got -1.0"),  # was blamed on the frequency band
+    ("time", ["--pulse-width", "nan"], "--pulse-width: got nan"),
+    ("frf", ["--pulse-width", "1e-3"], "--pulse-width: got 0.001; allowed: only with a t,force,response file"),
+    ("frf", ["--fmin", "nan"], "--fmin: got nan"),
+    ("frf", ["--fmax", "inf"], "--fmax: got inf"),
+])
+def test_modal_options_name_themselves(kind, options, field, tmp_path, capsys):
+    path = tmp_path / "m.csv"
+    if kind == "frf":
+        f = np.linspace(10, 500, 200)
+        H = 1 / (1e5 - (2 * np.pi * f) ** 2 + 20j * f)
+        np.savetxt(path, np.column_stack([f, H.real, H.imag]), delimiter=",", header="f_Hz,re,im", comments="")
+    else:
+        test = synthetic_hammer_test(1.0, 258.28, 52.3e6, 50e3, 0.05, 1e-4, delay=2e-4)
+        np.savetxt(path, np.column_stack([test.t, test.force[0], test.response[0]]), delimiter=",",
+                   header="t,force,response", comments="")
+    assert cli.main(["modal", str(path)] + options) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith(f"drakecreep modal: error: {field}")
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["--stiffness", "1e-300"], "--stiffness"),  # these printed inf / 1e+148 with a RuntimeWarning, exit 0
+    (["--stiffness", "1e300", "--mass", "1e-300"], "--stiffness"),
+    (["--mass", "1e-300"], "--mass"),
+    (["--damping", "1e300"], "--damping"),
+    (["--fs", "1e308", "--fd", "1e308"], "--fs"),
+    (["--feed", "1e300"], "--feed"),
+])
+def test_critical_refuses_overflowing_values(argv, field, capsys):
+    assert cli.main(["critical", "--json"] + argv) == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip()
+    assert captured.out == "" and err.count("\n") == 0 and err.startswith(f"drakecreep critical: error: {field}: got")
+
+
+def test_critical_at_the_bounds_is_finite(capsys):
+    assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-20", "--damping", "0"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert math.isfinite(out["natural_frequency_Hz"]) and math.isfinite(out["zeta"])

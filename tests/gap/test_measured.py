@@ -333,3 +333,19 @@ def test_emps_validation_pulses_are_drive_volts():
     recorded = run.u + pulses  # the file's vir
     jumps = recorded[edges + 1] - recorded[edges]
     np.testing.assert_allclose(np.abs(jumps), 5.0, atol=0.6)  # vir jumps by the pulse at every edge
+
+
+@pytest.mark.parametrize("gain", [1e300, 1e-300, 1e10])
+def test_absurd_u_gain_is_refused_where_it_is_read(tmp_path, gain):
+    # 1e300 passed the file check and overflowed the identification ("axis.damping: got inf")
+    with pytest.raises(InputError, match=r"u_gain: got .*allowed: a gain in \[1e-09, 1e\+09\] N per V"):
+        load_measured(_write(tmp_path, meta={**META, "u_gain": gain}))
+
+
+def test_time_errors_show_plain_numbers(tmp_path):
+    cols = _rows()
+    cols["t"] = [float(x) for x in cols["t"]]
+    cols["t"][5] = cols["t"][4]
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, cols=cols))
+    assert "np.float64" not in str(err.value) and "strictly increasing" in str(err.value)

@@ -162,3 +162,23 @@ def test_bad_method_is_an_input_error(short_paper):
         creep_boundary(short_paper, "magic", 3)
     with pytest.raises(InputError):
         with_value(short_paper, "compensation.coulomb_factor", -1.0)
+
+
+def test_write_report_is_atomic(tmp_path, monkeypatch):
+    import drakecreep.files
+    from drakecreep.studies.compensation import write_report
+
+    row = dict(label="none", method="none", load_case=3, feed_mm_s=1.0, status="ok", max_fluctuation_mm_s=1e-3,
+               fluctuation_rate_percent=0.1, stick_fraction=0.0, creep=False, following_error_max_um=1.0,
+               following_error_rms_um=1.0, converged=True, fluctuation_vs_none=1.0, stick_fraction_vs_none=0.0)
+    paths = write_report(tmp_path, [row, dict(row, feed_mm_s=2.0)])
+    before = {name: p.read_bytes() for name, p in paths.items()}
+
+    def fail(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(drakecreep.files.os, "replace", fail)
+    with pytest.raises(OSError):
+        write_report(tmp_path, [dict(row, feed_mm_s=5.0)])
+    assert {name: p.read_bytes() for name, p in paths.items()} == before  # no file half-replaced
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths.values())
