@@ -20,7 +20,7 @@ import sys
 
 from drakecreep.cli._common import print_json, workers
 from drakecreep.errors import InputError
-from drakecreep.gap.runs import load_runs, pick  # noqa: F401 (re-exported: the library side)
+from drakecreep.gap.runs import load_runs, pick, train_test  # noqa: F401 (pick re-exported: the library side)
 
 __all__ = ["add_parser", "run", "load_runs", "pick"]
 
@@ -33,9 +33,9 @@ def add_parser(subparsers):
                    "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
-                   "(default: even indices; parts of one split run: 0, 1, 4, 5, ...)")
-    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of "
-                   "one split run: 2, 3, 6, 7, ...)")
+                   "(default: even indices; parts of one split run: 0, 1, 4, 5, ...; three runs or parts: 0)")
+    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of one "
+                   "split run: 2, 3, 6, 7, ...; three runs or parts: 1, 2)")
     p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous)")
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
@@ -68,8 +68,7 @@ def run(args):
     split = len(runs) == 1
     runs = load_runs(args.data, args.meta, split=True if own else "half") if split else runs
     pairs = split and not own
-    train = pick(runs, args.train, 0, "--train", pairs=pairs)
-    test = pick(runs, args.test, 1, "--test", pairs=pairs)
+    train, test = train_test(runs, args.train, args.test, pairs=pairs)
     if set(r.label for r in train) & set(r.label for r in test):
         raise InputError("--test", args.test, "runs disjoint from the training runs")
     # everything the end of the run needs is checked before the diagnosis starts

@@ -10,7 +10,7 @@ import numpy as np
 
 from drakecreep.errors import InputError
 
-__all__ = ["load_runs", "pick", "split_half_cycles", "split_cycles"]
+__all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles"]
 
 
 def _reversals(run):
@@ -85,6 +85,17 @@ def load_runs(data, meta=None, split=True):
     elif split and len(runs) == 1:
         runs = split_cycles(runs[0])
     return runs
+
+
+def train_test(runs, train_spec=None, test_spec=None, pairs=False):
+    """Training and held-out runs from the ``--train`` / ``--test`` selections (:func:`pick`).
+
+    Without either selection: even / odd indices (or pairs of them, ``pairs``); three runs (or parts) are split
+    1 / 2 instead (the first trains, the other two are held out), since a diagnosis needs two held-out runs.
+    """
+    if not train_spec and not test_spec and len(runs) == 3:
+        return [runs[0]], list(runs[1:])
+    return pick(runs, train_spec, 0, "--train", pairs=pairs), pick(runs, test_spec, 1, "--test", pairs=pairs)
 
 
 def pick(runs, spec, default_parity, option="--train", pairs=False):

@@ -32,3 +32,17 @@ def test_split_half_cycles_cuts_every_reversal():
         dx = np.diff(p.x_ref)
         forward, backward = dx[dx > 0].sum(), -dx[dx < 0].sum()
         assert min(forward, backward) < 0.01 * max(forward, backward)
+
+
+def test_default_train_test_split_keeps_two_held_out_runs():
+    from types import SimpleNamespace
+
+    from drakecreep.gap.runs import train_test
+
+    runs = [SimpleNamespace(label=f"r{i}") for i in range(5)]
+    assert [[r.label for r in part] for part in train_test(runs[:3])] == [["r0"], ["r1", "r2"]]
+    assert [[r.label for r in part] for part in train_test(runs[:4])] == [["r0", "r2"], ["r1", "r3"]]
+    assert [[r.label for r in part] for part in train_test(runs)] == [["r0", "r2", "r4"], ["r1", "r3"]]
+    assert [[r.label for r in part] for part in train_test(runs[:3], "r2", "0,1")] == [["r2"], ["r0", "r1"]]
+    assert [[r.label for r in part] for part in train_test(runs[:3], pairs=True)] == [["r0"], ["r1", "r2"]]
+    assert [[r.label for r in part] for part in train_test(runs[:4], pairs=True)] == [["r0", "r1"], ["r2", "r3"]]
