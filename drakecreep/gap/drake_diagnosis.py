@@ -30,6 +30,7 @@ import numpy as np
 import yaml
 
 from drakecreep.errors import InputError
+from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
@@ -142,7 +143,7 @@ class DrakeDiagnosis:
                 "delay_samples": float(self.model["delay"]), "claimed": list(self.claimed),
                 "parameters": {k: float(v) for k, v in self.model["parameters"].items()},
                 "units": {k: AXIS_UNITS[k] for k in self.model["parameters"]}}
-        Path(path).write_text(yaml.safe_dump(data, sort_keys=False))
+        write_text(path, yaml.safe_dump(data, sort_keys=False))  # atomically
         return Path(path)
 
 

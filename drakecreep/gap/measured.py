@@ -45,6 +45,7 @@ import yaml
 
 from drakecreep.data import emps_data_dir
 from drakecreep.errors import InputError
+from drakecreep.files import write_atomic, write_text
 from drakecreep.gap.formats import read_signals
 
 __all__ = [
@@ -583,15 +584,18 @@ def save_measured(data, csv_path, meta_path=None):
     header = [f"{n}[{data.meta.u_units if n == 'u' else COLUMNS[n][0]}]" for n in names]
     if multi:
         header.append("run")
-    with open(csv_path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        for r in data.runs:
-            block = np.column_stack([getattr(r, n) for n in names])
-            for row in block:
-                cells = [repr(float(x)) for x in row]
-                w.writerow(cells + [r.label] if multi else cells)
-    meta_path.write_text(yaml.safe_dump(_meta_to_dict(data.meta), sort_keys=False))
+    def write_csv(tmp):
+        with open(tmp, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            for r in data.runs:
+                block = np.column_stack([getattr(r, n) for n in names])
+                for row in block:
+                    cells = [repr(float(x)) for x in row]
+                    w.writerow(cells + [r.label] if multi else cells)
+
+    write_atomic(csv_path, write_csv)  # a failure keeps the old file, never half of a new one
+    write_text(meta_path, yaml.safe_dump(_meta_to_dict(data.meta), sort_keys=False))
     return csv_path, meta_path
 
 

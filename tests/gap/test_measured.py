@@ -349,3 +349,25 @@ def test_time_errors_show_plain_numbers(tmp_path):
     with pytest.raises(InputError) as err:
         load_measured(_write(tmp_path, cols=cols))
     assert "np.float64" not in str(err.value) and "strictly increasing" in str(err.value)
+
+
+def test_save_measured_keeps_the_old_file_when_writing_fails(tmp_path, monkeypatch):
+    from drakecreep.data import example_path
+    from drakecreep.gap import measured
+
+    data = measured.load_measured(example_path("emps_segment.csv"))
+    csv_path, _ = measured.save_measured(data, tmp_path / "runs.csv")
+    before = csv_path.read_text()
+    calls = {"n": 0}
+    real = np.column_stack
+
+    def failing(arrays):
+        calls["n"] += 1
+        raise OSError("disk full")
+
+    monkeypatch.setattr(measured.np, "column_stack", failing)
+    with pytest.raises(OSError):
+        measured.save_measured(data, csv_path)
+    monkeypatch.setattr(measured.np, "column_stack", real)
+    assert calls["n"] == 1 and csv_path.read_text() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["runs.csv", "runs.yaml"]  # no temporary left
