@@ -8,7 +8,8 @@ from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 from drakecreep.params import PRESETS, load_params, preset, with_value
 
-__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers", "count", "MAX_WORKERS"]
+__all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers",
+           "count", "MAX_WORKERS", "comma_items", "distinct", "names"]
 
 
 def number(text):
@@ -20,6 +21,27 @@ def number(text):
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"{text!r} must be finite")
     return value
+
+
+def comma_items(text, option, allowed):
+    """The stripped comma-separated items of an option's value; an empty item (``1,,2``, ``1,``) is an error
+    (an item lost, not a shorter list)."""
+    items = [x.strip() for x in text.split(",")]
+    if not all(items):
+        raise InputError(option, text, allowed + " (no empty item)")
+    return items
+
+
+def distinct(values, option, text, allowed):
+    """``values`` if no value repeats, else an error naming ``option`` (its value ``text``) with ``allowed``."""
+    if len(set(values)) != len(values):
+        raise InputError(option, text, allowed)
+    return values
+
+
+def names(text):
+    """A comma-separated list of names as a tuple (blank items are skipped)."""
+    return tuple(x.strip() for x in text.split(",") if x.strip())
 
 
 def positive_float(text):

@@ -1,6 +1,6 @@
 """``drakecreep compensate``: friction compensation methods against none over feeds and loads."""
 
-from drakecreep.cli._common import add_params_options, params_from_args, positive_float, print_json
+from drakecreep.cli._common import add_params_options, comma_items, distinct, params_from_args, positive_float, print_json
 from drakecreep.errors import InputError
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS
 
@@ -42,18 +42,14 @@ def add_parser(subparsers):
 
 
 def _list(text, option, kind, check, allowed):
-    items = [x.strip() for x in text.split(",")]
-    if not all(items):  # "1,,2" or "1,": an item lost, not a shorter list
-        raise InputError(option, text, allowed + " (no empty item)")
+    items = comma_items(text, option, allowed)
     try:
         values = [kind(x) for x in items]
     except ValueError:
         raise InputError(option, text, allowed) from None
     if not all(check(v) for v in values):
         raise InputError(option, text, allowed)
-    if len(set(values)) != len(values):
-        raise InputError(option, text, allowed + ", each once")
-    return values
+    return distinct(values, option, text, allowed + ", each once")
 
 
 def run(args):

@@ -18,7 +18,7 @@ parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
 import os
 import sys
 
-from drakecreep.cli._common import print_json, workers
+from drakecreep.cli._common import names, print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import load_runs, pick, train_test  # noqa: F401 (pick re-exported: the library side)
 
@@ -98,17 +98,12 @@ def run(args):
     if getattr(args, "effects", None):
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 
-        effects = _names(args.effects)
+        effects = names(args.effects)
         for e in effects:
             if e != "control_delay" and e not in DRAKE_EFFECTS:
                 raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
                     tuple(DRAKE_EFFECTS) + ("control_delay",))))
     return _run_drake(args, train, test, score_runs, effects)
-
-
-def _names(text):
-    """A comma-separated option value as a tuple of names."""
-    return tuple(x.strip() for x in text.split(",") if x.strip())
 
 
 def _say(args):
@@ -196,9 +191,9 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     say = _say(args)
     kwargs = {}
     if args.uncertain:
-        kwargs["uncertain"] = _names(args.uncertain)
+        kwargs["uncertain"] = names(args.uncertain)
     if getattr(args, "effects", None):
-        kwargs["effects"] = _names(args.effects)
+        kwargs["effects"] = names(args.effects)
     result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, **kwargs)
     payload = result.to_json()
     lines = list(result.summary())

@@ -3,7 +3,7 @@ the product diagnosis (``diagnose_drake``, the Drake replay model), scored on au
 
 import sys
 
-from drakecreep.cli._common import count, print_json
+from drakecreep.cli._common import count, names, print_json
 
 __all__ = ["add_parser", "run"]
 
@@ -59,7 +59,7 @@ def run(args):
     if args.effects is not None:
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
-        effects = tuple(e.strip() for e in args.effects.split(",") if e.strip())
+        effects = names(args.effects)
         allowed = tuple(DRAKE_EFFECTS) + ("control_delay",)
         for e in effects or ("",):
             if e not in allowed:

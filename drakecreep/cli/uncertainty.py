@@ -2,50 +2,38 @@
 
 import os
 
-from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, positive_float, print_json, workers
+from drakecreep.cli._common import (add_params_options, comma_items, distinct, feed_from_mm_s, params_from_args,
+                                    positive_float, print_json, workers)
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
 
 #: feeds (mm/s) of the default study: the paper's creep range and above
 DEFAULT_FEEDS_MM_S = (0.05, 0.1, 0.2, 0.5, 1.0)
-
-
-def _items(text, option, allowed):
-    """The comma-separated items of an option's value; an empty item (``1,,2``, ``1,``) is an error."""
-    items = [v.strip() for v in text.split(",")]
-    if not all(items):
-        raise InputError(option, text, allowed + " (no empty item)")
-    return items
-
-
-def _distinct(values, option, text):
-    if len(set(values)) != len(values):
-        raise InputError(option, text, "distinct values (each is a column of the study)")
-    return values
+_DISTINCT = "distinct values (each is a column of the study)"
 
 
 def _feeds(text):
     allowed = "comma-separated feeds in mm/s, e.g. 0.05,0.1,0.2"
-    items = _items(text, "--feeds", allowed)
+    items = comma_items(text, "--feeds", allowed)
     try:
         values = [float(v) for v in items]
     except ValueError:
         raise InputError("--feeds", text, allowed) from None
-    return _distinct([feed_from_mm_s(v, "--feeds") for v in values], "--feeds", text)
+    return distinct([feed_from_mm_s(v, "--feeds") for v in values], "--feeds", text, _DISTINCT)
 
 
 def _load_cases(text, params):
     n = len(params.loads.cases)
     allowed = f"comma-separated integers in 0..{n} (0 = unloaded)"
-    items = _items(text, "--load-cases", allowed)
+    items = comma_items(text, "--load-cases", allowed)
     try:
         values = [int(v) for v in items]
     except ValueError:
         raise InputError("--load-cases", text, "comma-separated load case numbers, e.g. 1,2,3") from None
     if any(not 0 <= v <= n for v in values):
         raise InputError("--load-cases", text, allowed)
-    return _distinct(values, "--load-cases", text)
+    return distinct(values, "--load-cases", text, _DISTINCT)
 
 
 def add_parser(subparsers):

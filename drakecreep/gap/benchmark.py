@@ -350,10 +350,9 @@ def audit_replay(runs, models):
         key = (tuple(sorted((k, float(v)) for k, v in params.items())), bool(flexible), float(delay))
         if key not in done:
             try:
-                errs, _ = score_parameters(runs, params, flexible=flexible, delay=delay)
+                errs, rms = score_parameters(runs, params, flexible=flexible, delay=delay)
                 per = [float(e["force"]) for e in errs.values()]
-                done[key] = {"energy": float(np.mean(np.square(per))), "force_rms": float(math.sqrt(np.mean(np.square(per)))),
-                             "per_run": per}
+                done[key] = {"energy": float(np.mean(np.square(per))), "force_rms": rms, "per_run": per}
             except InputError:
                 done[key] = None
         out[label] = done[key]

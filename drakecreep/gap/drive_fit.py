@@ -338,7 +338,12 @@ class _Replayer:
         return out
 
     def errors(self, runs, params):
-        return {r.label: drake_replay_errors(s) for r, s in zip(runs, self(runs, params))}
+        return self.many_errors([(runs, params)])[0]
+
+    def many_errors(self, jobs):
+        """``{label: replay errors}`` of each ``(runs, params)`` of ``jobs``, replayed at once (:meth:`many`)."""
+        return [{r.label: drake_replay_errors(s) for r, s in zip(runs, sims)}
+                for (runs, _), sims in zip(jobs, self.many(jobs))]
 
 
 def _residual(runs, sims, scale):
@@ -619,8 +624,8 @@ def _replay_null(train, test, fit, replayer, nominal_errors):
     e_nom = float(np.sum(_energy(nominal_errors, labels)))
     refits = [fit.without(i) for i in range(len(train))]
     changes = []
-    for sims in replayer.many([(test, refit) for refit in refits]):
-        e = float(np.sum(_energy({r.label: drake_replay_errors(s) for r, s in zip(test, sims)}, labels)))
+    for errors in replayer.many_errors([(test, refit) for refit in refits]):
+        e = float(np.sum(_energy(errors, labels)))
         changes.append(abs(1.0 - e / e_nom) if e_nom > 0 else 0.0)
     return float(max(changes))
 
