@@ -21,6 +21,17 @@ plus a fixed time frequency ``f_r``)::
 
     r(x_m, t) = pc cos(2 pi x_m / Lp) + ps sin(2 pi x_m / Lp) + tc cos(2 pi f_r t) + ts sin(2 pi f_r t)
 
+With bristles (``bristles=True``, ``bristle_stiffness`` ``sigma0 > 0``) the Coulomb-Stribeck part is the LuGre
+law instead (Canudas de Wit et al. 1995): a bristle deflection ``z`` is appended to the state, and::
+
+    dz/dt = v - sigma0 |v| z / g(v),     g(v) = Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)
+    f     = L(x, t) [sigma0 z + sigma1 dz/dt + (Fv + dFv s(v)) v],   sigma1 = 2 zeta sqrt(sigma0 m_t)
+
+so the axis sticks (the bristles hold any force below ``g(0)`` with a presliding displacement
+``|F| / sigma0``) where the regularized law creeps at ``v_reg atanh(F / Fc)``. In steady sliding both laws
+give ``g(v) sign(v) + (Fv + dFv s) v``. ``zeta`` is ``bristle_damping_ratio`` (the bristle mode on the
+table mass; 1 = critically damped, an assumption: the damping is not identifiable at 1 kHz).
+
 ``dFc``, ``dFv`` make it asymmetric (``Fc + dFc`` forward, ``Fc - dFc`` backward). ``F`` is the drive
 force plus any external force (input ``force``, N). The offset is the constant force of the IDIM
 model (``tau = M ddq + Fv dq + Fc sign(dq) + offset``, :mod:`drakecreep.gap.idim`).
@@ -37,11 +48,11 @@ from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.errors import InputError
-from drakecreep.model._scalar import exp, tanh, vector
+from drakecreep.model._scalar import exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
-           "set_axis_parameters", "axis_friction"]
+           "set_axis_parameters", "axis_friction", "bristle_rates", "has_bristles"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -67,6 +78,8 @@ AXIS_PARAMETERS = {
     "time_ripple_sin": 0.0,
     "ripple_frequency": 50.0,
     "friction_drift": 0.0,
+    "bristle_stiffness": 0.0,
+    "bristle_damping_ratio": 1.0,
 }
 AXIS_UNITS = {
     "mass": "kg", "viscous": "N s/m", "viscous_asym": "N s/m", "coulomb": "N", "coulomb_asym": "N", "offset": "N",
@@ -75,6 +88,7 @@ AXIS_UNITS = {
     "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
     "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
     "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
+    "bristle_stiffness": "N/m", "bristle_damping_ratio": "-",
 }
 _POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "position_period",
              "friction_period", "ripple_frequency")
@@ -94,6 +108,10 @@ def axis_parameters(**values):
         if not math.isfinite(x) or (name in _POSITIVE and x <= 0):
             raise InputError(f"axis.{name}", value, "a finite number" + (" > 0" if name in _POSITIVE else ""))
         out[name] = x
+    if out["bristle_stiffness"] < 0:
+        raise InputError("axis.bristle_stiffness", out["bristle_stiffness"], "a number >= 0 N/m (0: no bristles)")
+    if out["bristle_damping_ratio"] < 0:
+        raise InputError("axis.bristle_damping_ratio", out["bristle_damping_ratio"], "a number >= 0")
     if not 0 < out["motor_mass_fraction"] < 1:
         raise InputError("axis.motor_mass_fraction", out["motor_mass_fraction"], "a number in (0, 1)")
     return np.array([out[n] for n in _NAMES])
@@ -101,15 +119,45 @@ def axis_parameters(**values):
 
 def axis_friction(v, p, x=0.0, t=0.0):
     """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] for a parameter vector
-    ``p`` (order of :data:`AXIS_PARAMETERS`)."""
+    ``p`` (order of :data:`AXIS_PARAMETERS`): the regularized law, which is also the steady sliding friction of
+    the LuGre bristles (:func:`bristle_rates`)."""
     P = dict(zip(_NAMES, p))
+    g, s = _sliding_level(P, v)
+    return _level(P, x, t) * (s * g + (P["viscous"] + P["viscous_asym"] * s) * v)
+
+
+def _level(P, x, t):
+    phase = 2.0 * math.pi * x / P["friction_period"]
+    return (1.0 + P["friction_ripple_cos"] * cos(phase) + P["friction_ripple_sin"] * sin(phase)
+            + P["friction_drift"] * t)
+
+
+def _sliding_level(P, v):
+    """``g(v)``: the Coulomb-Stribeck level (with its asymmetry) the bristles relax to."""
     s = tanh(v / P["regularization_velocity"])
     w = v / P["stribeck_velocity"]
-    phase = 2.0 * math.pi * x / P["friction_period"]
-    level = (1.0 + P["friction_ripple_cos"] * cos(phase) + P["friction_ripple_sin"] * sin(phase)
-             + P["friction_drift"] * t)
-    return level * (s * (P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w))
-                    + (P["viscous"] + P["viscous_asym"] * s) * v)
+    return P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w), s
+
+
+def has_bristles(p):
+    """True when the parameter vector ``p`` (or mapping) switches the LuGre bristles on (``bristle_stiffness > 0``)."""
+    value = p["bristle_stiffness"] if isinstance(p, dict) else p[_NAMES.index("bristle_stiffness")]
+    return float(value) > 0.0
+
+
+def bristle_rates(v, z, p, table_mass):
+    """``(dz/dt, friction)`` of the LuGre bristles at table speed ``v`` [m/s] and deflection ``z`` [m] for the
+    parameter vector ``p``, without the position/time level ``L`` (:mod:`drakecreep.model.axis` docstring).
+
+    ``dz/dt = v - a(v) z`` is linear in ``z`` with ``a = sigma0 |v| / |g(v)|``: a sampled replay advances it with
+    its exact solution over a step (``drakecreep.gap.drake_replay.SampledReplay``).
+    """
+    P = dict(zip(_NAMES, p))
+    g, s = _sliding_level(P, v)
+    sigma0 = P["bristle_stiffness"]
+    sigma1 = 2.0 * P["bristle_damping_ratio"] * (sigma0 * table_mass) ** 0.5
+    zdot = v - sigma0 * fabs(v) * z / (fabs(g) + 1e-9)
+    return zdot, sigma0 * z + sigma1 * zdot + (P["viscous"] + P["viscous_asym"] * s) * v
 
 
 def axis_ripple(x, t, p):
@@ -134,7 +182,10 @@ def set_axis_parameters(axis, context, **values):
 @TemplateSystem.define("MeasuredAxis_")
 def MeasuredAxis_(T):
     class Impl(LeafSystem_[T]):
-        """Rigid or two-mass axis with parameterised friction.
+        """Rigid or two-mass axis with parameterised friction, optionally with LuGre bristles.
+
+        State ``[x_m, v_m(, x_t, v_t)(, z)]``: the table's pair with ``flexible``, the bristle deflection ``z``
+        [m] with ``bristles`` (then ``bristle_stiffness`` must be > 0).
 
         Input ports
         -----------
@@ -144,32 +195,50 @@ def MeasuredAxis_(T):
         ------------
         motor_state : 2, ``[x_m (m), v_m (m/s)]`` (the motor encoder's view)
         table_state : 2, ``[x_t (m), v_t (m/s)]`` (the linear scale's view; = motor_state when rigid)
-        friction_force : 1, ``f(v_t)`` (N)
+        friction_force : 1, friction on the table (N)
         """
 
-        def _construct(self, flexible=False, parameters=None, initial_state=None, converter=None):
+        def _construct(self, flexible=False, parameters=None, initial_state=None, bristles=False, converter=None):
             LeafSystem_[T].__init__(self, converter=converter)
             self.flexible = bool(flexible)
+            self.bristles = bool(bristles)
             self.parameters = axis_parameters() if parameters is None else np.asarray(parameters, dtype=float)
             if self.parameters.shape != (len(_NAMES),):
                 raise InputError("axis.parameters", self.parameters.shape, f"{len(_NAMES)} values")
             n = 4 if self.flexible else 2
-            self.initial_state = [0.0] * n if initial_state is None else [float(v) for v in initial_state]
-            if len(self.initial_state) != n:
-                raise InputError("axis.initial_state", len(self.initial_state), f"{n} entries")
-            self.DeclareContinuousState(BasicVector_[T](self.initial_state), num_q=n // 2, num_v=n // 2, num_z=0)
+            size = n + (1 if self.bristles else 0)
+            self.initial_state = [0.0] * size if initial_state is None else [float(v) for v in initial_state]
+            if len(self.initial_state) != size:
+                raise InputError("axis.initial_state", len(self.initial_state), f"{size} entries")
+            self.DeclareContinuousState(BasicVector_[T](self.initial_state), num_q=n // 2, num_v=n // 2,
+                                        num_z=size - n)
             self.DeclareNumericParameter(BasicVector_[T](self.parameters))
             self._force = self.DeclareVectorInputPort("force", 1)
             deps = {self.xc_ticket(), self.all_parameters_ticket()}
             self.DeclareVectorOutputPort("motor_state", 2, self._calc_motor, prerequisites_of_calc=deps)
             self.DeclareVectorOutputPort("table_state", 2, self._calc_table, prerequisites_of_calc=deps)
-            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction, prerequisites_of_calc=deps)
+            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction,
+                                         prerequisites_of_calc=deps | {self.time_ticket()})
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.flexible, other.parameters, other.initial_state, converter=converter)
+            Impl._construct(self, other.flexible, other.parameters, other.initial_state, other.bristles,
+                            converter=converter)
 
         def _p(self, context):
             return context.get_numeric_parameter(0).CopyToVector()
+
+        def _table(self):
+            return 2 if self.flexible else 0
+
+        def _friction(self, x, p, t):
+            """``(friction on the table, [dz/dt] or [])``."""
+            P = dict(zip(_NAMES, p))
+            i = self._table()
+            if not self.bristles:
+                return axis_friction(x[i + 1], p, x[i], t), []
+            m_t = P["mass"] * (1.0 - P["motor_mass_fraction"]) if self.flexible else P["mass"]
+            zdot, f = bristle_rates(x[i + 1], x[-1], p, m_t)
+            return _level(P, x[i], t) * f, [zdot]
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             x = context.get_continuous_state_vector().CopyToVector()
@@ -177,17 +246,18 @@ def MeasuredAxis_(T):
             P = dict(zip(_NAMES, p))
             F = self._force.Eval(context)[0]
             t = context.get_time()
+            friction, zdot = self._friction(x, p, t)
             if self.flexible:
                 m_m = P["motor_mass_fraction"] * P["mass"]
                 m_t = P["mass"] - m_m
                 spring = P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
                 a_m = (F + axis_ripple(x[0], t, p) - spring) / m_m
-                a_t = (spring - axis_friction(x[3], p, x[2], t) - P["offset"]) / m_t
+                a_t = (spring - friction - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
             else:
-                push = F + axis_ripple(x[0], t, p) - axis_friction(x[1], p, x[0], t) - P["offset"]
+                push = F + axis_ripple(x[0], t, p) - friction - P["offset"]
                 rates = [x[1], push / P["mass"]]
-            derivatives.get_mutable_vector().SetFromVector(vector(rates))
+            derivatives.get_mutable_vector().SetFromVector(vector(rates + zdot))
 
         def _calc_motor(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
@@ -195,11 +265,12 @@ def MeasuredAxis_(T):
 
         def _calc_table(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            output.SetFromVector(vector([x[-2], x[-1]]))
+            i = self._table()
+            output.SetFromVector(vector([x[i], x[i + 1]]))
 
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            output.SetAtIndex(0, axis_friction(x[-1], self._p(context), x[-2], context.get_time()))
+            output.SetAtIndex(0, self._friction(x, self._p(context), context.get_time())[0])
 
     return Impl
 

@@ -118,23 +118,30 @@ SAMPLED_CASES = {
                                           position_ripple_sin=1.0, friction_ripple_cos=0.1, friction_drift=0.01)),
     "axial_mode_58hz": (True, 0.0, dict(regularization_velocity=1e-3, stiffness=2e6, damping=300.0)),
     "one_sample_delay": (False, 1.0, dict(regularization_velocity=1e-3)),
+    "lugre_bristles": (False, 0.0, dict(regularization_velocity=1e-3, bristle_stiffness=5e6, stribeck_extra=4.0,
+                                        stribeck_velocity=2e-3)),
+    "lugre_two_mass": (True, 0.0, dict(regularization_velocity=1e-3, stiffness=2e6, damping=300.0,
+                                       bristle_stiffness=2e7, bristle_damping_ratio=0.5)),
 }
 
 
 @pytest.mark.parametrize("case", sorted(SAMPLED_CASES))
 def test_sampled_replay_agrees_with_the_continuous_replay(run, case):
     """The fast discrete-time replay (controller + fixed sub-steps of the axis in one SymbolicVectorSystem) against
-    the error-controlled Drake replay: positions within 2e-5 of the travel, force error within 0.02 points of %."""
+    the error-controlled Drake replay: positions within 2e-5 of the travel, force error within 0.02 points of %
+    (0.05 with LuGre bristles: their step converges at first order where the sticking table crosses v = 0; the
+    reference is then integrated at accuracy 1e-8)."""
     from drakecreep.gap.drake_replay import SampledReplay
 
     flexible, delay, extra = SAMPLED_CASES[case]
     p = axis_from_idim(PUBLISHED_IDIM, **extra)
-    ref = DrakeReplay(run, flexible=flexible, delay=delay).simulate(p)
+    lugre = extra.get("bristle_stiffness", 0.0) > 0
+    ref = DrakeReplay(run, flexible=flexible, delay=delay, accuracy=1e-8 if lugre else 1e-4).simulate(p)
     fast = SampledReplay(run, flexible=flexible, delay=delay, free=("viscous", "coulomb")).simulate(p)
     travel = np.ptp(run.x_motor)
     assert np.max(np.abs(fast.x_motor - ref.x_motor)) < 2e-5 * travel
     assert np.max(np.abs(fast.x_table - ref.x_table)) < 2e-5 * travel
-    assert abs(drake_replay_errors(fast)["force"] - drake_replay_errors(ref)["force"]) < 0.02
+    assert abs(drake_replay_errors(fast)["force"] - drake_replay_errors(ref)["force"]) < (0.05 if lugre else 0.02)
     assert np.linalg.norm(fast.u - ref.u) < 0.01 * np.linalg.norm(ref.u)
 
 

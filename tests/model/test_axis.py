@@ -57,3 +57,58 @@ def test_scalar_types_and_validation():
     assert len(axis_parameters()) == len(AXIS_PARAMETERS)
     np.testing.assert_array_equal(MeasuredAxis(False).CreateDefaultContext().get_numeric_parameter(0).CopyToVector(),
                                   axis_parameters())
+
+
+def _push(force, seconds=0.5, **values):
+    """Rigid axis from rest under a constant force: final [x, v(, z)]."""
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import ConstantVectorSource
+
+    bristles = values.get("bristle_stiffness", 0.0) > 0
+    b = DiagramBuilder()
+    axis = b.AddSystem(MeasuredAxis(False, axis_parameters(**values), [0.0, 0.0] + ([0.0] if bristles else []),
+                                    bristles))
+    src = b.AddSystem(ConstantVectorSource([force]))
+    b.Connect(src.get_output_port(), axis.GetInputPort("force"))
+    sim = Simulator(b.Build())
+    sim.get_mutable_integrator().set_target_accuracy(1e-8)
+    sim.AdvanceTo(seconds)
+    return axis.GetMyContextFromRoot(sim.get_context()).get_continuous_state_vector().CopyToVector()
+
+
+def test_lugre_bristles_stick_where_the_regularized_law_creeps():
+    """Below the breakaway force the bristles hold the table after a presliding displacement of a few F / sigma0
+    (quasi-static LuGre: x = -(g / sigma0) ln(1 - F / g), 3.2 um here, plus the step's overshoot); the regularized
+    law creeps at v_reg atanh(F / Fc); above the breakaway both slide at the same steady speed."""
+    common = dict(mass=50.0, coulomb=20.0, viscous=400.0, regularization_velocity=1e-4)
+    held = _push(16.0, **common, bristle_stiffness=1e7)
+    later = _push(16.0, 1.0, **common, bristle_stiffness=1e7)
+    quasi_static = -(20.0 / 1e7) * math.log(1.0 - 16.0 / 20.0)
+    assert quasi_static < held[0] < 1.5 * quasi_static
+    assert abs(held[1]) < 1e-6 and abs(later[0] - held[0]) < 1e-8  # 10 nm in 0.5 s: settled, not creeping
+    creep = _push(16.0, **common)
+    assert creep[1] == pytest.approx(1e-4 * math.atanh(16.0 / 20.0), rel=0.05)
+    assert creep[0] > 10 * held[0]  # 55 um after 0.5 s, and going
+    # sliding at 30 N: steady speed (30 - 20) / 400 for both laws; the steady bristle force is the regularized one
+    for extra in ({}, {"bristle_stiffness": 1e7}):
+        state = _push(30.0, 1.5, **common, **extra)  # 12 time constants M / Fv
+        assert state[1] == pytest.approx(0.025, rel=1e-4)
+    vec = axis_parameters(**common, bristle_stiffness=1e7)
+    assert 1e7 * state[2] == pytest.approx(axis_friction(0.025, vec) - 400.0 * 0.025, rel=1e-5)
+    # the Stribeck level raises the breakaway force: 22 N breaks away without it, not with 5 N more static friction
+    assert _push(22.0, **common, bristle_stiffness=1e7)[1] > 0.004  # (22 - 20) / 400 = 5 mm/s
+    assert abs(_push(22.0, **common, bristle_stiffness=1e7, stribeck_extra=5.0, stribeck_velocity=1e-3)[1]) < 1e-5
+
+
+def test_bristle_state_layout_and_validation():
+    axis = MeasuredAxis(True, axis_parameters(bristle_stiffness=1e6), [0.0] * 5, True)
+    ctx = axis.CreateDefaultContext()
+    assert ctx.num_continuous_states() == 5
+    ctx.SetContinuousState([0.0, 0.0, 1e-3, 2e-3, 0.0])
+    assert axis.GetOutputPort("table_state").Eval(ctx)[1] == 2e-3
+    assert axis.ToAutoDiffXd() is not None and axis.ToSymbolic() is not None
+    with pytest.raises(InputError, match="initial_state"):
+        MeasuredAxis(False, None, [0.0, 0.0], True)
+    with pytest.raises(InputError, match="bristle_stiffness"):
+        axis_parameters(bristle_stiffness=-1.0)
