@@ -25,7 +25,7 @@ import argparse
 import time
 
 
-from drakecreep.gap.drake_diagnosis import NOMINAL_PARAMETERS, diagnose_drake
+from drakecreep.gap.drake_diagnosis import diagnose_drake
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors, make_replay
 from drakecreep.gap.identify import identify
@@ -87,7 +87,7 @@ def validate(diag, est, max_nfev=6):
     path used in the fits and by the error-controlled :class:`DrakeReplay` (a cross-check of the fast path).
     """
     nominal = diag.nominal
-    fitted = list(NOMINAL_PARAMETERS)
+    fitted = list(nominal.fitted)
     for name in diag.claimed:
         if name != "control_delay":
             fitted += [p for p in DRAKE_EFFECTS[name].parameters if p not in fitted]

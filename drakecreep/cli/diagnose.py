@@ -42,6 +42,9 @@ def add_parser(subparsers):
                    "ones: stribeck, asymmetric_friction, position_friction, position_ripple, time_ripple, "
                    "thermal_drift, axial_mode, control_delay; kind drakecreep runs: lead_error, force_ripple, "
                    "stribeck, law_coulomb, ...)")
+    p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
+                   "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "
+                   "sticks below the breakaway force; slower), auto (both, the lower training cost kept)")
     p.add_argument("--score", metavar="FILE", help="after the diagnosis, replay the augmented model (parameters "
                    "fixed) on this file")
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
@@ -83,6 +86,9 @@ def run(args):
     for r in score_runs or ():
         check_replayable(r)
     if own:
+        if args.nominal_friction:
+            raise InputError("--nominal-friction", args.nominal_friction, "only for runs of controller kind p_p_cascade (kind "
+                             "drakecreep: the params file's friction.law, effect law_lugre)")
         return _run_drakecreep_kind(args, train, test, score_runs)
     if args.uncertain:
         raise InputError("--uncertain", args.uncertain, "only for runs of controller kind drakecreep "
@@ -132,7 +138,7 @@ def _run_drake(args, train, test, score_runs, effects=None):
 
     say(f"{len(train)} training, {len(test)} held-out runs; identifying the nominal axis")
     diag = diagnose_drake(train, test, effects, progress=say, on_ranking=keep_ranking,
-                          workers=args.workers)
+                          workers=args.workers, friction=args.nominal_friction or "regularized")
     model = diag.model
     if score_runs:
         say(f"replaying the augmented model on {args.score} (parameters fixed)")

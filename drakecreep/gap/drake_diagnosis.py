@@ -2,7 +2,12 @@
 
 :func:`diagnose_drake` returns a typed :class:`DrakeDiagnosis` (no dict with private keys):
 
-1. nominal: :func:`drakecreep.gap.identify.identify` of viscous, Coulomb and offset on the training runs;
+1. nominal: :func:`drakecreep.gap.identify.identify` of viscous, Coulomb and offset on the training runs, with
+   the friction law (``friction``) regularized Coulomb (default) or LuGre (bristle stiffness fitted too), or
+   both identified and the one with the lower training cost kept (``auto``). A measured axis that sticks at
+   standstill and after reversals needs the bristles (a regularized law creeps under any force, and the
+   candidates then absorb the stiction: ``docs/gap_benchmark.md``); one without stiction fits the regularized
+   law better;
 2. ranking: every candidate of :data:`~drakecreep.gap.drake_effects.DRAKE_EFFECTS` (and the computation
    delay) is first fitted on the training runs' inverse dynamics (:mod:`drakecreep.gap.screen`, the axis's
    own force terms, seconds): a candidate whose held-out inverse-dynamics gain is not above one standard
@@ -10,8 +15,11 @@
    training runs from the screen's best start and replayed, fixed, on the held-out runs
    (:class:`~drakecreep.gap.drake_effects.EffectFit`);
 3. a candidate *passes* when its held-out force error is below the reference model's by more than
-   ``k_se`` standard errors of the per-run paired differences (the threshold comes from the held-out runs'
-   own spread, not from a constant);
+   ``t_(1-alpha, n-1)`` standard errors of the per-run paired differences (``alpha`` =
+   :data:`drakecreep.gap.claims.ALPHA`, ``n`` held-out runs: the threshold is the held-out runs' own spread,
+   with the Student quantile such a small sample needs, as the ``drakecreep`` kind's diagnosis,
+   :mod:`drakecreep.gap.drive_fit`; a fixed 2 standard errors of 3 runs lets 9 % of useless candidates
+   through);
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
    augmented so far and kept only if they pass again against it.
 
@@ -29,7 +37,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from scipy import stats
+
 from drakecreep.errors import InputError
+from drakecreep.gap.claims import ALPHA
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
@@ -39,9 +50,12 @@ from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "fit_candidate", "paired_gain", "load_model",
-           "NOMINAL_PARAMETERS"]
+           "NOMINAL_PARAMETERS", "NOMINAL_FRICTION"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
+#: Friction laws of the nominal model: ``lugre`` adds the bristle stiffness to :data:`NOMINAL_PARAMETERS` (the axis
+#: sticks below the breakaway force), ``regularized`` is ``Fc tanh(v / v_reg)`` (it creeps under any force).
+NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness",), "regularized": NOMINAL_PARAMETERS}
 
 
 def paired_gain(reference, candidate):
@@ -116,10 +130,12 @@ class DrakeDiagnosis:
     seconds: float = 0.0
     k_se: float = 2.0
     where: dict = field(default_factory=dict)
+    friction: str = "regularized"
 
     def summary(self):
         """Lines of text."""
-        lines = [f"nominal held-out force error {rms_force_error(self.nominal_test_errors):.3f} %"]
+        lines = [f"nominal ({self.friction} friction) held-out force error "
+                 f"{rms_force_error(self.nominal_test_errors):.3f} %; claim bar {self.k_se:.2f} standard errors"]
         for r in self.ranking:
             if r.screened_out:
                 sc = r.screen
@@ -167,12 +183,18 @@ def fit_candidate(name, train, test, nominal, max_nfev, start):
         return fit_delay(train, test, nominal, start=start)
     # the two-mass replay is the costly one (its mode sets the sub-steps): rank the mode with the nominal
     # friction fixed (2 parameters, not 5); the greedy step refits the friction with it if it passes
-    refit = () if name == "axial_mode" else NOMINAL_PARAMETERS
+    refit = () if name == "axial_mode" else tuple(nominal.fitted)
     return fit_effect(name, train, test, nominal, max_nfev=max_nfev, starts=(start,) if start else None, refit=refit)
 
 
-def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=None, screen=True,
-                   screen_k_se=1.0, on_nominal=None, on_ranking=None, workers=1):
+def _passes(reference, candidate, bar):
+    """The claim rule of the module docstring (3): ``(gain, standard error, passes)``."""
+    gain, se = paired_gain(reference, candidate)
+    return gain, se, bool(gain > bar * se)
+
+
+def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress=None, screen=True,
+                   screen_k_se=1.0, on_nominal=None, on_ranking=None, workers=1, friction="regularized"):
     """Diagnose the gap of the Drake replay model (see the module docstring).
 
     Parameters
@@ -184,8 +206,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
         Candidates (names of ``DRAKE_EFFECTS`` or ``"control_delay"``); default all of them.
     max_nfev : int
         Least-squares evaluations per start.
-    k_se : float
-        Standard errors a held-out gain must exceed.
+    k_se : float, optional
+        Standard errors a held-out gain must exceed; default the Student quantile ``t_(1-ALPHA, n-1)`` of the
+        ``n`` held-out runs (2.92 for three).
     progress : callable, optional
         Called with a line of text after each step.
     screen : bool
@@ -203,6 +226,10 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
         Processes for the closed-loop fits of the candidates that pass the screen (they are independent;
         ``spawn`` processes, each imports Drake once, a few seconds). 1 fits them one after another in this
         process. The result does not depend on it.
+    friction : {"auto", "lugre", "regularized"}
+        Friction law of the nominal model (:data:`NOMINAL_FRICTION`); ``auto`` identifies both and keeps the
+        one with the lower training cost. The default stays ``regularized``: the LuGre replay needs 2-5 sub-steps
+        per sample more, and the EMPS diagnosis would miss its 60 s (docs/gap_benchmark.md, "LuGre nominal").
 
     Returns
     -------
@@ -219,10 +246,18 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
             raise InputError("effects", n, why)
     if not isinstance(workers, int) or workers < 1:
         raise InputError("workers", workers, "an integer >= 1")
+    if friction != "auto" and friction not in NOMINAL_FRICTION:
+        raise InputError("friction", friction, "one of auto, " + ", ".join(NOMINAL_FRICTION))
     say = progress or (lambda line: None)
-    nominal = identify(train, NOMINAL_PARAMETERS, max_nfev=max_nfev)
+    if k_se is None:
+        k_se = float(stats.t.ppf(1.0 - ALPHA, len(test) - 1))
+    laws = tuple(NOMINAL_FRICTION) if friction == "auto" else (friction,)
+    fits = {law: identify(train, NOMINAL_FRICTION[law], max_nfev=max_nfev) for law in laws}
+    friction = min(laws, key=lambda law: fits[law].cost)
+    nominal = fits[friction]
     nom_test, _ = score_parameters(test, nominal.parameters)
-    say(f"nominal identified ({nominal.n_evaluations} replays)")
+    say(f"nominal identified ({sum(f.n_evaluations for f in fits.values())} replays): {friction} friction"
+        + (" (training cost " + ", ".join(f"{law} {fits[law].cost:.4g}" for law in laws) + ")" if len(laws) > 1 else ""))
     if on_nominal is not None:
         on_nominal(nominal, nom_test)
     ranking, jobs = [], []
@@ -241,9 +276,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
         jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
 
     def ranked(n, sc, fit):
-        gain, se = paired_gain(nom_test, fit.test_errors)
-        say(f"{n}: held-out gain {gain:+.3f} +- {k_se * se:.3f} points of %")
-        return RankedEffect(fit=fit, gain=gain, standard_error=se, passes=gain > k_se * se, screen=sc, effect=n)
+        gain, se, ok = _passes(nom_test, fit.test_errors, k_se)
+        say(f"{n}: held-out gain {gain:+.3f} +- {k_se * se:.3f} points of %" + ("  passes" if ok else ""))
+        return RankedEffect(fit=fit, gain=gain, standard_error=se, passes=ok, screen=sc, effect=n)
 
     if workers == 1 or len(jobs) < 2:
         for n, sc, start in jobs:
@@ -264,7 +299,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
     if on_ranking is not None:
         on_ranking(nominal, nom_test, tuple(ranking))
     claimed, current, current_test = [], nominal, nom_test
-    fitted = list(NOMINAL_PARAMETERS)
+    fitted = list(nominal.fitted)
     model = {"parameters": dict(nominal.parameters), "flexible": False, "delay": nominal.delay}
     for r in ranking:
         if not r.passes:
@@ -274,9 +309,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
             fit = fit_delay(train, test, current, start=r.fit.delay) if r.name == "control_delay" else \
                 fit_effect(r.name, train, test, current, max_nfev=max_nfev, refit=tuple(fitted),
                            starts=({k: r.fit.parameters[k] for k in DRAKE_EFFECTS[r.name].parameters},))
-        gain, se = paired_gain(current_test, fit.test_errors)
+        gain, se, ok = _passes(current_test, fit.test_errors, k_se)
         say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: gain {gain:+.3f} +- {k_se * se:.3f}")
-        if gain > k_se * se:
+        if ok:
             claimed.append(r.name)
             current, current_test = fit, fit.test_errors
             if r.name != "control_delay":
@@ -285,4 +320,4 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=2.0, progress=
     where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])
     return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
                           model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se,
-                          where=where)
+                          where=where, friction=friction)

@@ -522,7 +522,7 @@ class SampledReplay:
         simulator.AdvanceTo(float(n * self.h))
         lg = log.FindLog(context)
         data = _on_samples(lg.sample_times(), lg.data(), np.arange(n + 1) * self.h)
-        nc, na = layout["nc"], layout["na"]
+        nc = layout["nc"]
         f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
         return DrakeReplayResult(
             run=self.run, x_motor=data[nc, :n], x_table=data[nc + layout["table"], :n], u=data[layout["u"], 1:],

@@ -35,11 +35,15 @@ from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
-__all__ = ["IdimStart", "Identified", "idim_start", "identify", "LOG_SCALED", "CORRELATION_LIMIT"]
+__all__ = ["IdimStart", "Identified", "idim_start", "identify", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
 
 #: parameters fitted on a log scale (they must stay > 0)
 LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "damping", "viscous",
-              "coulomb", "stribeck_extra")
+              "coulomb", "stribeck_extra", "bristle_stiffness")
+#: presliding displacement [m] the bristle stiffness starts from (``sigma0 = Fc / 5 um``) when it is refined:
+#: an assumption, the middle of the 1-10 um that ball-screw and guide contacts show (Armstrong-Helouvry et al.
+#: 1994, Automatica 30(7), section 3.1); the fit moves it
+PRESLIDING_START = 5e-6
 #: |correlation| above which two fitted parameters are reported as not separable
 CORRELATION_LIMIT = 0.95
 _ONE_WAY_SHARE = 0.02
@@ -294,6 +298,9 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     base = dict(AXIS_PARAMETERS)
     base.update(start.parameters)
     base["regularization_velocity"] = _regularization(runs)
+    if "bristle_stiffness" in uncertain:
+        # LuGre bristles from a presliding displacement of PRESLIDING_START at the Coulomb level
+        base["bristle_stiffness"] = max(abs(base["coulomb"]), 1.0) / PRESLIDING_START
     base.update(fixed or {})
     warnings = list(start.warnings)
     if any("offset fixed at 0" in w for w in warnings) and "offset" in uncertain and "coulomb" in uncertain:

@@ -48,6 +48,7 @@ def drake_to_json_dict(diagnosis, **extra):
     d = ranking_json(diagnosis.nominal, diagnosis.nominal_test_errors, diagnosis.ranking, diagnosis.k_se)
     d.update(to_jsonable({
         "model_kind": "drakecreep.measured_axis (Drake replay: P-P cascade + MeasuredAxis)",
+        "nominal_friction": diagnosis.friction,
         "claimed": list(diagnosis.claimed),
         "model": diagnosis.model,
         "held_out_errors": diagnosis.test_errors,

@@ -64,7 +64,7 @@ def test_text_output(csv_file, capsys):
     assert cli.main(["diagnose", str(csv_file), "--train", "w0,w1", "--test", "w2,w3", "--effects",
                      "thermal_drift", "-q"]) == 0
     out = capsys.readouterr().out
-    assert "nominal held-out force error" in out and "claimed:" in out
+    assert "nominal (regularized friction) held-out force error" in out and "claimed:" in out
 
 
 @pytest.mark.parametrize("argv, word", [
@@ -95,3 +95,9 @@ def test_a_score_file_with_another_controller_is_refused_before_work(csv_file, t
     other.with_suffix(".yaml").write_text(yaml.safe_dump(meta))
     assert cli.main(["diagnose", str(csv_file), "--score", str(other)]) == 2
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_nominal_friction_choices(csv_file, capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["diagnose", str(csv_file), "--nominal-friction", "coulomb"])
+    assert exc.value.code == 2 and "--nominal-friction" in capsys.readouterr().err

@@ -83,3 +83,10 @@ def test_diagnose_without_params_for_kind_drakecreep_is_one_line_exit_2(blank_cs
     assert cli.main(["diagnose", str(path), "--meta", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "params" in err[0]
+
+
+def test_nominal_friction_is_refused_for_drakecreep_runs(own_csv, capsys):
+    path, _ = own_csv
+    assert cli.main(["diagnose", str(path), "--nominal-friction", "lugre"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--nominal-friction" in err[0]

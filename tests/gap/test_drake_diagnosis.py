@@ -57,3 +57,28 @@ def test_bad_requests(runs):
         diagnose_drake(runs[:2], runs[2:3])
     with pytest.raises(InputError, match="workers"):
         diagnose_drake(runs[:2], runs[2:], effects=("stribeck",), workers=0)
+
+
+def test_a_sticking_axis_gets_the_lugre_nominal():
+    """Runs of an axis with LuGre bristles (it sticks): the LuGre nominal replays the held-out runs better than the
+    regularized one, ``auto`` keeps it (lower training cost) and finds the bristle stiffness's order of magnitude.
+    The error energy above the noise's own (0.5 N of white noise on the force) is at least halved."""
+    truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, bristle_stiffness=1e7)
+    full = load_emps("estimation").runs[0]
+    runs, floor = [], []
+    for seed, a in enumerate((0, 3000, 6000, 9000)):
+        run = full.slice(a, a + 800)
+        res = DrakeReplay(run).simulate(truth)
+        noise = np.random.default_rng(seed).normal(0.0, 0.5, res.u.size)
+        runs.append(dataclasses.replace(run, x_motor=res.x_motor, u=res.u + noise / run.u_gain, label=f"s{a}"))
+        floor.append(100 * np.linalg.norm(noise) / np.linalg.norm(runs[-1].force))
+    kwargs = dict(effects=("thermal_drift",), max_nfev=4, screen=True)
+    auto = diagnose_drake(runs[:2], runs[2:], friction="auto", **kwargs)
+    plain = diagnose_drake(runs[:2], runs[2:], friction="regularized", **kwargs)
+    assert auto.friction == "lugre" and plain.friction == "regularized"
+    assert 3e6 < auto.nominal.parameters["bristle_stiffness"] < 3e7
+    excess = lambda d: sum(e["force"] ** 2 - f ** 2 for e, f in zip(d.nominal_test_errors.values(), floor[2:]))  # noqa: E731
+    assert excess(auto) < 0.5 * excess(plain)
+    assert any("lugre friction" in line for line in auto.summary())
+    with pytest.raises(InputError, match="friction"):
+        diagnose_drake(runs[:2], runs[2:], friction="coulomb")
