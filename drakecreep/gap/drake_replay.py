@@ -127,6 +127,9 @@ class DrakeReplay:
     compiled : bool
         Simulate the axis as a ``SymbolicVectorSystem`` made from :class:`MeasuredAxis` (no Python in the
         integration loop, its coefficients a symbolic ``parameter`` vector) rather than the leaf system.
+    bristles : bool
+        Build the axis with the LuGre bristle state. A simulation whose ``bristle_stiffness`` says otherwise
+        runs on a twin replay with the other layout (built once, on first use).
     """
 
     def __init__(self, run, flexible=False, delay=0.0, quantize=True, accuracy=1e-4, max_step=None, compiled=True,
@@ -313,7 +316,9 @@ class SampledReplay:
         every tick:        one explicit-midpoint step of the axis over h / m, force = gain applied + f_ext[k]
         j <- (j + 1) mod m
 
-    so no error-controlled integrator runs between the 1 kHz events. ``m`` comes from the stiffest rate of
+    so no error-controlled integrator runs between the 1 kHz events. With LuGre bristles
+    (``bristle_stiffness > 0``) their deflection is advanced by the exact solution of its linear ODE over the tick
+    (exponential Euler), the rest of the axis by the midpoint step. ``m`` comes from the stiffest rate of
     the axis at the parameters simulated (friction slope ``Fc / v_reg`` over the mass; twice the axial
     mode's angular frequency): ``h / m`` times that rate stays below ``rate_step`` (a rebuild happens only when new parameter values
     need more ticks than the built system has).
