@@ -4,8 +4,9 @@ An effect is claimed only when the replay of the held-out runs (parameters fixed
 improves by more than run-to-run variation explains: the pooled force-error energy shrinks by more than a
 threshold the caller derives from its training runs (``drakecreep.gap.drive_fit`` refits the uncertain fields
 with each training run left out and takes the largest change of the held-out replay), and a majority of the
-held-out runs get better (:func:`replay_test`). ``diagnose_drake`` uses the paired standard error of the
-per-run differences instead (:func:`drakecreep.gap.drake_diagnosis.paired_gain`).
+held-out runs get better (:func:`replay_test`). ``diagnose_drake`` asks instead for a held-out gain above
+``t_(1-ALPHA, n-1)`` paired standard errors of the per-run differences
+(:func:`drakecreep.gap.drake_diagnosis.paired_gain`), the bar ``drive_fit`` also applies.
 
 (The former rigid diagnosis's permutation null and inverse-dynamics tests lived here; they went with it.)
 """

@@ -140,9 +140,8 @@ def _sliding_level(P, v):
 
 
 def has_bristles(p):
-    """True when the parameter vector ``p`` (or mapping) switches the LuGre bristles on (``bristle_stiffness > 0``)."""
-    value = p["bristle_stiffness"] if isinstance(p, dict) else p[_NAMES.index("bristle_stiffness")]
-    return float(value) > 0.0
+    """True when the parameter vector ``p`` switches the LuGre bristles on (``bristle_stiffness > 0``)."""
+    return float(p[_NAMES.index("bristle_stiffness")]) > 0.0
 
 
 def bristle_rates(v, z, p, table_mass):
@@ -230,14 +229,20 @@ def MeasuredAxis_(T):
         def _table(self):
             return 2 if self.flexible else 0
 
+        def _masses(self, P):
+            """``(m_m, m_t)``: motor side and table (both the whole mass when rigid)."""
+            if not self.flexible:
+                return P["mass"], P["mass"]
+            m_m = P["motor_mass_fraction"] * P["mass"]
+            return m_m, P["mass"] - m_m
+
         def _friction(self, x, p, t):
             """``(friction on the table, [dz/dt] or [])``."""
             P = dict(zip(_NAMES, p))
             i = self._table()
             if not self.bristles:
                 return axis_friction(x[i + 1], p, x[i], t), []
-            m_t = P["mass"] * (1.0 - P["motor_mass_fraction"]) if self.flexible else P["mass"]
-            zdot, f = bristle_rates(x[i + 1], x[-1], p, m_t)
+            zdot, f = bristle_rates(x[i + 1], x[-1], p, self._masses(P)[1])
             return _level(P, x[i], t) * f, [zdot]
 
         def DoCalcTimeDerivatives(self, context, derivatives):
@@ -248,8 +253,7 @@ def MeasuredAxis_(T):
             t = context.get_time()
             friction, zdot = self._friction(x, p, t)
             if self.flexible:
-                m_m = P["motor_mass_fraction"] * P["mass"]
-                m_t = P["mass"] - m_m
+                m_m, m_t = self._masses(P)
                 spring = P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
                 a_m = (F + axis_ripple(x[0], t, p) - spring) / m_m
                 a_t = (spring - friction - P["offset"]) / m_t

@@ -14,16 +14,23 @@ from drakecreep.gap.measured import load_emps
 TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=4.0, viscous_asym=-40.0)
 
 
+def _simulated(truth, starts, n, prefix):
+    """EMPS slices at ``starts`` of ``n`` samples replayed from ``truth``, 0.5 N of white noise on the force:
+    ``(runs, noise floor of each run's relative force error [%])``."""
+    full = load_emps("estimation").runs[0]
+    out, floor = [], []
+    for seed, a in enumerate(starts):
+        run = full.slice(a, a + n)
+        res = DrakeReplay(run).simulate(truth)
+        noise = np.random.default_rng(seed).normal(0.0, 0.5, res.u.size)
+        out.append(dataclasses.replace(run, x_motor=res.x_motor, u=res.u + noise / run.u_gain, label=f"{prefix}{a}"))
+        floor.append(100 * np.linalg.norm(noise) / np.linalg.norm(out[-1].force))
+    return out, floor
+
+
 @pytest.fixture(scope="module")
 def runs():
-    full = load_emps("estimation").runs[0]
-    out = []
-    for seed, a in enumerate((0, 3000, 6000, 9000, 12000)):
-        run = full.slice(a, a + 1000)
-        res = DrakeReplay(run).simulate(TRUTH)
-        u = res.u + np.random.default_rng(seed).normal(0.0, 0.5 / run.u_gain, res.u.size)
-        out.append(dataclasses.replace(run, x_motor=res.x_motor, u=u, label=f"w{a}"))
-    return out
+    return _simulated(TRUTH, (0, 3000, 6000, 9000, 12000), 1000, "w")[0]
 
 
 def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
@@ -64,14 +71,7 @@ def test_a_sticking_axis_gets_the_lugre_nominal():
     regularized one, ``auto`` keeps it (lower training cost) and finds the bristle stiffness's order of magnitude.
     The error energy above the noise's own (0.5 N of white noise on the force) is at least halved."""
     truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, bristle_stiffness=1e7)
-    full = load_emps("estimation").runs[0]
-    runs, floor = [], []
-    for seed, a in enumerate((0, 3000, 6000, 9000)):
-        run = full.slice(a, a + 800)
-        res = DrakeReplay(run).simulate(truth)
-        noise = np.random.default_rng(seed).normal(0.0, 0.5, res.u.size)
-        runs.append(dataclasses.replace(run, x_motor=res.x_motor, u=res.u + noise / run.u_gain, label=f"s{a}"))
-        floor.append(100 * np.linalg.norm(noise) / np.linalg.norm(runs[-1].force))
+    runs, floor = _simulated(truth, (0, 3000, 6000, 9000), 800, "s")
     kwargs = dict(effects=("thermal_drift",), max_nfev=4, screen=True)
     auto = diagnose_drake(runs[:2], runs[2:], friction="auto", **kwargs)
     plain = diagnose_drake(runs[:2], runs[2:], friction="regularized", **kwargs)
