@@ -51,6 +51,7 @@ import numpy as np
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
 from drakecreep.gap.drake_replay import rms_force_error
+from drakecreep.gap.screen import SLOW_SHARE
 from drakecreep.gap.truth import out_and_back
 
 __all__ = [
@@ -229,8 +230,9 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
     return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples)[0]
 
 
-#: Samples slower than this share of the training runs' top speed are left out of the SNR's energies.
-SNR_SLOW_SHARE = 0.05
+#: Samples slower than this share of the training runs' top speed are left out of the SNR's energies (the
+#: screen's own window, :data:`drakecreep.gap.screen.SLOW_SHARE`).
+SNR_SLOW_SHARE = SLOW_SHARE
 
 
 def _idim_energy(runs):
@@ -369,7 +371,9 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6):
     res = diagnose_dataset(ds, effects=effects, progress=progress, max_nfev=max_nfev)
     claimed = list(res.claimed)
     ranking = [{"effect": r.name, "gain": None if r.screened_out else r.gain,
-                "standard_error": None if r.screened_out else r.standard_error, "passes": bool(r.passes),
+                "standard_error": None if r.screened_out else r.standard_error,
+                "log_error_ratio": None if r.screened_out else r.log_ratio,
+                "log_error_ratio_standard_error": None if r.screened_out else r.log_ratio_se, "passes": bool(r.passes),
                 "screened_out": bool(r.screened_out),
                 "screen_gain": None if r.screen is None or r.screen.name in ("axial_mode", "control_delay")
                 else float(r.screen.gain)} for r in res.ranking]

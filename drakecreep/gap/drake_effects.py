@@ -58,7 +58,10 @@ DRAKE_EFFECTS = {
     "stribeck": DrakeEffect("stribeck", ("stribeck_extra", "stribeck_velocity"),
                             ({"stribeck_extra": 2.0, "stribeck_velocity": 2e-3},
                              {"stribeck_extra": 2.0, "stribeck_velocity": 2e-2}),
-                            signature="force error peaks at low speed, after reversals"),
+                            signature="force error peaks at low speed, after reversals",
+                            # velocity weakening: the static level is above Coulomb (a negative extra is
+                            # velocity strengthening, not this effect; on EMPS such a start stalled the fit)
+                            bounds={"stribeck_extra": (0.0, math.inf)}),
     "asymmetric_friction": DrakeEffect("asymmetric_friction", ("coulomb_asym", "viscous_asym"),
                                        ({"coulomb_asym": 0.0, "viscous_asym": 0.0},),
                                        signature="force error of opposite mean in the two directions"),

@@ -30,7 +30,8 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
             row["closed_loop"] = {"held_out_force_error_percent": r.fit.test_force_error,
                                   "train_force_error_percent": r.fit.train_force_error,
                                   "gain_points": r.gain, "standard_error_points": r.standard_error,
-                                  "threshold_points": k_se * r.standard_error,
+                                  "log_error_ratio": r.log_ratio, "log_error_ratio_standard_error": r.log_ratio_se,
+                                  "threshold_log_error_ratio": k_se * r.log_ratio_se,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
         rows.append(row)
@@ -82,17 +83,16 @@ def _drake_figures(diagnosis, residuals=None):
         fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
         y = np.arange(len(ranked))[::-1]
         cl = [r.gain if not r.screened_out else np.nan for r in ranked]
-        se = [diagnosis.k_se * r.standard_error if not r.screened_out else 0.0 for r in ranked]
         sc = [r.screen.gain if r.screen is not None else np.nan for r in ranked]
-        ax.barh(y + 0.2, cl, 0.4, xerr=se, color=["tab:green" if r.passes else "tab:gray" for r in ranked],
-                label=f"closed-loop replay (bar: {diagnosis.k_se:g} SE)")
+        ax.barh(y + 0.2, cl, 0.4, color=["tab:green" if r.passes else "tab:gray" for r in ranked],
+                label=f"closed-loop replay (green: passes, {diagnosis.k_se:.3g} SE of the log error ratio)")
         ax.barh(y - 0.2, sc, 0.4, color="tab:blue", alpha=0.5, label="inverse dynamics (screen)")
         ax.axvline(0, color="k", lw=0.8)
         ax.set_yticks(y, [r.name + (" (screened out)" if r.screened_out else "") for r in ranked])
         ax.set_xlabel("held-out force error decrease [points of %]")
         # one wild screen score must not squash the others: clip the axis to the closed-loop gains' scale
         # (at least +-5 points) and write the clipped values at the edge
-        span = max(5.0, 3.0 * np.nanmax(np.abs(np.r_[cl, se, 0.0])))
+        span = max(5.0, 3.0 * np.nanmax(np.abs(np.r_[cl, 0.0])))
         ax.set_xlim(-span, span)
         for yi, v in zip(y, sc):
             if np.isfinite(v) and abs(v) > span:
@@ -177,9 +177,10 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                      f"{escape(', '.join(extra.get('test_runs', [])))}. Diagnosis {diagnosis.seconds:.0f} s.</p>")
     parts.append("<h2>Answer</h2><ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when its closed-loop replay of the held-out runs "
-                 f"(parameters fixed from the training runs) beats the current model by more than {k:g} standard "
-                 "errors of the per-run differences, and its inverse-dynamics fit of the held-out runs does too "
-                 "(the screen). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
+                 f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
+                 f"by more than {k:.3g} standard errors of the per-run log error ratio, and its inverse-dynamics fit "
+                 "of the held-out runs' sliding samples beats the nominal's by more than one standard error (the "
+                 "screen). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
     parts.append(table(["parameter", "value", "95 % half-width", "unit"],
                        [[n, f"{_edge(n, nom.parameters[n])[0]:.5g}",
@@ -190,9 +191,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     rows = []
     for r in diagnosis.ranking:
         sc = r.screen
-        scr = "-" if sc is None or not np.isfinite(sc.gain) else f"{sc.gain:+.3f} ± {k * sc.standard_error:.3f}"
+        scr = "-" if sc is None or not np.isfinite(sc.gain) else f"{sc.gain:+.3f} ± {sc.standard_error:.3f}"
         if r.screened_out:
-            rows.append([r.name, scr, "screened out", "-", "-", ""])
+            rows.append([r.name, scr, "screened out", "-", "-", "-", ""])
             continue
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
@@ -200,12 +201,14 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         params = "; ".join("{} = {:.4g} {}".format(n, *_edge(n, r.fit.parameters[n])) for n in names)
         if r.name == "control_delay":
             params = f"delay = {r.fit.delay:.3g} samples"
-        rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f} ± {k * r.standard_error:.3f}",
+        rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f}",
+                     f"x{r.error_ratio:.3f} ({r.log_ratio:+.3f} vs {k * r.log_ratio_se:.3f})",
                      ("yes" if r.passes else "no") + ("" if r.name in diagnosis.claimed or not r.passes
                                                       else " (not kept by the greedy step)"), params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
-    parts.append(table(["effect", "inverse-dynamics gain [points of %]", "closed-loop held-out force error [%]",
-                        "closed-loop gain [points of %]", "passes alone", "fitted parameters"], rows))
+    parts.append(table(["effect", "inverse-dynamics gain ± 1 SE [points of %]",
+                        "closed-loop held-out force error [%]", "closed-loop gain [points of %]",
+                        "error ratio (log ratio vs bar)", "passes alone", "fitted parameters"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = ("position", "velocity", "acceleration", "force")
     rows = [[lab] + [f"{diagnosis.nominal_test_errors[lab][s]:.4g} → {diagnosis.test_errors[lab][s]:.4g}"
