@@ -176,8 +176,7 @@ class DrakeDiagnosis:
         for r in self.ranking:
             if r.screened_out:
                 sc = r.screen
-                lines.append(f"  {r.name:20s} screened out: held-out inverse-dynamics gain {sc.gain:+.3f} "
-                             f"+- {self.k_se * sc.standard_error:.3f} points of % (not fitted in closed loop)")
+                lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, "
                          + _verdict(r.gain, r.log_ratio, r.log_ratio_se, self.k_se, r.passes))
@@ -237,7 +236,7 @@ def _refit(train, model, names, max_nfev):
     A candidate refits the nominal friction together with its own parameters. Against the model it starts from,
     its gain would include what the extra iterations of the friction alone give: the nominal of ``max_nfev``
     evaluations is not converged, and on effect-free data every refitting candidate "gained" 0.3-0.5 points of %
-    on the held-out runs, consistently enough to pass (docs/gap_benchmark.md, "Equal effort").
+    on the held-out runs, consistently enough to pass (docs/gap_benchmark.md, "Since then: equal effort").
     """
     return identify(train, tuple(names), flexible=model.flexible, delay=model.delay, fixed=dict(model.parameters),
                     max_nfev=max_nfev)
@@ -249,6 +248,12 @@ def _passes(reference, candidate, bar):
     gain, se = paired_gain(reference, candidate)
     lr, lr_se = paired_log_ratio(reference, candidate)
     return gain, se, lr, lr_se, bool(lr > bar * lr_se)
+
+
+def _screen_numbers(sc):
+    """Why a candidate was screened out, in a few words."""
+    why = f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, standard error {sc.standard_error:.3f}"
+    return why if getattr(sc, "inside", True) else why + "; fitted values outside the effect's bounds"
 
 
 def _verdict(gain, lr, lr_se, bar, ok):
@@ -338,8 +343,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         if sc is not None and not sc.passes:
             ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
                                         screen=sc, effect=n))
-            say(f"{n}: screened out (held-out inverse-dynamics gain {sc.gain:+.3f} +- "
-                f"{k_se * sc.standard_error:.3f} points of %)")
+            say(f"{n}: screened out ({_screen_numbers(sc)})")
             continue
         jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
 
