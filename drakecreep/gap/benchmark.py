@@ -230,32 +230,27 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
     return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples)[0]
 
 
-#: Samples slower than this share of the training runs' top speed are left out of the SNR's energies (the
-#: screen's own window, :data:`drakecreep.gap.screen.SLOW_SHARE`).
-SNR_SLOW_SHARE = SLOW_SHARE
-
-
 def _idim_energy(runs):
     """Mean square residual [N^2] of the nominal inverse-dynamics least squares of the Drake path on ``runs``.
 
     The screen's nominal (:mod:`drakecreep.gap.screen`): the rigid replay axis's own force function
     (``M ddq + f(dq) + offset``, ``tanh``-regularised friction) on the screen's IDIM signals, the mass from
     :func:`drakecreep.gap.identify.idim_start`, viscous, Coulomb and offset by linear least squares on every
-    run stacked (not normalised per run), on the samples faster than :data:`SNR_SLOW_SHARE` of the top speed.
+    run stacked (not normalised per run), on the samples faster than :data:`~drakecreep.gap.screen.SLOW_SHARE` of the top speed.
     At standstill and in reversals the force is the static friction the controller holds, which no rigid
     inverse dynamics determines: on effect-free twins those 20 % of the samples carry about 90 % of the
     residual energy and would make the SNR a measure of stiction, not of the effect (the rigid diagnosis's
     SNR left out the samples below 1 % of the top speed for the same reason).
     """
     from drakecreep.gap.identify import idim_start
-    from drakecreep.gap.screen import _project, _signals
+    from drakecreep.gap.screen import _project, _signals, _sliding
     from drakecreep.model.axis import AXIS_PARAMETERS
 
     values = dict(AXIS_PARAMETERS)
     values["mass"] = idim_start(runs).parameters["mass"]
     sig = [_signals(r) for r in runs]
     v_top = max(float(np.max(np.abs(s[2]))) for s in sig)
-    sig = [tuple(a[np.abs(s[2]) >= SNR_SLOW_SHARE * v_top] for a in s) for s in sig]
+    sig = _sliding(sig, v_top, SLOW_SHARE)
     _, r = _project(sig, [1.0] * len(sig), values, ("viscous", "coulomb", "offset"))
     return float(r @ r) / r.size
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ALPHA", "replay_test"]
+__all__ = ["ALPHA", "replay_test", "mean_and_standard_error"]
 
 #: One-sided level of the tests of a claim.
 ALPHA = 0.05
@@ -42,3 +42,10 @@ def replay_test(e_nom, e_eff, threshold=0.0):
     better = int(np.sum(lr < 0))
     return {"log_ratios": lr.tolist(), "shrink": shrink, "threshold": float(threshold),
             "runs_better": better, "passes": bool(shrink > threshold and 2 * better > lr.size)}
+
+
+def mean_and_standard_error(d):
+    """Mean and standard error of per-run paired differences ``d`` (``inf`` for fewer than two runs)."""
+    d = np.asarray(d, dtype=float)
+    se = float(d.std(ddof=1) / np.sqrt(d.size)) if d.size > 1 else float("inf")
+    return float(d.mean()), se

@@ -41,13 +41,12 @@ import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import yaml
 
 from scipy import stats
 
 from drakecreep.errors import InputError
-from drakecreep.gap.claims import ALPHA
+from drakecreep.gap.claims import ALPHA, mean_and_standard_error
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
@@ -74,9 +73,7 @@ def paired_gain(reference, candidate):
     reference, candidate : dict
         Run label -> replay errors (as :func:`drakecreep.gap.drake_replay.drake_replay_errors`).
     """
-    d = np.array([reference[k]["force"] - candidate[k]["force"] for k in reference])
-    se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("inf")
-    return float(d.mean()), se
+    return mean_and_standard_error([reference[k]["force"] - candidate[k]["force"] for k in reference])
 
 
 def paired_log_ratio(reference, candidate):
@@ -94,9 +91,8 @@ def paired_log_ratio(reference, candidate):
         Run label -> replay errors (as :func:`drakecreep.gap.drake_replay.drake_replay_errors`).
     """
     tiny = 1e-12
-    d = np.array([math.log(max(reference[k]["force"], tiny) / max(candidate[k]["force"], tiny)) for k in reference])
-    se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("inf")
-    return float(d.mean()), se
+    return mean_and_standard_error([math.log(max(reference[k]["force"], tiny) / max(candidate[k]["force"], tiny))
+                                    for k in reference])
 
 
 @dataclass(frozen=True)

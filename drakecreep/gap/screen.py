@@ -37,6 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from drakecreep.errors import InputError
+from drakecreep.gap.claims import mean_and_standard_error
 from drakecreep.gap.idim import idim_signals
 from drakecreep.model.axis import AXIS_PARAMETERS, axis_friction, axis_parameters, axis_ripple
 
@@ -268,9 +269,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
             best, best_cost = values, cost
     train_err = _errors(tr, best)
     test_err = _errors(te, best)
-    d = nom_test - test_err
-    se = float(d.std(ddof=1) / math.sqrt(d.size)) if d.size > 1 else float("inf")
-    gain = float(d.mean())
+    gain, se = mean_and_standard_error(nom_test - test_err)
     # the linear parameters are solved unbounded: a value outside the effect's bounds is not that effect
     inside = all(bounds[n][0] <= best[n] <= bounds[n][1] for n in effect.parameters if n in bounds)
     return ScreenResult(effect.name, {n: best[n] for n in effect.parameters}, _rms(train_err), _rms(test_err),
