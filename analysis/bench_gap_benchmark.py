@@ -7,12 +7,16 @@ figures use the held-out seeds (``--seeds heldout``, the default); ``--seeds dev
 Rows are written to ``--json`` after every dataset (a run cut short still gives figures: ``--score FILE``
 prints the scores of such a file); progress goes to stderr.
 
-Run (about 2-3 min per dataset on one core)::
+Run (about 2-4 min per dataset on one core)::
 
     PYTHONPATH=. nohup python analysis/bench_gap_benchmark.py --seeds heldout --n-per-effect 3 --n-null 6 \\
         --n-ool 3 --json heldout.json > heldout.txt 2> heldout.err &
     PYTHONPATH=. python analysis/bench_gap_benchmark.py --score heldout.json
     PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --resume heldout.json --json heldout2.json  # go on
+    # two processes (or machines) sharing one run, scored together
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --shard 0/2 --json a.json &
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --shard 1/2 --json b.json &
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py --score a.json b.json
 """
 
 import argparse
@@ -80,16 +84,27 @@ def main():
     ap.add_argument("--seeds", choices=("heldout", "dev"), default="heldout")
     ap.add_argument("--tries", type=float, default=4.0, help="candidates per library effect / --n-per-effect")
     ap.add_argument("--json", help="write scores and rows to this file (after every dataset)")
-    ap.add_argument("--score", help="only print the scores of a JSON file written by this script")
+    ap.add_argument("--score", nargs="+", metavar="JSON",
+                    help="only print the scores of JSON files written by this script (the shards of one run together)")
+    ap.add_argument("--shard", default="0/1", metavar="I/N",
+                    help="diagnose only every N-th dataset from the I-th (0-based): N processes share one run")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
     args = ap.parse_args()
     if args.score:
-        with open(args.score) as fh:
-            data = json.load(fh)
+        data = {"datasets": []}
+        for path in args.score:
+            with open(path) as fh:
+                data["datasets"] += json.load(fh)["datasets"]
         data["scores"] = score_rows(data["datasets"])
         report(data)
         return
+    try:
+        shard = tuple(int(x) for x in args.shard.split("/"))
+        if len(shard) != 2 or not 0 <= shard[0] < shard[1]:
+            raise ValueError
+    except ValueError:
+        ap.error(f"--shard: got {args.shard!r}; allowed: I/N with integers 0 <= I < N")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     done = []
     if args.resume:
@@ -106,7 +121,7 @@ def main():
                                               "datasets": rows}, indent=1, default=str))
 
     res = run_benchmark(seed=seed, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
-                        progress=True, tries=args.tries, on_row=write, done=done)
+                        progress=True, tries=args.tries, on_row=write, done=done, shard=shard)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, p_p_cascade, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "

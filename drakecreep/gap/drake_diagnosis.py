@@ -10,8 +10,8 @@
    law better;
 2. ranking: every candidate of :data:`~drakecreep.gap.drake_effects.DRAKE_EFFECTS` (and the computation
    delay) is first fitted on the training runs' inverse dynamics (:mod:`drakecreep.gap.screen`, the axis's
-   own force terms, seconds): a candidate whose held-out inverse-dynamics gain is not above one standard
-   error is not fitted further (the claim needs both gains); the others are fitted by closed-loop output error on the
+   own force terms, seconds): a candidate whose held-out inverse-dynamics log error ratio is not above one
+   standard error is not fitted further (the claim needs both gains); the others are fitted by closed-loop output error on the
    training runs from the screen's best start and replayed, fixed, on the held-out runs
    (:class:`~drakecreep.gap.drake_effects.EffectFit`);
 3. a candidate *passes* when its held-out force error is below the reference model's, on the log scale
@@ -248,7 +248,8 @@ def _passes(reference, candidate, bar):
 
 def _screen_numbers(sc):
     """Why a candidate was screened out, in a few words."""
-    why = f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, standard error {sc.standard_error:.3f}"
+    why = (f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, error x{math.exp(-sc.log_ratio):.3f} "
+           f"(log ratio {sc.log_ratio:+.3f}, standard error {sc.log_ratio_se:.3f})")
     return why if getattr(sc, "inside", True) else why + "; fitted values outside the effect's bounds"
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 
 import numpy as np
 
@@ -21,7 +22,9 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
         row = {"effect": r.name, "screened_out": bool(r.screened_out), "passes": bool(r.passes)}
         if sc is not None:
             row["inverse_dynamics"] = {"held_out_force_error_percent": sc.test_error, "gain_points": sc.gain,
-                                       "standard_error_points": sc.standard_error, "passes": bool(sc.passes),
+                                       "standard_error_points": sc.standard_error,
+                                       "log_error_ratio": sc.log_ratio, "log_error_ratio_standard_error": sc.log_ratio_se,
+                                       "passes": bool(sc.passes),
                                        "start": sc.start}
         if not r.screened_out:
             from drakecreep.gap.drake_effects import DRAKE_EFFECTS
@@ -180,7 +183,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
                  f"by more than {k:.3g} standard errors of the per-run log error ratio, and its inverse-dynamics fit "
                  "of the held-out runs' sliding samples beats the nominal's by more than one standard error (the "
-                 "screen). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
+                 "screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
     parts.append(table(["parameter", "value", "95 % half-width", "unit"],
                        [[n, f"{_edge(n, nom.parameters[n])[0]:.5g}",
@@ -191,7 +194,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     rows = []
     for r in diagnosis.ranking:
         sc = r.screen
-        scr = "-" if sc is None or not np.isfinite(sc.gain) else f"{sc.gain:+.3f} ± {sc.standard_error:.3f}"
+        scr = "-" if sc is None or not np.isfinite(sc.gain) else \
+            f"{sc.gain:+.3f}; x{math.exp(-sc.log_ratio):.3f} ({sc.log_ratio:+.3f} ± {sc.log_ratio_se:.3f})"
         if r.screened_out:
             rows.append([r.name, scr, "screened out", "-", "-", "-", ""])
             continue
@@ -206,7 +210,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                      ("yes" if r.passes else "no") + ("" if r.name in diagnosis.claimed or not r.passes
                                                       else " (not kept by the greedy step)"), params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
-    parts.append(table(["effect", "inverse-dynamics gain ± 1 SE [points of %]",
+    parts.append(table(["effect", "inverse-dynamics gain [points of %]; error ratio (log ratio ± 1 SE)",
                         "closed-loop held-out force error [%]", "closed-loop gain [points of %]",
                         "error ratio (log ratio vs bar)", "passes alone", "fitted parameters"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")

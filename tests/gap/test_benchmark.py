@@ -100,13 +100,14 @@ def test_score_rows():
 
 def _dataset(seed, withheld, effects, n=1000):
     """A short development dataset whose withheld effect has the given parameters (not drawn)."""
-    from drakecreep.gap.benchmark import N_TEST, N_TRAIN, Dataset, snr
+    from drakecreep.gap.benchmark import N_AUDIT, N_TEST, N_TRAIN, Dataset, snr
 
     rng = np.random.default_rng(seed)
     tr = T.draw_truth(rng, "p_p_cascade", "rigid", withheld)
     tr.effects.update(effects)
-    refs, pulses, _ = T.draw_profiles(rng, 10, n=n)
-    drift, noise = T.noise_draws(tr, 10, n, rng)
+    n_runs = N_TRAIN + N_TEST + N_AUDIT
+    refs, pulses, _ = T.draw_profiles(rng, n_runs, n=n)
+    drift, noise = T.noise_draws(tr, n_runs, n, rng)
     sim, twin = T.simulate_batch([(tr, refs, pulses, drift, noise, True), (tr, refs, pulses, drift, noise, False)])
     runs = T.make_runs(tr, refs, pulses, sim)
     i, j = N_TRAIN, N_TRAIN + N_TEST
@@ -157,3 +158,16 @@ def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkey
     assert earlier[0]["seed"] not in seen and len(seen) == 2
     assert [r["seed"] for r in again["datasets"]] == [r["seed"] for r in first["datasets"]]
     assert again["datasets"][0]["marker"] == "earlier"
+
+
+def test_shards_split_one_run_without_overlap(monkeypatch):
+    from drakecreep.gap import benchmark
+
+    monkeypatch.setattr(benchmark, "evaluate", lambda ds, **kw: {"seed": ds.seed, "withheld": [], "claimed": [], "seconds": 0.0})
+    monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
+    kw = dict(seed=DEV_SEEDS, n_per_effect=0, n_null=5, n_ool=0, n_no_candidate=0, audit=False, n_samples=300)
+    whole = [r["seed"] for r in run_benchmark(**kw)["datasets"]]
+    parts = [[r["seed"] for r in run_benchmark(shard=(i, 2), **kw)["datasets"]] for i in (0, 1)]
+    assert len(whole) == 5 and parts[0] == whole[0::2] and parts[1] == whole[1::2]
+    with pytest.raises(InputError, match="shard"):
+        run_benchmark(shard=(2, 2), **kw)

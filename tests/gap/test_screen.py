@@ -39,6 +39,9 @@ def test_the_screen_ranks_the_withheld_effect_above_a_bystander(asym_runs):
     # is a necessary condition, not the claim (the closed-loop replay separates them: test_drake_diagnosis.py);
     # the withheld effect still explains more
     assert asym.gain > drift.gain and asym.test_error < drift.test_error
+    # decided on the per-run log error ratio (the claim's statistic), not on the gain in points
+    assert asym.log_ratio > asym.log_ratio_se > 0 and asym.log_ratio > drift.log_ratio
+    assert drift.passes == (drift.inside and drift.log_ratio > drift.log_ratio_se)
     # the start handed to the closed-loop fit is the withheld value (variable projection: linear parameters)
     assert asym.start["viscous_asym"] == pytest.approx(-40.0, abs=8.0)
 
