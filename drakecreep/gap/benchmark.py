@@ -2,8 +2,8 @@
 
 Datasets come from the independent, richer truth of :mod:`drakecreep.gap.truth` (two bodies with an axial
 mode, LuGre on the table, run-to-run friction drift, force noise, encoder and scale quantisation, a current
-loop) on a ``flexible`` and a ``rigid`` axis. A dataset has 10 runs at shuffled speeds and positions: 4 for
-training, 3 held out (``diagnose_drake`` fits on the first and decides its claims on the second) and 3
+loop) on a ``flexible`` and a ``rigid`` axis. A dataset has 12 runs at shuffled speeds and positions: 4 for
+training, 5 held out (``diagnose_drake`` fits on the first and decides its claims on the second) and 3
 **audit** runs the diagnosis never sees, on which the benchmark replays, through the same Drake replay
 (:func:`drakecreep.gap.drake_effects.score_parameters`), the nominal model, the claimed (augmented) model
 and the true effect fitted with its expected label.
