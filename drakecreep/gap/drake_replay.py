@@ -37,7 +37,8 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
-from drakecreep.model.axis import AXIS_PARAMETERS, MeasuredAxis, MeasuredAxis_, axis_parameters, has_bristles
+from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, axis_parameters,
+                                   has_bristles)
 from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 
 __all__ = [
@@ -359,7 +360,7 @@ class SampledReplay:
         m_m = P["motor_mass_fraction"] * P["mass"] if self.flexible else P["mass"]
         m_t = P["mass"] - m_m if self.flexible else P["mass"]
         level = 1.0 + abs(P["friction_ripple_cos"]) + abs(P["friction_ripple_sin"]) + abs(P["friction_drift"]) * \
-            self.run.n * self.h
+            self.run.n * self.h + sum(abs(P[n]) for n in FRICTION_MAP)
         viscous = abs(P["viscous"]) + abs(P["viscous_asym"])
         if has_bristles(values):
             # the bristles' own rate is integrated exactly; what remains is their mode on the table mass,

@@ -33,7 +33,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
-from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
+from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
 
@@ -172,6 +172,7 @@ class _Problem:
         # x = value / scale: one unit of x is a typical size of the parameter (force terms: the Coulomb level)
         force = max(abs(base.get("coulomb", 0.0)), 1.0)
         typical = {"friction_drift": 1e-2, "friction_ripple_cos": 0.3, "friction_ripple_sin": 0.3,
+                   **{n: 0.1 for n in FRICTION_MAP},
                    "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
                    "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
                    "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2}

@@ -39,7 +39,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import mean_and_standard_error
 from drakecreep.gap.idim import idim_signals
-from drakecreep.model.axis import AXIS_PARAMETERS, axis_friction, axis_parameters, axis_ripple
+from drakecreep.model.axis import AXIS_PARAMETERS, FRICTION_MAP, axis_friction, axis_parameters, axis_ripple
 
 __all__ = ["ScreenResult", "screen_effect", "screen_delay", "inverse_dynamics_force", "NOT_SCREENED", "LINEAR",
            "SLOW_SHARE"]
@@ -50,7 +50,6 @@ NOT_SCREENED = ("axial_mode", "control_delay")
 #: dense starts of phase-like parameters (the least squares refines each; cheap on inverse dynamics)
 _DENSE = {
     "position_period": tuple(np.geomspace(5e-4, 0.04, 14)),
-    "friction_period": tuple(np.geomspace(5e-3, 0.8, 9)),
     "stribeck_velocity": tuple(np.geomspace(5e-4, 5e-2, 5)),
 }
 
@@ -180,7 +179,8 @@ def _fit(sig, base, names, start, bounds):
     if not nl:
         values, r = _project(sig, norms, values, lin)
         return values, 0.5 * float(r @ r)
-    scale = np.array([max(abs(values[n]), 1e-3) for n in nl])
+    # (the friction map's amplitudes multiply the friction levels, so they are not LINEAR: bilinear with them)
+    scale = np.array([max(abs(values[n]), 0.1 if n in FRICTION_MAP else 1e-3) for n in nl])
     positive = ("mass", "period", "velocity", "frequency", "stiffness")
     lo = np.array([bounds.get(n, (1e-6 * s if any(w in n for w in positive) else -np.inf, np.inf))[0] / s
                    for n, s in zip(nl, scale)])
@@ -242,6 +242,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     """
     base = dict(AXIS_PARAMETERS)
     base.update(nominal_parameters)
+    base.update(effect.fixed_by(train))
     tr = [_signals(r) for r in train]
     te = [_signals(r) for r in test]
     v_top = max(float(np.max(np.abs(s[2]))) for s in tr)

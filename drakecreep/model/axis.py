@@ -14,7 +14,9 @@ the axial stiffness ``k`` and damping ``c`` of the screw chain::
 with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecreep.model.friction`)::
 
     f(v) = L(x, t) [s(v) (Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)) + (Fv + dFv s(v)) v]
-    L(x, t) = 1 + fc cos(2 pi x / Lf) + fs sin(2 pi x / Lf) + drift t      (position-dependent, thermal)
+    L(x, t) = 1 + fc cos(2 pi x / Lf) + fs sin(2 pi x / Lf) + m(x) + drift t   (position-dependent, thermal)
+
+with ``m(x)`` a smooth map along the travel (:func:`friction_map`: four ``tanh`` steps);
 
 and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
 plus a fixed time frequency ``f_r``)::
@@ -52,7 +54,7 @@ from drakecreep.model._scalar import exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
-           "set_axis_parameters", "axis_friction", "bristle_rates", "has_bristles"]
+           "set_axis_parameters", "axis_friction", "friction_map", "FRICTION_MAP", "bristle_rates", "has_bristles"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -74,6 +76,12 @@ AXIS_PARAMETERS = {
     "friction_ripple_cos": 0.0,
     "friction_ripple_sin": 0.0,
     "friction_period": 0.1,
+    "friction_map_0": 0.0,
+    "friction_map_1": 0.0,
+    "friction_map_2": 0.0,
+    "friction_map_3": 0.0,
+    "friction_map_start": 0.0,
+    "friction_map_end": 1.0,
     "time_ripple_cos": 0.0,
     "time_ripple_sin": 0.0,
     "ripple_frequency": 50.0,
@@ -87,6 +95,8 @@ AXIS_UNITS = {
     "motor_mass_fraction": "-", "stiffness": "N/m", "damping": "N s/m",
     "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
     "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
+    "friction_map_0": "-", "friction_map_1": "-", "friction_map_2": "-", "friction_map_3": "-",
+    "friction_map_start": "m", "friction_map_end": "m",
     "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
     "bristle_stiffness": "N/m", "bristle_damping_ratio": "-",
 }
@@ -112,6 +122,9 @@ def axis_parameters(**values):
         raise InputError("axis.bristle_stiffness", out["bristle_stiffness"], "a number >= 0 N/m (0: no bristles)")
     if out["bristle_damping_ratio"] < 0:
         raise InputError("axis.bristle_damping_ratio", out["bristle_damping_ratio"], "a number >= 0")
+    if not out["friction_map_end"] > out["friction_map_start"]:
+        raise InputError("axis.friction_map_end", out["friction_map_end"],
+                         f"a position > friction_map_start ({out['friction_map_start']} m)")
     if not 0 < out["motor_mass_fraction"] < 1:
         raise InputError("axis.motor_mass_fraction", out["motor_mass_fraction"], "a number in (0, 1)")
     return np.array([out[n] for n in _NAMES])
@@ -126,10 +139,35 @@ def axis_friction(v, p, x=0.0, t=0.0):
     return _level(P, x, t) * (s * g + (P["viscous"] + P["viscous_asym"] * s) * v)
 
 
+#: smooth steps of the friction map (``friction_map_0`` .. ``_3``)
+FRICTION_MAP = tuple(f"friction_map_{k}" for k in range(4))
+
+
 def _level(P, x, t):
     phase = 2.0 * math.pi * x / P["friction_period"]
     return (1.0 + P["friction_ripple_cos"] * cos(phase) + P["friction_ripple_sin"] * sin(phase)
-            + P["friction_drift"] * t)
+            + friction_map(P, x) + P["friction_drift"] * t)
+
+
+def friction_map(P, x):
+    """The smooth position-dependent part of the friction level ``L`` (``P``: parameters by name)::
+
+        m(x) = sum_k a_k tanh((x - c_k) / w),   c_k = x0 + (k + 1/2) w,   w = (x1 - x0) / K
+
+    ``K`` = 4 smooth steps spread evenly over ``[x0, x1]`` (``friction_map_start``, ``friction_map_end``: the
+    travel the training runs cover, set by the diagnosis), amplitudes ``a_k`` (``friction_map_k``). Any smooth
+    level along the travel at that resolution (a ramp, a bump, a worn stretch), linear in the amplitudes; outside
+    ``[x0, x1]`` it stays at its edge values (no extrapolated trend). The steps are odd about their centres, so
+    a constant level stays the Coulomb and viscous levels' business.
+    """
+    x0, x1 = P["friction_map_start"], P["friction_map_end"]
+    w = (x1 - x0) / len(FRICTION_MAP)
+    out = 0.0
+    for k, name in enumerate(FRICTION_MAP):
+        if isinstance(P[name], float) and P[name] == 0.0:
+            continue  # off (the default): nothing to evaluate
+        out = out + P[name] * tanh((x - (x0 + (k + 0.5) * w)) / w)
+    return out
 
 
 def _sliding_level(P, v):

@@ -53,8 +53,9 @@ def test_effects_outside_the_replay_axis_are_refused_not_ranked():
 def test_compiled_axis_carries_every_effect_term():
     run = load_emps("estimation").runs[0].slice(0, 400)
     p = dict(NOMINAL, stribeck_extra=3.0, stribeck_velocity=5e-3, coulomb_asym=1.5, viscous_asym=-20.0,
-             friction_ripple_cos=0.1, friction_period=0.05, position_ripple_sin=2.0, time_ripple_cos=3.0,
-             ripple_frequency=40.0, friction_drift=0.01)
+             friction_ripple_cos=0.1, friction_period=0.05, friction_map_1=0.1, friction_map_2=-0.05,
+             friction_map_start=run.x_motor.min(), friction_map_end=run.x_motor.max() + 0.01, position_ripple_sin=2.0,
+             time_ripple_cos=3.0, ripple_frequency=40.0, friction_drift=0.01)
     for flexible in (False, True):
         p2 = dict(p, stiffness=3e6, damping=300.0) if flexible else p
         a = DrakeReplay(run, flexible=flexible).simulate(p2)

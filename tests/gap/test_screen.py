@@ -70,3 +70,17 @@ def test_the_delay_scan_finds_a_whole_sample_delay():
 def test_modes_and_delays_are_never_screened_out(asym_runs):
     sc = screen_effect(DRAKE_EFFECTS["axial_mode"], asym_runs[:2], asym_runs[2:], BASE)
     assert sc.passes and sc.start == {}
+
+
+def test_a_friction_ramp_along_the_travel_is_found_by_the_smooth_map():
+    """A friction level rising by about 30 % along the travel (the map's own steps, over a span the screen does
+    not know): the position_friction candidate fits its map over the training runs' travel and passes; the
+    fitted level rises along the travel too."""
+    from drakecreep.model.axis import FRICTION_MAP
+
+    full = load_emps("estimation").runs[0]
+    span = dict(friction_map_start=float(full.x_motor.min()), friction_map_end=float(full.x_motor.max()))
+    runs = _runs(dict(BASE, **span, **{n: 0.05 for n in FRICTION_MAP}))
+    sc = screen_effect(DRAKE_EFFECTS["position_friction"], runs[:3], runs[3:], BASE)
+    assert sc.passes and sc.log_ratio > 0.1
+    assert sum(sc.start[n] for n in FRICTION_MAP) > 0.1

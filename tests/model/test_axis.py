@@ -39,6 +39,23 @@ def test_asymmetry_ripple_and_drift_terms():
     assert _xdot(MeasuredAxis(False), [0.0, 0.0], 0.0, t=0.025, **ripple)[1] == pytest.approx(5.0)
 
 
+def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
+    """Four tanh steps over [start, end]: nothing happens while all amplitudes are 0, equal amplitudes make a
+    ramp odd about the middle, and beyond the span the level stays near its edge value."""
+    p = dict(coulomb=20.0, regularization_velocity=1e-6, friction_map_start=0.1, friction_map_end=0.3)
+    flat = axis_parameters(**p)
+    ramp = axis_parameters(**p, **{f"friction_map_{k}": 0.05 for k in range(4)})
+    assert axis_friction(0.1, flat, 0.17) == pytest.approx(20.0)
+    lo, mid, hi = (axis_friction(0.1, ramp, x) for x in (0.1, 0.2, 0.3))
+    assert lo < mid < hi and mid == pytest.approx(20.0, rel=1e-9)  # odd about the span's middle
+    # centres 0.125 .. 0.275, width 0.05: from one end to the other step k moves by 2 tanh(k + 1/2) of its amplitude
+    assert hi - lo == pytest.approx(20.0 * 0.05 * 2 * sum(math.tanh(k + 0.5) for k in range(4)), rel=1e-9)
+    far = [axis_friction(0.1, ramp, x) for x in (0.5, 1.0)]
+    assert far[0] == pytest.approx(far[1], rel=1e-3) and far[0] > hi
+    with pytest.raises(InputError, match="friction_map_end"):
+        axis_parameters(friction_map_start=0.2, friction_map_end=0.2)
+
+
 def test_two_mass_axis_spring_and_mass_split():
     p = dict(mass=100.0, motor_mass_fraction=0.25, stiffness=1e6, damping=0.0)
     xdot = _xdot(MeasuredAxis(True), [1e-5, 0.0, 0.0, 0.0], 0.0, **p)
