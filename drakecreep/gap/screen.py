@@ -49,7 +49,6 @@ NOT_SCREENED = ("axial_mode", "control_delay")
 
 #: dense starts of phase-like parameters (the least squares refines each; cheap on inverse dynamics)
 _DENSE = {
-    "position_period": tuple(np.geomspace(5e-4, 0.04, 14)),
     "stribeck_velocity": tuple(np.geomspace(5e-4, 5e-2, 5)),
 }
 
@@ -260,6 +259,8 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     starts = [dict(s) for s in effect.starts]
     if effect.name == "time_ripple":
         starts = [{"ripple_frequency": f} for f in _peak_frequencies(whole, base, effect.bounds["ripple_frequency"])]
+    if "position_period" in effect.parameters:
+        starts = [{"position_period": period} for period in _peak_periods(tr, reference, effect.bounds["position_period"])]
     from drakecreep.gap.drake_effects import physical_bounds
 
     bounds = dict(effect.bounds)
@@ -304,6 +305,32 @@ def _peak_frequencies(sig, base, band, count=3):
         peaks = np.array([int(np.argmax(pi))])
     order = peaks[np.argsort(pi[peaks])[::-1]][:count]
     return tuple(float(fi[i]) for i in order)
+
+
+def _peak_periods(sig, base, band, count=3):
+    """The ``count`` periods [m] of the largest peaks of the Lomb-Scargle periodogram of the inverse-dynamics
+    residual against the motor position (``band``: shortest and longest period).
+
+    A force periodic in position is a spectral line in the position's frequency; the samples are not evenly
+    spaced in position, hence Lomb-Scargle (:func:`scipy.signal.lombscargle`). The grid of angular frequencies
+    is fine enough that the phase over the travel covered stays within 1/8 cycle between neighbours: a least
+    squares refined from 14 log-spaced starts converged to a neighbouring period with the wrong sign of the
+    amplitude on development data with a lead error (docs/gap_benchmark.md, "period scan").
+    """
+    from scipy.signal import find_peaks, lombscargle
+
+    q = np.concatenate([s[1] for s in sig])
+    r = np.concatenate([(s[4] - inverse_dynamics_force(base, *s[:4])) / np.linalg.norm(s[4]) for s in sig])
+    travel = max(float(np.ptp(q)), 1e-6)
+    w_lo, w_hi = 2.0 * math.pi / band[1], 2.0 * math.pi / band[0]
+    step = 0.25 * math.pi / travel  # 1/8 cycle over the travel
+    w = np.arange(w_lo, w_hi + step, step) if (w_hi - w_lo) / step < 2e5 else np.linspace(w_lo, w_hi, 200_000)
+    power = lombscargle(q - q.mean(), r - r.mean(), w)
+    peaks, _ = find_peaks(power)
+    if peaks.size == 0:
+        peaks = np.array([int(np.argmax(power))])
+    order = peaks[np.argsort(power[peaks])[::-1]][:count]
+    return tuple(float(2.0 * math.pi / w[i]) for i in order)
 
 
 def screen_delay(train, nominal_parameters, *, max_delay=3.0, step=0.05):
