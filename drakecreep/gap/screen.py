@@ -259,12 +259,17 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     starts = [dict(s) for s in effect.starts]
     if effect.name == "time_ripple":
         starts = [{"ripple_frequency": f} for f in _peak_frequencies(whole, base, effect.bounds["ripple_frequency"])]
-    if "position_period" in effect.parameters:
-        starts = [{"position_period": period} for period in _peak_periods(tr, reference, effect.bounds["position_period"])]
     from drakecreep.gap.drake_effects import physical_bounds
 
     bounds = dict(effect.bounds)
     bounds.update(physical_bounds(effect, base))
+    if "position_period" in effect.parameters:
+        # a period the samples cannot resolve at the top speed (its frequency v / P above the Nyquist frequency
+        # of the screen's signals) is aliased: a "peak" there fits noise at a false period
+        h = float(np.median(np.diff(whole[0][0])))
+        lo, hi = bounds["position_period"]
+        bounds["position_period"] = band = (min(max(lo, 2.0 * h * v_top), 0.5 * hi), hi)
+        starts = [{"position_period": period} for period in _peak_periods(tr, reference, band)]
     for key, dense in _DENSE.items():
         if key in effect.parameters:
             lo, hi = bounds.get(key, (-np.inf, np.inf))

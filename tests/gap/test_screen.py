@@ -94,3 +94,15 @@ def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     sc = screen_effect(DRAKE_EFFECTS["position_ripple"], runs[:3], runs[3:], BASE)
     assert sc.passes and sc.start["position_period"] == pytest.approx(3.7e-3, rel=2e-3)
     assert sc.start["position_ripple_sin"] == pytest.approx(3.0, rel=0.2)
+
+
+def test_no_ripple_period_shorter_than_the_samples_resolve(asym_runs):
+    """The period search stops where the ripple's frequency at the top speed reaches the Nyquist frequency of the
+    screen's signals (every second sample): shorter periods are aliased."""
+    from drakecreep.gap.screen import _signals
+
+    sc = screen_effect(DRAKE_EFFECTS["position_ripple"], asym_runs[:2], asym_runs[2:], BASE)
+    v_top = max(float(np.max(np.abs(_signals(r)[2]))) for r in asym_runs[:2])
+    h = float(np.median(np.diff(_signals(asym_runs[0])[0])))
+    assert 2 * h * v_top > DRAKE_EFFECTS["position_ripple"].bounds["position_period"][0]  # the limit is active here
+    assert sc.start["position_period"] >= 2 * h * v_top * (1 - 1e-9)
