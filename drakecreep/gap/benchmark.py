@@ -51,7 +51,7 @@ import numpy as np
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
 from drakecreep.gap.drake_replay import rms_force_error
-from drakecreep.gap.screen import SLOW_SHARE
+from drakecreep.gap.screen import NOT_SCREENED, SLOW_SHARE
 from drakecreep.gap.truth import out_and_back
 
 __all__ = [
@@ -374,15 +374,17 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
     t0 = time.perf_counter()
     res = diagnose_dataset(ds, effects=effects, progress=progress, max_nfev=max_nfev, friction=friction)
     claimed = list(res.claimed)
+    def screened(r):  # the inverse-dynamics screen's numbers (none for candidates it does not screen)
+        return r.screen if r.screen is not None and r.screen.name not in NOT_SCREENED else None
+
     ranking = [{"effect": r.name, "gain": None if r.screened_out else r.gain,
                 "standard_error": None if r.screened_out else r.standard_error,
                 "log_error_ratio": None if r.screened_out else r.log_ratio,
                 "log_error_ratio_standard_error": None if r.screened_out else r.log_ratio_se, "passes": bool(r.passes),
                 "screened_out": bool(r.screened_out),
-                "screen_gain": None if r.screen is None or r.screen.name in ("axial_mode", "control_delay")
-                else float(r.screen.gain),
-                "screen_log_error_ratio": None if r.screen is None or r.screen.name in ("axial_mode", "control_delay")
-                else float(r.screen.log_ratio)} for r in res.ranking]
+                "screen_gain": None if screened(r) is None else float(r.screen.gain),
+                "screen_log_error_ratio": None if screened(r) is None else float(r.screen.log_ratio)}
+               for r in res.ranking]
     row = {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
            "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed, "friction": res.friction,
            "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),

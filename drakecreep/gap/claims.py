@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["ALPHA", "replay_test", "mean_and_standard_error"]
+__all__ = ["ALPHA", "replay_test", "mean_and_standard_error", "mean_log_ratio"]
 
 #: One-sided level of the tests of a claim.
 ALPHA = 0.05
@@ -49,3 +49,10 @@ def mean_and_standard_error(d):
     d = np.asarray(d, dtype=float)
     se = float(d.std(ddof=1) / np.sqrt(d.size)) if d.size > 1 else float("inf")
     return float(d.mean()), se
+
+
+def mean_log_ratio(reference, candidate, floor=1e-12):
+    """Mean and standard error of the per-run ``ln(reference / candidate)`` of two error arrays (the factor by
+    which a candidate shrinks each run's error; errors below ``floor`` count as ``floor``)."""
+    reference, candidate = np.asarray(reference, dtype=float), np.asarray(candidate, dtype=float)
+    return mean_and_standard_error(np.log(np.maximum(reference, floor) / np.maximum(candidate, floor)))

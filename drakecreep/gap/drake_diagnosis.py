@@ -46,7 +46,7 @@ import yaml
 from scipy import stats
 
 from drakecreep.errors import InputError
-from drakecreep.gap.claims import ALPHA, mean_and_standard_error
+from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
@@ -90,9 +90,7 @@ def paired_log_ratio(reference, candidate):
     reference, candidate : dict
         Run label -> replay errors (as :func:`drakecreep.gap.drake_replay.drake_replay_errors`).
     """
-    tiny = 1e-12
-    return mean_and_standard_error([math.log(max(reference[k]["force"], tiny) / max(candidate[k]["force"], tiny))
-                                    for k in reference])
+    return mean_log_ratio([reference[k]["force"] for k in reference], [candidate[k]["force"] for k in reference])
 
 
 @dataclass(frozen=True)
@@ -248,7 +246,7 @@ def _passes(reference, candidate, bar):
 
 def _screen_numbers(sc):
     """Why a candidate was screened out, in a few words."""
-    why = (f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, error x{math.exp(-sc.log_ratio):.3f} "
+    why = (f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, error x{sc.error_ratio:.3f} "
            f"(log ratio {sc.log_ratio:+.3f}, standard error {sc.log_ratio_se:.3f})")
     return why if getattr(sc, "inside", True) else why + "; fitted values outside the effect's bounds"
 

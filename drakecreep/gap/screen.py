@@ -37,7 +37,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from drakecreep.errors import InputError
-from drakecreep.gap.claims import mean_and_standard_error
+from drakecreep.gap.claims import mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
 from drakecreep.model.axis import AXIS_PARAMETERS, FRICTION_MAP, axis_friction, axis_parameters, axis_ripple
 
@@ -90,6 +90,11 @@ class ScreenResult:
     inside: bool = True
     log_ratio: float = float("nan")
     log_ratio_se: float = float("nan")
+
+    @property
+    def error_ratio(self):
+        """Geometric mean over the held-out runs of the candidate's inverse-dynamics error over the reference's."""
+        return math.exp(-self.log_ratio)
 
 
 def _signals(run, shift=0.0):
@@ -284,7 +289,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     gain, se = mean_and_standard_error(nom_test - test_err)
     # decided on the per-run log error ratio, as the claim: the held-out runs differ in speed, and a gain in
     # points of a slow run's error is not one of a fast run's
-    lr, lr_se = mean_and_standard_error(np.log(np.maximum(nom_test, 1e-12) / np.maximum(test_err, 1e-12)))
+    lr, lr_se = mean_log_ratio(nom_test, test_err)
     # the linear parameters are solved unbounded: a value outside the effect's bounds is not that effect
     inside = all(bounds[n][0] <= best[n] <= bounds[n][1] for n in effect.parameters if n in bounds)
     return ScreenResult(effect.name, {n: best[n] for n in effect.parameters}, _rms(train_err), _rms(test_err),

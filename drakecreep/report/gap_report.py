@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import io
 import json
-import math
 
 import numpy as np
 
@@ -195,7 +194,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     for r in diagnosis.ranking:
         sc = r.screen
         scr = "-" if sc is None or not np.isfinite(sc.gain) else \
-            f"{sc.gain:+.3f}; x{math.exp(-sc.log_ratio):.3f} ({sc.log_ratio:+.3f} ± {sc.log_ratio_se:.3f})"
+            f"{sc.gain:+.3f}; x{sc.error_ratio:.3f} ({sc.log_ratio:+.3f} ± {sc.log_ratio_se:.3f})"
         if r.screened_out:
             rows.append([r.name, scr, "screened out", "-", "-", "-", ""])
             continue
