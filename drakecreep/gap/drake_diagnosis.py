@@ -36,7 +36,10 @@ two-mass option and the delay), and what :func:`load_model` reads back for a rep
 
 from __future__ import annotations
 
+import concurrent.futures as cf
+import contextlib
 import math
+import multiprocessing
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -236,6 +239,21 @@ def _refit(train, model, names, max_nfev):
                     max_nfev=max_nfev)
 
 
+def _greedy_fit(name, train, test, current, fitted, start, max_nfev):
+    """Candidate ``name`` refitted on top of ``current`` (the greedy step), from its ranking fit's values
+    ``start``. Module level, so a process pool can run it beside its reference (:func:`_reference_errors`)."""
+    if name == "control_delay":
+        return fit_delay(train, test, current, start=start)
+    return fit_effect(name, train, test, current, max_nfev=max_nfev, refit=tuple(fitted), starts=(start,))
+
+
+def _reference_errors(train, test, current, fitted, max_nfev):
+    """Held-out errors of the greedy step's equal-effort reference: ``current`` with ``fitted`` refitted
+    (:func:`_refit`) and replayed fixed on ``test``. Module level, for a process pool."""
+    return score_parameters(test, _refit(train, current, fitted, max_nfev).parameters, flexible=current.flexible,
+                            delay=current.delay)[0]
+
+
 def _passes(reference, candidate, bar):
     """The claim rule of the module docstring (3): ``(gain, standard error, log ratio, its standard error,
     passes)``; gains in points of %."""
@@ -287,9 +305,10 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         ``(nominal, nominal_test_errors, ranking)`` once every candidate is ranked, before the greedy
         augmentation (the CLI writes the ranking there, so a late failure keeps it).
     workers : int
-        Processes for the closed-loop fits of the candidates that pass the screen (they are independent;
-        ``spawn`` processes, each imports Drake once, a few seconds). 1 fits them one after another in this
-        process. The result does not depend on it.
+        Processes for the closed-loop fits of the candidates that pass the screen (they are independent),
+        and, in the greedy step, for a candidate's refit beside its equal-effort reference (one pool for
+        both; ``spawn`` processes, each imports Drake once, a few seconds). 1 fits them one after another in
+        this process. The result does not depend on it.
     friction : {"auto", "lugre", "regularized"}
         Friction law of the nominal model (:data:`NOMINAL_FRICTION`); ``auto`` identifies both and keeps the
         one with the lower training cost. The default stays ``regularized``: the LuGre replay needs 2-5 sub-steps
@@ -351,46 +370,56 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     def origin(n):  # the model a candidate starts from: see _refit
         return first if _refits(n) else nominal
 
-    if workers == 1 or len(jobs) < 2:
-        for n, sc, start in jobs:
-            ranking.append(ranked(n, sc, fit_candidate(n, train, test, origin(n), max_nfev, start)))
-    else:
-        import concurrent.futures as cf
-        import multiprocessing
-
-        with cf.ProcessPoolExecutor(min(workers, len(jobs)), mp_context=multiprocessing.get_context("spawn")) as pool:
+    with contextlib.ExitStack() as stack:
+        # one pool for the ranking and the greedy step (each spawned process imports Drake once)
+        pool = None if workers == 1 else stack.enter_context(cf.ProcessPoolExecutor(
+            min(workers, max(len(jobs), 2)), mp_context=multiprocessing.get_context("spawn")))
+        if pool is None or len(jobs) < 2:
+            for n, sc, start in jobs:
+                ranking.append(ranked(n, sc, fit_candidate(n, train, test, origin(n), max_nfev, start)))
+        else:
             futures = {pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start): (n, sc)
                        for n, sc, start in jobs}
             done = {}
             for future in cf.as_completed(futures):
                 n, sc = futures[future]
                 done[n] = ranked(n, sc, future.result())
-        ranking += [done[n] for n, _, _ in jobs]
-    ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
-    if on_ranking is not None:
-        on_ranking(nominal, nom_test, tuple(ranking))
-    claimed, current, current_test = [], nominal, nom_test
-    fitted = list(nominal.fitted)
-    model = {"parameters": dict(nominal.parameters), "flexible": False, "delay": nominal.delay}
-    for r in ranking:
-        if not r.passes:
-            continue
-        fit, reference = r.fit, current_test
-        if claimed:
-            fit = fit_delay(train, test, current, start=r.fit.delay) if r.name == "control_delay" else \
-                fit_effect(r.name, train, test, current, max_nfev=max_nfev, refit=tuple(fitted),
-                           starts=({k: r.fit.parameters[k] for k in DRAKE_EFFECTS[r.name].parameters},))
-            if r.name != "control_delay":  # the same refit without the candidate (equal effort)
-                reference, _ = score_parameters(test, _refit(train, current, fitted, max_nfev).parameters,
-                                                flexible=current.flexible, delay=current.delay)
-        gain, se, lr, lr_se, ok = _passes(reference, fit.test_errors, k_se)
-        say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(gain, lr, lr_se, k_se, ok)}")
-        if ok:
-            claimed.append(r.name)
-            current, current_test = fit, fit.test_errors
-            if r.name != "control_delay":
-                fitted += [p for p in DRAKE_EFFECTS[r.name].parameters if p not in fitted]
-            model = {"parameters": dict(fit.parameters), "flexible": fit.flexible, "delay": fit.delay}
+            ranking += [done[n] for n, _, _ in jobs]
+        ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
+        if on_ranking is not None:
+            on_ranking(nominal, nom_test, tuple(ranking))
+        claimed, current, current_test = [], nominal, nom_test
+        fitted = list(nominal.fitted)
+        model = {"parameters": dict(nominal.parameters), "flexible": False, "delay": nominal.delay}
+        for r in ranking:
+            if not r.passes:
+                continue
+            fit, reference = r.fit, current_test
+            if claimed:
+                start = r.fit.delay if r.name == "control_delay" else \
+                    {k: r.fit.parameters[k] for k in DRAKE_EFFECTS[r.name].parameters}
+                args = (train, test, current, tuple(fitted))
+                # the candidate on top of the claims and, but for the delay (it refits nothing), the same refit
+                # without it (equal effort); independent, so side by side when there is a pool
+                if pool is None:
+                    fit = _greedy_fit(r.name, *args, start, max_nfev)
+                    if r.name != "control_delay":
+                        reference = _reference_errors(*args, max_nfev)
+                else:
+                    f_fit = pool.submit(_greedy_fit, r.name, *args, start, max_nfev)
+                    f_ref = pool.submit(_reference_errors, *args, max_nfev) if r.name != "control_delay" else None
+                    fit = f_fit.result()
+                    if f_ref is not None:
+                        reference = f_ref.result()
+            gain, se, lr, lr_se, ok = _passes(reference, fit.test_errors, k_se)
+            say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: "
+                f"{_verdict(gain, lr, lr_se, k_se, ok)}")
+            if ok:
+                claimed.append(r.name)
+                current, current_test = fit, fit.test_errors
+                if r.name != "control_delay":
+                    fitted += [p for p in DRAKE_EFFECTS[r.name].parameters if p not in fitted]
+                model = {"parameters": dict(fit.parameters), "flexible": fit.flexible, "delay": fit.delay}
     where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])
     return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
                           model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se,

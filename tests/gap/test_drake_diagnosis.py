@@ -47,14 +47,22 @@ def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
     assert any("claimed: asymmetric_friction" in line for line in diag.summary())
 
 
-def test_candidates_fitted_in_worker_processes_give_the_same_diagnosis(runs):
-    kwargs = dict(effects=("asymmetric_friction", "control_delay"), max_nfev=3)
+def test_candidates_fitted_in_worker_processes_give_the_same_diagnosis():
+    """Both stages in the pool: the ranking fits, and the greedy step's second claim (the candidate refitted on top
+    of the first beside its equal-effort reference)."""
+    truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=8.0, viscous_asym=-40.0,
+                           time_ripple_cos=3.0, time_ripple_sin=0.0, ripple_frequency=7.0)
+    runs = _simulated(truth, (0, 3000, 6000, 9000, 12000), 1000, "r")[0]
+    kwargs = dict(effects=("asymmetric_friction", "time_ripple"), max_nfev=3)
     serial = diagnose_drake(runs[:2], runs[2:], **kwargs)
     pooled = diagnose_drake(runs[:2], runs[2:], workers=2, **kwargs)
+    assert serial.claimed == ("time_ripple", "asymmetric_friction")  # the greedy step's refit ran
     assert [r.name for r in pooled.ranking] == [r.name for r in serial.ranking]
     assert [r.gain for r in pooled.ranking] == pytest.approx([r.gain for r in serial.ranking], rel=1e-9, abs=1e-12)
     assert pooled.claimed == serial.claimed
     assert pooled.model["parameters"] == pytest.approx(serial.model["parameters"], rel=1e-9)
+    assert [pooled.test_errors[k]["force"] for k in serial.test_errors] == pytest.approx(
+        [serial.test_errors[k]["force"] for k in serial.test_errors], rel=1e-9)
 
 
 def test_bad_requests(runs):
