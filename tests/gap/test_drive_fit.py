@@ -206,3 +206,7 @@ def test_leave_one_out_step_is_close_to_the_refit():
         for p in paths:
             a, b = drive_fit.get_value(refit, p), drive_fit.get_value(step, p)
             assert abs(a - b) <= 2e-3 * abs(a), (i, p, a, b)
+    # converged here; a fit cut short by max_nfev says so
+    assert not any("before converging" in w for w in drive_fit.fit_drive(runs, RIG, paths, replayer, max_nfev=20)[2])
+    warnings = drive_fit.fit_drive(runs, RIG, paths, replayer, max_nfev=1)[2]
+    assert any("stopped after 1 evaluations" in w and "table.seal_force" in w for w in warnings), warnings
