@@ -4,9 +4,12 @@ A ball nut resists the screw's rotation: preload drag plus a share of the axial 
 (:func:`drakecreep.model.nut_table.friction_split`). Its sliding speed is the screw's, ``omega Ph / 2 pi``
 at the table's scale, and it loads the motor side of the screw's elasticity, where the velocity loop
 and a friction compensator act. The law and its shape are the drive's (``params.friction``); only the
-level is the nut's.
+level is the nut's. The viscous term is not: ``friction.viscous`` is the axis's one viscous coefficient
+``Fv``, and it acts with the guides on the table wherever the nut's Coulomb level acts
+(:func:`nut_friction_params`), as in the linearization (``servo.linearize.nut_on_table``).
 """
 
+import dataclasses
 import math
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
@@ -17,7 +20,7 @@ from drakecreep.model._scalar import vector
 from drakecreep.model.friction import make_friction_law
 from drakecreep.model.nut_table import friction_split
 
-__all__ = ["NutFriction", "NutFriction_", "nut_friction_levels", "add_nut_friction"]
+__all__ = ["NutFriction", "NutFriction_", "nut_friction_levels", "nut_friction_params", "add_nut_friction"]
 
 
 def nut_friction_levels(params, load):
@@ -26,6 +29,14 @@ def nut_friction_levels(params, load):
         return 0.0, 0.0
     fc = friction_split(params, load)[1]
     return fc, params.friction.static_ratio * fc
+
+
+def nut_friction_params(friction):
+    """The friction parameters of the nut's drag on the screw: ``friction`` (law, shape, bristles) with no viscous
+    term. ``friction.viscous`` is counted once, on the table: moving the nut's Coulomb level between the table
+    and the screw (``friction.nut_friction_on``) must not add a second ``Fv`` (before this, the ``screw`` side
+    had ``2 Fv`` in total, against ``Fv`` in the linearization and on the ``table`` side)."""
+    return dataclasses.replace(friction, viscous=0.0)
 
 
 @TemplateSystem.define("NutFriction_")
@@ -88,7 +99,7 @@ def add_nut_friction(builder, systems, params, scenario, ports):
     if fc <= 0.0:
         return ports
     ports = dict(ports)
-    nut = builder.AddSystem(NutFriction(params.friction, fc, fs, params.screw.lead))
+    nut = builder.AddSystem(NutFriction(nut_friction_params(params.friction), fc, fs, params.screw.lead))
     nut.set_name("nut_friction")
     total = builder.AddSystem(Adder(2, 1))
     total.set_name("motor_load_sum")

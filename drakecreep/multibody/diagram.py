@@ -64,7 +64,7 @@ from drakecreep.errors import InputError
 from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.model.diagram import SIGNALS, FeedDrive
 from drakecreep.model.disturbances import LoadRipple
-from drakecreep.model.nut_friction import NutFriction, nut_friction_levels
+from drakecreep.model.nut_friction import NutFriction, nut_friction_levels, nut_friction_params
 from drakecreep.model.nut_table import table_friction_levels
 from drakecreep.model.reference import FeedReference
 from drakecreep.model.sensors import LinearScale, MotorEncoder, encoder_resolution, quantize
@@ -473,7 +473,7 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         zero = put("no_friction", ConstantVectorSource([0.0]))
         builder.Connect(zero.get_output_port(), mux.get_input_port(1))
     if fc_n > 0.0:
-        nut = put("nut_friction", NutFriction(params.friction, fc_n, fs_n, params.screw.lead))
+        nut = put("nut_friction", NutFriction(nut_friction_params(params.friction), fc_n, fs_n, params.screw.lead))
         builder.Connect(coords["nut_motion"](), nut.GetInputPort("motor_state"))
         builder.Connect(nut.GetOutputPort("friction_torque"), mux.get_input_port(2))
     else:

@@ -23,7 +23,7 @@ import scipy.linalg
 from pydrake.systems.primitives import FirstOrderTaylorApproximation
 
 from drakecreep.model.friction import make_friction_law
-from drakecreep.model.nut_friction import nut_friction_levels
+from drakecreep.model.nut_friction import nut_friction_levels, nut_friction_params
 from drakecreep.model.nut_table import table_friction_levels
 from drakecreep.multibody.diagram import (
     MultibodyOptions,
@@ -71,7 +71,8 @@ def linearize_multibody_plant(params, scenario, options=None):
     fc, fs = table_friction_levels(params, load) if options.friction else (0.0, 0.0)
     fc_n, fs_n = nut_friction_levels(params, load) if options.friction else (0.0, 0.0)
     f_guide = float(law.steady_state_force(v, fc, fs)) if fc > 0 else 0.0
-    f_nut = float(law.steady_state_force(v, fc_n, fs_n)) if fc_n > 0 else 0.0
+    f_nut = float(make_friction_law(nut_friction_params(params.friction)).steady_state_force(v, fc_n, fs_n)) \
+        if fc_n > 0 else 0.0
     applied = _load_forces(drive, idx, load) + amap @ np.array([0.0, f_guide, f_nut * ratio, 0.0])
 
     context = diagram.CreateDefaultContext()

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from drakecreep.model.diagram import initial_conditions
+from drakecreep.model.nut_friction import nut_friction_params
 from drakecreep.model.screw import bearing_element, nut_element
 
 __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
@@ -104,9 +105,12 @@ class BaselineModel:
         fc, fs = (self.fc, self.fs) if fc is None else (fc, fs)
         return fc + (fs - fc) * math.exp(-abs(v / f.stribeck_velocity) ** f.stribeck_exponent)
 
-    def friction(self, v, z, fc=None, fs=None):
-        """Friction force and its state rate at speed ``v``; levels default to the table's."""
+    def friction(self, v, z, fc=None, fs=None, viscous=True):
+        """Friction force and its state rate at speed ``v``; levels default to the table's. ``viscous`` False:
+        without the ``Fv v`` term (the nut on the screw, :func:`drakecreep.model.nut_friction.nut_friction_params`)."""
         f = self.p.friction
+        if not viscous:
+            f = nut_friction_params(f)
         fc, fs = (self.fc, self.fs) if fc is None else (fc, fs)
         if f.law == "coulomb":
             return fc * math.tanh(v / f.regularization_velocity) + f.viscous * v, 0.0
@@ -159,7 +163,8 @@ class BaselineModel:
         k, c = self.stiffness(x)
         spring = k * (theta * self.ratio - x) + c * (omega * self.ratio - v)
         friction, zdot = self.friction(v, z)
-        nut, znut_dot = self.friction(omega * self.ratio, z_nut, self.fc_nut, self.fs_nut) if self.fc_nut > 0 else (0.0, 0.0)
+        nut, znut_dot = self.friction(omega * self.ratio, z_nut, self.fc_nut, self.fs_nut, viscous=False) \
+            if self.fc_nut > 0 else (0.0, 0.0)
         out += [omega, (tau - (spring + nut) * self.ratio - self.p.motor.viscous_damping * omega) / self.inertia]
         if self.lag > 0:
             out.append((tau_cmd - tau) / self.lag)

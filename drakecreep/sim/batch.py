@@ -153,15 +153,17 @@ class BatchedFeedDrive(LeafSystem):
         shape = q * q if c.gaussian else np.abs(q) ** c.delta
         return fc + drop * np.exp(-shape)
 
-    def _friction(self, v, w, fc, drop):
-        """Friction force and (LuGre) bristle-state rate of every case at speeds ``v``."""
+    def _friction(self, v, w, fc, drop, viscous=True):
+        """Friction force and (LuGre) bristle-state rate of every case at speeds ``v``; ``viscous`` False: without
+        the ``Fv v`` term (the nut on the screw, :func:`drakecreep.model.nut_friction.nut_friction_params`)."""
         c = self.c
+        fv = c.fv if viscous else 0.0
         if c.law == "lugre":
             rate = v - np.abs(v) * w * fc / self._g(v, fc, drop)
-            return fc * w + c.s1 * rate + c.fv * v, rate
+            return fc * w + c.s1 * rate + fv * v, rate
         if c.law == "stribeck":
-            return self._g(v, fc, drop) * np.tanh(v / c.vreg) + c.fv * v, None
-        return fc * np.tanh(v / c.vreg) + c.fv * v, None
+            return self._g(v, fc, drop) * np.tanh(v / c.vreg) + fv * v, None
+        return fc * np.tanh(v / c.vreg) + fv * v, None
 
     def _split(self, s):
         c, lag = self.c, self.c.lag
@@ -196,7 +198,7 @@ class BatchedFeedDrive(LeafSystem):
         nut, nut_rate = 0.0, None
         if c.nut:
             w_nut = s.reshape(self.ns, c.n)[5 + c.lag] if c.nz else None
-            nut, nut_rate = self._friction(omega * c.ratio, w_nut, c.fc_nut, c.drop_nut)
+            nut, nut_rate = self._friction(omega * c.ratio, w_nut, c.fc_nut, c.drop_nut, viscous=False)
         rows = [omega, (tau - (spring + nut) * c.ratio - c.bm * omega) / c.inertia]
         if c.lag:
             rows.append((tau_cmd - tau) / c.tc)

@@ -57,11 +57,28 @@ def test_nut_drag_loads_the_motor_not_the_table(on_screw):
     guides, nut = friction_split(on_screw, on_screw.load_case(3))
     steady = r.time >= 0.5
     assert np.mean(r.signals["friction_force"][steady]) == pytest.approx(guides + 200.0 * 1e-3, rel=0.02)
-    assert np.mean(r.signals["nut_friction_force"][steady]) == pytest.approx(nut + 200.0 * 1e-3, rel=0.02)
+    assert np.mean(r.signals["nut_friction_force"][steady]) == pytest.approx(nut, rel=0.02)  # no viscous term
     # the screw now carries only the guides' friction (plus the axial load), so it stretches less
     total = simulate(with_value(on_screw, "friction.nut_friction_on", "table"), Scenario(feed=1e-3, load_case=3, duration=0.8))
     drop = np.mean(total.signals["spring_force"][steady]) - np.mean(r.signals["spring_force"][steady])
     assert drop == pytest.approx(nut, rel=0.05)
+
+
+def test_the_viscous_coefficient_is_counted_once_on_either_side(paper):
+    """``friction.viscous`` is the axis's one Fv: where the nut's Coulomb level acts must not change the steady
+    force. At 20 mm/s a second Fv (the nut's drag carrying the drive's viscous term too, as before) would add
+    Fv v = 4 N to the force command on the screw side."""
+    scenario = Scenario(feed=0.02, load_case=0, duration=0.8)
+    force = {}
+    for side in ("table", "screw"):
+        p = with_value(with_value(paper, "friction.nut_friction_on", side), "simulation.steady_start", 0.3)
+        r = simulate(p, scenario)
+        assert r.ok
+        force[side] = float(np.mean(r.signals["force_command"][r.time >= 0.5]))
+    assert abs(force["screw"] - force["table"]) < 0.1 * paper.friction.viscous * 0.02, force
+    model = BaselineModel(with_value(paper, "friction.nut_friction_on", "screw"), scenario)
+    assert model.friction(0.02, 0.0, model.fc_nut, model.fs_nut, viscous=False)[0] == pytest.approx(
+        model.friction(0.02, 0.0, model.fc_nut, model.fs_nut)[0] - paper.friction.viscous * 0.02)
 
 
 def test_compiled_equals_leaf_with_the_nut_on_the_screw(on_screw):
