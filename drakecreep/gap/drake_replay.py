@@ -694,6 +694,13 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
     feed = float(np.max(np.abs(vr))) or 1e-6
     scenario = Scenario(feed=min(feed, 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
+    # u[k] is the force command the controller computes at t_k from the measurement at t_k (what the truth and a
+    # drive's own trace record). A log published at t_k holds the command before the speed loop's update at t_k
+    # (the last tick of the previous sample): with the position loop at 1 kHz and the speed loop at 4 kHz that
+    # tick's force lags the sample's by an acceleration-dependent step (+-7 kg of apparent mass on a 72 kg
+    # axis, docs/gap_benchmark.md, 3d). So the log runs at the speed loop's period and u is read one tick later.
+    ctrl = params.controller
+    tick = min(ctrl.velocity_period, run.dt) if ctrl.sampled else run.dt
     b = DiagramBuilder()
     if backend == "compiled":
         fd = build_diagram(params, scenario, reference=ConstantVectorSource(np.zeros(2)),
@@ -706,13 +713,13 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         b.Connect(reference.get_output_port(), mux.get_input_port(0))
         b.Connect(ext.get_output_port(), mux.get_input_port(1))
         b.Connect(mux.get_output_port(0), system.GetInputPort("inputs"))
-        logs = {"signals": LogVectorOutput(system.GetOutputPort("signals"), b, run.dt)}
+        logs = {"signals": LogVectorOutput(system.GetOutputPort("signals"), b, tick)}
         names = compiled.signal_names
         rows = [names.index(k) for k in ("motor_angle", "table_position", "force_command")]
     else:
         fd = build_diagram(params, scenario, reference=reference, external_force=ext)
         system = b.AddSystem(fd.diagram)
-        logs = {key: LogVectorOutput(system.GetOutputPort(key), b, run.dt)
+        logs = {key: LogVectorOutput(system.GetOutputPort(key), b, tick)
                 for key in ("motor.motor_state", "table.table_state", "controller.controller_signals")}
         rows = None
     root = b.Build()
@@ -720,13 +727,17 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     if backend == "compiled":
         compiled.set_initial_state(root.GetMutableSubsystemContext(system, context))
     simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
-    simulator.AdvanceTo(float(t[-1]))
+    after = tick if ctrl.sampled else 0.0
+    simulator.AdvanceTo(float(t[-1]) + after)
     data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
+    late = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t + after)
+            for k, v in logs.items()}
     if rows is not None:
-        angle, x_table, u = data["signals"][rows]
+        angle, x_table, _ = data["signals"][rows]
+        u = late["signals"][rows[2]]
     else:
-        angle, x_table, u = (data["motor.motor_state"][0], data["table.table_state"][0],
-                             data["controller.controller_signals"][1])
+        angle, x_table = data["motor.motor_state"][0], data["table.table_state"][0]
+        u = late["controller.controller_signals"][1]
     x_motor = angle * params.screw.lead / (2 * math.pi) + x_origin
     x_table = x_table + x_origin
     force = u * run.u_gain + f_ext

@@ -92,23 +92,50 @@ def test_bad_metadata_is_refused_before_work(run):
         DrakeReplay(run, delay=-1)
 
 
-def test_drakecreep_kind_replays_its_own_simulation():
-    """A run simulated by the project's diagram, replayed through it from its measured reference, comes back."""
-    from drakecreep.params import preset
+def _own_run(params, feed=0.01, duration=0.15):
+    """A ``kind: drakecreep`` run recorded from the project's own simulation at the position loop's 1 kHz, with
+    ``u[k]`` the force command computed at ``t_k`` (the measured-format convention): the simulation is logged at
+    the speed loop's period, and a log entry holds the command *before* that instant's update, so ``u[k]`` is the
+    entry one speed tick after ``t_k``."""
     from drakecreep.scenario import Scenario
     from drakecreep.sim.simulation import simulate
 
-    p = preset("rigid_axis")
-    p = dataclasses.replace(p, simulation=dataclasses.replace(p.simulation, log_period=1e-3, steady_start=0.05))
-    sim = simulate(p, Scenario(feed=0.01, load_case=0, duration=0.15), backend="compiled")
+    tick = params.controller.velocity_period
+    p = dataclasses.replace(params, simulation=dataclasses.replace(params.simulation, log_period=tick,
+                                                                    steady_start=0.05))
+    sim = simulate(p, Scenario(feed=feed, load_case=0, duration=duration), backend="compiled")
     s = sim.signals
+    step = int(round(1e-3 / tick))
+    k = np.arange(0, sim.time.size - 1, step)
     meta = MeasuredMeta(u_units="N", u_gain=1.0, params=p, controller=ControllerMeta(kind="drakecreep"))
-    run = MeasuredRun(t=sim.time, x_ref=s["x_ref"], x_motor=s["motor_position"], u=s["force_command"], meta=meta,
-                      x_table=s["table_position"])
+    return MeasuredRun(t=sim.time[k], x_ref=s["x_ref"][k], x_motor=s["motor_position"][k],
+                       u=s["force_command"][k + 1], meta=meta, x_table=s["table_position"][k]), s["force_command"][k]
+
+
+def test_drakecreep_kind_replays_its_own_simulation():
+    """A run simulated by the project's diagram, replayed through it from its measured reference, comes back."""
+    from drakecreep.params import preset
+
+    run, _ = _own_run(preset("rigid_axis"))
     back = replay_drakecreep(run)
     assert np.max(np.abs(back.x_motor - run.x_motor)) < 1e-7
     assert np.max(np.abs(back.x_table - run.x_table)) < 1e-7
     assert np.linalg.norm(back.u - run.u) < 0.01 * np.linalg.norm(run.u)
+
+
+def test_drakecreep_kind_force_is_the_command_computed_at_the_sample():
+    """With the speed loop at 4 kHz and the position loop at 1 kHz the force moves within a sample by a step that
+    grows with the acceleration: the command computed at ``t_k`` is not the one that was applied just before. The
+    replay's ``u[k]`` is the former (``u[k]`` of the measured format). A ramp with a short acceleration phase: the
+    pre-update command differs from the replay by far more than the replay from the convention's."""
+    from drakecreep.params import preset, with_value
+
+    p = with_value(preset("rigid_axis"), "simulation.acceleration_time", 0.02)
+    run, before = _own_run(p, feed=0.05, duration=0.1)
+    back = replay_drakecreep(run)
+    on = np.linalg.norm(back.u - run.u)
+    assert on < 0.01 * np.linalg.norm(run.u)
+    assert np.linalg.norm(back.u - before) > 5 * on
 
 
 SAMPLED_CASES = {
