@@ -1,5 +1,6 @@
 """``drakecreep gap-benchmark``: datasets from an independent, richer truth with withheld effects, diagnosed blind by
-the product diagnosis (``diagnose_drake``, the Drake replay model), scored on audit runs it never sees."""
+the product diagnosis of each controller kind (``diagnose_drake`` for p_p_cascade, ``diagnose_drive`` on a
+declared params file for drakecreep), scored on audit runs it never sees."""
 
 import sys
 
@@ -10,23 +11,22 @@ __all__ = ["add_parser", "run"]
 
 def add_parser(subparsers):
     """Register ``gap-benchmark``."""
-    from drakecreep.gap.benchmark import BENCHMARK_KINDS, DEV_SEEDS, HELDOUT_SEEDS
-    from drakecreep.gap.truth import CONTROLLER_KINDS
+    from drakecreep.gap.benchmark import BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS
 
     p = subparsers.add_parser("gap-benchmark", help="withheld-effect benchmark of the gap diagnosis on realistic data",
                               description=__doc__)
     p.add_argument("--seeds", choices=("heldout", "dev"), default="heldout",
                    help=f"held-out seeds (from {HELDOUT_SEEDS}, reported) or development seeds (from {DEV_SEEDS})")
-    p.add_argument("--kinds", nargs="+", choices=CONTROLLER_KINDS, default=list(BENCHMARK_KINDS),
-                   help="controller kinds of the truth (only p_p_cascade is benchmarked: the drakecreep kind's "
-                        "product diagnosis, diagnose_drive, is not)")
+    p.add_argument("--kinds", nargs="+", choices=BENCHMARK_KINDS, default=list(DEFAULT_KINDS),
+                   help="controller kinds of the truth (default p_p_cascade; drakecreep is diagnosed by "
+                        "diagnose_drive on the params file its user would write, minutes per dataset)")
     p.add_argument("--n-per-effect", type=count, default=10, help="datasets per library effect with SNR >= 3 (default 10)")
     p.add_argument("--n-null", type=count, default=10, help="null datasets per controller kind (default 10)")
     p.add_argument("--n-ool", type=count, default=6,
                    help="datasets per out-of-library and per no-candidate effect and kind (default 6)")
     p.add_argument("--samples", type=count, default=3000, help="samples per run at 1 kHz (default 3000)")
-    p.add_argument("--effects", help="comma-separated candidates of the diagnosis (default: all; a subset is for "
-                                     "quick checks: the reported figures use all)")
+    p.add_argument("--effects", help="comma-separated candidates of the diagnosis of the one kind given (default: "
+                                     "all; a subset is for quick checks: the reported figures use all)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
@@ -41,7 +41,7 @@ MAX_SAMPLES = 1_000_000
 def run(args):
     """Run and print the scores (each dataset takes minutes: ``diagnose_drake`` fits every candidate)."""
     from drakecreep.errors import InputError
-    from drakecreep.gap.benchmark import BENCHMARK_KINDS, DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
+    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
 
     if not 600 <= args.samples <= MAX_SAMPLES:
         raise InputError("--samples", args.samples, f"an integer in [600, {MAX_SAMPLES}] samples per run (1 kHz)")
@@ -51,16 +51,16 @@ def run(args):
             raise InputError(option, n, f"an integer in [0, {MAX_DATASETS}]")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
-    for k in args.kinds:
-        if k not in BENCHMARK_KINDS:
-            raise InputError("--kinds", k, "p_p_cascade (the drakecreep kind's product diagnosis, diagnose_drive, "
-                                           "is not benchmarked yet)")
     effects = None
     if args.effects is not None:
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+        from drakecreep.gap.drive_fit import EFFECTS as DRIVE_EFFECTS
 
+        kinds = sorted(set(args.kinds))
+        if len(kinds) != 1:
+            raise InputError("--effects", args.effects, "with one --kinds only (each kind has its own candidates)")
         effects = names(args.effects)
-        allowed = tuple(DRAKE_EFFECTS) + ("control_delay",)
+        allowed = tuple(DRIVE_EFFECTS) if kinds[0] == "drakecreep" else tuple(DRAKE_EFFECTS) + ("control_delay",)
         for e in effects or ("",):
             if e not in allowed:
                 raise InputError("--effects", e, "comma-separated names of " + ", ".join(allowed))
@@ -75,7 +75,7 @@ def run(args):
     def pct(d):
         return "-" if d["rate"] is None else f"{100 * d['rate']:.0f} % (n={d['n']})"
 
-    print(f"datasets diagnosed with diagnose_drake: {s['n_datasets']} ({args.seeds} seeds from {seed}); "
+    print(f"datasets diagnosed: {s['n_datasets']} ({args.seeds} seeds from {seed}); "
           f"skipped for SNR < 3: {sum(res['low_snr_skipped'].values())}")
     print(f"top-1 where SNR >= 3: {pct(s['top1_snr3'])} (target >= 90 %)")
     print(f"claims on null datasets: {pct(s['claims_on_nulls'])} (target <= 5 %)")

@@ -8,9 +8,12 @@ training, 5 held out (``diagnose_drake`` fits on the first and decides its claim
 (:func:`drakecreep.gap.drake_effects.score_parameters`), the nominal model, the claimed (augmented) model
 and the true effect fitted with its expected label.
 
-Controller kinds: only ``p_p_cascade`` is benchmarked (:data:`BENCHMARK_KINDS`). The product path of the
-``drakecreep`` kind is :func:`drakecreep.gap.drive_fit.diagnose_drive` on a ``DriveParams`` file; it is not
-benchmarked here (:func:`run_benchmark` refuses the kind rather than score it with another diagnosis).
+Controller kinds (:data:`BENCHMARK_KINDS`): ``p_p_cascade`` is diagnosed with ``diagnose_drake``; ``drakecreep``
+with its own product path, :func:`drakecreep.gap.drive_fit.diagnose_drive`, on the params file the truth's
+user would write (:func:`declared_params`: the truth's effect-free physics mapped onto ``DriveParams``, its
+friction levels off by a drawn factor). For that kind only Stribeck, lead error and the time ripple have a
+``DriveParams`` candidate (:data:`EXPECTED_DRIVE`); every other withheld effect is out of its library (the
+right answer is "unexplained"), and its audit has no true-effect fit (no relative shrink).
 
 Kinds of dataset (:attr:`Dataset.category`):
 
@@ -41,6 +44,7 @@ runs of the squared relative force error; no claim = no shrink); claims that mak
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 import time
@@ -62,7 +66,13 @@ __all__ = [
     "N_AUDIT",
     "N_SAMPLES",
     "EXPECTED",
+    "EXPECTED_DRIVE",
     "BENCHMARK_KINDS",
+    "DEFAULT_KINDS",
+    "DECLARED_SPREAD",
+    "category_of",
+    "expected_of",
+    "declared_params",
     "Dataset",
     "out_and_back",
     "design",
@@ -104,8 +114,94 @@ EXPECTED = {
     "bearing_defect": "position_ripple",
     "time_ripple": "time_ripple",
 }
-#: Controller kinds the benchmark diagnoses with the product path (``diagnose_drake``).
-BENCHMARK_KINDS = ("p_p_cascade",)
+#: The candidate of :data:`drakecreep.gap.drive_fit.EFFECTS` that should win for each withheld effect on
+#: ``kind: drakecreep`` data. The truth's time ripple acts on the motor side, the params file's
+#: ``force_ripple`` on the table: the same force below the axial mode. The other library effects have no
+#: ``DriveParams`` field (``drive_fit.NOT_IN_MODEL``): for this kind they are out of library.
+EXPECTED_DRIVE = {"stribeck": "stribeck", "lead_error": "lead_error", "time_ripple": "force_ripple"}
+#: Controller kinds the benchmark diagnoses, each with its product path (``diagnose_drake``, ``diagnose_drive``).
+BENCHMARK_KINDS = ("p_p_cascade", "drakecreep")
+#: Kinds a benchmark runs when none are given.
+DEFAULT_KINDS = ("p_p_cascade",)
+#: Standard deviation of the log factor by which each friction level of a ``drakecreep`` dataset's params file
+#: is off (seal force, nut preload, viscous: what ``diagnose_drive`` fits by default). Assumption: a user's
+#: catalogue or commissioning values, about 15 % off.
+DECLARED_SPREAD = 0.15
+#: Table travel [m] from the diagram's origin at which the declared chain's stiffness and damping are the
+#: truth's (the shaft's stiffness varies along the screw; the truth's spring does not).
+DECLARED_AT = 0.1
+
+
+def category_of(kind, withheld):
+    """``null``, ``library``, ``no_candidate`` or ``out_of_library`` of a withheld effect for a controller kind."""
+    if not withheld:
+        return "null"
+    w = withheld[0]
+    if w in T.NO_CANDIDATE:
+        return "no_candidate"
+    library = EXPECTED_DRIVE if kind == "drakecreep" else T.LIBRARY_EFFECTS
+    return "library" if w in library else "out_of_library"
+
+
+def expected_of(kind, withheld):
+    """The candidate that should be claimed first for a withheld effect and kind, or None (no claim)."""
+    if category_of(kind, withheld) != "library":
+        return None
+    return (EXPECTED_DRIVE if kind == "drakecreep" else EXPECTED)[withheld[0]]
+
+
+def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
+    """The params file a user of the truth's ``drakecreep``-kind machine would write (its effect-free physics).
+
+    Mapped onto :class:`~drakecreep.params.DriveParams` (measured in docs/gap_benchmark.md, section 3d):
+
+    * motor side: the reflected mass ``m1`` as inertia ``m1 (lead / 2 pi)^2``, 80 % rotor and 20 % screw
+      (through the screw's density), no coupling; its Coulomb friction as the nut's preload drag on the screw
+      (with the drive's friction law: the diagram has one), its viscous part as ``motor.viscous_damping``;
+    * table: ``table.mass = m2 - nut.mass``; its LuGre friction (``Fc``, ``Fs / Fc``, ``vs``, ``sigma0``,
+      ``sigma1``, viscous) as the seal force and the friction parameters, no guide coefficient;
+    * axial chain: shaft 4 times stiffer than the truth's spring at :data:`DECLARED_AT`, bearing and nut equal,
+      so that the chain's stiffness and damping there are the truth's;
+    * current-loop lag, force limit, controller gains and periods (``controller_meta``) as the truth's.
+
+    Not expressible, so left out: the truth's constant force offset, the motor friction's own law (a ``tanh``
+    Coulomb force), the run-to-run drift and the noise. ``rng`` draws the factor ``exp(N(0, spread))`` by which
+    each of the seal force, the nut preload and the viscous coefficient is off (None: exact).
+    """
+    import dataclasses as dc
+
+    from drakecreep.model.screw import shaft_section_area
+
+    p = T.controller_meta(tr).params
+    ratio = tr.lead / (2 * math.pi)
+    inertia = tr.m1 * ratio ** 2
+    k, c = tr.k_axial, tr.c_axial
+    screw = p.screw
+    a = screw.nut_start_distance + DECLARED_AT
+    area = 4.0 * k * a / screw.youngs_modulus  # shaft 4 k at a (fixed-free: E A / a)
+    d_root = math.sqrt(4.0 * area / math.pi)
+    element = 2.0 / (1.0 / k - 1.0 / (4.0 * k))  # bearing = nut, in series with the shaft: k at a
+    damping = c * element ** 2 / (2.0 * k ** 2)  # chain damping k^2 (c_b / k_b^2 + c_n / k_n^2) = c at a
+    d_nom = d_root + 3e-3
+    screw = dc.replace(screw, root_diameter=d_root, nominal_diameter=d_nom, mounting="fixed-free",
+                       density=0.2 * inertia / (math.pi / 32.0 * screw.length * d_nom ** 4),
+                       bearing_stiffness=element, bearing_damping=damping, chain_damping="viscous",
+                       seat_joint_stiffness=0.0, seat_joint_damping=0.0)
+    assert abs(shaft_section_area(screw) - area) <= 1e-9 * area
+    off = (lambda: 1.0) if rng is None else (lambda: float(np.exp(rng.normal(0.0, spread))))
+    share = tr.motor_friction_share
+    motor = dc.replace(p.motor, rotor_inertia=0.8 * inertia, coupling_inertia=0.0,
+                       viscous_damping=share * tr.Fv * ratio ** 2, current_loop_time_constant=tr.current_lag,
+                       peak_torque=T._controller_gains(tr)["sat"] * ratio)
+    nut = dc.replace(p.nut, axial_stiffness=element, axial_damping=damping,
+                     preload_torque=share * tr.Fc * ratio * off(), load_friction_coefficient=0.0,
+                     seat_joint_stiffness=0.0, seat_joint_damping=0.0)
+    table = dc.replace(p.table, mass=tr.m2 - nut.mass, guide_friction_coefficient=0.0,
+                       seal_force=(1.0 - share) * tr.Fc * off())
+    friction = dc.replace(p.friction, law="lugre", static_ratio=max(tr.Fs_ratio, 1.0), stribeck_velocity=tr.vs,
+                          stribeck_exponent=2.0, viscous=(1.0 - share) * tr.Fv * off(),
+                          bristle_stiffness=tr.sigma0, bristle_damping=tr.sigma1, nut_friction_on="screw")
+    return dc.replace(p, screw=screw, motor=motor, nut=nut, table=table, friction=friction)
 
 
 @dataclass
@@ -131,16 +227,13 @@ class Dataset:
 
     @property
     def category(self):
-        """``null``, ``library``, ``no_candidate`` or ``out_of_library``."""
-        if not self.withheld:
-            return "null"
-        w = self.withheld[0]
-        return "library" if w in T.LIBRARY_EFFECTS else ("no_candidate" if w in T.NO_CANDIDATE else "out_of_library")
+        """``null``, ``library``, ``no_candidate`` or ``out_of_library`` (:func:`category_of`)."""
+        return category_of(self.kind, self.withheld)
 
     @property
     def expected(self):
         """The candidate that should be claimed first, or None (the right answer is no claim)."""
-        return EXPECTED.get(self.withheld[0]) if self.withheld else None
+        return expected_of(self.kind, self.withheld)
 
 
 def _slots():
@@ -200,6 +293,9 @@ def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
         sims = iter(T.simulate_batch(jobs))
         for (sd, w, k, a), (tr, refs, pulses, drift, noise) in zip(part, draws):
             runs = T.make_runs(tr, refs, pulses, next(sims))
+            if k == "drakecreep":  # the params file its user would write, friction levels off by a drawn factor
+                declared = declared_params(tr, np.random.default_rng((sd, 1)))
+                runs = [dataclasses.replace(r, meta=dataclasses.replace(r.meta, params=declared)) for r in runs]
             i, j = N_TRAIN, N_TRAIN + N_TEST
             ds = Dataset(seed=sd, withheld=tuple(w), truth=tr, train=runs[:i], test=runs[i:j], audit=runs[j:])
             if w:
@@ -277,8 +373,7 @@ def snr(runs, twin):
 
 def _check_kind(kind):
     if kind not in BENCHMARK_KINDS:
-        raise InputError("kind", kind, "p_p_cascade (the drakecreep kind's product diagnosis, "
-                                       "drakecreep.gap.drive_fit.diagnose_drive, is not benchmarked yet)")
+        raise InputError("kind", kind, "one of " + ", ".join(BENCHMARK_KINDS))
 
 
 def diagnose_dataset(ds, effects=None, progress=None, max_nfev=6, friction="auto"):
@@ -305,6 +400,9 @@ def diagnose_dataset(ds, effects=None, progress=None, max_nfev=6, friction="auto
     from drakecreep.gap.drake_diagnosis import diagnose_drake
 
     _check_kind(ds.kind)
+    if ds.kind != "p_p_cascade":
+        raise InputError("kind", ds.kind, "p_p_cascade (diagnose_dataset runs diagnose_drake; a drakecreep dataset "
+                                          "is diagnosed by diagnose_drive in evaluate)")
     return diagnose_drake(ds.train, ds.test, effects=effects, max_nfev=max_nfev, progress=progress, friction=friction)
 
 
@@ -369,8 +467,61 @@ def _shrink(e, nominal):
     return None if (e is None or nominal is None) else 1.0 - e["energy"] / nominal["energy"]
 
 
+def _evaluate_drive(ds, effects=None, progress=None, audit=True):
+    """One benchmark row of a ``drakecreep`` dataset: ``diagnose_drive`` on the declared params file, its default
+    uncertain fields, then the audit runs replayed with the fitted params file (nominal) and the augmented one."""
+    from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+    from drakecreep.gap.drive_fit import diagnose_drive
+
+    t0 = time.perf_counter()
+    kw = {} if effects is None else {"effects": tuple(effects)}
+    res = diagnose_drive(ds.train, ds.test, progress=progress or False, **kw)
+    claimed = list(res.claimed)
+    ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
+                "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason}
+               for c in res.candidates]
+    row = {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
+           "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed, "friction": res.params.friction.law,
+           "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
+           "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
+           "test_force_nominal": rms_force_error(res.nominal_test_errors),
+           "test_force_claimed": rms_force_error(res.test_errors), "diagnosis_seconds": res.seconds,
+           "truth": {k: v for k, v in ds.truth.effects.items()}, "warnings": list(res.warnings),
+           "claimed_model": {"fitted": {f.path: f.value for f in res.fitted},
+                             "effects": {c.name: dict(c.values) for c in res.candidates if c.name in claimed}}}
+    if audit:
+        t1 = time.perf_counter()
+
+        def replayed(params):
+            try:
+                per = [float(drake_replay_errors(replay_drakecreep(r, params))["force"]) for r in ds.audit]
+            except InputError:
+                return None
+            energy = float(np.mean(np.square(per)))
+            return {"energy": energy, "force_rms": math.sqrt(energy), "per_run": per}
+
+        a = {"nominal": replayed(res.nominal)}
+        a["claimed"] = replayed(res.params) if claimed else a["nominal"]
+        row["audit"] = {k: (None if v is None else {"energy": v["energy"], "force_rms": v["force_rms"]})
+                        for k, v in a.items()}
+        row["audit_shrink"] = _shrink(a["claimed"], a["nominal"]) if claimed else 0.0
+        row["true_shrink"] = None  # no true-effect fit for this kind (module docstring)
+        row["worse"] = bool(claimed and a["claimed"] is not None and a["nominal"] is not None
+                            and a["claimed"]["energy"] > a["nominal"]["energy"])
+        row["audit_seconds"] = time.perf_counter() - t1
+    row["seconds"] = time.perf_counter() - t0
+    return row
+
+
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):
-    """Diagnose ``ds`` with ``diagnose_drake`` and score the answer against the truth: one benchmark row."""
+    """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
+
+    ``p_p_cascade``: ``diagnose_drake`` (``max_nfev``, ``friction`` are its settings); ``drakecreep``:
+    ``diagnose_drive`` with its defaults (:func:`_evaluate_drive`).
+    """
+    _check_kind(ds.kind)
+    if ds.kind == "drakecreep":
+        return _evaluate_drive(ds, effects=effects, progress=progress, audit=audit)
     t0 = time.perf_counter()
     res = diagnose_dataset(ds, effects=effects, progress=progress, max_nfev=max_nfev, friction=friction)
     claimed = list(res.claimed)
@@ -414,7 +565,7 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
     return row
 
 
-def benchmark_specs(seed, kinds=BENCHMARK_KINDS, n_per_effect=10, tries=4.0, n_null=10, n_ool=6, n_no_candidate=None):
+def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_null=10, n_ool=6, n_no_candidate=None):
     """The candidate dataset list of a benchmark: ``(seed, withheld, kind, axis)``, round-robin over effects.
 
     Per controller kind: up to ``ceil(tries * n_per_effect)`` candidates per library effect (the first
@@ -425,25 +576,26 @@ def benchmark_specs(seed, kinds=BENCHMARK_KINDS, n_per_effect=10, tries=4.0, n_n
     n_nc = n_ool if n_no_candidate is None else n_no_candidate
     slots = _slots() + [()]
 
-    def count(w):
-        if not w:
+    def count(kind, w):
+        category = category_of(kind, w)
+        if category == "null":
             return n_null
-        if w[0] in T.LIBRARY_EFFECTS:
+        if category == "library":
             return int(math.ceil(tries * n_per_effect))
-        return n_nc if w[0] in T.NO_CANDIDATE else n_ool
+        return n_nc if category == "no_candidate" else n_ool
 
-    counts = [count(w) for w in slots]
+    counts = {kind: [count(kind, w) for w in slots] for kind in kinds}
     specs = []
-    for j in range(max(counts + [0])):
+    for j in range(max([c for cs in counts.values() for c in cs] + [0])):
         for kind in kinds:
-            for si, (w, c) in enumerate(zip(slots, counts)):
+            for si, (w, c) in enumerate(zip(slots, counts[kind])):
                 if j < c:
                     specs.append((seed + 100000 * T.CONTROLLER_KINDS.index(kind) + 1000 * si + j, w, kind,
                                   T.AXES[j % len(T.AXES)]))
     return specs
 
 
-def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
+def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
                   done=(), shard=(0, 1)):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
@@ -487,7 +639,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
         while pos < len(specs) and len(part) < chunk:
             sd, w, k, a = specs[pos]
             pos += 1
-            if w and w[0] in T.LIBRARY_EFFECTS and len(kept.get((k, w), [])) >= n_per_effect:
+            if category_of(k, w) == "library" and len(kept.get((k, w), [])) >= n_per_effect:
                 continue
             part.append(specs[pos - 1])
         if not part:
@@ -530,7 +682,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=BENCHMARK_KINDS, n_per_effect=10, n_
         if on_row is not None:
             on_row(row, rows)
     short = {f"{k}/{e}": len(kept.get((k, (e,)), [])) for k in kinds for e in T.LIBRARY_EFFECTS
-             if len(kept.get((k, (e,)), [])) < n_per_effect}
+             if category_of(k, (e,)) == "library" and len(kept.get((k, (e,)), [])) < n_per_effect}
     return {"scores": score_rows(rows), "datasets": rows, "failed": failed, "low_snr_skipped": skipped, "short": short}
 
 
@@ -606,8 +758,10 @@ def score_rows(rows):
     out["per_kind"] = {k: block([r for r in rows if r["kind"] == k]) for k in sorted({r["kind"] for r in rows})}
     out["per_axis"] = {a: block([r for r in rows if r["axis"] == a]) for a in sorted({r["axis"] for r in rows})}
     per = {}
+    several = len({r["kind"] for r in rows}) > 1  # an effect's category and answer depend on the kind
     for r in rows:
-        per.setdefault(r["withheld"][0] if r["withheld"] else "null", []).append(r)
+        name = r["withheld"][0] if r["withheld"] else "null"
+        per.setdefault(f"{r['kind']}/{name}" if several else name, []).append(r)
     out["per_effect"] = {}
     for key, rs in per.items():
         scored = [r for r in rs if r["snr"] >= 3] if rs[0]["category"] == "library" else rs

@@ -182,6 +182,8 @@ class DriveDiagnosis:
     ----------
     prior, params : DriveParams
         The run's params file and the augmented one (fitted values + claimed effects).
+    nominal : DriveParams or None
+        The params file with the uncertain fields fitted, before any claim.
     fitted : tuple of FittedParameter
         Of the final (augmented) model.
     warnings : tuple of str
@@ -215,6 +217,7 @@ class DriveDiagnosis:
     replay_null: float | None = None
     simulations: int = 0
     seconds: float = 0.0
+    nominal: DriveParams | None = None
 
     def summary(self):
         """Lines of text (units labelled)."""
@@ -754,4 +757,5 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
-                          replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0)
+                          replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0,
+                          nominal=params)

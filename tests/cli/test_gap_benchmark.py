@@ -34,9 +34,11 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
     assert err.count("\n") == 1 and "--samples" in err
 
 
-@pytest.mark.parametrize("argv, needle", [(["--kinds", "drakecreep"], "diagnose_drive"),
-                                          (["--effects", "gremlins"], "--effects"),
-                                          (["--effects", "lead_error"], "--effects")])
+@pytest.mark.parametrize("argv, needle", [(["--effects", "gremlins"], "--effects"),
+                                          (["--effects", "lead_error"], "--effects"),
+                                          (["--kinds", "drakecreep", "--effects", "asymmetric_friction"], "--effects"),
+                                          (["--kinds", "drakecreep", "p_p_cascade", "--effects", "stribeck"],
+                                           "one --kinds")])
 def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv, needle):
     assert cli.main(["gap-benchmark"] + argv) == 2
     err = capsys.readouterr().err

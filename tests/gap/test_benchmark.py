@@ -6,8 +6,9 @@ import pytest
 
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
-from drakecreep.gap.benchmark import (DEV_SEEDS, EXPECTED, HELDOUT_SEEDS, benchmark_specs, design, out_and_back,
-                                      run_benchmark, score_rows)
+from drakecreep.gap.benchmark import (DECLARED_AT, DECLARED_SPREAD, DEV_SEEDS, EXPECTED, EXPECTED_DRIVE, HELDOUT_SEEDS,
+                                      benchmark_specs, category_of, declared_params, design, evaluate, expected_of,
+                                      generate_dataset, out_and_back, run_benchmark, score_rows)
 
 
 def test_specs_cover_every_effect_and_axis_and_keep_seed_sets_apart():
@@ -48,9 +49,75 @@ def test_the_benchmark_does_not_use_the_former_rigid_diagnosis():
     assert "drakecreep.gap.drake_diagnosis" in names
 
 
-def test_the_drakecreep_kind_is_refused_before_any_work():
-    with pytest.raises(InputError, match="diagnose_drive"):
-        run_benchmark(seed=DEV_SEEDS, kinds=("drakecreep",), n_per_effect=0, n_null=1, n_ool=0)
+def test_an_unknown_kind_is_refused_before_any_work():
+    with pytest.raises(InputError, match="kind"):
+        run_benchmark(seed=DEV_SEEDS, kinds=("pid",), n_per_effect=0, n_null=1, n_ool=0)
+
+
+def test_the_drakecreep_kind_has_its_own_library():
+    """Only Stribeck, lead error and the time ripple have a DriveParams candidate; every other library effect of the
+    truth is out of that kind's library, and the specs draw it like one (no SNR selection)."""
+    from drakecreep.gap.drive_fit import EFFECTS, NOT_IN_MODEL
+
+    assert set(EXPECTED_DRIVE.values()) <= set(EFFECTS)
+    for e in T.LIBRARY_EFFECTS:
+        lib = category_of("drakecreep", (e,))
+        assert lib == ("library" if e in EXPECTED_DRIVE else "out_of_library"), e
+        assert category_of("p_p_cascade", (e,)) == "library" and expected_of("p_p_cascade", (e,)) == EXPECTED[e]
+        if e not in EXPECTED_DRIVE:
+            assert expected_of("drakecreep", (e,)) is None
+    assert {"asymmetric_friction", "position_friction", "cogging", "structural_mode", "control_delay"} <= set(NOT_IN_MODEL)
+    assert category_of("drakecreep", ()) == "null" and category_of("drakecreep", ("load_friction",)) == "no_candidate"
+    specs = benchmark_specs(HELDOUT_SEEDS, kinds=("p_p_cascade", "drakecreep"), n_per_effect=2, tries=2, n_null=1,
+                            n_ool=1)
+    mine = [s for s in specs if s[2] == "drakecreep"]
+    assert sum(1 for s in mine if s[1] == ("stribeck",)) == 4 and sum(1 for s in mine if s[1] == ("cogging",)) == 1
+    assert sum(1 for s in specs if s[2] == "p_p_cascade" and s[1] == ("cogging",)) == 4
+    assert len({s[0] for s in specs}) == len(specs)
+    assert {s[2] for s in benchmark_specs(HELDOUT_SEEDS, n_per_effect=1, n_null=1, n_ool=1)} == {"p_p_cascade"}
+
+
+def test_declared_params_carry_the_truths_effect_free_physics():
+    import math
+
+    from drakecreep.model.nut_friction import nut_friction_levels
+    from drakecreep.model.nut_table import table_friction_levels
+    from drakecreep.model.screw import axial_damping, axial_stiffness, screw_inertia
+
+    for seed, axis in ((1, "flexible"), (2, "rigid")):
+        tr = T.draw_truth(np.random.default_rng(seed), "drakecreep", axis)
+        p = declared_params(tr)
+        ratio = tr.lead / (2 * math.pi)
+        inertia = p.motor.rotor_inertia + p.motor.coupling_inertia + screw_inertia(p.screw)
+        assert inertia / ratio ** 2 == pytest.approx(tr.m1, rel=1e-9)
+        assert p.table.mass + p.nut.mass == pytest.approx(tr.m2, rel=1e-12)
+        assert axial_stiffness(p.screw, p.nut, DECLARED_AT) == pytest.approx(tr.k_axial, rel=1e-9)
+        assert axial_damping(p.screw, p.nut, DECLARED_AT) == pytest.approx(tr.c_axial, rel=1e-9)
+        load = p.load_case(0)
+        share = tr.motor_friction_share
+        assert table_friction_levels(p, load)[0] == pytest.approx((1 - share) * tr.Fc, rel=1e-9)
+        assert nut_friction_levels(p, load)[0] == pytest.approx(share * tr.Fc, rel=1e-9)
+        assert p.friction.viscous + p.motor.viscous_damping / ratio ** 2 == pytest.approx(tr.Fv, rel=1e-9)
+        assert (p.friction.law, p.friction.bristle_stiffness, p.controller.velocity_gain) == (
+            "lugre", tr.sigma0, T._controller_gains(tr)["kv"])
+        off = declared_params(tr, np.random.default_rng(0))
+        factors = [off.table.seal_force / p.table.seal_force, off.nut.preload_torque / p.nut.preload_torque,
+                   off.friction.viscous / p.friction.viscous]
+        assert all(f != 1.0 and abs(math.log(f)) < 5 * DECLARED_SPREAD for f in factors), factors
+        assert off.table.mass == p.table.mass and off.screw == p.screw
+
+
+def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
+    """One short null of the drakecreep kind (one candidate, to stay fast): the runs carry the declared params
+    file, the row has the drive diagnosis's ranking and the audit replays of the fitted params file."""
+    ds = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="drakecreep", axis="rigid", n_samples=600)
+    assert all(r.meta.params is not None and r.meta.params.table.mass > 0 for r in ds.train + ds.test + ds.audit)
+    row = evaluate(ds, effects=("force_ripple",))
+    assert row["kind"] == "drakecreep" and row["category"] == "null" and row["expected"] is None
+    assert [r["effect"] for r in row["ranking"]] == ["force_ripple"]
+    assert set(row["claimed_model"]["fitted"]) == {"table.seal_force", "nut.preload_torque", "friction.viscous"}
+    assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
+    assert row["worse"] is (bool(row["claimed"]) and row["audit"]["claimed"]["energy"] > row["audit"]["nominal"]["energy"])
 
 
 def test_design_cycles_through_slots():
