@@ -39,7 +39,7 @@ MAX_SAMPLES = 1_000_000
 
 
 def run(args):
-    """Run and print the scores (each dataset takes minutes: ``diagnose_drake`` fits every candidate)."""
+    """Run and print the scores (each dataset takes minutes: its kind's diagnosis fits every candidate)."""
     from drakecreep.errors import InputError
     from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
 

@@ -168,8 +168,6 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
     Coulomb force), the run-to-run drift and the noise. ``rng`` draws the factor ``exp(N(0, spread))`` by which
     each of the seal force, the nut preload and the viscous coefficient is off (None: exact).
     """
-    import dataclasses as dc
-
     from drakecreep.model.screw import shaft_section_area
 
     p = T.controller_meta(tr).params
@@ -183,25 +181,25 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
     element = 2.0 / (1.0 / k - 1.0 / (4.0 * k))  # bearing = nut, in series with the shaft: k at a
     damping = c * element ** 2 / (2.0 * k ** 2)  # chain damping k^2 (c_b / k_b^2 + c_n / k_n^2) = c at a
     d_nom = d_root + 3e-3
-    screw = dc.replace(screw, root_diameter=d_root, nominal_diameter=d_nom, mounting="fixed-free",
+    screw = dataclasses.replace(screw, root_diameter=d_root, nominal_diameter=d_nom, mounting="fixed-free",
                        density=0.2 * inertia / (math.pi / 32.0 * screw.length * d_nom ** 4),
                        bearing_stiffness=element, bearing_damping=damping, chain_damping="viscous",
                        seat_joint_stiffness=0.0, seat_joint_damping=0.0)
     assert abs(shaft_section_area(screw) - area) <= 1e-9 * area
     off = (lambda: 1.0) if rng is None else (lambda: float(np.exp(rng.normal(0.0, spread))))
     share = tr.motor_friction_share
-    motor = dc.replace(p.motor, rotor_inertia=0.8 * inertia, coupling_inertia=0.0,
+    motor = dataclasses.replace(p.motor, rotor_inertia=0.8 * inertia, coupling_inertia=0.0,
                        viscous_damping=share * tr.Fv * ratio ** 2, current_loop_time_constant=tr.current_lag,
                        peak_torque=T._controller_gains(tr)["sat"] * ratio)
-    nut = dc.replace(p.nut, axial_stiffness=element, axial_damping=damping,
+    nut = dataclasses.replace(p.nut, axial_stiffness=element, axial_damping=damping,
                      preload_torque=share * tr.Fc * ratio * off(), load_friction_coefficient=0.0,
                      seat_joint_stiffness=0.0, seat_joint_damping=0.0)
-    table = dc.replace(p.table, mass=tr.m2 - nut.mass, guide_friction_coefficient=0.0,
+    table = dataclasses.replace(p.table, mass=tr.m2 - nut.mass, guide_friction_coefficient=0.0,
                        seal_force=(1.0 - share) * tr.Fc * off())
-    friction = dc.replace(p.friction, law="lugre", static_ratio=max(tr.Fs_ratio, 1.0), stribeck_velocity=tr.vs,
+    friction = dataclasses.replace(p.friction, law="lugre", static_ratio=max(tr.Fs_ratio, 1.0), stribeck_velocity=tr.vs,
                           stribeck_exponent=2.0, viscous=(1.0 - share) * tr.Fv * off(),
                           bristle_stiffness=tr.sigma0, bristle_damping=tr.sigma1, nut_friction_on="screw")
-    return dc.replace(p, screw=screw, motor=motor, nut=nut, table=table, friction=friction)
+    return dataclasses.replace(p, screw=screw, motor=motor, nut=nut, table=table, friction=friction)
 
 
 @dataclass
