@@ -133,21 +133,22 @@ DECLARED_AT = 0.1
 
 
 def category_of(kind, withheld):
-    """``null``, ``library``, ``no_candidate`` or ``out_of_library`` of a withheld effect for a controller kind."""
+    """``null``, ``library``, ``no_candidate`` or ``out_of_library`` of a withheld effect for a controller kind:
+    a library effect is one the kind's diagnosis has a candidate for (:data:`EXPECTED`, :data:`EXPECTED_DRIVE`)."""
     if not withheld:
         return "null"
-    w = withheld[0]
-    if w in T.NO_CANDIDATE:
+    if withheld[0] in T.NO_CANDIDATE:
         return "no_candidate"
-    library = EXPECTED_DRIVE if kind == "drakecreep" else T.LIBRARY_EFFECTS
-    return "library" if w in library else "out_of_library"
+    return "library" if withheld[0] in _expected(kind) else "out_of_library"
 
 
 def expected_of(kind, withheld):
     """The candidate that should be claimed first for a withheld effect and kind, or None (no claim)."""
-    if category_of(kind, withheld) != "library":
-        return None
-    return (EXPECTED_DRIVE if kind == "drakecreep" else EXPECTED)[withheld[0]]
+    return _expected(kind).get(withheld[0]) if withheld else None
+
+
+def _expected(kind):
+    return EXPECTED_DRIVE if kind == "drakecreep" else EXPECTED
 
 
 def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
@@ -168,8 +169,6 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
     Coulomb force), the run-to-run drift and the noise. ``rng`` draws the factor ``exp(N(0, spread))`` by which
     each of the seal force, the nut preload and the viscous coefficient is off (None: exact).
     """
-    from drakecreep.model.screw import shaft_section_area
-
     p = T.controller_meta(tr).params
     ratio = tr.lead / (2 * math.pi)
     inertia = tr.m1 * ratio ** 2
@@ -185,7 +184,6 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
                        density=0.2 * inertia / (math.pi / 32.0 * screw.length * d_nom ** 4),
                        bearing_stiffness=element, bearing_damping=damping, chain_damping="viscous",
                        seat_joint_stiffness=0.0, seat_joint_damping=0.0)
-    assert abs(shaft_section_area(screw) - area) <= 1e-9 * area
     off = (lambda: 1.0) if rng is None else (lambda: float(np.exp(rng.normal(0.0, spread))))
     share = tr.motor_friction_share
     motor = dataclasses.replace(p.motor, rotor_inertia=0.8 * inertia, coupling_inertia=0.0,
@@ -465,9 +463,30 @@ def _shrink(e, nominal):
     return None if (e is None or nominal is None) else 1.0 - e["energy"] / nominal["energy"]
 
 
+def _row(ds, claimed, ranking, **fields):
+    """The keys every benchmark row has (the dataset, the claims, the ranking), then ``fields``."""
+    return {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
+            "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed,
+            "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
+            "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
+            "truth": {k: v for k, v in ds.truth.effects.items()}, **fields}
+
+
+def _audit_fields(a, claimed):
+    """Row fields of the audit replays ``a`` (``nominal``, ``claimed`` and optionally ``true``: ``{"energy",
+    "force_rms", ...}`` or None)."""
+    return {"audit": {k: (None if v is None else {"energy": v["energy"], "force_rms": v["force_rms"]})
+                      for k, v in a.items()},
+            "audit_shrink": _shrink(a["claimed"], a["nominal"]) if claimed else 0.0,
+            "true_shrink": _shrink(a.get("true"), a["nominal"]),
+            "worse": bool(claimed and a["claimed"] is not None and a["nominal"] is not None
+                          and a["claimed"]["energy"] > a["nominal"]["energy"])}
+
+
 def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     """One benchmark row of a ``drakecreep`` dataset: ``diagnose_drive`` on the declared params file, its default
-    uncertain fields, then the audit runs replayed with the fitted params file (nominal) and the augmented one."""
+    uncertain fields, then the audit runs replayed with the fitted params file (nominal) and the augmented one
+    (no true-effect fit for this kind: module docstring)."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import diagnose_drive
 
@@ -478,34 +497,26 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason}
                for c in res.candidates]
-    row = {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
-           "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed, "friction": res.params.friction.law,
-           "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
-           "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
-           "test_force_nominal": rms_force_error(res.nominal_test_errors),
-           "test_force_claimed": rms_force_error(res.test_errors), "diagnosis_seconds": res.seconds,
-           "truth": {k: v for k, v in ds.truth.effects.items()}, "warnings": list(res.warnings),
-           "claimed_model": {"fitted": {f.path: f.value for f in res.fitted},
-                             "effects": {c.name: dict(c.values) for c in res.candidates if c.name in claimed}}}
+    row = _row(ds, claimed, ranking, friction=res.params.friction.law,
+               test_force_nominal=rms_force_error(res.nominal_test_errors),
+               test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
+               warnings=list(res.warnings),
+               claimed_model={"fitted": {f.path: f.value for f in res.fitted},
+                              "effects": {c.name: dict(c.values) for c in res.candidates if c.name in claimed}})
     if audit:
         t1 = time.perf_counter()
 
         def replayed(params):
             try:
-                per = [float(drake_replay_errors(replay_drakecreep(r, params))["force"]) for r in ds.audit]
+                errors = {r.label: drake_replay_errors(replay_drakecreep(r, params)) for r in ds.audit}
             except InputError:
                 return None
-            energy = float(np.mean(np.square(per)))
-            return {"energy": energy, "force_rms": math.sqrt(energy), "per_run": per}
+            rms = rms_force_error(errors)
+            return {"energy": rms * rms, "force_rms": rms, "per_run": [float(e["force"]) for e in errors.values()]}
 
         a = {"nominal": replayed(res.nominal)}
         a["claimed"] = replayed(res.params) if claimed else a["nominal"]
-        row["audit"] = {k: (None if v is None else {"energy": v["energy"], "force_rms": v["force_rms"]})
-                        for k, v in a.items()}
-        row["audit_shrink"] = _shrink(a["claimed"], a["nominal"]) if claimed else 0.0
-        row["true_shrink"] = None  # no true-effect fit for this kind (module docstring)
-        row["worse"] = bool(claimed and a["claimed"] is not None and a["nominal"] is not None
-                            and a["claimed"]["energy"] > a["nominal"]["energy"])
+        row.update(_audit_fields(a, claimed))
         row["audit_seconds"] = time.perf_counter() - t1
     row["seconds"] = time.perf_counter() - t0
     return row
@@ -534,15 +545,11 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 "screen_gain": None if screened(r) is None else float(r.screen.gain),
                 "screen_log_error_ratio": None if screened(r) is None else float(r.screen.log_ratio)}
                for r in res.ranking]
-    row = {"seed": ds.seed, "withheld": list(ds.withheld), "expected": ds.expected, "category": ds.category,
-           "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed, "friction": res.friction,
-           "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
-           "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
-           "test_force_nominal": rms_force_error(res.nominal_test_errors),
-           "test_force_claimed": rms_force_error(res.test_errors),
-           "diagnosis_seconds": res.seconds, "truth": {k: v for k, v in ds.truth.effects.items()},
-           "claimed_model": {"parameters": {k: float(v) for k, v in res.model["parameters"].items()},
-                             "flexible": bool(res.model["flexible"]), "delay": float(res.model["delay"])}}
+    row = _row(ds, claimed, ranking, friction=res.friction,
+               test_force_nominal=rms_force_error(res.nominal_test_errors),
+               test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
+               claimed_model={"parameters": {k: float(v) for k, v in res.model["parameters"].items()},
+                              "flexible": bool(res.model["flexible"]), "delay": float(res.model["delay"])})
     if audit:
         t1 = time.perf_counter()
         nom = res.nominal
@@ -551,13 +558,7 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
         true = true_effect_fit(res, ds, max_nfev=max_nfev)
         if true is not None:
             models["true"] = (dict(true.parameters), bool(true.flexible), float(true.delay))
-        a = audit_replay(ds.audit, models)
-        row["audit"] = {k: (None if v is None else {"energy": v["energy"], "force_rms": v["force_rms"]})
-                        for k, v in a.items()}
-        row["audit_shrink"] = _shrink(a["claimed"], a["nominal"]) if claimed else 0.0
-        row["true_shrink"] = _shrink(a.get("true"), a["nominal"])
-        row["worse"] = bool(claimed and a["claimed"] is not None and a["nominal"] is not None
-                            and a["claimed"]["energy"] > a["nominal"]["energy"])
+        row.update(_audit_fields(audit_replay(ds.audit, models), claimed))
         row["audit_seconds"] = time.perf_counter() - t1
     row["seconds"] = time.perf_counter() - t0
     return row

@@ -254,6 +254,15 @@ def _reference_errors(train, test, current, fitted, max_nfev):
                             delay=current.delay)[0]
 
 
+def _submit(pool, fn, *args):
+    """``fn(*args)`` on ``pool``, or here and now without one (a done future either way)."""
+    if pool is not None:
+        return pool.submit(fn, *args)
+    done = cf.Future()
+    done.set_result(fn(*args))
+    return done
+
+
 def _passes(reference, candidate, bar):
     """The claim rule of the module docstring (3): ``(gain, standard error, log ratio, its standard error,
     passes)``; gains in points of %."""
@@ -401,16 +410,11 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 args = (train, test, current, tuple(fitted))
                 # the candidate on top of the claims and, but for the delay (it refits nothing), the same refit
                 # without it (equal effort); independent, so side by side when there is a pool
-                if pool is None:
-                    fit = _greedy_fit(r.name, *args, start, max_nfev)
-                    if r.name != "control_delay":
-                        reference = _reference_errors(*args, max_nfev)
-                else:
-                    f_fit = pool.submit(_greedy_fit, r.name, *args, start, max_nfev)
-                    f_ref = pool.submit(_reference_errors, *args, max_nfev) if r.name != "control_delay" else None
-                    fit = f_fit.result()
-                    if f_ref is not None:
-                        reference = f_ref.result()
+                f_fit = _submit(pool, _greedy_fit, r.name, *args, start, max_nfev)
+                f_ref = _submit(pool, _reference_errors, *args, max_nfev) if r.name != "control_delay" else None
+                fit = f_fit.result()
+                if f_ref is not None:
+                    reference = f_ref.result()
             gain, se, lr, lr_se, ok = _passes(reference, fit.test_errors, k_se)
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: "
                 f"{_verdict(gain, lr, lr_se, k_se, ok)}")

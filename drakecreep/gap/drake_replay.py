@@ -729,15 +729,17 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
     after = tick if ctrl.sampled else 0.0
     simulator.AdvanceTo(float(t[-1]) + after)
-    data = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t) for k, v in logs.items()}
-    late = {k: _on_samples(v.FindLog(context).sample_times(), v.FindLog(context).data(), t + after)
-            for k, v in logs.items()}
+    def sampled(key, at):
+        log = logs[key].FindLog(context)
+        return _on_samples(log.sample_times(), log.data(), at)
+
     if rows is not None:
-        angle, x_table, _ = data["signals"][rows]
-        u = late["signals"][rows[2]]
+        signals = sampled("signals", t)
+        angle, x_table = signals[rows[0]], signals[rows[1]]
+        u = sampled("signals", t + after)[rows[2]]
     else:
-        angle, x_table = data["motor.motor_state"][0], data["table.table_state"][0]
-        u = late["controller.controller_signals"][1]
+        angle, x_table = sampled("motor.motor_state", t)[0], sampled("table.table_state", t)[0]
+        u = sampled("controller.controller_signals", t + after)[1]
     x_motor = angle * params.screw.lead / (2 * math.pi) + x_origin
     x_table = x_table + x_origin
     force = u * run.u_gain + f_ext
