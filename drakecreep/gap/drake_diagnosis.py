@@ -275,7 +275,13 @@ def _screen_numbers(sc):
     """Why a candidate was screened out, in a few words."""
     why = (f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, error x{sc.error_ratio:.3f} "
            f"(log ratio {sc.log_ratio:+.3f}, standard error {sc.log_ratio_se:.3f})")
-    return why if getattr(sc, "inside", True) else why + "; fitted values outside the effect's bounds"
+    if not getattr(sc, "inside", True):
+        why += "; fitted values outside the effect's bounds"
+    c = getattr(sc, "constancy", None)
+    if c is not None and not c.constant:
+        why += (f"; not the same in every training run (chi2 {c.chi2:.1f} on {c.dof} degrees of freedom, "
+                f"p = {c.p_value:.2g})")
+    return why
 
 
 def _verdict(gain, lr, lr_se, bar, ok):

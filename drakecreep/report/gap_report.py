@@ -25,6 +25,10 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                        "log_error_ratio": sc.log_ratio, "log_error_ratio_standard_error": sc.log_ratio_se,
                                        "passes": bool(sc.passes),
                                        "start": sc.start}
+            c = getattr(sc, "constancy", None)
+            if c is not None:
+                row["inverse_dynamics"]["constancy"] = {"per_run": list(c.per_run), "chi2": c.chi2, "dof": c.dof,
+                                                        "p_value": c.p_value, "constant": bool(c.constant)}
         if not r.screened_out:
             from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 

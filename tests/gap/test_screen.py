@@ -106,3 +106,38 @@ def test_no_ripple_period_shorter_than_the_samples_resolve(asym_runs):
     h = float(np.median(np.diff(_signals(asym_runs[0])[0])))
     assert 2 * h * v_top > DRAKE_EFFECTS["position_ripple"].bounds["position_period"][0]  # the limit is active here
     assert sc.start["position_period"] >= 2 * h * v_top * (1 - 1e-9)
+
+
+def test_a_friction_drift_at_one_rate_in_every_run_passes_the_constancy_test():
+    """A friction level rising by 10 % per second in every run: the drift candidate passes, and the rates fitted
+    on each training run alone agree within their standard errors."""
+    runs = _runs(dict(BASE, friction_drift=0.1))
+    sc = screen_effect(DRAKE_EFFECTS["thermal_drift"], runs[:3], runs[3:], BASE)
+    assert sc.passes and sc.constancy is not None and sc.constancy.constant
+    assert len(sc.constancy.per_run) == 3 and all(r["friction_drift"] > 0 for r in sc.constancy.per_run)
+
+
+def test_a_drift_that_stands_in_for_a_spring_fails_the_constancy_test():
+    """A cable carrier's position force (development seed 11001, out-and-back runs at four speeds): within each
+    run a drift ``d t`` is a spring ``d Fc x / v``, so the drift gains on the held-out inverse dynamics, but its
+    rate differs from run to run beyond the standard errors, and the screen rules it out. Without the
+    constancy test it passes (the false claims of held-out run 4, docs/gap_benchmark.md 3e)."""
+    from drakecreep.gap.benchmark import generate_datasets
+    from drakecreep.gap.identify import idim_start
+
+    ds = generate_datasets([(11001, ("cable_carrier",), "p_p_cascade", "rigid")])[0]
+    nominal = idim_start(ds.train).parameters
+    drift = DRAKE_EFFECTS["thermal_drift"]
+    sc = screen_effect(drift, ds.train, ds.test, nominal)
+    assert not sc.passes and not sc.constancy.constant and sc.constancy.p_value < 0.01
+    assert sc.log_ratio > sc.log_ratio_se  # the held-out gain alone would let it through
+    assert screen_effect(dataclasses.replace(drift, run_constancy=False), ds.train, ds.test, nominal).passes
+
+
+def test_a_held_out_run_slower_than_the_sliding_cut_is_left_out_not_nan():
+    """A held-out run that never reaches SLOW_SHARE of the training runs' top speed has no sliding sample: it is
+    left out of the screen's statistic instead of making it NaN (which failed every candidate)."""
+    runs = _runs(dict(BASE, time_ripple_cos=3.0, ripple_frequency=13.0))
+    slow = dataclasses.replace(runs[4], x_motor=runs[4].x_motor[0] + 0.01 * (runs[4].x_motor - runs[4].x_motor[0]))
+    sc = screen_effect(DRAKE_EFFECTS["time_ripple"], runs[:2], runs[2:4] + [slow], BASE)
+    assert np.isfinite(sc.log_ratio) and sc.passes
