@@ -141,3 +141,17 @@ def test_a_held_out_run_slower_than_the_sliding_cut_is_left_out_not_nan():
     slow = dataclasses.replace(runs[4], x_motor=runs[4].x_motor[0] + 0.01 * (runs[4].x_motor - runs[4].x_motor[0]))
     sc = screen_effect(DRAKE_EFFECTS["time_ripple"], runs[:2], runs[2:4] + [slow], BASE)
     assert np.isfinite(sc.log_ratio) and sc.passes
+
+
+def test_a_friction_level_change_between_runs_is_not_credited_to_a_candidate():
+    """Held-out runs 15 % hotter than the training runs (friction drifts between runs): scored without each
+    run's own friction level the drift candidate gains on them (it raises the friction over a run); with it
+    (the default) it does not, and the reference's held-out error is the effect-free one's."""
+    train = _runs(BASE)[:3]
+    hot = _runs(dict(BASE, coulomb=1.15 * BASE["coulomb"], viscous=1.15 * BASE["viscous"]))[3:]
+    drift = DRAKE_EFFECTS["thermal_drift"]
+    assert screen_effect(drift, train, hot, BASE, run_level=False).passes
+    sc = screen_effect(drift, train, hot, BASE)
+    assert not sc.passes
+    same = screen_effect(drift, train, _runs(BASE)[3:], BASE)
+    assert sc.nominal_test_error == pytest.approx(same.nominal_test_error, rel=0.05)
