@@ -27,10 +27,10 @@ seconds:
   the held-out runs is not credited to a candidate;
 * a **constancy test** for candidates flagged ``run_constancy`` (the friction drift): fitted on each training
   run alone, the candidate's amplitudes must agree within their standard errors (:func:`constancy`, a
-  Chow-type Wald test at :data:`~drakecreep.gap.claims.ALPHA`). It is not asked of every candidate: on 49
-  development datasets it also rejected true position ripples and position frictions (p down to 1e-100),
-  whose rigid inverse-dynamics amplitude really varies with the run's speed on a flexible axis
-  (docs/gap_benchmark.md, 3g).
+  Chow-type Wald test at :data:`~drakecreep.gap.claims.ALPHA`). It is not asked of every candidate: on 53
+  development datasets it also rejected true position ripples and position frictions (p down to 1e-139):
+  their rigid inverse-dynamics amplitudes differ from run to run by more than the noise, as the runs cover
+  different stretches of travel at different speeds (docs/gap_benchmark.md, 3g).
 
 Two candidates have no rigid inverse-dynamics form and are never screened out: the axial mode (the
 two-mass axis needs the table's state) and the computation delay (screened here only for its start value:
@@ -86,6 +86,8 @@ class ScreenResult:
     log_ratio, log_ratio_se : float
         Mean and standard error of the per-run ``ln(reference / candidate)`` of the held-out errors: the
         statistic the screen is decided on, as the claim (:func:`drakecreep.gap.drake_diagnosis.paired_log_ratio`).
+    constancy : Constancy or None
+        The constancy test across the training runs, for candidates flagged ``run_constancy`` (else None).
     """
 
     name: str
@@ -406,10 +408,11 @@ def constancy(tr, pooled, refit, effect, alpha=ALPHA):
     """Chow-type test of one candidate on the training runs' inverse dynamics (IDIM signals ``tr``).
 
     Each training run is fitted alone, the nominal parameters ``refit`` and the candidate's amplitudes free
-    (its :data:`SHAPE` parameters held at the ``pooled`` fit). The amplitudes' covariance per run is
-    ``tau s^2 (J^T J)^+`` (``J`` the Jacobian of the run's normalised force, ``s^2`` its residual variance,
-    ``tau`` the integrated autocorrelation time of the residual: the filtered signals' samples are not
-    independent). A physical effect has one value; an effect that only mimics another varies with the run's
+    (its :data:`SHAPE` parameters held at the ``pooled`` fit). The information on the amplitudes per run is
+    ``Ja^T (I - P_n) Ja / (tau s^2)`` (:func:`_profile_information`: ``J`` the Jacobian of the run's normalised
+    force, the nominal columns profiled out, ``s^2`` the residual variance, ``tau`` the integrated
+    autocorrelation time of the residual: the filtered signals' samples are not independent). The statistic is
+    the Wald ``chi2`` of the per-run amplitudes about their precision-weighted mean. A physical effect has one value; an effect that only mimics another varies with the run's
     conditions. The case that motivates it: within an out-and-back run at speed ``v``, a friction drift
     ``d t`` is a force ``d Fc x / v`` (a spring), so on a cable carrier's spring the drift fits a ``d``
     proportional to each run's speed (docs/gap_benchmark.md, 3e).
