@@ -283,7 +283,9 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     te = [_signals(r) for r in test]
     v_top = max(float(np.max(np.abs(s[2]))) for s in tr)
     whole, tr, te = tr, _sliding(tr, v_top, slow_share), _sliding(te, v_top, slow_share)
-    if effect.name in NOT_SCREENED:
+    if effect.name in NOT_SCREENED or len(te) < 2:
+        # (fewer than two held-out runs with sliding samples: no standard error, so the screen cannot decide
+        # and leaves the candidate to the closed loop, as a candidate it has no form for)
         nom_test = _errors(te, base)
         return ScreenResult(effect.name, {}, float("nan"), float("nan"), _rms(nom_test), float("nan"),
                             float("nan"), True)

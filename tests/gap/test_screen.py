@@ -1,6 +1,7 @@
 """The inverse-dynamics pre-screen (drakecreep.gap.screen) on runs replayed through a known axis."""
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pytest
@@ -155,3 +156,14 @@ def test_a_friction_level_change_between_runs_is_not_credited_to_a_candidate():
     assert not sc.passes
     same = screen_effect(drift, train, _runs(BASE)[3:], BASE)
     assert sc.nominal_test_error == pytest.approx(same.nominal_test_error, rel=0.05)
+
+
+def test_with_fewer_than_two_sliding_held_out_runs_the_screen_leaves_the_candidate_to_the_closed_loop():
+    """Every held-out run slower than the sliding cut: the screen has no statistic, so it passes the candidate
+    on (the closed-loop claim test decides) instead of ruling it out on NaN."""
+    runs = _runs(dict(BASE, time_ripple_cos=3.0, ripple_frequency=13.0))
+    slow = [dataclasses.replace(r, x_motor=r.x_motor[0] + 0.01 * (r.x_motor - r.x_motor[0])) for r in runs[2:]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sc = screen_effect(DRAKE_EFFECTS["stribeck"], runs[:2], slow, BASE)
+    assert sc.passes and np.isnan(sc.log_ratio)
