@@ -13,7 +13,7 @@ effect's, with the constancy test's p-value, then three counts:
 * candidates passing the held-out screen with and without the per-run level: the withheld effect's own and the
   others, per dataset category.
 
-Run (about 4 min on two free cores)::
+Run (about 3 min on two free cores)::
 
     PYTHONPATH=. python analysis/screen_study.py --shard 0/2 --json a.json &
     PYTHONPATH=. python analysis/screen_study.py --shard 1/2 --json b.json &

@@ -45,6 +45,9 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     # the ranking file is written (before the augmentation) and agrees with the final JSON
     ranking = json.loads((out / "ranking.json").read_text())
     assert [r["effect"] for r in ranking["ranking"]] == [r["effect"] for r in data["ranking"]]
+    # the drift's constancy test across the two training runs is in the ranking, per run
+    drift = next(r for r in ranking["ranking"] if r["effect"] == "thermal_drift")["inverse_dynamics"]["constancy"]
+    assert len(drift["per_run"]) == 2 and 0.0 <= drift["p_value"] <= 1.0 and drift["dof"] == 1
     assert json.loads((out / "diagnosis.json").read_text())["claimed"] == ["asymmetric_friction"]
     manifest = json.loads((out / "manifest.json").read_text())
     assert {"diagnosis.html", "diagnosis.json", "augmented_model.yaml", "ranking.json"} <= set(manifest["files"])
