@@ -729,6 +729,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
     after = tick if ctrl.sampled else 0.0
     simulator.AdvanceTo(float(t[-1]) + after)
+
     def sampled(key, at):
         log = logs[key].FindLog(context)
         return _on_samples(log.sample_times(), log.data(), at)

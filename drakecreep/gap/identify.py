@@ -35,7 +35,7 @@ from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP
 
-__all__ = ["IdimStart", "Identified", "idim_start", "identify", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
+__all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
 
 #: parameters fitted on a log scale (they must stay > 0)
 LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "damping", "viscous",
@@ -350,7 +350,7 @@ def _regularization(runs):
     return float(np.clip(0.01 * np.median(speeds), 1e-5, 1e-3))
 
 
-def _correlation_time(r, limit=0.05, max_lag=2000):
+def correlation_time(r, limit=0.05, max_lag=2000):
     """Integrated autocorrelation time ``1 + 2 sum rho(k)`` (summed while ``rho > limit``) of a residual."""
     r = np.asarray(r, dtype=float) - np.mean(r)
     n = r.size
@@ -372,7 +372,7 @@ def _confidence(sol, prob, values):
     J = sol.jac
     m, p = J.shape
     # residuals of a closed-loop replay are correlated in time: count independent samples as m / tau_int
-    inflation = _correlation_time(sol.fun)
+    inflation = correlation_time(sol.fun)
     s2 = 2.0 * sol.cost / max(m - p, 1)
     # d value / d x: the chain rule of the scaling
     v = np.array([values[n] for n in prob.names])

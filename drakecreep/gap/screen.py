@@ -130,9 +130,16 @@ def inverse_dynamics_force(parameters, t, q, dq, ddq):
 
     ``M ddq + f(dq, q, t) + offset - r(q, t)`` with the axis's own friction and ripple functions.
     """
+    other, friction = _force_parts(parameters, t, q, dq, ddq)
+    return other + friction
+
+
+def _force_parts(parameters, t, q, dq, ddq):
+    """:func:`inverse_dynamics_force` as ``(M ddq + offset - r(q, t), f(dq, q, t))``: all but the friction, and
+    the friction."""
     p = axis_parameters(**parameters)
     P = dict(zip(AXIS_PARAMETERS, p))
-    return P["mass"] * ddq + axis_friction(dq, p, q, t) + P["offset"] - axis_ripple(q, t, p)
+    return P["mass"] * ddq + P["offset"] - axis_ripple(q, t, p), axis_friction(dq, p, q, t)
 
 
 def _errors(runs_sig, values, level=False):
@@ -140,13 +147,9 @@ def _errors(runs_sig, values, level=False):
     factor first (the run's friction level, a nuisance: friction drifts between runs)."""
     out = []
     for t, q, dq, ddq, tau in runs_sig:
-        f = inverse_dynamics_force(values, t, q, dq, ddq)
-        if level:
-            p = axis_parameters(**values)
-            fr = axis_friction(dq, p, q, t)
-            rest = tau - (f - fr)
-            f = f - fr + float(fr @ rest) / max(float(fr @ fr), 1e-300) * fr
-        out.append(100.0 * np.linalg.norm(tau - f) / np.linalg.norm(tau))
+        other, fr = _force_parts(values, t, q, dq, ddq)
+        scale = float(fr @ (tau - other)) / max(float(fr @ fr), 1e-300) if level else 1.0
+        out.append(100.0 * np.linalg.norm(tau - other - scale * fr) / np.linalg.norm(tau))
     return np.array(out)
 
 
@@ -401,8 +404,8 @@ def _pinv_scaled(a):
 
 
 def _rank_scaled(a):
-    b, _ = _scaled(a)
-    s = np.linalg.eigvalsh(b)
+    """Rank of a symmetric matrix after scaling it to unit diagonal (relative cut RCOND)."""
+    s = np.linalg.eigvalsh(_scaled(a)[0])
     return int(np.sum(s > RCOND * max(float(np.max(s)), 1e-300)))
 
 
@@ -426,7 +429,7 @@ def constancy(tr, pooled, refit, effect, alpha=ALPHA):
     """
     from scipy import stats
 
-    from drakecreep.gap.identify import _correlation_time
+    from drakecreep.gap.identify import correlation_time
 
     amps = tuple(n for n in effect.parameters if n not in SHAPE)
     if len(tr) < 2 or not amps:
@@ -441,7 +444,7 @@ def constancy(tr, pooled, refit, effect, alpha=ALPHA):
         r = (sig[4] - inverse_dynamics_force(values, *sig[:4])) / norm
         J = _jacobian(sig, norm, values, names)
         m, p = J.shape
-        s2 = _correlation_time(r) * float(r @ r) / max(m - p, 1)
+        s2 = correlation_time(r) * float(r @ r) / max(m - p, 1)
         k = len(names) - len(amps)
         infos.append(_profile_information(J[:, :k], J[:, k:]) / s2)
         thetas.append(np.array([values[n] for n in amps]))
