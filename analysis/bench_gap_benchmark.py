@@ -42,7 +42,8 @@ def print_scores(s, indent=""):
     print(f"{indent}claims on nulls: {_pct(s['claims_on_nulls']):16s} target {TARGETS['claims_on_nulls']}")
     print(f"{indent}out-of-library answered unexplained: {_pct(s['out_of_library_unexplained']):16s} "
           f"target {TARGETS['out_of_library_unexplained']}")
-    print(f"{indent}no-candidate effect (load friction) not claimed: {_pct(s['no_candidate_unclaimed'])}")
+    if s["no_candidate_unclaimed"]["n"]:
+        print(f"{indent}no-candidate effects not claimed: {_pct(s['no_candidate_unclaimed'])}")
     m = s["median_relative_shrink_snr3"]
     print(f"{indent}median audit shrink / true effect's (SNR >= 3, n={s['n_relative_shrink']}): "
           f"{'-' if m is None else f'{100 * m:.0f} %'}   target {TARGETS['median_relative_shrink_snr3']}")

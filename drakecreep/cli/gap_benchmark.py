@@ -80,7 +80,8 @@ def run(args):
     print(f"top-1 where SNR >= 3: {pct(s['top1_snr3'])} (target >= 90 %)")
     print(f"claims on null datasets: {pct(s['claims_on_nulls'])} (target <= 5 %)")
     print(f"out-of-library answered unexplained: {pct(s['out_of_library_unexplained'])} (target >= 90 %)")
-    print(f"no-candidate effect (load friction) not claimed: {pct(s['no_candidate_unclaimed'])}")
+    if s["no_candidate_unclaimed"]["n"]:
+        print(f"no-candidate effects not claimed: {pct(s['no_candidate_unclaimed'])}")
     m = s["median_relative_shrink_snr3"]
     print("median audit replay shrink relative to the true effect's (SNR >= 3): "
           + ("-" if m is None else f"{100 * m:.0f} %") + " (target >= 70 %)")

@@ -20,8 +20,9 @@ Kinds of dataset (:attr:`Dataset.category`):
 * ``null``: all the realism, no withheld effect: the right answer is no claim;
 * ``library``: one withheld effect of :data:`drakecreep.gap.truth.LIBRARY_EFFECTS`; the right answer is its
   Drake candidate :data:`EXPECTED` (top-1 = the first claimed effect);
-* ``no_candidate``: load-dependent friction (:data:`drakecreep.gap.truth.NO_CANDIDATE`); the replay axis has
-  no such term (``drake_effects.NOT_RANKED``): the right answer is no claim; reported separately;
+* ``no_candidate``: a withheld effect of :data:`drakecreep.gap.truth.NO_CANDIDATE` (the replay axis has no
+  such term, ``drake_effects.NOT_RANKED``): the right answer is no claim; reported separately. Empty since the
+  load-dependent friction got its candidate;
 * ``out_of_library``: one withheld effect of :data:`drakecreep.gap.truth.OUT_OF_LIBRARY` (a cable carrier's
   position force, a drive-gain saturation): the right answer is "unexplained" (no claim).
 
@@ -114,6 +115,7 @@ EXPECTED = {
     "control_delay": "control_delay",
     "bearing_defect": "position_ripple",
     "time_ripple": "time_ripple",
+    "load_friction": "load_friction",
 }
 #: The candidate of :data:`drakecreep.gap.drive_fit.EFFECTS` that should win for each withheld effect on
 #: ``kind: drakecreep`` data. The truth's time ripple acts on the motor side, the params file's
@@ -541,7 +543,10 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
     ranking = [{"effect": r.name, "gain": None if r.screened_out else r.gain,
                 "standard_error": None if r.screened_out else r.standard_error,
                 "log_error_ratio": None if r.screened_out else r.log_ratio,
-                "log_error_ratio_standard_error": None if r.screened_out else r.log_ratio_se, "passes": bool(r.passes),
+                "log_error_ratio_standard_error": None if r.screened_out else r.log_ratio_se,
+                "level_log_error_ratio": None if r.screened_out else r.level_log_ratio,
+                "level_log_error_ratio_standard_error": None if r.screened_out else r.level_log_ratio_se,
+                "passes": bool(r.passes),
                 "screened_out": bool(r.screened_out),
                 "screen_gain": None if screened(r) is None else float(r.screen.gain),
                 "screen_log_error_ratio": None if screened(r) is None else float(r.screen.log_ratio)}

@@ -60,9 +60,12 @@ from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "diagnose_drake", "fit_candidate", "paired_gain", "paired_log_ratio",
            "load_model",
-           "NOMINAL_PARAMETERS", "NOMINAL_FRICTION"]
+           "NOMINAL_PARAMETERS", "NOMINAL_FRICTION", "CLAIM_RULE"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
+#: Which held-out force error a claim is decided on (:func:`_passes`): ``plain``, ``level`` (each held-out run
+#: with its own friction level) or ``both``.
+CLAIM_RULE = "plain"
 #: Friction laws of the nominal model: ``lugre`` adds the bristle stiffness to :data:`NOMINAL_PARAMETERS` (the axis
 #: sticks below the breakaway force), ``regularized`` is ``Fc tanh(v / v_reg)`` (it creeps under any force).
 NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness",), "regularized": NOMINAL_PARAMETERS}
@@ -79,7 +82,7 @@ def paired_gain(reference, candidate):
     return mean_and_standard_error([reference[k]["force"] - candidate[k]["force"] for k in reference])
 
 
-def paired_log_ratio(reference, candidate):
+def paired_log_ratio(reference, candidate, key="force"):
     """Mean and standard error of the per-run ``ln(reference / candidate)`` of the held-out force errors.
 
     The claim's statistic (module docstring, 3): the factor by which a candidate shrinks each run's error. The
@@ -92,8 +95,10 @@ def paired_log_ratio(reference, candidate):
     ----------
     reference, candidate : dict
         Run label -> replay errors (as :func:`drakecreep.gap.drake_replay.drake_replay_errors`).
+    key : str
+        Which error: ``force``, or ``force_level`` (each run with its own friction level).
     """
-    return mean_log_ratio([reference[k]["force"] for k in reference], [candidate[k]["force"] for k in reference])
+    return mean_log_ratio([reference[k][key] for k in reference], [candidate[k][key] for k in reference])
 
 
 @dataclass(frozen=True)
@@ -111,6 +116,8 @@ class RankedEffect:
     effect: str = ""
     log_ratio: float = float("nan")
     log_ratio_se: float = float("nan")
+    level_log_ratio: float = float("nan")
+    level_log_ratio_se: float = float("nan")
 
     @property
     def error_ratio(self):
@@ -263,12 +270,19 @@ def _submit(pool, fn, *args):
     return done
 
 
-def _passes(reference, candidate, bar):
+def _passes(reference, candidate, bar, rule=None):
     """The claim rule of the module docstring (3): ``(gain, standard error, log ratio, its standard error,
-    passes)``; gains in points of %."""
+    level log ratio, its standard error, passes)``; gains in points of %. ``rule`` (default
+    :data:`CLAIM_RULE`): ``plain`` decides on the force error, ``level`` on the force error with each run's own
+    friction level, ``both`` on both."""
+    rule = rule or CLAIM_RULE
     gain, se = paired_gain(reference, candidate)
     lr, lr_se = paired_log_ratio(reference, candidate)
-    return gain, se, lr, lr_se, bool(lr > bar * lr_se)
+    has_level = all("force_level" in e for e in (*reference.values(), *candidate.values()))
+    lv, lv_se = paired_log_ratio(reference, candidate, "force_level") if has_level else (float("nan"),) * 2
+    plain_ok, level_ok = bool(lr > bar * lr_se), bool(lv > bar * lv_se) if has_level else True
+    ok = {"plain": plain_ok, "level": level_ok, "both": plain_ok and level_ok}[rule]
+    return gain, se, lr, lr_se, lv, lv_se, ok
 
 
 def _screen_numbers(sc):
@@ -284,10 +298,11 @@ def _screen_numbers(sc):
     return why
 
 
-def _verdict(gain, lr, lr_se, bar, ok):
+def _verdict(gain, lr, lr_se, bar, ok, lv=float("nan"), lv_se=float("nan")):
     """One line of a candidate's held-out numbers."""
+    level = "" if math.isnan(lv) else f"; with each run's friction level {lv:+.3f} vs bar {bar * lv_se:.3f}"
     return (f"gain {gain:+.3f} points of %, error x{math.exp(-lr):.3f} (log ratio {lr:+.3f} vs bar "
-            f"{bar * lr_se:.3f})" + ("  passes" if ok else ""))
+            f"{bar * lr_se:.3f}{level})" + ("  passes" if ok else ""))
 
 
 def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress=None, screen=True,
@@ -377,10 +392,10 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
 
     def ranked(n, sc, fit):
-        gain, se, lr, lr_se, ok = _passes(nom_test, fit.test_errors, k_se)
-        say(f"{n}: held-out {_verdict(gain, lr, lr_se, k_se, ok)}")
+        gain, se, lr, lr_se, lv, lv_se, ok = _passes(nom_test, fit.test_errors, k_se)
+        say(f"{n}: held-out {_verdict(gain, lr, lr_se, k_se, ok, lv, lv_se)}")
         return RankedEffect(fit=fit, gain=gain, standard_error=se, passes=ok, screen=sc, effect=n, log_ratio=lr,
-                            log_ratio_se=lr_se)
+                            log_ratio_se=lr_se, level_log_ratio=lv, level_log_ratio_se=lv_se)
 
     def origin(n):  # the model a candidate starts from: see _refit
         return first if _refits(n) else nominal
@@ -421,9 +436,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 fit = f_fit.result()
                 if f_ref is not None:
                     reference = f_ref.result()
-            gain, se, lr, lr_se, ok = _passes(reference, fit.test_errors, k_se)
+            gain, se, lr, lr_se, lv, lv_se, ok = _passes(reference, fit.test_errors, k_se)
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: "
-                f"{_verdict(gain, lr, lr_se, k_se, ok)}")
+                f"{_verdict(gain, lr, lr_se, k_se, ok, lv, lv_se)}")
             if ok:
                 claimed.append(r.name)
                 current, current_test = fit, fit.test_errors

@@ -79,6 +79,13 @@ DRAKE_EFFECTS = {
     "asymmetric_friction": DrakeEffect("asymmetric_friction", ("coulomb_asym", "viscous_asym"),
                                        ({"coulomb_asym": 0.0, "viscous_asym": 0.0},),
                                        signature="force error of opposite mean in the two directions"),
+    # a ball nut's friction grows with the axial load on its balls: mu |F_ax| on top of the Coulomb level
+    # (drakecreep.model.axis); mu >= 0 (a friction that falls with load is not this effect)
+    "load_friction": DrakeEffect("load_friction", ("load_friction_coefficient",),
+                                 ({"load_friction_coefficient": 0.0},),
+                                 signature="friction that grows with the axial load: the force error follows the "
+                                           "acceleration force's magnitude, against the motion",
+                                 bounds={"load_friction_coefficient": (0.0, 1.0)}),
     # four smooth steps over the training travel (drakecreep.model.axis.friction_map), not a sinusoid: on
     # development data a sinusoid of 0.9 m period at its amplitude bound stood in for a friction ramp, and one
     # held-out run got worse (docs/gap_benchmark.md); |a_k| <= 0.2 keeps the friction level above 0.2 of nominal
@@ -107,7 +114,6 @@ NOT_RANKED = {
     "quantization": "the encoder resolution is declared in the metadata and always applied in the replay; "
                     "an undeclared coarser resolution is not fitted",
     "backlash": "needs the table position (a linear scale) beside the motor encoder; not in the replay axis",
-    "load_dependent_friction": "not modelled in the replay axis (the project's NutTable has it per load case)",
     "drive_gain_nonlinearity": "not modelled in the replay axis; a constant gain error is the mass/friction scale",
     "lead_error": "on a motor-encoder loop a lead error moves the table only; its force signature is the "
                   "position ripple (ranked as position_ripple)",

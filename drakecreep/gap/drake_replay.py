@@ -37,8 +37,8 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
-from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, axis_parameters,
-                                   has_bristles)
+from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, axis_friction,
+                                   axis_parameters, axis_ripple, has_bristles)
 from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 
 __all__ = [
@@ -598,7 +598,30 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     }
     if run.x_table is not None:
         out["table_position"] = relative_error(run.x_table, result.x_table)
+    if result.parameters:
+        out["force_level"] = _force_level_error(result, cutoff, order)
     return out
+
+
+def _force_level_error(result, cutoff, order):
+    """Force error [%] with the run's own friction level: the simulated friction force scaled by the
+    least-squares factor that best explains the force residual (the closed-loop counterpart of
+    :func:`drakecreep.gap.screen.screen_effect`'s ``run_level``).
+
+    In the position loop, a friction level ``s`` times the model's is supplied by the controller at the
+    frequencies the loop follows: the measured force is, to first order, the simulated one plus ``(s - 1) f``
+    with ``f`` the model's friction on the simulated motion (the table's, behind the screw). Friction drifts
+    between runs, so a held-out run's level is a nuisance, not something a candidate may be credited with.
+    """
+    run = result.run
+    p = axis_parameters(**result.parameters)
+    _, dv, _ = filtered_derivatives(result.x_table, run.dt, cutoff, order)
+    t = np.arange(run.n) * run.dt
+    load = result.force + axis_ripple(result.x_motor, t, p)  # the nut's load as on the rigid axis
+    fr = np.asarray(axis_friction(dv, p, result.x_table, t, load), dtype=float)
+    e = np.asarray(run.force, dtype=float) - result.force
+    scale = float(fr @ e) / max(float(fr @ fr), 1e-300)
+    return relative_error(run.force, result.force + scale * fr)
 
 
 def rms_force_error(errors):

@@ -125,21 +125,24 @@ def _signals(run, shift=0.0):
     return s.t - float(run.t[0]), s.q, s.dq, s.ddq, s.tau
 
 
-def inverse_dynamics_force(parameters, t, q, dq, ddq):
+def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
     """Drive force [N] the rigid replay axis needs for the motion ``q, dq, ddq`` at times ``t`` (arrays).
 
-    ``M ddq + f(dq, q, t) + offset - r(q, t)`` with the axis's own friction and ripple functions.
+    ``M ddq + f(dq, q, t, F_ax) + offset - r(q, t)`` with the axis's own friction and ripple functions; the
+    nut's axial load ``F_ax`` of a load-dependent friction is, as on the rigid Drake axis, the drive force with
+    the ripple, here with the measured drive force ``tau`` (the force stays affine in the coefficient).
     """
-    other, friction = _force_parts(parameters, t, q, dq, ddq)
+    other, friction = _force_parts(parameters, t, q, dq, ddq, tau)
     return other + friction
 
 
-def _force_parts(parameters, t, q, dq, ddq):
-    """:func:`inverse_dynamics_force` as ``(M ddq + offset - r(q, t), f(dq, q, t))``: all but the friction, and
-    the friction."""
+def _force_parts(parameters, t, q, dq, ddq, tau=0.0):
+    """:func:`inverse_dynamics_force` as ``(M ddq + offset - r(q, t), f(dq, q, t, F_ax))``: all but the friction,
+    and the friction."""
     p = axis_parameters(**parameters)
     P = dict(zip(AXIS_PARAMETERS, p))
-    return P["mass"] * ddq + P["offset"] - axis_ripple(q, t, p), axis_friction(dq, p, q, t)
+    ripple = axis_ripple(q, t, p)
+    return P["mass"] * ddq + P["offset"] - ripple, axis_friction(dq, p, q, t, tau + ripple)
 
 
 def _errors(runs_sig, values, level=False):
@@ -147,7 +150,7 @@ def _errors(runs_sig, values, level=False):
     factor first (the run's friction level, a nuisance: friction drifts between runs)."""
     out = []
     for t, q, dq, ddq, tau in runs_sig:
-        other, fr = _force_parts(values, t, q, dq, ddq)
+        other, fr = _force_parts(values, t, q, dq, ddq, tau)
         scale = float(fr @ (tau - other)) / max(float(fr @ fr), 1e-300) if level else 1.0
         out.append(100.0 * np.linalg.norm(tau - other - scale * fr) / np.linalg.norm(tau))
     return np.array(out)
@@ -159,7 +162,8 @@ def _rms(a):
 
 #: parameters the drive force of the rigid axis is affine in, for fixed values of all the others (solved by
 #: linear least squares inside the fit: variable projection)
-LINEAR = ("viscous", "viscous_asym", "coulomb", "coulomb_asym", "offset", "stribeck_extra",
+LINEAR = ("viscous", "viscous_asym", "coulomb", "coulomb_asym", "offset", "load_friction_coefficient",
+          "stribeck_extra",
           "position_ripple_cos", "position_ripple_sin", "time_ripple_cos", "time_ripple_sin")
 
 
@@ -176,8 +180,8 @@ def _project(sig, norms, values, lin):
     v0.update({n: 0.0 for n in lin})
     rows, rhs = [], []
     for (t, q, dq, ddq, tau), nrm in zip(sig, norms):
-        f0 = inverse_dynamics_force(v0, t, q, dq, ddq)
-        cols = [inverse_dynamics_force(dict(v0, **{n: 1.0}), t, q, dq, ddq) - f0 for n in lin]
+        f0 = inverse_dynamics_force(v0, t, q, dq, ddq, tau)
+        cols = [inverse_dynamics_force(dict(v0, **{n: 1.0}), t, q, dq, ddq, tau) - f0 for n in lin]
         rows.append(np.column_stack(cols) / nrm if cols else np.zeros((tau.size, 0)))
         rhs.append((tau - f0) / nrm)
     A, b = np.vstack(rows), np.concatenate(rhs)
@@ -365,12 +369,12 @@ class Constancy:
 
 def _jacobian(sig, norm, values, names):
     """Central-difference Jacobian of the normalised inverse-dynamics force of one run in ``names``."""
-    t, q, dq, ddq, _ = sig
+    t, q, dq, ddq, tau = sig
     cols = []
     for n in names:
         h = 1e-6 * max(abs(values[n]), 1.0 if n in LINEAR else 1e-2)
-        hi = inverse_dynamics_force(dict(values, **{n: values[n] + h}), t, q, dq, ddq)
-        lo = inverse_dynamics_force(dict(values, **{n: values[n] - h}), t, q, dq, ddq)
+        hi = inverse_dynamics_force(dict(values, **{n: values[n] + h}), t, q, dq, ddq, tau)
+        lo = inverse_dynamics_force(dict(values, **{n: values[n] - h}), t, q, dq, ddq, tau)
         cols.append((hi - lo) / (2.0 * h * norm))
     return np.column_stack(cols)
 
@@ -441,7 +445,7 @@ def constancy(tr, pooled, refit, effect, alpha=ALPHA):
         # physical model; one run alone may pull an amplitude past them, with the large variance that says so)
         values, _ = _fit([sig], pooled, names, {}, {})
         norm = float(np.linalg.norm(sig[4]))
-        r = (sig[4] - inverse_dynamics_force(values, *sig[:4])) / norm
+        r = (sig[4] - inverse_dynamics_force(values, *sig)) / norm
         J = _jacobian(sig, norm, values, names)
         m, p = J.shape
         s2 = correlation_time(r) * float(r @ r) / max(m - p, 1)
@@ -465,7 +469,7 @@ def _peak_frequencies(sig, base, band, count=3):
     dt = float(np.median(np.diff(sig[0][0])))
     nper = min(1024, min(s[0].size for s in sig))
     for t, q, dq, ddq, tau in sig:
-        f, p = welch(tau - inverse_dynamics_force(base, t, q, dq, ddq), fs=1.0 / dt, nperseg=nper)
+        f, p = welch(tau - inverse_dynamics_force(base, t, q, dq, ddq, tau), fs=1.0 / dt, nperseg=nper)
         total = p if total is None else total + p
     inside = (f >= band[0]) & (f <= band[1])
     fi, pi = f[inside], total[inside]
@@ -491,7 +495,7 @@ def _peak_periods(sig, base, band, count=3):
     from scipy.signal import find_peaks, lombscargle
 
     q = np.concatenate([s[1] for s in sig])
-    r = np.concatenate([(s[4] - inverse_dynamics_force(base, *s[:4])) / np.linalg.norm(s[4]) for s in sig])
+    r = np.concatenate([(s[4] - inverse_dynamics_force(base, *s)) / np.linalg.norm(s[4]) for s in sig])
     travel = max(float(np.ptp(q)), 1e-6)
     w_lo, w_hi = 2.0 * math.pi / band[1], 2.0 * math.pi / band[0]
     step = 0.25 * math.pi / travel  # 1/8 cycle over the travel

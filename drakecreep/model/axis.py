@@ -16,7 +16,10 @@ with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecree
     f(v) = L(x, t) [s(v) (Fc + dFc s(v) + (Fs - Fc) exp(-(v/vs)^2)) + (Fv + dFv s(v)) v]
     L(x, t) = 1 + fc cos(2 pi x / Lf) + fs sin(2 pi x / Lf) + m(x) + drift t   (position-dependent, thermal)
 
-with ``m(x)`` a smooth map along the travel (:func:`friction_map`: four ``tanh`` steps);
+with ``m(x)`` a smooth map along the travel (:func:`friction_map`: four ``tanh`` steps). The Coulomb level
+``Fc`` rises by ``mu |F_ax|`` with the axial load through the nut (``load_friction_coefficient`` ``mu``,
+dimensionless, as in :class:`drakecreep.params.NutParams`; ``F_ax`` the screw's spring force, or on the rigid
+axis the drive force with the ripple);
 
 and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
 plus a fixed time frequency ``f_r``)::
@@ -64,6 +67,7 @@ AXIS_PARAMETERS = {
     "coulomb": 0.0,
     "coulomb_asym": 0.0,
     "offset": 0.0,
+    "load_friction_coefficient": 0.0,
     "stribeck_extra": 0.0,
     "stribeck_velocity": 1e-3,
     "regularization_velocity": 1e-3,
@@ -91,6 +95,7 @@ AXIS_PARAMETERS = {
 }
 AXIS_UNITS = {
     "mass": "kg", "viscous": "N s/m", "viscous_asym": "N s/m", "coulomb": "N", "coulomb_asym": "N", "offset": "N",
+    "load_friction_coefficient": "-",
     "stribeck_extra": "N", "stribeck_velocity": "m/s", "regularization_velocity": "m/s",
     "motor_mass_fraction": "-", "stiffness": "N/m", "damping": "N s/m",
     "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
@@ -130,12 +135,12 @@ def axis_parameters(**values):
     return np.array([out[n] for n in _NAMES])
 
 
-def axis_friction(v, p, x=0.0, t=0.0):
-    """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] for a parameter vector
-    ``p`` (order of :data:`AXIS_PARAMETERS`): the regularized law, which is also the steady sliding friction of
-    the LuGre bristles (:func:`bristle_rates`)."""
+def axis_friction(v, p, x=0.0, t=0.0, load=0.0):
+    """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] under the axial load ``load``
+    [N] through the nut for a parameter vector ``p`` (order of :data:`AXIS_PARAMETERS`): the regularized law,
+    which is also the steady sliding friction of the LuGre bristles (:func:`bristle_rates`)."""
     P = dict(zip(_NAMES, p))
-    g, s = _sliding_level(P, v)
+    g, s = _sliding_level(P, v, load)
     return _level(P, x, t) * (s * g + (P["viscous"] + P["viscous_asym"] * s) * v)
 
 
@@ -170,11 +175,17 @@ def friction_map(P, x):
     return out
 
 
-def _sliding_level(P, v):
-    """``g(v)``: the Coulomb-Stribeck level (with its asymmetry) the bristles relax to."""
+def _sliding_level(P, v, load=0.0):
+    """``g(v)``: the Coulomb-Stribeck level (with its asymmetry) the bristles relax to; it rises by
+    ``load_friction_coefficient`` times the axial load's magnitude (a ball nut's rolling friction grows with
+    the load on its balls: the nut's preload is in the Coulomb level, a working load adds to it)."""
     s = tanh(v / P["regularization_velocity"])
     w = v / P["stribeck_velocity"]
-    return P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w), s
+    g = P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w)
+    mu = P["load_friction_coefficient"]
+    if not (isinstance(mu, float) and mu == 0.0):  # off (the default): no |load| term
+        g = g + mu * fabs(load)
+    return g, s
 
 
 def has_bristles(p):
@@ -182,15 +193,16 @@ def has_bristles(p):
     return float(p[_NAMES.index("bristle_stiffness")]) > 0.0
 
 
-def bristle_rates(v, z, p, table_mass):
-    """``(dz/dt, friction)`` of the LuGre bristles at table speed ``v`` [m/s] and deflection ``z`` [m] for the
-    parameter vector ``p``, without the position/time level ``L`` (:mod:`drakecreep.model.axis` docstring).
+def bristle_rates(v, z, p, table_mass, load=0.0):
+    """``(dz/dt, friction)`` of the LuGre bristles at table speed ``v`` [m/s] and deflection ``z`` [m] under the
+    axial load ``load`` [N] for the parameter vector ``p``, without the position/time level ``L``
+    (:mod:`drakecreep.model.axis` docstring).
 
     ``dz/dt = v - a(v) z`` is linear in ``z`` with ``a = sigma0 |v| / |g(v)|``: a sampled replay advances it with
     its exact solution over a step (``drakecreep.gap.drake_replay.SampledReplay``).
     """
     P = dict(zip(_NAMES, p))
-    g, s = _sliding_level(P, v)
+    g, s = _sliding_level(P, v, load)
     sigma0 = P["bristle_stiffness"]
     sigma1 = 2.0 * P["bristle_damping_ratio"] * (sigma0 * table_mass) ** 0.5
     zdot = v - sigma0 * fabs(v) * z / (fabs(g) + 1e-9)
@@ -255,7 +267,8 @@ def MeasuredAxis_(T):
             self.DeclareVectorOutputPort("motor_state", 2, self._calc_motor, prerequisites_of_calc=deps)
             self.DeclareVectorOutputPort("table_state", 2, self._calc_table, prerequisites_of_calc=deps)
             self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction,
-                                         prerequisites_of_calc=deps | {self.time_ticket()})
+                                         prerequisites_of_calc=deps | {self.time_ticket(),
+                                                                       self.all_input_ports_ticket()})
 
         def _construct_copy(self, other, converter=None):
             Impl._construct(self, other.flexible, other.parameters, other.initial_state, other.bristles,
@@ -274,14 +287,21 @@ def MeasuredAxis_(T):
             m_m = P["motor_mass_fraction"] * P["mass"]
             return m_m, P["mass"] - m_m
 
-        def _friction(self, x, p, t):
-            """``(friction on the table, [dz/dt] or [])``."""
+        def _friction(self, x, p, t, load):
+            """``(friction on the table, [dz/dt] or [])`` under the axial load ``load`` (:meth:`_load`)."""
             P = dict(zip(_NAMES, p))
             i = self._table()
             if not self.bristles:
-                return axis_friction(x[i + 1], p, x[i], t), []
-            zdot, f = bristle_rates(x[i + 1], x[-1], p, self._masses(P)[1])
+                return axis_friction(x[i + 1], p, x[i], t, load), []
+            zdot, f = bristle_rates(x[i + 1], x[-1], p, self._masses(P)[1], load)
             return _level(P, x[i], t) * f, [zdot]
+
+        def _load(self, x, P, F, t, p):
+            """Axial load through the nut [N]: the screw's spring force (two-mass), or the drive force with the
+            ripple (rigid: the motor side's share of the inertia is not split off)."""
+            if self.flexible:
+                return P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
+            return F + axis_ripple(x[0], t, p)
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             x = context.get_continuous_state_vector().CopyToVector()
@@ -289,15 +309,15 @@ def MeasuredAxis_(T):
             P = dict(zip(_NAMES, p))
             F = self._force.Eval(context)[0]
             t = context.get_time()
-            friction, zdot = self._friction(x, p, t)
+            load = self._load(x, P, F, t, p)
+            friction, zdot = self._friction(x, p, t, load)
             if self.flexible:
                 m_m, m_t = self._masses(P)
-                spring = P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
-                a_m = (F + axis_ripple(x[0], t, p) - spring) / m_m
-                a_t = (spring - friction - P["offset"]) / m_t
+                a_m = (F + axis_ripple(x[0], t, p) - load) / m_m
+                a_t = (load - friction - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
             else:
-                push = F + axis_ripple(x[0], t, p) - friction - P["offset"]
+                push = load - friction - P["offset"]
                 rates = [x[1], push / P["mass"]]
             derivatives.get_mutable_vector().SetFromVector(vector(rates + zdot))
 
@@ -312,7 +332,9 @@ def MeasuredAxis_(T):
 
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            output.SetAtIndex(0, self._friction(x, self._p(context), context.get_time())[0])
+            p, t = self._p(context), context.get_time()
+            load = self._load(x, dict(zip(_NAMES, p)), self._force.Eval(context)[0], t, p)
+            output.SetAtIndex(0, self._friction(x, p, t, load)[0])
 
     return Impl
 

@@ -57,6 +57,26 @@ def test_parameters_change_without_rebuild(run, nominal):
     assert drake_replay_errors(heavy)["force"] > drake_replay_errors(again)["force"]
 
 
+def test_force_level_error_removes_a_friction_level_and_nothing_else(run):
+    """A run recorded with 1.3 times the nominal friction: the plain force error sees it, the error with the run's
+    own friction level (``force_level``) hardly does; a heavier table is not a friction level, and stays."""
+    import dataclasses
+
+    base = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-4)
+    rep = DrakeReplay(run)
+
+    def measured(params):
+        sim = rep.simulate(params)
+        return dataclasses.replace(run, x_motor=sim.x_motor, u=sim.u)
+
+    rough = measured(dict(base, coulomb=1.3 * base["coulomb"], viscous=1.3 * base["viscous"]))
+    err = drake_replay_errors(DrakeReplay(rough).simulate(base))
+    assert err["force"] > 5.0 and err["force_level"] < 0.2 * err["force"]
+    heavy = measured(dict(base, mass=1.5 * base["mass"]))
+    err = drake_replay_errors(DrakeReplay(heavy).simulate(base))
+    assert err["force"] > 1.0 and err["force_level"] > 0.7 * err["force"]
+
+
 @pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
 def test_computation_delay_holds_older_outputs(run, delay, shift):
     """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later."""

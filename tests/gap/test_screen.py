@@ -87,6 +87,19 @@ def test_a_friction_ramp_along_the_travel_is_found_by_the_smooth_map():
     assert sum(sc.start[n] for n in FRICTION_MAP) > 0.1
 
 
+def test_a_load_dependent_friction_is_found_and_a_null_gives_it_nothing():
+    """Runs of an axis whose Coulomb level rises by 0.3 |F| (the rigid axis's own load-friction term): the
+    candidate passes with the coefficient within 20 %; on the same runs without it, it fits about nothing and
+    does not pass."""
+    runs = _runs(dict(BASE, load_friction_coefficient=0.3))
+    sc = screen_effect(DRAKE_EFFECTS["load_friction"], runs[:3], runs[3:], BASE)
+    assert sc.passes and sc.log_ratio > 0.1
+    assert sc.start["load_friction_coefficient"] == pytest.approx(0.3, rel=0.2)
+    null = _runs(BASE)
+    sc = screen_effect(DRAKE_EFFECTS["load_friction"], null[:3], null[3:], BASE)
+    assert not sc.passes and abs(sc.start["load_friction_coefficient"]) < 0.02
+
+
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     """A 3 N force ripple of period 3.7 mm (none of the candidate's own starts): the Lomb-Scargle scan of the
     residual against position starts the fit at the period, which it refines to within 0.2 %, with the amplitude

@@ -56,6 +56,26 @@ def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
         axis_parameters(friction_map_start=0.2, friction_map_end=0.2)
 
 
+def test_load_friction_raises_the_coulomb_level_with_the_axial_load():
+    """``mu |F_ax|`` on top of the Coulomb level: on the rigid axis ``F_ax`` is the drive force (with the ripple),
+    on the two-mass axis the screw's spring force; the friction port reports the same force the dynamics use."""
+    p = dict(mass=95.0, coulomb=20.0, regularization_velocity=1e-6, load_friction_coefficient=0.25)
+    for force in (60.0, -60.0):  # the load's magnitude, whatever its sign
+        assert _xdot(MeasuredAxis(False), [0.1, 0.05], force, **p)[1] == pytest.approx(
+            (force - (20.0 + 0.25 * 60.0)) / 95.0, rel=1e-9)
+    vec = axis_parameters(**p)
+    assert axis_friction(-0.05, vec, load=40.0) == pytest.approx(-30.0)
+    two = MeasuredAxis(True)
+    ctx = two.CreateDefaultContext()
+    ctx.SetContinuousState([2e-5, 0.0, 0.0, 0.05])
+    set_axis_parameters(two, ctx, **dict(p, stiffness=1e6))
+    two.GetInputPort("force").FixValue(ctx, [500.0])  # the drive force does not reach the nut directly
+    assert two.GetOutputPort("friction_force").Eval(ctx)[0] == pytest.approx(20.0 + 0.25 * 20.0)
+    # off by default: the same axis without it
+    assert axis_friction(0.05, axis_parameters(coulomb=20.0, regularization_velocity=1e-6), load=1e4) == \
+        pytest.approx(20.0)
+
+
 def test_two_mass_axis_spring_and_mass_split():
     p = dict(mass=100.0, motor_mass_fraction=0.25, stiffness=1e6, damping=0.0)
     xdot = _xdot(MeasuredAxis(True), [1e-5, 0.0, 0.0, 0.0], 0.0, **p)
