@@ -38,6 +38,9 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                   "gain_points": r.gain, "standard_error_points": r.standard_error,
                                   "log_error_ratio": r.log_ratio, "log_error_ratio_standard_error": r.log_ratio_se,
                                   "threshold_log_error_ratio": k_se * r.log_ratio_se,
+                                  "level_log_error_ratio": r.level_log_ratio,
+                                  "level_log_error_ratio_standard_error": r.level_log_ratio_se,
+                                  "threshold_level_log_error_ratio": k_se * r.level_log_ratio_se,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
         rows.append(row)
@@ -209,13 +212,16 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         if r.name == "control_delay":
             params = f"delay = {r.fit.delay:.3g} samples"
         rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f}",
-                     f"x{r.error_ratio:.3f} ({r.log_ratio:+.3f} vs {k * r.log_ratio_se:.3f})",
+                     f"x{r.error_ratio:.3f} ({r.log_ratio:+.3f} vs {k * r.log_ratio_se:.3f})"
+                     + ("" if not np.isfinite(r.level_log_ratio) else
+                        f"; own level {r.level_log_ratio:+.3f} vs {k * r.level_log_ratio_se:.3f}"),
                      ("yes" if r.passes else "no") + ("" if r.name in diagnosis.claimed or not r.passes
                                                       else " (not kept by the greedy step)"), params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
     parts.append(table(["effect", "inverse-dynamics gain [points of %]; error ratio (log ratio ± 1 SE)",
                         "closed-loop held-out force error [%]", "closed-loop gain [points of %]",
-                        "error ratio (log ratio vs bar)", "passes alone", "fitted parameters"], rows))
+                        "error ratio (log ratio vs bar; with each run's own friction level)", "passes alone",
+                        "fitted parameters"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = ("position", "velocity", "acceleration", "force")
     rows = [[lab] + [f"{diagnosis.nominal_test_errors[lab][s]:.4g} → {diagnosis.test_errors[lab][s]:.4g}"

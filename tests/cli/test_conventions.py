@@ -28,6 +28,16 @@ def test_help_has_no_restructuredtext_markup(command, capsys):
     assert "``" not in text and not re.search(r":(func|class|mod|data|attr):", text)
 
 
+def test_diagnose_help_lists_every_ranked_effect(capsys):
+    from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+    with pytest.raises(SystemExit):
+        cli.main(["diagnose", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for name in tuple(DRAKE_EFFECTS) + ("control_delay",):
+        assert name in text, name
+
+
 def test_the_shipped_example_is_the_emps_estimation_file_in_shop_units():
     example = load_measured(EXAMPLE).runs[0]
     emps = load_emps("estimation").runs[0]
