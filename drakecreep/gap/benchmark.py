@@ -24,7 +24,8 @@ Kinds of dataset (:attr:`Dataset.category`):
   such term, ``drake_effects.NOT_RANKED``): the right answer is no claim; reported separately. Empty since the
   load-dependent friction got its candidate;
 * ``out_of_library``: one withheld effect of :data:`drakecreep.gap.truth.OUT_OF_LIBRARY` (a cable carrier's
-  position force, a drive-gain saturation): the right answer is "unexplained" (no claim).
+  position force; the drive-gain saturation was one until session 27, when it got its candidate): the right
+  answer is "unexplained" (no claim).
 
 **SNR** of a dataset: ``sqrt(E_with / E_without - 1)``, with ``E`` the mean square residual of the nominal
 inverse-dynamics least squares of the Drake path on the training runs (the screen's nominal,
@@ -116,6 +117,7 @@ EXPECTED = {
     "bearing_defect": "position_ripple",
     "time_ripple": "time_ripple",
     "load_friction": "load_friction",
+    "drive_saturation": "drive_saturation",
 }
 #: The candidate of :data:`drakecreep.gap.drive_fit.EFFECTS` that should win for each withheld effect on
 #: ``kind: drakecreep`` data. The truth's time ripple acts on the motor side, the params file's

@@ -105,6 +105,13 @@ DRAKE_EFFECTS = {
     "thermal_drift": DrakeEffect("thermal_drift", ("friction_drift",), ({"friction_drift": 0.0},),
                                  signature="friction level that changes over the run, at the same rate in every run",
                                  run_constancy=True),
+    # a drive-gain nonlinearity: the drive applies F / sqrt(1 + (c F)^2) of the commanded F (a smooth saturation
+    # at 1 / c; drakecreep.model.axis.applied_force); c <= 0.05 1/N (a limit of at least 20 N)
+    "drive_saturation": DrakeEffect("drive_saturation", ("inverse_drive_limit",),
+                                    tuple({"inverse_drive_limit": c} for c in (1.0 / 400.0, 1.0 / 150.0, 1.0 / 60.0)),
+                                    signature="the axis gets less force than commanded, more so the larger the "
+                                              "command (a saturating drive gain)",
+                                    bounds={"inverse_drive_limit": (0.0, 0.05)}),
     "axial_mode": DrakeEffect("axial_mode", ("stiffness", "damping"), _mode_starts(), flexible=True,
                               signature="oscillation at a structural frequency (5-300 Hz)",
                               bounds={"stiffness": (1e3, 1e11)}),
@@ -114,7 +121,6 @@ NOT_RANKED = {
     "quantization": "the encoder resolution is declared in the metadata and always applied in the replay; "
                     "an undeclared coarser resolution is not fitted",
     "backlash": "needs the table position (a linear scale) beside the motor encoder; not in the replay axis",
-    "drive_gain_nonlinearity": "not modelled in the replay axis; a constant gain error is the mass/friction scale",
     "lead_error": "on a motor-encoder loop a lead error moves the table only; its force signature is the "
                   "position ripple (ranked as position_ripple)",
     "cogging": "ranked as position_ripple with the motor revolution as period",

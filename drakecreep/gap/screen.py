@@ -48,7 +48,8 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
-from drakecreep.model.axis import AXIS_PARAMETERS, FRICTION_MAP, axis_friction, axis_parameters, axis_ripple
+from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, applied_force, axis_friction, axis_parameters,
+                                   axis_ripple)
 
 __all__ = ["ScreenResult", "Constancy", "constancy", "screen_effect", "screen_delay", "inverse_dynamics_force",
            "NOT_SCREENED", "LINEAR", "SHAPE", "SLOW_SHARE", "MIN_SLIDING"]
@@ -137,12 +138,16 @@ def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
 
 
 def _force_parts(parameters, t, q, dq, ddq, tau=0.0):
-    """:func:`inverse_dynamics_force` as ``(M ddq + offset - r(q, t), f(dq, q, t, F_ax))``: all but the friction,
-    and the friction."""
+    """:func:`inverse_dynamics_force` as ``(M ddq + offset - r(q, t) + tau - g(tau), f(dq, q, t, F_ax))``: all but
+    the friction, and the friction. ``tau - g(tau)`` is what a saturating drive does not apply of the measured
+    command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive), so that the residual
+    ``tau - F`` is the applied force's, ``g(tau) - (M ddq + ...)``."""
     p = axis_parameters(**parameters)
     P = dict(zip(AXIS_PARAMETERS, p))
     ripple = axis_ripple(q, t, p)
-    return P["mass"] * ddq + P["offset"] - ripple, axis_friction(dq, p, q, t, tau + ripple)
+    applied = applied_force(tau, p)
+    return (P["mass"] * ddq + P["offset"] - ripple + (tau - applied),
+            axis_friction(dq, p, q, t, applied + ripple))
 
 
 def _errors(runs_sig, values, level=False):

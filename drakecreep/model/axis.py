@@ -19,7 +19,8 @@ with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecree
 with ``m(x)`` a smooth map along the travel (:func:`friction_map`: four ``tanh`` steps). The Coulomb level
 ``Fc`` rises by ``mu |F_ax|`` with the axial load through the nut (``load_friction_coefficient`` ``mu``,
 dimensionless, as in :class:`drakecreep.params.NutParams`; ``F_ax`` the screw's spring force, or on the rigid
-axis the drive force with the ripple);
+axis the drive force with the ripple). The drive applies ``F / sqrt(1 + (c F)^2)`` of the commanded force
+``F`` (``inverse_drive_limit`` ``c`` [1/N], 0 by default: a linear drive; :func:`applied_force`);
 
 and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
 plus a fixed time frequency ``f_r``)::
@@ -57,7 +58,8 @@ from drakecreep.model._scalar import exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
-           "set_axis_parameters", "axis_friction", "friction_map", "FRICTION_MAP", "bristle_rates", "has_bristles"]
+           "set_axis_parameters", "axis_friction", "applied_force", "friction_map", "FRICTION_MAP", "bristle_rates",
+           "has_bristles"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -92,6 +94,7 @@ AXIS_PARAMETERS = {
     "friction_drift": 0.0,
     "bristle_stiffness": 0.0,
     "bristle_damping_ratio": 1.0,
+    "inverse_drive_limit": 0.0,
 }
 AXIS_UNITS = {
     "mass": "kg", "viscous": "N s/m", "viscous_asym": "N s/m", "coulomb": "N", "coulomb_asym": "N", "offset": "N",
@@ -103,7 +106,7 @@ AXIS_UNITS = {
     "friction_map_0": "-", "friction_map_1": "-", "friction_map_2": "-", "friction_map_3": "-",
     "friction_map_start": "m", "friction_map_end": "m",
     "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
-    "bristle_stiffness": "N/m", "bristle_damping_ratio": "-",
+    "bristle_stiffness": "N/m", "bristle_damping_ratio": "-", "inverse_drive_limit": "1/N",
 }
 _POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "position_period",
              "friction_period", "ripple_frequency")
@@ -130,6 +133,9 @@ def axis_parameters(**values):
     if not out["friction_map_end"] > out["friction_map_start"]:
         raise InputError("axis.friction_map_end", out["friction_map_end"],
                          f"a position > friction_map_start ({out['friction_map_start']} m)")
+    if out["inverse_drive_limit"] < 0:
+        raise InputError("axis.inverse_drive_limit", out["inverse_drive_limit"],
+                         "a number >= 0 1/N (0: a linear drive)")
     if not 0 < out["motor_mass_fraction"] < 1:
         raise InputError("axis.motor_mass_fraction", out["motor_mass_fraction"], "a number in (0, 1)")
     return np.array([out[n] for n in _NAMES])
@@ -207,6 +213,16 @@ def bristle_rates(v, z, p, table_mass, load=0.0):
     sigma1 = 2.0 * P["bristle_damping_ratio"] * (sigma0 * table_mass) ** 0.5
     zdot = v - sigma0 * fabs(v) * z / (fabs(g) + 1e-9)
     return zdot, sigma0 * z + sigma1 * zdot + (P["viscous"] + P["viscous_asym"] * s) * v
+
+
+def applied_force(F, p):
+    """Force [N] the drive applies for the commanded ``F`` [N]: ``F / sqrt(1 + (c F)^2)`` with
+    ``c = inverse_drive_limit`` (a drive-gain nonlinearity: linear for small forces, saturating smoothly at
+    ``1 / c``; ``c = 0``, the default, is a linear drive)."""
+    c = dict(zip(_NAMES, p))["inverse_drive_limit"]
+    if isinstance(c, float) and c == 0.0:
+        return F
+    return F / (1.0 + (c * F) * (c * F)) ** 0.5
 
 
 def axis_ripple(x, t, p):
@@ -307,7 +323,7 @@ def MeasuredAxis_(T):
             x = context.get_continuous_state_vector().CopyToVector()
             p = self._p(context)
             P = dict(zip(_NAMES, p))
-            F = self._force.Eval(context)[0]
+            F = applied_force(self._force.Eval(context)[0], p)
             t = context.get_time()
             load = self._load(x, P, F, t, p)
             friction, zdot = self._friction(x, p, t, load)
@@ -333,7 +349,7 @@ def MeasuredAxis_(T):
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
             p, t = self._p(context), context.get_time()
-            load = self._load(x, dict(zip(_NAMES, p)), self._force.Eval(context)[0], t, p)
+            load = self._load(x, dict(zip(_NAMES, p)), applied_force(self._force.Eval(context)[0], p), t, p)
             output.SetAtIndex(0, self._friction(x, p, t, load)[0])
 
     return Impl

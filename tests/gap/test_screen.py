@@ -100,6 +100,17 @@ def test_a_load_dependent_friction_is_found_and_a_null_gives_it_nothing():
     assert not sc.passes and abs(sc.start["load_friction_coefficient"]) < 0.02
 
 
+def test_a_saturating_drive_is_found_and_a_linear_one_gives_it_nothing():
+    """Runs of an axis whose drive applies ``F / sqrt(1 + (F / 80 N)^2)`` of the command: the drive-saturation
+    candidate passes with the limit within 20 %; on the same runs with a linear drive it does not pass."""
+    runs = _runs(dict(BASE, inverse_drive_limit=1.0 / 80.0))
+    sc = screen_effect(DRAKE_EFFECTS["drive_saturation"], runs[:3], runs[3:], BASE)
+    assert sc.passes and sc.log_ratio > 0.1
+    assert 1.0 / sc.start["inverse_drive_limit"] == pytest.approx(80.0, rel=0.2)
+    null = _runs(BASE)
+    assert not screen_effect(DRAKE_EFFECTS["drive_saturation"], null[:3], null[3:], BASE).passes
+
+
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     """A 3 N force ripple of period 3.7 mm (none of the candidate's own starts): the Lomb-Scargle scan of the
     residual against position starts the fit at the period, which it refines to within 0.2 %, with the amplitude

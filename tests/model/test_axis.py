@@ -76,6 +76,17 @@ def test_load_friction_raises_the_coulomb_level_with_the_axial_load():
         pytest.approx(20.0)
 
 
+def test_a_saturating_drive_applies_less_than_commanded():
+    from drakecreep.model.axis import applied_force
+
+    p = dict(mass=100.0, inverse_drive_limit=1.0 / 50.0)
+    assert _xdot(MeasuredAxis(False), [0.0, 0.0], 50.0, **p)[1] == pytest.approx(50.0 / math.sqrt(2.0) / 100.0)
+    assert applied_force(-1e6, axis_parameters(**p)) == pytest.approx(-50.0, rel=1e-6)
+    assert applied_force(3.0, axis_parameters()) == 3.0  # a linear drive by default
+    with pytest.raises(InputError, match="inverse_drive_limit"):
+        axis_parameters(inverse_drive_limit=-1.0)
+
+
 def test_two_mass_axis_spring_and_mass_split():
     p = dict(mass=100.0, motor_mass_fraction=0.25, stiffness=1e6, damping=0.0)
     xdot = _xdot(MeasuredAxis(True), [1e-5, 0.0, 0.0, 0.0], 0.0, **p)
