@@ -379,8 +379,11 @@ def _jacobian(sig, norm, values, names):
     for n in names:
         h = 1e-6 * max(abs(values[n]), 1.0 if n in LINEAR else 1e-2)
         hi = inverse_dynamics_force(dict(values, **{n: values[n] + h}), t, q, dq, ddq, tau)
-        lo = inverse_dynamics_force(dict(values, **{n: values[n] - h}), t, q, dq, ddq, tau)
-        cols.append((hi - lo) / (2.0 * h * norm))
+        try:
+            lo, span = inverse_dynamics_force(dict(values, **{n: values[n] - h}), t, q, dq, ddq, tau), 2.0 * h
+        except InputError:  # at the edge of the parameter's domain (a drive limit of 0): one-sided
+            lo, span = inverse_dynamics_force(values, t, q, dq, ddq, tau), h
+        cols.append((hi - lo) / (span * norm))
     return np.column_stack(cols)
 
 

@@ -191,3 +191,17 @@ def test_with_fewer_than_two_sliding_held_out_runs_the_screen_leaves_the_candida
         warnings.simplefilter("error")
         sc = screen_effect(DRAKE_EFFECTS["stribeck"], runs[:2], slow, BASE)
     assert sc.passes and np.isnan(sc.log_ratio)
+
+
+def test_the_constancy_test_takes_a_one_sided_step_at_the_edge_of_a_parameter_s_domain():
+    """A drive limit fitted at 0 (a linear drive) in a run: the central difference would step below 0, which
+    the axis rejects; the Jacobian steps one way instead, and the test still gives a p-value."""
+    import dataclasses as dc
+
+    from drakecreep.gap.screen import _signals, constancy
+
+    runs = _runs(BASE)
+    sat = dc.replace(DRAKE_EFFECTS["drive_saturation"], run_constancy=True)
+    c = constancy([_signals(r) for r in runs[:3]], dict(BASE, inverse_drive_limit=0.0),
+                  ("viscous", "coulomb", "offset"), sat)
+    assert 0.0 <= c.p_value <= 1.0 and len(c.per_run) == 3
