@@ -617,7 +617,7 @@ def _force_level_error(result, cutoff, order):
     p = axis_parameters(**result.parameters)
     _, dv, _ = filtered_derivatives(result.x_table, run.dt, cutoff, order)
     t = np.arange(run.n) * run.dt
-    load = applied_force(result.force, p) + axis_ripple(result.x_motor, t, p)  # the nut's load as on the rigid axis
+    load = applied_force(result.force, p) + axis_ripple(result.x_motor, t, p)  # the nut's load, as the rigid axis
     fr = np.asarray(axis_friction(dv, p, result.x_table, t, load), dtype=float)
     e = np.asarray(run.force, dtype=float) - result.force
     scale = float(fr @ e) / max(float(fr @ fr), 1e-300)

@@ -129,9 +129,11 @@ def _signals(run, shift=0.0):
 def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
     """Drive force [N] the rigid replay axis needs for the motion ``q, dq, ddq`` at times ``t`` (arrays).
 
-    ``M ddq + f(dq, q, t, F_ax) + offset - r(q, t)`` with the axis's own friction and ripple functions; the
-    nut's axial load ``F_ax`` of a load-dependent friction is, as on the rigid Drake axis, the drive force with
-    the ripple, here with the measured drive force ``tau`` (the force stays affine in the coefficient).
+    ``M ddq + f(dq, q, t, F_ax) + offset - r(q, t) + tau - g(tau)`` with the axis's own friction, ripple and
+    drive functions, given the measured drive command ``tau``: the nut's axial load ``F_ax`` of a load-dependent
+    friction is, as on the rigid Drake axis, the applied force with the ripple, ``g(tau) + r`` (so the force
+    stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating drive does not apply of the
+    command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive).
     """
     other, friction = _force_parts(parameters, t, q, dq, ddq, tau)
     return other + friction
