@@ -40,7 +40,9 @@ class DrakeEffect:
     nominal fit and the runs that returns such a tuple (used for the time ripple: the peak of the force
     residual's spectrum). ``run_constancy``: the screen also asks the candidate's amplitudes to be the same in
     every training run (:func:`drakecreep.gap.screen.constancy`), for a candidate whose signature another force
-    reproduces within one run.
+    reproduces within one run. ``shifts_nominal``: the candidate takes over part of the nominal friction (a
+    load-dependent friction is mostly a higher friction level), so its closed-loop start also moves the nominal
+    friction by what the screen's fit moved it (:func:`drakecreep.gap.screen.screen_effect`).
     """
 
     name: str
@@ -51,6 +53,7 @@ class DrakeEffect:
     bounds: dict = field(default_factory=dict)
     spans_travel: bool = False
     run_constancy: bool = False
+    shifts_nominal: bool = False
 
     def fixed_by(self, runs):
         """Axis parameters the candidate takes from the training ``runs``, not from a fit: for a map along the
@@ -85,7 +88,7 @@ DRAKE_EFFECTS = {
                                  ({"load_friction_coefficient": 0.0},),
                                  signature="friction that grows with the axial load: the force error follows the "
                                            "acceleration force's magnitude, against the motion",
-                                 bounds={"load_friction_coefficient": (0.0, 1.0)}),
+                                 bounds={"load_friction_coefficient": (0.0, 1.0)}, shifts_nominal=True),
     # four smooth steps over the training travel (drakecreep.model.axis.friction_map), not a sinusoid: on
     # development data a sinusoid of 0.9 m period at its amplitude bound stood in for a friction ramp, and one
     # held-out run got worse (docs/gap_benchmark.md); |a_k| <= 0.2 keeps the friction level above 0.2 of nominal
