@@ -191,7 +191,8 @@ class DrakeDiagnosis:
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, "
-                         + _verdict(r.gain, r.log_ratio, r.log_ratio_se, self.k_se, r.passes))
+                         + _verdict(r.gain, r.log_ratio, r.log_ratio_se, self.k_se, r.passes, r.level_log_ratio,
+                                    r.level_log_ratio_se))
         if self.claimed:
             lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error "
                          f"{rms_force_error(self.test_errors):.3f} %")

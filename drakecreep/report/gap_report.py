@@ -187,9 +187,11 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     parts.append("<h2>Answer</h2><ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when its closed-loop replay of the held-out runs "
                  f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
-                 f"by more than {k:.3g} standard errors of the per-run log error ratio, and its inverse-dynamics fit "
-                 "of the held-out runs' sliding samples beats the nominal's by more than one standard error (the "
-                 "screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
+                 f"by more than {k:.3g} standard errors of the per-run log error ratio, both as the errors are and "
+                 "with each held-out run's friction scaled to its own level (friction drifts from run to run; "
+                 "a candidate that only fits the level the held-out runs happen to have is not claimed), and its "
+                 "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
+                 "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
     parts.append(table(["parameter", "value", "95 % half-width", "unit"],
                        [[n, f"{_edge(n, nom.parameters[n])[0]:.5g}",
