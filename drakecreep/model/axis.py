@@ -141,6 +141,12 @@ def axis_parameters(**values):
     return np.array([out[n] for n in _NAMES])
 
 
+def _off(coefficient):
+    """True for a plain-number coefficient of 0 (a term switched off): its term is left out rather than
+    multiplied by 0, so the float path does no work for it (a symbolic 0 simplifies away by itself)."""
+    return isinstance(coefficient, float) and coefficient == 0.0
+
+
 def axis_friction(v, p, x=0.0, t=0.0, load=0.0):
     """Friction force [N] opposing ``v`` at position ``x`` [m] and time ``t`` [s] under the axial load ``load``
     [N] through the nut for a parameter vector ``p`` (order of :data:`AXIS_PARAMETERS`): the regularized law,
@@ -175,7 +181,7 @@ def friction_map(P, x):
     w = (x1 - x0) / len(FRICTION_MAP)
     out = 0.0
     for k, name in enumerate(FRICTION_MAP):
-        if isinstance(P[name], float) and P[name] == 0.0:
+        if _off(P[name]):
             continue  # off (the default): nothing to evaluate
         out = out + P[name] * tanh((x - (x0 + (k + 0.5) * w)) / w)
     return out
@@ -189,7 +195,7 @@ def _sliding_level(P, v, load=0.0):
     w = v / P["stribeck_velocity"]
     g = P["coulomb"] + P["coulomb_asym"] * s + P["stribeck_extra"] * exp(-w * w)
     mu = P["load_friction_coefficient"]
-    if not (isinstance(mu, float) and mu == 0.0):  # off (the default): no |load| term
+    if not _off(mu):  # off (the default): no |load| term
         g = g + mu * fabs(load)
     return g, s
 
@@ -220,7 +226,7 @@ def applied_force(F, p):
     ``c = inverse_drive_limit`` (a drive-gain nonlinearity: linear for small forces, saturating smoothly at
     ``1 / c``; ``c = 0``, the default, is a linear drive)."""
     c = dict(zip(_NAMES, p))["inverse_drive_limit"]
-    if isinstance(c, float) and c == 0.0:
+    if _off(c):
         return F
     return F / (1.0 + (c * F) * (c * F)) ** 0.5
 
