@@ -49,7 +49,7 @@ from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, applied_force, axis_friction, axis_parameters,
-                                   axis_ripple)
+                                   axis_ripple, nut_load)
 
 __all__ = ["ScreenResult", "Constancy", "constancy", "screen_effect", "screen_delay", "inverse_dynamics_force",
            "NOT_SCREENED", "LINEAR", "SHAPE", "SLOW_SHARE", "MIN_SLIDING"]
@@ -133,8 +133,9 @@ def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
 
     ``M ddq + f(dq, q, t, F_ax) + offset - r(q, t) + tau - g(tau)`` with the axis's own friction, ripple and
     drive functions, given the measured drive command ``tau``: the nut's axial load ``F_ax`` of a load-dependent
-    friction is, as on the rigid Drake axis, the applied force with the ripple, ``g(tau) + r`` (so the force
-    stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating drive does not apply of the
+    friction is, as on the rigid Drake axis, the applied force with the ripple less the motor side's inertia
+    force, ``g(tau) + r - alpha M ddq`` (:func:`~drakecreep.model.axis.nut_load` with the measured
+    acceleration, so the force stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating drive does not apply of the
     command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive).
     """
     other, friction = _force_parts(parameters, t, q, dq, ddq, tau)
@@ -151,7 +152,7 @@ def _force_parts(parameters, t, q, dq, ddq, tau=0.0):
     ripple = axis_ripple(q, t, p)
     applied = applied_force(tau, p)
     return (P["mass"] * ddq + P["offset"] - ripple + (tau - applied),
-            axis_friction(dq, p, q, t, applied + ripple))
+            axis_friction(dq, p, q, t, nut_load(applied + ripple, p, acceleration=ddq)))
 
 
 def _errors(runs_sig, values, level=False):

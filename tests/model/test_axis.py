@@ -9,7 +9,7 @@ from pydrake.symbolic import Expression
 
 from drakecreep.errors import InputError
 from drakecreep.model.axis import AXIS_PARAMETERS, MeasuredAxis, MeasuredAxis_, axis_friction, axis_parameters, \
-    set_axis_parameters
+    bristle_rates, nut_load, set_axis_parameters
 
 
 def _xdot(system, state, force, t=0.0, **values):
@@ -57,12 +57,19 @@ def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
 
 
 def test_load_friction_raises_the_coulomb_level_with_the_axial_load():
-    """``mu |F_ax|`` on top of the Coulomb level: on the rigid axis ``F_ax`` is the drive force (with the ripple),
-    on the two-mass axis the screw's spring force; the friction port reports the same force the dynamics use."""
+    """``mu |F_ax|`` on top of the Coulomb level: on the rigid axis ``F_ax`` is the drive force less the motor
+    side's inertia force (``(1 - alpha) F + alpha (f + offset)``, alpha = 0.2), on the two-mass axis the screw's
+    spring force; the friction port reports the same force the dynamics use."""
     p = dict(mass=95.0, coulomb=20.0, regularization_velocity=1e-6, load_friction_coefficient=0.25)
-    for force in (60.0, -60.0):  # the load's magnitude, whatever its sign
+    for force, load in ((60.0, 0.8 * 60.0 + 0.2 * 20.0), (-60.0, -0.8 * 60.0 + 0.2 * 20.0)):
         assert _xdot(MeasuredAxis(False), [0.1, 0.05], force, **p)[1] == pytest.approx(
-            (force - (20.0 + 0.25 * 60.0)) / 95.0, rel=1e-9)
+            (force - (20.0 + 0.25 * abs(load))) / 95.0, rel=1e-9)
+    # the same nut load from the measured acceleration (the screen's form): F - alpha M a
+    vec = axis_parameters(**p)
+    a = (60.0 - 20.0) / 95.0  # without the load term, as nut_load's simulation form
+    assert nut_load(60.0, vec, acceleration=a) == pytest.approx(nut_load(60.0, vec, friction=20.0), rel=1e-12)
+    with pytest.raises(ValueError):
+        nut_load(60.0, vec)
     vec = axis_parameters(**p)
     assert axis_friction(-0.05, vec, load=40.0) == pytest.approx(-30.0)
     two = MeasuredAxis(True)
@@ -147,6 +154,19 @@ def test_lugre_bristles_stick_where_the_regularized_law_creeps():
     # the Stribeck level raises the breakaway force: 22 N breaks away without it, not with 5 N more static friction
     assert _push(22.0, **common, bristle_stiffness=1e7)[1] > 0.004  # (22 - 20) / 400 = 5 mm/s
     assert abs(_push(22.0, **common, bristle_stiffness=1e7, stribeck_extra=5.0, stribeck_velocity=1e-3)[1]) < 1e-5
+
+
+def test_the_load_scales_the_bristle_force_and_not_its_target():
+    """Normal-load-scaled LuGre: at the steady deflection ``z = g0 / sigma0`` the friction is ``g0 + mu |load|``
+    (the regularized law's level) and the bristles do not move (``dz/dt = 0``) whatever the load does; with the
+    load in the target ``g`` instead, a changing load would move ``z`` and ``sigma1 dz/dt`` would add a force."""
+    vec = axis_parameters(coulomb=20.0, regularization_velocity=1e-6, bristle_stiffness=1e7,
+                          load_friction_coefficient=0.3)
+    for load in (0.0, 50.0, -120.0):
+        zdot, f = bristle_rates(0.05, 20.0 / 1e7, vec, 60.0, load)
+        assert zdot == pytest.approx(0.0, abs=1e-10)  # the 1e-9 N guard in |g0|: 2.5e-12 m/s
+        assert f == pytest.approx(20.0 + 0.3 * abs(load), rel=1e-7)  # sigma1 times that 2.5e-12 m/s: 1.2e-7 N
+        assert f == pytest.approx(axis_friction(0.05, vec, load=load), rel=1e-7)
 
 
 def test_bristle_state_layout_and_validation():
