@@ -40,7 +40,7 @@ def add_parser(subparsers):
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous)")
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
-                   "time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind drakecreep runs: "
+                   "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind drakecreep runs: "
                    "lead_error, force_ripple, stribeck, law_coulomb, ...)")
     p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
                    "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "

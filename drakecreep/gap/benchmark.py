@@ -24,8 +24,8 @@ Kinds of dataset (:attr:`Dataset.category`):
   such term, ``drake_effects.NOT_RANKED``): the right answer is no claim; reported separately. Empty since the
   load-dependent friction got its candidate;
 * ``out_of_library``: one withheld effect of :data:`drakecreep.gap.truth.OUT_OF_LIBRARY` (a cable carrier's
-  position force; the drive-gain saturation was one until session 27, when it got its candidate): the right
-  answer is "unexplained" (no claim).
+  position force, a backlash; the drive-gain saturation was one until session 27, when it got its candidate):
+  the right answer is "unexplained" (no claim).
 
 **SNR** of a dataset: ``sqrt(E_with / E_without - 1)``, with ``E`` the mean square residual of the nominal
 inverse-dynamics least squares of the Drake path on the training runs (the screen's nominal,
@@ -104,13 +104,14 @@ N_TRAIN, N_TEST, N_AUDIT = 4, 5, 3
 N_SAMPLES = 3000
 
 #: The candidate of :data:`drakecreep.gap.drake_effects.DRAKE_EFFECTS` (or ``control_delay``) that should win for
-#: each withheld library effect of the truth. Lead error, cogging and a bearing defect are all forces periodic in
-#: position on a motor-encoder loop (``NOT_RANKED``): ``position_ripple``, whose period is free.
+#: each withheld library effect of the truth. Cogging and a bearing defect are forces periodic in position of
+#: constant amplitude: ``position_ripple``, whose period is free; a lead error's grows with the square of the
+#: speed: ``lead_error``.
 EXPECTED = {
     "stribeck": "stribeck",
     "asymmetric_friction": "asymmetric_friction",
     "position_friction": "position_friction",
-    "lead_error": "position_ripple",
+    "lead_error": "lead_error",
     "cogging": "position_ripple",
     "structural_mode": "axial_mode",
     "control_delay": "control_delay",

@@ -26,7 +26,7 @@ import numpy as np
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import drake_replay_errors, make_replay, rms_force_error
 from drakecreep.gap.identify import identify
-from drakecreep.model.axis import FRICTION_MAP
+from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
            "score_parameters", "residual_peak_frequency"]
@@ -99,8 +99,17 @@ DRAKE_EFFECTS = {
                                      bounds={n: (-0.2, 0.2) for n in FRICTION_MAP}, spans_travel=True),
     "position_ripple": DrakeEffect("position_ripple", ("position_ripple_cos", "position_ripple_sin", "position_period"),
                                    tuple({"position_period": p} for p in (1.25e-3, 2.5e-3, 5e-3)),
-                                   signature="force ripple periodic in position (cogging, lead-error harmonic)",
+                                   signature="force ripple periodic in position (cogging, a bearing)",
                                    bounds={"position_period": (2e-4, 0.05)}),
+    # a kinematic lead error, first and second harmonic of the lead (drakecreep.model.axis.lead_error): on a
+    # motor-encoder loop its force is the table's inertia times e''(x) v^2, a position ripple growing with the
+    # square of the speed (the position_ripple candidate, of constant amplitude, cannot serve runs at 5-150 mm/s).
+    # Starts: the periodogram's peaks and twice them (screen); amplitudes up to 0.1 mm, far beyond any screw's
+    "lead_error": DrakeEffect("lead_error", LEAD_ERROR + ("lead",),
+                              tuple({"lead": x} for x in (2.5e-3, 5e-3, 1e-2, 2e-2)),
+                              signature="force ripple periodic in position whose amplitude grows with the square of "
+                                        "the speed (the table's inertia behind a periodic lead error)",
+                              bounds=dict({n: (-1e-4, 1e-4) for n in LEAD_ERROR}, lead=(1e-3, 0.05))),
     "time_ripple": DrakeEffect("time_ripple", ("time_ripple_cos", "time_ripple_sin", "ripple_frequency"),
                                signature="force ripple at a fixed time frequency",
                                bounds={"ripple_frequency": (0.5, 400.0)}),
@@ -126,8 +135,6 @@ NOT_RANKED = {
     "quantization": "the encoder resolution is declared in the metadata and always applied in the replay; "
                     "an undeclared coarser resolution is not fitted",
     "backlash": "needs the table position (a linear scale) beside the motor encoder; not in the replay axis",
-    "lead_error": "on a motor-encoder loop a lead error moves the table only; its force signature is the "
-                  "position ripple (ranked as position_ripple)",
     "cogging": "ranked as position_ripple with the motor revolution as period",
 }
 

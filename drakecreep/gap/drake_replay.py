@@ -38,7 +38,7 @@ from pydrake.trajectories import PiecewisePolynomial
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, applied_force,
-                                   axis_friction, axis_parameters, axis_ripple, has_bristles)
+                                   axis_friction, axis_parameters, axis_ripple, has_bristles, lead_error, nut_load)
 from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 
 __all__ = [
@@ -78,6 +78,18 @@ def axis_from_idim(params, **extra):
     values = {"mass": p["M"], "viscous": p["Fv"], "coulomb": p["Fc"], "offset": p.get("offset", 0.0)}
     values.update(extra)
     return values
+
+
+def _table_position(x_motor, vec):
+    """The rigid axis's table position [m] from the motor's: ``x + e(x)`` with the lead error of ``vec``
+    (:func:`~drakecreep.model.axis.lead_error`; the compiled replays log the state, not the leaf's table port)."""
+    e = lead_error(np.asarray(x_motor, dtype=float), vec)[0]
+    return x_motor + e
+
+
+def _lead_offset(x0, vec):
+    """The lead error at ``x0`` [m] for ``vec``: the two-mass axis's table starts there, on its relaxed spring."""
+    return float(lead_error(float(x0), vec)[0])
 
 
 @dataclass(frozen=True)
@@ -235,7 +247,12 @@ class DrakeReplay:
                 self._sibling = DrakeReplay(self.run, bristles=not self.bristles, **self._options)
             return self._sibling.simulate(parameters)
         self.context.SetTimeStateAndParametersFrom(self._default)
-        self.axis.GetMyMutableContextFromRoot(self.context).get_mutable_numeric_parameter(0).SetFromVector(vec)
+        axis_ctx = self.axis.GetMyMutableContextFromRoot(self.context)
+        axis_ctx.get_mutable_numeric_parameter(0).SetFromVector(vec)
+        if self.flexible and lead_error(self.x0, vec)[0] != 0.0:  # the table on the relaxed spring: x0 + e(x0)
+            state = axis_ctx.get_continuous_state_vector().CopyToVector()
+            state[2] = self.x0 + _lead_offset(self.x0, vec)
+            axis_ctx.SetContinuousState(state)
         for log in (self._log_motor, self._log_table, self._log_u, self._log_force):
             log.FindMutableLog(self.context).Clear()
         self.simulator.Initialize()
@@ -249,8 +266,11 @@ class DrakeReplay:
         # a log taken at t_k holds the discrete state from before the update at t_k: the output of sample k
         # (held over [t_k, t_k+1)) is the log at t_k+1
         f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
+        x_table = out["table"][0][:n]
+        if self.compiled and not self.flexible:
+            x_table = _table_position(out["motor"][0][:n], vec)
         return DrakeReplayResult(
-            run=self.run, x_motor=out["motor"][0][:n], x_table=out["table"][0][:n], u=out["u"][0][1:],
+            run=self.run, x_motor=out["motor"][0][:n], x_table=x_table, u=out["u"][0][1:],
             force=out["force"][0][1:] + f_ext, parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
             wall_time=_time.perf_counter() - start)
 
@@ -429,6 +449,8 @@ class SampledReplay:
         cctx.SetDiscreteState(0, [Expression(v) for v in xc])
         it = 2 if self.flexible else 0  # the table's position in the axis state
         fb = xa[0] if ctrl.feedback == "motor" else xa[it]
+        if ctrl.feedback != "motor" and not self.flexible:
+            fb = fb + lead_error(Expression(xa[0]), p_all)[0]  # the rigid table at x + e(x)
         csym.GetInputPort("x_ref").FixValue(cctx, [Expression(inp[0])])
         csym.GetInputPort("position").FixValue(cctx, [Expression(fb)])
         c_update = csym.EvalUniquePeriodicDiscreteUpdate(cctx).get_vector(0).CopyToVector()
@@ -518,6 +540,12 @@ class SampledReplay:
         m, sysm, simulator, context, default, log, layout = self._system(vec)
         self.substeps = m
         context.SetTimeStateAndParametersFrom(default)
+        if self.flexible and lead_error(float(self.run.x_motor[0]), vec)[0] != 0.0:
+            # the table on the relaxed spring: x0 + e(x0)
+            sub = sysm.GetMyMutableContextFromRoot(context)
+            state = sub.get_discrete_state_vector().CopyToVector()
+            state[layout["nc"] + 2] += _lead_offset(self.run.x_motor[0], vec)
+            sub.SetDiscreteState(state)
         if self.free:
             sub = sysm.GetMyMutableContextFromRoot(context)
             sub.get_mutable_numeric_parameter(0).SetFromVector(
@@ -530,8 +558,9 @@ class SampledReplay:
         data = _on_samples(lg.sample_times(), lg.data(), np.arange(n + 1) * self.h)
         nc = layout["nc"]
         f_ext = self.run.f_ext if self.run.f_ext is not None else 0.0
+        x_table = data[nc + layout["table"], :n] if self.flexible else _table_position(data[nc, :n], vec)
         return DrakeReplayResult(
-            run=self.run, x_motor=data[nc, :n], x_table=data[nc + layout["table"], :n], u=data[layout["u"], 1:],
+            run=self.run, x_motor=data[nc, :n], x_table=x_table, u=data[layout["u"], 1:],
             force=layout["gain"] * data[nc - 1, 1:] + f_ext,
             parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
             wall_time=_time.perf_counter() - start)
@@ -617,7 +646,9 @@ def _force_level_error(result, cutoff, order):
     p = axis_parameters(**result.parameters)
     _, dv, _ = filtered_derivatives(result.x_table, run.dt, cutoff, order)
     t = np.arange(run.n) * run.dt
-    load = applied_force(result.force, p) + axis_ripple(result.x_motor, t, p)  # the nut's load, as the rigid axis
+    # the nut's load as the rigid axis has it (nut_load)
+    load = nut_load(applied_force(result.force, p) + axis_ripple(result.x_motor, t, p), p,
+                    friction=axis_friction(dv, p, result.x_table, t, 0.0))
     fr = np.asarray(axis_friction(dv, p, result.x_table, t, load), dtype=float)
     e = np.asarray(run.force, dtype=float) - result.force
     scale = float(fr @ e) / max(float(fr @ fr), 1e-300)

@@ -33,7 +33,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
-from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP
+from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
 
@@ -175,9 +175,11 @@ class _Problem:
                    **{n: 0.1 for n in FRICTION_MAP},
                    "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
                    "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
-                   "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2}
+                   "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2,
+                   **{n: 1e-5 for n in LEAD_ERROR}}
         # phase-like parameters: a step must move the phase over a run by much less than a cycle
         fine = {"ripple_frequency": 1.0, "position_period": 0.01 * base["position_period"],
+                "lead": 0.01 * base.get("lead", 5e-3),
                 "friction_period": 0.05 * base["friction_period"]}
         scale = []
         for i, n in enumerate(self.names):

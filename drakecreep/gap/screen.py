@@ -48,8 +48,8 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
-from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, applied_force, axis_friction, axis_parameters,
-                                   axis_ripple, nut_load)
+from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, LEAD_ERROR, applied_force, axis_friction,
+                                   axis_parameters, axis_ripple, lead_error_force, nut_load)
 
 __all__ = ["ScreenResult", "Constancy", "constancy", "screen_effect", "screen_delay", "inverse_dynamics_force",
            "NOT_SCREENED", "LINEAR", "SHAPE", "SLOW_SHARE", "MIN_SLIDING"]
@@ -151,7 +151,7 @@ def _force_parts(parameters, t, q, dq, ddq, tau=0.0):
     P = dict(zip(AXIS_PARAMETERS, p))
     ripple = axis_ripple(q, t, p)
     applied = applied_force(tau, p)
-    return (P["mass"] * ddq + P["offset"] - ripple + (tau - applied),
+    return (P["mass"] * ddq + P["offset"] - ripple - lead_error_force(q, dq, p) + (tau - applied),
             axis_friction(dq, p, q, t, nut_load(applied + ripple, p, acceleration=ddq)))
 
 
@@ -174,7 +174,7 @@ def _rms(a):
 #: linear least squares inside the fit: variable projection)
 LINEAR = ("viscous", "viscous_asym", "coulomb", "coulomb_asym", "offset", "load_friction_coefficient",
           "stribeck_extra",
-          "position_ripple_cos", "position_ripple_sin", "time_ripple_cos", "time_ripple_sin")
+          "position_ripple_cos", "position_ripple_sin", "time_ripple_cos", "time_ripple_sin") + LEAD_ERROR
 
 
 #: relative singular-value cut of the linear least squares of :func:`_project` (unit-norm columns)
@@ -326,6 +326,16 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
         lo, hi = bounds["position_period"]
         bounds["position_period"] = band = (min(max(lo, 2.0 * h * v_top), 0.5 * hi), hi)
         starts = [{"position_period": period} for period in _peak_periods(tr, reference, band)]
+    if "lead" in effect.parameters:
+        # the lead error's force is m_t e''(x) v^2: lines at the lead and at half of it; a peak is either
+        # (the second harmonic's force is 4 times its amplitude's), and its second harmonic must be resolved
+        h = float(np.median(np.diff(whole[0][0])))
+        lo, hi = bounds["lead"]
+        band = (min(max(lo, 4.0 * h * v_top), 0.5 * hi), hi)
+        bounds["lead"] = band
+        peaks = _peak_periods(tr, reference, (0.5 * band[0], band[1]))
+        starts = [{"lead": lead} for lead in dict.fromkeys(x for p in peaks for x in (p, 2.0 * p))
+                  if band[0] <= lead <= band[1]] or [{"lead": band[0]}]
     for key, dense in _DENSE.items():
         if key in effect.parameters:
             lo, hi = bounds.get(key, (-np.inf, np.inf))
@@ -356,7 +366,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
 
 
 #: parameters that set a candidate's shape, not its size (held at the pooled fit in the constancy test)
-SHAPE = ("stribeck_velocity", "position_period", "ripple_frequency")
+SHAPE = ("stribeck_velocity", "position_period", "ripple_frequency", "lead")
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,9 @@ maps them onto the candidates of the diagnosis); this module only simulates them
   ``F / sqrt(1 + (F / F_k)^2)``);
 * outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a **cable carrier**, a
   conservative force of the table position (linear and quadratic about a neutral position, the same in
-  both directions of motion: not friction, not periodic).
+  both directions of motion: not friction, not periodic), and **backlash**, a lost motion of 4-20 um in the
+  screw-nut chain (a dead zone of the axial spring: no force until the balls bear; the diagnosis ranks no
+  backlash, ``drake_effects.NOT_RANKED``).
 
 Cross-tests (``tests/gap/test_truth.py``, with the measured differences and the tolerances):
 
@@ -100,7 +102,7 @@ LIBRARY_EFFECTS = ("stribeck", "asymmetric_friction", "position_friction", "lead
 #: last in :data:`LIBRARY_EFFECTS`, so the benchmark's seeds still draw the same datasets).
 NO_CANDIDATE = ()
 #: Withheld effects outside the diagnosis's library (the answer must be "unexplained").
-OUT_OF_LIBRARY = ("cable_carrier",)
+OUT_OF_LIBRARY = ("cable_carrier", "backlash")
 WITHHELD = LIBRARY_EFFECTS + NO_CANDIDATE + OUT_OF_LIBRARY
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 AXES = ("flexible", "rigid")
@@ -228,6 +230,9 @@ def draw_truth(rng, kind, axis, withheld=()):
             # assumption (no rig data): a 0.1-0.3 m travel carrier pulls 8-25 N at 0.1 m from its neutral point
             p[h] = {"stiffness_N_m": rng.uniform(80.0, 250.0) * sgn(), "quadratic_N": rng.uniform(2.0, 6.0) * sgn(),
                     "neutral_m": rng.uniform(0.0, 0.15)}
+        elif h == "backlash":
+            # assumption: the lost motion of a ball screw without preload (or with a worn one), 4-20 um in all
+            p[h] = {"lost_motion_m": rng.uniform(4e-6, 20e-6)}
         elif h == "drive_saturation":
             # assumption: the drive's force constant falls off above F_k (tanh), F_k 60-160 N (a few times the
             # friction level of these axes, so the larger accelerations and speeds reach it)
@@ -367,6 +372,7 @@ def _columns(jobs):
         put("cc_q", one(e.get("quadratic_N", 0.0)))
         put("cc_x0", one(e.get("neutral_m", 0.0)))
         put("knee", one(eff.get("drive_saturation", {}).get("knee_N", 0.0)))
+        put("bl", one(0.5 * eff.get("backlash", {}).get("lost_motion_m", 0.0)))
     return {k: np.array(v) for k, v in cols.items()}
 
 
@@ -403,6 +409,7 @@ def simulate_batch(jobs):
     has_knee = bool(np.any(p["knee"] > 0))
     knee_safe = np.where(p["knee"] > 0, p["knee"], 1.0)
     has_cc = bool(np.any(p["cc_k"] != 0) or np.any(p["cc_q"] != 0))
+    has_bl = bool(np.any(p["bl"] > 0))
     w_lead = 2 * np.pi / p["lead"]
     v_eps = 1e-4
 
@@ -471,7 +478,12 @@ def simulate_batch(jobs):
                     dstretch = v1 * (1.0 + lead_err_slope(x1)) - v2
                 else:
                     stretch, dstretch = x1 - x2, v1 - v2
-                fk = p["k"] * stretch + p["c"] * dstretch
+                if has_bl:  # a dead zone of +-bl in the chain: no force (and no damping) until the balls bear
+                    bearing = np.abs(stretch) >= p["bl"]
+                    fk = np.where(bearing, p["k"] * (stretch - np.clip(stretch, -p["bl"], p["bl"]))
+                                  + p["c"] * dstretch, 0.0)
+                else:
+                    fk = p["k"] * stretch + p["c"] * dstretch
                 fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
                 th = w_lead * x1
                 extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])

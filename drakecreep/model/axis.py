@@ -22,10 +22,16 @@ dimensionless, as in :class:`drakecreep.params.NutParams`; ``F_ax`` the screw's 
 axis what the nut passes on to the table, :func:`nut_load`). The drive applies ``F / sqrt(1 + (c F)^2)`` of the commanded force
 ``F`` (``inverse_drive_limit`` ``c`` [1/N], 0 by default: a linear drive; :func:`applied_force`);
 
-and a ripple force on the motor side (cogging or a lead-error harmonic at the position period ``Lp``,
+and a ripple force on the motor side (cogging or a bearing's force at the position period ``Lp``,
 plus a fixed time frequency ``f_r``)::
 
     r(x_m, t) = pc cos(2 pi x_m / Lp) + ps sin(2 pi x_m / Lp) + tc cos(2 pi f_r t) + ts sin(2 pi f_r t)
+
+A lead error moves the nut ``e(x_m)`` ahead of where the screw's angle puts it (:func:`lead_error`: the first
+two harmonics of the ``lead``). On the two-mass axis the spring's motor end is at ``x_m + e(x_m)`` (exact
+kinematics); on the rigid axis the table is at ``x + e(x)``, and the drive must supply the table's extra
+inertial force ``m_t e''(x) v^2`` (``m_t = (1 - motor_mass_fraction) M``; the terms in ``e'`` (about 1 %) are
+left out), a ripple of position whose amplitude grows with the square of the speed.
 
 With bristles (``bristles=True``, ``bristle_stiffness`` ``sigma0 > 0``) the Coulomb-Stribeck part is the LuGre
 law instead (Canudas de Wit et al. 1995): a bristle deflection ``z`` is appended to the state, and::
@@ -59,7 +65,7 @@ from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
            "set_axis_parameters", "axis_friction", "applied_force", "nut_load", "friction_map", "FRICTION_MAP",
-           "bristle_rates", "has_bristles"]
+           "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -88,6 +94,11 @@ AXIS_PARAMETERS = {
     "friction_map_3": 0.0,
     "friction_map_start": 0.0,
     "friction_map_end": 1.0,
+    "lead_error_cos": 0.0,
+    "lead_error_sin": 0.0,
+    "lead_error_2_cos": 0.0,
+    "lead_error_2_sin": 0.0,
+    "lead": 5e-3,
     "time_ripple_cos": 0.0,
     "time_ripple_sin": 0.0,
     "ripple_frequency": 50.0,
@@ -105,11 +116,12 @@ AXIS_UNITS = {
     "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
     "friction_map_0": "-", "friction_map_1": "-", "friction_map_2": "-", "friction_map_3": "-",
     "friction_map_start": "m", "friction_map_end": "m",
+    "lead_error_cos": "m", "lead_error_sin": "m", "lead_error_2_cos": "m", "lead_error_2_sin": "m", "lead": "m",
     "time_ripple_cos": "N", "time_ripple_sin": "N", "ripple_frequency": "Hz", "friction_drift": "1/s",
     "bristle_stiffness": "N/m", "bristle_damping_ratio": "-", "inverse_drive_limit": "1/N",
 }
 _POSITIVE = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "position_period",
-             "friction_period", "ripple_frequency")
+             "friction_period", "ripple_frequency", "lead")
 _NAMES = tuple(AXIS_PARAMETERS)
 
 
@@ -265,6 +277,42 @@ def nut_load(drive, p, friction=None, acceleration=None):
     return (1.0 - alpha) * drive + alpha * (friction + P["offset"])
 
 
+#: the lead error's harmonic amplitudes [m]: ``(cos, sin)`` of the lead's first and second harmonic
+LEAD_ERROR = ("lead_error_cos", "lead_error_sin", "lead_error_2_cos", "lead_error_2_sin")
+
+
+def lead_error(x, p):
+    """``(e, de/dx, d2e/dx2)`` of the lead error at the motor position ``x`` [m] for the parameter vector ``p``::
+
+        e(x) = sum_k=1,2 c_k cos(k theta) + s_k sin(k theta),   theta = 2 pi x / lead
+
+    (``lead_error_cos/sin``, ``lead_error_2_cos/sin`` [m], ``lead`` [m]). Plain zeros when every amplitude is a
+    plain 0 (the default): nothing to evaluate.
+    """
+    P = dict(zip(_NAMES, p))
+    e = d1 = d2 = 0.0
+    for k, (c, s) in enumerate(((P[LEAD_ERROR[0]], P[LEAD_ERROR[1]]), (P[LEAD_ERROR[2]], P[LEAD_ERROR[3]])), 1):
+        if _off(c) and _off(s):
+            continue
+        w = 2.0 * math.pi * k / P["lead"]
+        cs, sn = cos(w * x), sin(w * x)
+        e = e + c * cs + s * sn
+        d1 = d1 + w * (s * cs - c * sn)
+        d2 = d2 - w * w * (c * cs + s * sn)
+    return e, d1, d2
+
+
+def lead_error_force(x, v, p):
+    """Force [N] along +x on the RIGID axis from a lead error (:func:`lead_error`): ``-m_t e''(x) v^2``, the table's
+    extra inertial force the drive must supply (``m_t = (1 - motor_mass_fraction) mass``; the terms in ``e'``,
+    about 1 % of the inertia force, are left out)."""
+    e2 = lead_error(x, p)[2]
+    if _off(e2):
+        return 0.0
+    P = dict(zip(_NAMES, p))
+    return -(1.0 - P["motor_mass_fraction"]) * P["mass"] * e2 * v * v
+
+
 def axis_ripple(x, t, p):
     """Position-periodic (cogging, lead-error harmonic force) plus time-periodic ripple force [N] along +x."""
     P = dict(zip(_NAMES, p))
@@ -353,10 +401,12 @@ def MeasuredAxis_(T):
             return _level(P, x[i], t) * f, [zdot]
 
         def _load(self, x, P, F, t, p):
-            """Axial load through the nut [N]: the screw's spring force (two-mass), or :func:`nut_load` (rigid; 0
-            when the load term is off: nothing reads it then)."""
+            """Axial load through the nut [N]: the screw's spring force (two-mass; its motor end at
+            ``x_m + e(x_m)`` with a lead error), or :func:`nut_load` (rigid; 0 when the load term is off: nothing
+            reads it then)."""
             if self.flexible:
-                return P["stiffness"] * (x[0] - x[2]) + P["damping"] * (x[1] - x[3])
+                e, e1, _ = lead_error(x[0], p)
+                return P["stiffness"] * (x[0] + e - x[2]) + P["damping"] * (x[1] * (1.0 + e1) - x[3])
             if _off(P["load_friction_coefficient"]):
                 return 0.0
             return nut_load(F + axis_ripple(x[0], t, p), p, friction=self._friction(x, p, t, 0.0)[0])
@@ -371,11 +421,14 @@ def MeasuredAxis_(T):
             friction, zdot = self._friction(x, p, t, load)
             if self.flexible:
                 m_m, m_t = self._masses(P)
-                a_m = (F + axis_ripple(x[0], t, p) - load) / m_m
+                # the spring pulls the motor side back through the lead error's gearing, (1 + e'): the work
+                # balance of the kinematic constraint
+                e1 = lead_error(x[0], p)[1]
+                a_m = (F + axis_ripple(x[0], t, p) - load * (1.0 + e1)) / m_m
                 a_t = (load - friction - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
             else:
-                push = F + axis_ripple(x[0], t, p) - friction - P["offset"]
+                push = F + axis_ripple(x[0], t, p) + lead_error_force(x[0], x[1], p) - friction - P["offset"]
                 rates = [x[1], push / P["mass"]]
             derivatives.get_mutable_vector().SetFromVector(vector(rates + zdot))
 
@@ -385,8 +438,11 @@ def MeasuredAxis_(T):
 
         def _calc_table(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            i = self._table()
-            output.SetFromVector(vector([x[i], x[i + 1]]))
+            if self.flexible:
+                output.SetFromVector(vector([x[2], x[3]]))
+                return
+            e, e1, _ = lead_error(x[0], self._p(context))  # the rigid table follows the nut: x + e(x)
+            output.SetFromVector(vector([x[0] + e, x[1] * (1.0 + e1)]))
 
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()

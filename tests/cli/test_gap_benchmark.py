@@ -35,7 +35,7 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
 
 
 @pytest.mark.parametrize("argv, needle", [(["--effects", "gremlins"], "--effects"),
-                                          (["--effects", "lead_error"], "--effects"),
+                                          (["--effects", "backlash"], "--effects"),
                                           (["--kinds", "drakecreep", "--effects", "asymmetric_friction"], "--effects"),
                                           (["--kinds", "drakecreep", "p_p_cascade", "--effects", "stribeck"],
                                            "one --kinds")])

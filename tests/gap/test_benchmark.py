@@ -32,8 +32,9 @@ def test_every_library_effect_has_an_expected_drake_candidate():
     assert set(EXPECTED) == set(T.LIBRARY_EFFECTS)
     assert set(EXPECTED.values()) <= set(DRAKE_EFFECTS) | {"control_delay"}
     # the effects the benchmark expects "no claim" for are really outside the ranked candidates
-    assert "backlash" in NOT_RANKED and {"load_friction", "drive_saturation"} <= set(DRAKE_EFFECTS)
+    assert "backlash" in NOT_RANKED and {"load_friction", "drive_saturation", "lead_error"} <= set(DRAKE_EFFECTS)
     assert not (set(T.OUT_OF_LIBRARY) | set(T.NO_CANDIDATE)) & set(DRAKE_EFFECTS)
+    assert "backlash" in T.OUT_OF_LIBRARY and EXPECTED["lead_error"] == "lead_error"
 
 
 def test_the_benchmark_does_not_use_the_former_rigid_diagnosis():

@@ -177,3 +177,21 @@ def test_load_friction_raises_the_table_friction_by_its_steady_factor():
         rise = np.median(sims[0]["u"][k][legs] - sims[1]["u"][k][legs]) * T.GTAU
         f_t = share * (tr.Fc + tr.Fv * v)
         assert rise == pytest.approx(f_t * 0.3 / 0.7, rel=0.05)
+
+
+def test_backlash_is_a_lost_motion_between_motor_and_table():
+    """With a lost motion ``b`` the motor runs ``b`` further than the table on the way out and back: the motor-
+    minus-table position of the forward and backward cruise differs by ``b`` more than the twin's (whose
+    difference is the spring's deflection under the friction)."""
+    tr = T.draw_truth(np.random.default_rng(11), "p_p_cascade", "rigid", ("backlash",))
+    tr.effects["backlash"] = {"lost_motion_m": 12e-6}
+    refs = T.out_and_back(0.02, 0.05, n=1500, leg=0.6, starts=(0.1, 0.8))[None, :]
+    zero = np.zeros_like(refs)
+    v = np.gradient(refs[0], T.DT)
+    cruise = np.abs(v) > 0.9 * 0.02
+    gaps = []
+    for sim in T.simulate_batch([(tr, refs, zero, np.ones(1), zero, w) for w in (True, False)]):
+        d = sim["x_motor"][0] - sim["x_table"][0]
+        gaps.append(np.mean(d[cruise & (v > 0)]) - np.mean(d[cruise & (v < 0)]))
+    assert gaps[0] - gaps[1] == pytest.approx(12e-6, rel=0.05)
+    assert abs(gaps[1]) < 1e-6

@@ -180,3 +180,28 @@ def test_bristle_state_layout_and_validation():
         MeasuredAxis(False, None, [0.0, 0.0], True)
     with pytest.raises(InputError, match="bristle_stiffness"):
         axis_parameters(bristle_stiffness=-1.0)
+
+
+def test_a_lead_error_moves_the_table_and_costs_its_inertial_force():
+    """Rigid: the table at ``x + e(x)`` and the drive short of ``m_t e''(x) v^2``; two-mass: the spring's motor end
+    at ``x_m + e(x_m)``, so a table there sits on a relaxed spring."""
+    from drakecreep.model.axis import lead_error, lead_error_force
+
+    p = dict(mass=100.0, motor_mass_fraction=0.25, lead_error_cos=5e-6, lead_error_2_sin=2e-6, lead=4e-3)
+    vec = axis_parameters(**p)
+    x, v = 1.3e-3, 0.1
+    w = 2 * math.pi / 4e-3
+    e = 5e-6 * math.cos(w * x) + 2e-6 * math.sin(2 * w * x)
+    e2 = -w * w * (5e-6 * math.cos(w * x) + 4 * 2e-6 * math.sin(2 * w * x))
+    assert lead_error(x, vec)[0] == pytest.approx(e, rel=1e-12)
+    assert lead_error(x, vec)[2] == pytest.approx(e2, rel=1e-12)
+    assert lead_error_force(x, v, vec) == pytest.approx(-75.0 * e2 * v * v, rel=1e-12)
+    rigid = MeasuredAxis(False)
+    assert _xdot(rigid, [x, v], 0.0, **p)[1] == pytest.approx(-75.0 * e2 * v * v / 100.0, rel=1e-9)
+    ctx = rigid.CreateDefaultContext()
+    ctx.SetContinuousState([x, v])
+    set_axis_parameters(rigid, ctx, **p)
+    assert rigid.GetOutputPort("table_state").Eval(ctx)[0] == pytest.approx(x + e, rel=1e-12)
+    e1 = lead_error(x, vec)[1]
+    two = _xdot(MeasuredAxis(True), [x, v, x + e, v * (1 + e1)], 0.0, **dict(p, stiffness=1e8, damping=1e3))
+    assert two[1] == pytest.approx(0.0, abs=1e-9) and two[3] == pytest.approx(0.0, abs=1e-9)
