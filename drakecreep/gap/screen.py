@@ -135,8 +135,9 @@ def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
     drive functions, given the measured drive command ``tau``: the nut's axial load ``F_ax`` of a load-dependent
     friction is, as on the rigid Drake axis, the applied force with the ripple less the motor side's inertia
     force, ``g(tau) + r - alpha M ddq`` (:func:`~drakecreep.model.axis.nut_load` with the measured
-    acceleration, so the force stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating drive does not apply of the
-    command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive).
+    acceleration, so the force stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating
+    drive does not apply of the command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive).
+    A lead error adds the table's inertial force ``m_t e''(q) dq^2`` (:func:`~drakecreep.model.axis.lead_error_force`).
     """
     other, friction = _force_parts(parameters, t, q, dq, ddq, tau)
     return other + friction

@@ -42,9 +42,9 @@ maps them onto the candidates of the diagnosis); this module only simulates them
   with a period that is not a divisor of the lead), a force ripple at a fixed time frequency (6-25 Hz,
   e.g. a pump), a load-dependent nut friction (``mu |F_axial|``, ``mu`` 0.2-0.4, with ``F_axial`` the
   screw's spring force: the table's LuGre force is scaled by ``1 + mu |F_axial| / F_c``, so in steady
-  sliding the Coulomb level is ``F_c + mu |F_axial|``) and a **drive-gain saturation**, the drive force ``F_k tanh(F_cmd / F_k)`` instead of the commanded
-  ``F_cmd`` (the recorded ``u`` is the command; the candidate's saturation has another shape,
-  ``F / sqrt(1 + (F / F_k)^2)``);
+  sliding the Coulomb level is ``F_c + mu |F_axial|``) and a **drive-gain saturation**, the drive force
+  ``F_k tanh(F_cmd / F_k)`` instead of the commanded ``F_cmd`` (the recorded ``u`` is the command; the
+  candidate's saturation has another shape, ``F / sqrt(1 + (F / F_k)^2)``);
 * outside the library (:data:`OUT_OF_LIBRARY`; the right answer is "unexplained"): a **cable carrier**, a
   conservative force of the table position (linear and quadratic about a neutral position, the same in
   both directions of motion: not friction, not periodic), and **backlash**, a lost motion of 4-20 um in the

@@ -19,8 +19,8 @@ with the friction (regularized by ``s(v) = tanh(v / v_reg)``, as :mod:`drakecree
 with ``m(x)`` a smooth map along the travel (:func:`friction_map`: four ``tanh`` steps). The Coulomb level
 ``Fc`` rises by ``mu |F_ax|`` with the axial load through the nut (``load_friction_coefficient`` ``mu``,
 dimensionless, as in :class:`drakecreep.params.NutParams`; ``F_ax`` the screw's spring force, or on the rigid
-axis what the nut passes on to the table, :func:`nut_load`). The drive applies ``F / sqrt(1 + (c F)^2)`` of the commanded force
-``F`` (``inverse_drive_limit`` ``c`` [1/N], 0 by default: a linear drive; :func:`applied_force`);
+axis what the nut passes on to the table, :func:`nut_load`). The drive applies ``F / sqrt(1 + (c F)^2)`` of the
+commanded force ``F`` (``inverse_drive_limit`` ``c`` [1/N], 0 by default: a linear drive; :func:`applied_force`);
 
 and a ripple force on the motor side (cogging or a bearing's force at the position period ``Lp``,
 plus a fixed time frequency ``f_r``)::
@@ -314,7 +314,8 @@ def lead_error_force(x, v, p):
 
 
 def axis_ripple(x, t, p):
-    """Position-periodic (cogging, lead-error harmonic force) plus time-periodic ripple force [N] along +x."""
+    """Position-periodic (cogging, a bearing) plus time-periodic ripple force [N] along +x (a lead error's force
+    is :func:`lead_error_force`)."""
     P = dict(zip(_NAMES, p))
     a = 2.0 * math.pi * x / P["position_period"]
     b = 2.0 * math.pi * P["ripple_frequency"] * t
@@ -347,7 +348,8 @@ def MeasuredAxis_(T):
         Output ports
         ------------
         motor_state : 2, ``[x_m (m), v_m (m/s)]`` (the motor encoder's view)
-        table_state : 2, ``[x_t (m), v_t (m/s)]`` (the linear scale's view; = motor_state when rigid)
+        table_state : 2, ``[x_t (m), v_t (m/s)]`` (the linear scale's view; when rigid, motor_state moved by the
+            lead error: ``[x + e(x), v (1 + e'(x))]``)
         friction_force : 1, friction on the table (N)
         """
 

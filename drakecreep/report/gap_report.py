@@ -141,9 +141,12 @@ _EDGE_UNITS = {"m/s": (1e3, "mm/s"), "m": (1e3, "mm"), "N/m": (1e-6, "N/um")}
 
 
 def _edge(name, value):
-    """``(value, unit)`` of MeasuredAxis parameter ``name`` in the report's units (mm/s, mm, N/um; else SI)."""
-    from drakecreep.model.axis import AXIS_UNITS
+    """``(value, unit)`` of MeasuredAxis parameter ``name`` in the report's units (mm/s, mm, N/um; a lead error's
+    amplitudes in um; else SI)."""
+    from drakecreep.model.axis import AXIS_UNITS, LEAD_ERROR
 
+    if name in LEAD_ERROR:
+        return value * 1e6, "um"
     unit = AXIS_UNITS[name]
     factor, shown = _EDGE_UNITS.get(unit, (1.0, unit))
     return value * factor, shown
