@@ -85,7 +85,7 @@ DRAKE_EFFECTS = {
     # a ball nut's friction grows with the axial load on its balls: mu |F_ax| on top of the Coulomb level
     # (drakecreep.model.axis); mu >= 0 (a friction that falls with load is not this effect). On the rigid axis
     # F_ax is the drive force less the motor side's inertia force (nut_load, motor_mass_fraction as assumed:
-    # fitting it beside mu put both at their bounds on development data)
+    # fitted beside mu on development data, the screen put both at their bounds)
     "load_friction": DrakeEffect("load_friction", ("load_friction_coefficient",),
                                  ({"load_friction_coefficient": 0.0},),
                                  signature="friction that grows with the axial load: the force error follows the "

@@ -264,7 +264,8 @@ def nut_load(drive, p, friction=None, acceleration=None):
     spring force instead (exact; :class:`MeasuredAxis_`).
 
     ``alpha`` is not identifiable on a rigid axis but through the load term, and then poorly: fitted beside
-    ``mu`` on development data both went to their bounds. It stays the assumed share (0.2 by default: rotor,
+    ``mu`` on development data, the screen put both at their bounds and the closed-loop replay got 9-55 times
+    worse (docs/gap_benchmark.md, 3l). It stays the assumed share (0.2 by default: rotor,
     coupling and screw of a machine-tool axis; 0.4-0.65 on the benchmark's truths). With ``alpha = 0`` the load
     would be the whole drive force, the motor side's inertia force counted as nut load.
     """
