@@ -36,8 +36,8 @@
    held-out runs, and most false claims were that;
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
    augmented so far and kept only if they pass again against it (refitted alone by the same effort). A step
-   refits the candidate's parameters with the nominal friction (the nominal's fitted set, plus the two-mass
-   friction once the axial mode is in); the effects claimed before keep their values. Refitting every claimed
+   refits the candidate's parameters with the nominal friction (the nominal's fitted set, plus the axial
+   mode's stiffness and damping once it is in); the effects claimed before keep their values. Refitting every claimed
    parameter at every step cost EMPS 25 s for its fourth claim (17 parameters against 8), which put the
    diagnosis over its 60 s.
 
@@ -456,7 +456,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             if ok:
                 claimed.append(r.name)
                 current, current_test = fit, fit.test_errors
-                if r.name == "axial_mode":  # its friction refit is the two-mass model's own from now on
+                if r.name == "axial_mode":  # the two-mass axis's spring is refitted with the friction from now on
                     fitted += [p for p in DRAKE_EFFECTS[r.name].parameters if p not in fitted]
                 model = {"parameters": dict(fit.parameters), "flexible": fit.flexible, "delay": fit.delay}
     where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])

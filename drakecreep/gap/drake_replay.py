@@ -249,9 +249,10 @@ class DrakeReplay:
         self.context.SetTimeStateAndParametersFrom(self._default)
         axis_ctx = self.axis.GetMyMutableContextFromRoot(self.context)
         axis_ctx.get_mutable_numeric_parameter(0).SetFromVector(vec)
-        if self.flexible and lead_error(self.x0, vec)[0] != 0.0:  # the table on the relaxed spring: x0 + e(x0)
+        offset = _lead_offset(self.x0, vec) if self.flexible else 0.0
+        if offset:  # the table on the relaxed spring: x0 + e(x0)
             state = axis_ctx.get_continuous_state_vector().CopyToVector()
-            state[2] = self.x0 + _lead_offset(self.x0, vec)
+            state[2] = self.x0 + offset
             axis_ctx.SetContinuousState(state)
         for log in (self._log_motor, self._log_table, self._log_u, self._log_force):
             log.FindMutableLog(self.context).Clear()
@@ -540,11 +541,11 @@ class SampledReplay:
         m, sysm, simulator, context, default, log, layout = self._system(vec)
         self.substeps = m
         context.SetTimeStateAndParametersFrom(default)
-        if self.flexible and lead_error(float(self.run.x_motor[0]), vec)[0] != 0.0:
-            # the table on the relaxed spring: x0 + e(x0)
+        offset = _lead_offset(self.run.x_motor[0], vec) if self.flexible else 0.0
+        if offset:  # the table on the relaxed spring: x0 + e(x0)
             sub = sysm.GetMyMutableContextFromRoot(context)
             state = sub.get_discrete_state_vector().CopyToVector()
-            state[layout["nc"] + 2] += _lead_offset(self.run.x_motor[0], vec)
+            state[layout["nc"] + 2] += offset
             sub.SetDiscreteState(state)
         if self.free:
             sub = sysm.GetMyMutableContextFromRoot(context)

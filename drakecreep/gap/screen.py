@@ -320,20 +320,22 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
 
     bounds = dict(effect.bounds)
     bounds.update(physical_bounds(effect, base))
+    # a period the samples cannot resolve at the top speed (its frequency v / P above the Nyquist frequency of
+    # the screen's signals) is aliased: a "peak" there fits noise at a false period
+    nyquist_period = 2.0 * float(np.median(np.diff(whole[0][0]))) * v_top
+
+    def resolvable(name, harmonic=1):  # the band of periods whose ``harmonic`` the samples resolve
+        lo, hi = bounds[name]
+        bounds[name] = band = (min(max(lo, harmonic * nyquist_period), 0.5 * hi), hi)
+        return band
+
     if "position_period" in effect.parameters:
-        # a period the samples cannot resolve at the top speed (its frequency v / P above the Nyquist frequency
-        # of the screen's signals) is aliased: a "peak" there fits noise at a false period
-        h = float(np.median(np.diff(whole[0][0])))
-        lo, hi = bounds["position_period"]
-        bounds["position_period"] = band = (min(max(lo, 2.0 * h * v_top), 0.5 * hi), hi)
-        starts = [{"position_period": period} for period in _peak_periods(tr, reference, band)]
+        starts = [{"position_period": period}
+                  for period in _peak_periods(tr, reference, resolvable("position_period"))]
     if "lead" in effect.parameters:
         # the lead error's force is m_t e''(x) v^2: lines at the lead and at half of it; a peak is either
         # (the second harmonic's force is 4 times its amplitude's), and its second harmonic must be resolved
-        h = float(np.median(np.diff(whole[0][0])))
-        lo, hi = bounds["lead"]
-        band = (min(max(lo, 4.0 * h * v_top), 0.5 * hi), hi)
-        bounds["lead"] = band
+        band = resolvable("lead", harmonic=2)
         peaks = _peak_periods(tr, reference, (0.5 * band[0], band[1]))
         starts = [{"lead": lead} for lead in dict.fromkeys(x for p in peaks for x in (p, 2.0 * p))
                   if band[0] <= lead <= band[1]] or [{"lead": band[0]}]

@@ -403,12 +403,12 @@ def MeasuredAxis_(T):
             zdot, f = bristle_rates(x[i + 1], x[-1], p, self._masses(P)[1], load)
             return _level(P, x[i], t) * f, [zdot]
 
-        def _load(self, x, P, F, t, p):
+        def _load(self, x, P, F, t, p, lead=None):
             """Axial load through the nut [N]: the screw's spring force (two-mass; its motor end at
-            ``x_m + e(x_m)`` with a lead error), or :func:`nut_load` (rigid; 0 when the load term is off: nothing
-            reads it then)."""
+            ``x_m + e(x_m)`` with a lead error, ``lead`` = :func:`lead_error` at ``x_m`` if already evaluated), or
+            :func:`nut_load` (rigid; 0 when the load term is off: nothing reads it then)."""
             if self.flexible:
-                e, e1, _ = lead_error(x[0], p)
+                e, e1, _ = lead if lead is not None else lead_error(x[0], p)
                 return P["stiffness"] * (x[0] + e - x[2]) + P["damping"] * (x[1] * (1.0 + e1) - x[3])
             if _off(P["load_friction_coefficient"]):
                 return 0.0
@@ -420,13 +420,14 @@ def MeasuredAxis_(T):
             P = dict(zip(_NAMES, p))
             F = applied_force(self._force.Eval(context)[0], p)
             t = context.get_time()
-            load = self._load(x, P, F, t, p)
+            lead = lead_error(x[0], p) if self.flexible else None
+            load = self._load(x, P, F, t, p, lead)
             friction, zdot = self._friction(x, p, t, load)
             if self.flexible:
                 m_m, m_t = self._masses(P)
                 # the spring pulls the motor side back through the lead error's gearing, (1 + e'): the work
                 # balance of the kinematic constraint
-                e1 = lead_error(x[0], p)[1]
+                e1 = lead[1]
                 a_m = (F + axis_ripple(x[0], t, p) - load * (1.0 + e1)) / m_m
                 a_t = (load - friction - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
