@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
+import dataclasses
 import math
 import multiprocessing
 import time as _time
@@ -117,7 +118,9 @@ class RankedEffect:
     """One candidate against the nominal model: its closed-loop fit, held-out gain [points of %], the log ratio
     of the held-out errors it is decided on (:func:`paired_log_ratio`) and whether it passes; ``screen`` is its
     inverse-dynamics pre-screen (:class:`drakecreep.gap.screen.ScreenResult`). A candidate the screen rules out
-    has ``fit = None`` and ``gain = nan`` (never fitted in closed loop)."""
+    has ``fit = None`` and ``gain = nan`` (never fitted in closed loop). ``reference_errors``: the held-out errors
+    of the candidate's own equal-effort reference when it has one (a candidate with ``screen_refits``:
+    :func:`_with_values`), else None (the nominal's)."""
 
     fit: EffectFit | None
     gain: float
@@ -129,6 +132,7 @@ class RankedEffect:
     log_ratio_se: float = float("nan")
     level_log_ratio: float = float("nan")
     level_log_ratio_se: float = float("nan")
+    reference_errors: dict | None = None
 
     @property
     def error_ratio(self):
@@ -274,6 +278,15 @@ def _reference_errors(train, test, current, fitted, max_nfev):
                             delay=current.delay)[0]
 
 
+def _with_values(model, values):
+    """``model`` with ``values`` in its parameters: the equal-effort reference of a candidate that refits nominal
+    parameters outside the friction on inverse dynamics (:class:`~drakecreep.gap.drake_effects.DrakeEffect`
+    ``screen_refits``, the drive saturation's mass). The candidate starts from its own values of them, its
+    reference from the screen's reference values, and both refit the friction by the same ``max_nfev``: against
+    the nominal's IDIM mass, the mass change alone would count as the candidate's gain."""
+    return dataclasses.replace(model, parameters=dict(model.parameters, **values))
+
+
 def _submit(pool, fn, *args):
     """``fn(*args)`` on ``pool``, or here and now without one (a done future either way)."""
     if pool is not None:
@@ -405,29 +418,36 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             continue
         jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
 
-    def ranked(n, sc, fit):
-        gain, se, lr, lr_se, lv, lv_se, ok = _passes(nom_test, fit.test_errors, k_se)
+    def ranked(n, sc, fit, own=None):
+        gain, se, lr, lr_se, lv, lv_se, ok = _passes(own or nom_test, fit.test_errors, k_se)
         say(f"{n}: held-out {_verdict(gain, lr, lr_se, k_se, ok, lv, lv_se)}")
         return RankedEffect(fit=fit, gain=gain, standard_error=se, passes=ok, screen=sc, effect=n, log_ratio=lr,
-                            log_ratio_se=lr_se, level_log_ratio=lv, level_log_ratio_se=lv_se)
+                            log_ratio_se=lr_se, level_log_ratio=lv, level_log_ratio_se=lv_se, reference_errors=own)
 
     def origin(n):  # the model a candidate starts from: see _refit
         return first if _refits(n) else nominal
+
+    def own_reference(sc):  # the reference model of a candidate with screen_refits (_with_values), or None
+        values = getattr(sc, "reference_values", None)
+        return _with_values(first, values) if values else None
 
     with contextlib.ExitStack() as stack:
         # one pool for the ranking and the greedy step (each spawned process imports Drake once)
         pool = None if workers == 1 else stack.enter_context(cf.ProcessPoolExecutor(
             min(workers, max(len(jobs), 2)), mp_context=multiprocessing.get_context("spawn")))
+        own = {n: _submit(pool, _reference_errors, train, test, own_reference(sc), first.fitted, max_nfev)
+               for n, sc, _ in jobs if own_reference(sc) is not None}
         if pool is None or len(jobs) < 2:
             for n, sc, start in jobs:
-                ranking.append(ranked(n, sc, fit_candidate(n, train, test, origin(n), max_nfev, start)))
+                fit = fit_candidate(n, train, test, origin(n), max_nfev, start)
+                ranking.append(ranked(n, sc, fit, own[n].result() if n in own else None))
         else:
             futures = {pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start): (n, sc)
                        for n, sc, start in jobs}
             done = {}
             for future in cf.as_completed(futures):
                 n, sc = futures[future]
-                done[n] = ranked(n, sc, future.result())
+                done[n] = ranked(n, sc, future.result(), own[n].result() if n in own else None)
             ranking += [done[n] for n, _, _ in jobs]
         ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
         if on_ranking is not None:
@@ -438,15 +458,20 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         for r in ranking:
             if not r.passes:
                 continue
-            fit, reference = r.fit, current_test
+            fit, reference = r.fit, r.reference_errors or current_test
+            values = getattr(r.screen, "reference_values", None)
             if claimed:
+                # (with the nominal parameters the candidate's screen moved: DrakeEffect.screen_refits)
                 start = r.fit.delay if r.name == "control_delay" else \
-                    {k: r.fit.parameters[k] for k in DRAKE_EFFECTS[r.name].parameters}
+                    {k: r.fit.parameters[k] for k in DRAKE_EFFECTS[r.name].parameters
+                     + DRAKE_EFFECTS[r.name].screen_refits}
                 args = (train, test, current, tuple(fitted))
                 # the candidate on top of the claims and, but for the delay (it refits nothing), the same refit
                 # without it (equal effort); independent, so side by side when there is a pool
                 f_fit = _submit(pool, _greedy_fit, r.name, *args, start, max_nfev)
-                f_ref = _submit(pool, _reference_errors, *args, max_nfev) if r.name != "control_delay" else None
+                f_ref = None if r.name == "control_delay" else \
+                    _submit(pool, _reference_errors, train, test, _with_values(current, values) if values else current,
+                            tuple(fitted), max_nfev)
                 fit = f_fit.result()
                 if f_ref is not None:
                     reference = f_ref.result()

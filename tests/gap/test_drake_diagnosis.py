@@ -156,3 +156,21 @@ def test_a_gain_that_each_run_s_own_friction_level_explains_is_not_claimed():
     # errors without the level (a replay that has no friction parameters) decide on the plain error alone
     plain_only = {k: {"force": v["force"]} for k, v in drifted.items()}
     assert D._passes({k: {"force": v["force"]} for k, v in reference.items()}, plain_only, bar, "both")[-1]
+
+
+def test_a_saturating_drive_is_claimed_with_its_mass_against_a_reference_of_equal_effort():
+    """A drive that applies ``F / sqrt(1 + (F / 150 N)^2)`` of the command: the IDIM mass of the nominal is too
+    large (it reads the unapplied command as inertia; about 150 kg against 95 kg). The candidate carries the mass its inverse-dynamics fit
+    found beside the limit (``screen_refits``), and is measured against its own reference, the nominal with the
+    screen's reference mass refitted by the same evaluations (``reference_errors``), not against the nominal."""
+    truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, inverse_drive_limit=1.0 / 150.0)
+    runs = _simulated(truth, (0, 3000, 6000, 9000, 12000), 1000, "s")[0]
+    diag = diagnose_drake(runs[:2], runs[2:], effects=("drive_saturation", "thermal_drift"), max_nfev=3)
+    assert diag.nominal.parameters["mass"] > 1.3 * truth["mass"]  # what the candidate has to undo
+    sat = {r.name: r for r in diag.ranking}["drive_saturation"]
+    assert sat.reference_errors is not None and sat.reference_errors != diag.nominal_test_errors
+    assert diag.claimed == ("drive_saturation",)
+    assert diag.model["parameters"]["mass"] == pytest.approx(truth["mass"], rel=0.05)
+    assert 1.0 / diag.model["parameters"]["inverse_drive_limit"] == pytest.approx(150.0, rel=0.1)
+    assert sat.log_ratio > 1.0  # the held-out error shrinks by more than e
+    assert {r.name: r for r in diag.ranking}["thermal_drift"].reference_errors is None

@@ -112,6 +112,20 @@ def test_a_saturating_drive_is_found_and_a_linear_one_gives_it_nothing():
     assert not screen_effect(DRAKE_EFFECTS["drive_saturation"], null[:3], null[3:], BASE).passes
 
 
+def test_the_saturation_candidate_carries_its_own_mass_and_the_references():
+    """The IDIM mass of a saturating drive is too large (the command per acceleration exceeds the force
+    applied). Given a nominal 30 % too heavy, the candidate refits the mass beside its limit (``screen_refits``):
+    its start has the axis's mass back within 5 %, and the reference's mass, refitted without the candidate,
+    stays larger (what its closed-loop reference starts from)."""
+    runs = _runs(dict(BASE, inverse_drive_limit=1.0 / 60.0))
+    heavy = dict(BASE, mass=1.3 * BASE["mass"])
+    sc = screen_effect(DRAKE_EFFECTS["drive_saturation"], runs[:3], runs[3:], heavy)
+    assert sc.passes
+    assert sc.start["mass"] == pytest.approx(BASE["mass"], rel=0.05)
+    assert sc.reference_values["mass"] > sc.start["mass"]
+    assert 1.0 / sc.start["inverse_drive_limit"] == pytest.approx(60.0, rel=0.2)
+
+
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     """A 3 N force ripple of period 3.7 mm (none of the candidate's own starts): the Lomb-Scargle scan of the
     residual against position starts the fit at the period, which it refines to within 0.2 %, with the amplitude
