@@ -198,9 +198,14 @@ class DrakeDiagnosis:
                 sc = r.screen
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
+            own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, "
                          + _verdict(r.gain, r.log_ratio, r.log_ratio_se, self.k_se, r.passes, r.level_log_ratio,
-                                    r.level_log_ratio_se))
+                                    r.level_log_ratio_se)
+                         + (" [against its own reference: the nominal with " + ", ".join(
+                             f"{k} {v:.4g} {AXIS_UNITS[k]}" for k, v in own.items())
+                            + " (candidate: " + ", ".join(f"{k} {r.fit.parameters[k]:.4g} {AXIS_UNITS[k]}"
+                                                           for k in own) + ")]" if own else ""))
         if self.claimed:
             lines.append(f"claimed: {' + '.join(self.claimed)}; held-out force error "
                          f"{rms_force_error(self.test_errors):.3f} %")

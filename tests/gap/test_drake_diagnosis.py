@@ -174,3 +174,5 @@ def test_a_saturating_drive_is_claimed_with_its_mass_against_a_reference_of_equa
     assert 1.0 / diag.model["parameters"]["inverse_drive_limit"] == pytest.approx(150.0, rel=0.1)
     assert sat.log_ratio > 1.0  # the held-out error shrinks by more than e
     assert {r.name: r for r in diag.ranking}["thermal_drift"].reference_errors is None
+    line = next(x for x in diag.summary() if x.strip().startswith("drive_saturation"))
+    assert "against its own reference: the nominal with mass" in line and "(candidate: mass" in line
