@@ -17,6 +17,12 @@
    residuals are correlated in time: ``m`` samples carry about ``m / tau_int`` independent ones), 95 %
    intervals ``+-1.96 std``. They still assume the model structure is right; a warning is raised for any pair of fitted parameters correlated beyond
    ``|rho| > 0.95`` (not separable by these runs) and for a rank-deficient Jacobian.
+4. **Leave one run out** (:attr:`Identified.jackknife`): with two or more runs, the values with each training
+   run left out, one Gauss-Newton step from the solution on the other runs' rows of the same Jacobian (no
+   replays; relative to the step on all runs, so a fit that is not converged is not mistaken for run-to-run
+   variation), and their jackknife standard deviation ``sqrt((n-1)/n sum (v_k - mean)^2)``. It asks how much
+   the values depend on which runs were measured, which the Jacobian's interval cannot see when the runs differ
+   (friction drifts between runs).
 
 Parameters that must stay positive are fitted on a log scale; the others on a scale of their start value.
 """
@@ -137,6 +143,11 @@ class Identified:
     evaluations_per_s : float
     flexible : bool
     delay : float
+    jackknife : tuple of dict
+        Per training run left out, the fitted values from the other runs (module docstring, 4); empty with
+        one run or nothing fitted.
+    jackknife_std : dict
+        Jackknife standard deviation of each fitted value over :attr:`jackknife` (SI).
     """
 
     parameters: dict
@@ -154,13 +165,17 @@ class Identified:
     flexible: bool = False
     delay: float = 0.0
     extra: dict = field(default_factory=dict)
+    jackknife: tuple = ()
+    jackknife_std: dict = field(default_factory=dict)
 
     def summary(self):
         """Lines of text: the fitted values with their intervals, the warnings."""
         lines = [f"identified ({'two-mass' if self.flexible else 'rigid'} axis, delay {self.delay:g} samples, "
                  f"{self.n_evaluations} replays at {self.evaluations_per_s:.2f}/s):"]
         for name in self.fitted:
-            lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}")
+            jack = (f" (leave one run out: std {self.jackknife_std[name]:.3g})" if name in self.jackknife_std else "")
+            lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}"
+                         + jack)
         lines += [f"  warning: {w}" for w in self.warnings]
         return lines
 
@@ -316,6 +331,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     cost_start = 0.5 * float(r0 @ r0)
     values = base
     std, ci, corr = {}, {}, np.zeros((0, 0))
+    jack, jack_std = (), {}
     cost = cost_start
     if uncertain:
         x0 = prob.to_x(base)
@@ -333,6 +349,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         cost = float(sol.cost)
         std, ci, corr, more = _confidence(sol, prob, values)
         warnings += more
+        jack, jack_std = _leave_one_run_out(sol, prob, lo, hi)
     results = prob.simulate(values)
     errors = {res.run.label + (f"#{i}" if sum(r.run.label == res.run.label for r in results) > 1 else ""):
               drake_replay_errors(res) for i, res in enumerate(results)}
@@ -340,7 +357,32 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     return Identified(parameters=values, fitted=uncertain, std=std, ci95=ci, correlation=corr,
                       warnings=tuple(warnings), start=start, train_errors=errors, cost_start=cost_start, cost=cost,
                       n_evaluations=prob.evaluations, evaluations_per_s=rate, flexible=bool(flexible),
-                      delay=float(delay))
+                      delay=float(delay), jackknife=jack, jackknife_std=jack_std)
+
+
+def _leave_one_run_out(sol, prob, lo, hi):
+    """The fitted values with each run left out (module docstring, 4): ``(tuple of dict, jackknife std)``.
+
+    One Gauss-Newton step on the other runs' rows of the solution's Jacobian (minimum norm, singular values below
+    1e-10 of the largest cut), less the step on all rows, clipped to the bounds."""
+    sizes = [2 * rep.run.n for rep in prob.replays]  # rows per run: force, then position (_Problem.residual_of)
+    if len(sizes) < 2 or sum(sizes) != sol.fun.size:
+        return (), {}
+    J, r = np.asarray(sol.jac, dtype=float), np.asarray(sol.fun, dtype=float)
+    step_all = -np.linalg.lstsq(J, r, rcond=1e-10)[0]
+    edges = np.cumsum([0] + sizes)
+    out = []
+    for k in range(len(sizes)):
+        keep = np.ones(r.size, dtype=bool)
+        keep[edges[k]:edges[k + 1]] = False
+        step = -np.linalg.lstsq(J[keep], r[keep], rcond=1e-10)[0]
+        x = np.clip(sol.x + step - step_all, lo, hi)
+        values = prob.to_values(x)
+        out.append({n: values[n] for n in prob.names})
+    n = len(out)
+    std = {name: float(math.sqrt((n - 1) / n * sum((v[name] - np.mean([w[name] for w in out])) ** 2 for v in out)))
+           for name in prob.names}
+    return tuple(out), std
 
 
 def _regularization(runs):
