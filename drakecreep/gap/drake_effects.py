@@ -44,8 +44,9 @@ class DrakeEffect:
     load-dependent friction is mostly a higher friction level), so its closed-loop start also moves the nominal
     friction by what the screen's fit moved it (:func:`drakecreep.gap.screen.screen_effect`). ``screen_refits``:
     nominal parameters outside the fitted friction that the candidate biases (a saturating drive: the mass) are
-    refitted beside it on inverse dynamics, the reference's too, and the candidate's closed-loop start carries
-    what its fit moved them; the closed-loop fit keeps them there.
+    refitted beside it on inverse dynamics, the reference's too; the candidate's closed-loop start carries its
+    fit's values of them (absolute), its equal-effort reference the reference's, and the closed-loop fits keep
+    them there.
     """
 
     name: str

@@ -21,8 +21,8 @@
    run left out, one Gauss-Newton step from the solution on the other runs' rows of the same Jacobian (no
    replays; relative to the step on all runs, so a fit that is not converged is not mistaken for run-to-run
    variation), and their jackknife standard deviation ``sqrt((n-1)/n sum (v_k - mean)^2)``. It asks how much
-   the values depend on which runs were measured, which the Jacobian's interval cannot see when the runs differ
-   (friction drifts between runs).
+   the values depend on which runs were measured; the Jacobian's interval assumes one axis behind every run,
+   and friction drifts between runs.
 
 Parameters that must stay positive are fitted on a log scale; the others on a scale of their start value.
 """
