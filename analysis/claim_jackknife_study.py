@@ -20,6 +20,9 @@ Development seeds only (nothing here is a held-out figure). Run (rows are writte
     PYTHONPATH=. python analysis/claim_jackknife_study.py --shard 0/2 --json a.json &
     PYTHONPATH=. python analysis/claim_jackknife_study.py --shard 1/2 --json b.json &
     wait; PYTHONPATH=. python analysis/claim_jackknife_study.py --score a.json b.json
+
+Session 29's rows (9 of the 16 datasets): ``analysis/claim_jackknife_dev.json``; what they say:
+docs/gap_benchmark.md, 3o.
 """
 
 import argparse
@@ -97,7 +100,10 @@ def _would_pass(c, t):
 
 
 def score(paths):
-    rows = [r for p in paths for r in json.load(open(p))]
+    rows = []
+    for p in paths:
+        data = json.load(open(p))
+        rows += data["rows"] if isinstance(data, dict) else data  # (a kept file has a note beside its rows)
     for r in rows:
         now = [c["effect"] for c in r["candidates"] if c["passes"]]
         then = [c["effect"] for c in r["candidates"] if _would_pass(c, r["t"])]
