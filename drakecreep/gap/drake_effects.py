@@ -46,7 +46,8 @@ class DrakeEffect:
     nominal parameters outside the fitted friction that the candidate biases (a saturating drive: the mass) are
     refitted beside it on inverse dynamics, the reference's too; the candidate's closed-loop start carries its
     fit's values of them (absolute), its equal-effort reference the reference's, and the closed-loop fits keep
-    them there.
+    them there. ``start_floor``: the least squares starts a parameter at least this far from 0 (one whose
+    effect is quadratic at 0 has no gradient there: a drive limit started at the screen's 1e-10 1/N never moved).
     """
 
     name: str
@@ -59,6 +60,7 @@ class DrakeEffect:
     run_constancy: bool = False
     shifts_nominal: bool = False
     screen_refits: tuple = ()
+    start_floor: dict = field(default_factory=dict)
 
     def fixed_by(self, runs):
         """Axis parameters the candidate takes from the training ``runs``, not from a fit: for a map along the
@@ -133,7 +135,7 @@ DRAKE_EFFECTS = {
                                     signature="the axis gets less force than commanded, more so the larger the "
                                               "command (a saturating drive gain)",
                                     bounds={"inverse_drive_limit": (0.0, 0.05)}, shifts_nominal=True,
-                                    screen_refits=("mass",)),
+                                    screen_refits=("mass",), start_floor={"inverse_drive_limit": 1.0 / 1000.0}),
     "axial_mode": DrakeEffect("axial_mode", ("stiffness", "damping"), _mode_starts(), flexible=True,
                               signature="oscillation at a structural frequency (5-300 Hz)",
                               bounds={"stiffness": (1e3, 1e11)}),
@@ -290,6 +292,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
             k = w * w * share * (1 - share) * m
             fixed.update(stiffness=k, damping=0.05 * 2 * math.sqrt(k * share * (1 - share) * m))
         fixed.update(start)
+        fixed.update({n: max(fixed[n], lo) for n, lo in effect.start_floor.items()})
         idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixed,
                        bounds=bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:

@@ -191,6 +191,10 @@ class _Problem:
                    "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
                    "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
                    "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2,
+                   # parameters whose start may be ~0 (the screen's answer on data without the effect): a scale of
+                   # the start's size makes every finite-difference step invisible (a 400 N drive limit; a load
+                   # friction coefficient of 0.1)
+                   "inverse_drive_limit": 1.0 / 400.0, "load_friction_coefficient": 0.1,
                    **{n: 1e-5 for n in LEAD_ERROR}}
         # phase-like parameters: a step must move the phase over a run by much less than a cycle
         fine = {"ripple_frequency": 1.0, "position_period": 0.01 * base["position_period"],

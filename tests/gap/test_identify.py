@@ -76,3 +76,22 @@ def test_leave_one_run_out_values_match_refits_and_see_a_run_that_differs():
     assert 1.0 < idf.jackknife_std["coulomb"] < 4.0
     assert any("leave one run out" in line for line in idf.summary())
     assert identify(runs[:1], uncertain=names, max_nfev=2, fixed=fixed).jackknife == ()
+
+
+def test_a_drive_limit_started_at_zero_is_still_found():
+    """The screen's drive limit on data that barely shows it can be ~0 (1e-10 1/N). The applied force
+    ``F / sqrt(1 + (c F)^2)`` is quadratic in ``c`` at 0: no gradient there, and from that start the least
+    squares never moved. The candidate starts at least at 1/1000 1/N (``start_floor``; the least-squares scale
+    is 1/400 1/N, not the start's size) and finds the limit of an axis that saturates at 150 N within 10 %."""
+    from drakecreep.gap.drake_effects import fit_effect
+
+    full = load_emps("estimation").runs[0]
+    truth = dict(TRUTH, inverse_drive_limit=1.0 / 150.0)
+    runs = [_synthetic(full.slice(a, a + 1500), truth, seed) for seed, a in enumerate((0, 5000, 10000))]
+    fixed = {"mass": PUBLISHED_IDIM["M"], "regularization_velocity": 1e-3, "inverse_drive_limit": 1e-10}
+    stuck = identify(runs[:2], uncertain=("inverse_drive_limit",), max_nfev=6, fixed=dict(TRUTH, **fixed))
+    assert stuck.parameters["inverse_drive_limit"] < 1e-6  # (why the floor: the start at ~0 does not move)
+    nominal = identify(runs[:2], uncertain=(), fixed=dict(TRUTH, **fixed))
+    fit = fit_effect("drive_saturation", runs[:2], runs[2:], nominal, max_nfev=6, refit=(),
+                     starts=({"inverse_drive_limit": 1e-10},))
+    assert 1.0 / fit.parameters["inverse_drive_limit"] == pytest.approx(150.0, rel=0.1)
