@@ -54,6 +54,9 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     html = (out / "diagnosis.html").read_text()
     assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
     assert "Unexplained: where" in html and "Residual-input independence" in html
+    # two training runs: the nominal's values with each left out, their spread in the table and the JSON
+    assert "leave one training run out" in html
+    assert set(data["nominal"]["leave_one_run_out_std"]) == set(data["nominal"]["ci95"])
     assert {"regimes", "bands", "independence", "split"} <= set(data["unexplained"])
     params, flexible, delay = load_model(out / "augmented_model.yaml")
     assert abs(params["viscous_asym"] + 40.0) < 10.0 and not flexible and delay == 0.0
