@@ -95,3 +95,23 @@ def test_a_drive_limit_started_at_zero_is_still_found():
     fit = fit_effect("drive_saturation", runs[:2], runs[2:], nominal, max_nfev=6, refit=(),
                      starts=({"inverse_drive_limit": 1e-10},))
     assert 1.0 / fit.parameters["inverse_drive_limit"] == pytest.approx(150.0, rel=0.1)
+
+
+def test_a_diverged_replay_is_a_poor_fit_not_a_crash():
+    """A replay whose samples went non-finite (a candidate's closed loop diverged) gives a large finite residual
+    the least squares steps back from; before, the trust-region SVD raised and the dataset was lost."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.identify import NONFINITE_RESIDUAL, _Problem
+
+    n = 50
+    run = SimpleNamespace(n=n, force=np.linspace(1.0, 2.0, n), x_motor=np.linspace(0.0, 1e-2, n))
+    force = run.force.copy()
+    force[10:] = np.nan
+    x = run.x_motor.copy()
+    x[-1] = np.inf
+    r = _Problem.residual_of([SimpleNamespace(run=run, force=force, x_motor=x)])
+    assert r.size == 2 * n and np.all(np.isfinite(r))
+    assert np.count_nonzero(r == NONFINITE_RESIDUAL) == (n - 10) + 1
+    good = _Problem.residual_of([SimpleNamespace(run=run, force=run.force, x_motor=run.x_motor)])
+    assert np.all(good == 0.0)
