@@ -440,8 +440,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         # one pool for the ranking and the greedy step (each spawned process imports Drake once)
         pool = None if workers == 1 else stack.enter_context(cf.ProcessPoolExecutor(
             min(workers, max(len(jobs), 2)), mp_context=multiprocessing.get_context("spawn")))
-        own = {n: _submit(pool, _reference_errors, train, test, own_reference(sc), first.fitted, max_nfev)
-               for n, sc, _ in jobs if own_reference(sc) is not None}
+        own = {n: _submit(pool, _reference_errors, train, test, model, first.fitted, max_nfev)
+               for n, model in ((n, own_reference(sc)) for n, sc, _ in jobs) if model is not None}
         if pool is None or len(jobs) < 2:
             for n, sc, start in jobs:
                 fit = fit_candidate(n, train, test, origin(n), max_nfev, start)

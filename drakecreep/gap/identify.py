@@ -393,10 +393,9 @@ def _leave_one_run_out(sol, prob, lo, hi):
         x = np.clip(sol.x + step - step_all, lo, hi)
         values = prob.to_values(x)
         out.append({n: values[n] for n in prob.names})
-    n = len(out)
-    std = {name: float(math.sqrt((n - 1) / n * sum((v[name] - np.mean([w[name] for w in out])) ** 2 for v in out)))
-           for name in prob.names}
-    return tuple(out), std
+    # jackknife: sqrt((n-1)/n sum (v_k - mean)^2) = sqrt(n-1) times the population standard deviation
+    spread = math.sqrt(len(out) - 1) * np.array([[v[n] for n in prob.names] for v in out]).std(axis=0)
+    return tuple(out), dict(zip(prob.names, (float(s) for s in spread)))
 
 
 def _regularization(runs):

@@ -47,7 +47,7 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
     shown = ("mass",) + tuple(n for n in nominal.fitted if n != "mass")
     return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in shown},
                                     "ci95": nominal.ci95,
-                                    "leave_one_run_out_std": getattr(nominal, "jackknife_std", {}),
+                                    "leave_one_run_out_std": nominal.jackknife_std,
                                     "warnings": list(nominal.warnings),
                                     "held_out_force_error_percent": rms_force_error(nominal_test_errors),
                                     "held_out_errors": nominal_test_errors},
@@ -198,7 +198,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
                  "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
-    jack = getattr(nom, "jackknife_std", {})
+    jack = nom.jackknife_std
     parts.append(table(["parameter", "value", "95 % half-width", "std, leave one training run out", "unit"],
                        [[n, f"{_edge(n, nom.parameters[n])[0]:.5g}",
                          f"{_edge(n, nom.ci95.get(n, float('nan')))[0]:.3g}",
