@@ -17,6 +17,7 @@ parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
 
 import os
 import sys
+from pathlib import Path
 
 from drakecreep.cli._common import names, print_json, workers
 from drakecreep.errors import InputError
@@ -69,7 +70,15 @@ def run(args):
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
     # both sets move both ways), into out-and-back cycles for the kind drakecreep branch
     split = len(runs) == 1
-    runs = load_runs(args.data, args.meta, split=True if own else "half") if split else runs
+    if split:
+        whole = runs[0]
+        runs = load_runs(args.data, args.meta, split=True if own else "half")
+        if len(runs) < 3 and not (args.train or args.test):
+            # too short, or too few reversals of the reference: say so, not "no training run"
+            what = "out-and-back cycles of >= 200 samples" if own else "parts between reversals of >= 500 samples"
+            raise InputError(f"DATA {Path(str(args.data)).name}", f"one run of {whole.n} samples "
+                             f"({whole.n * whole.dt:.3g} s): {len(runs)} {what}",
+                             "at least 3 parts (1 to train, 2 held out): a longer run, or several runs")
     pairs = split and not own
     train, test = train_test(runs, args.train, args.test, pairs=pairs)
     if set(r.label for r in train) & set(r.label for r in test):

@@ -83,8 +83,11 @@ def _frame(path, fmt, key):
         except ImportError:
             raise InputError(str(path), "HDF5", "CSV, Parquet or .mat (HDF5 needs the 'tables' package: "
                              "pip install tables)") from None
-        except (KeyError, ValueError, OSError, TypeError) as err:
+        except (KeyError, ValueError, TypeError) as err:
             raise InputError(f"{path}: file.key", key, f"the key of one pandas table in the file ({err})"[:200]) from None
+        except Exception as err:  # noqa: BLE001 - a corrupt or truncated file: OSError, tables' HDF5ExtError, ...
+            raise InputError(str(path), f"not a readable HDF5 file ({type(err).__name__})",
+                             "an HDF5 file written by pandas (DataFrame.to_hdf)") from None
     import scipy.io
 
     try:

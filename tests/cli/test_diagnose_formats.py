@@ -39,3 +39,25 @@ def test_bad_run_selection_names_the_option(capsys):
     assert cli.main(["diagnose", str(EXAMPLE), "--test", "r9"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("drakecreep diagnose: error: --test: got 'r9'")
+
+
+@pytest.mark.parametrize("rows", [300, 1500])
+def test_a_run_too_short_to_split_says_how_many_parts_it_gives(tmp_path, rows, capsys):
+    lines = EXAMPLE.read_text().splitlines()
+    body = [line for line in lines if not line.startswith("#")]
+    (tmp_path / "short.csv").write_text("\n".join(body[: rows + 1]) + "\n")
+    (tmp_path / "short.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
+    assert cli.main(["diagnose", str(tmp_path / "short.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("drakecreep diagnose: error: DATA short.csv: ")
+    assert f"one run of {rows} samples" in err[0] and "at least 3 parts" in err[0]
+
+
+@pytest.mark.parametrize("suffix, what", [(".parquet", "Parquet"), (".h5", "HDF5"), (".mat", "MATLAB")])
+def test_a_corrupt_binary_file_is_one_line_exit_2(tmp_path, suffix, what, capsys):
+    path = tmp_path / f"rig{suffix}"
+    path.write_bytes({".h5": b"\x89HDF\r\n\x1a\n" + bytes(100)}.get(suffix, b"\x00\x01garbage" * 50))
+    (tmp_path / "rig.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
+    assert cli.main(["diagnose", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"not a readable {what} file" in err[0]
