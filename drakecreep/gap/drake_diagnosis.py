@@ -66,7 +66,7 @@ from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
-from drakecreep.gap.screen import ScreenResult, screen_delay, screen_effect
+from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
 from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
@@ -410,18 +410,6 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     if on_nominal is not None:
         on_nominal(nominal, nom_test)
     ranking, jobs = [], []
-    for n in names:
-        if n == "control_delay":
-            sc = ScreenResult("control_delay", {}, *(float("nan"),) * 3, float("nan"), float("nan"), True)
-            jobs.append((n, sc, screen_delay(train, nominal.parameters)))
-            continue
-        sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=screen_k_se) if screen else None
-        if sc is not None and not sc.passes:
-            ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
-                                        screen=sc, effect=n))
-            say(f"{n}: screened out ({_screen_numbers(sc)})")
-            continue
-        jobs.append((n, sc, sc.start if sc is not None and sc.start else None))
 
     def ranked(n, sc, fit, own=None):
         gain, se, lr, lr_se, lv, lv_se, ok = _passes(own or nom_test, fit.test_errors, k_se)
@@ -437,22 +425,47 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         return _with_values(first, values) if values else None
 
     with contextlib.ExitStack() as stack:
-        # one pool for the ranking and the greedy step (each spawned process imports Drake once)
+        # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start
+        # on the first submissions)
         pool = None if workers == 1 else stack.enter_context(cf.ProcessPoolExecutor(
-            min(workers, max(len(jobs), 2)), mp_context=multiprocessing.get_context("spawn")))
-        own = {n: _submit(pool, _reference_errors, train, test, model, first.fitted, max_nfev)
-               for n, model in ((n, own_reference(sc)) for n, sc, _ in jobs) if model is not None}
-        if pool is None or len(jobs) < 2:
+            workers, mp_context=multiprocessing.get_context("spawn")))
+        fits_, own = {}, {}
+
+        def launch(n, sc, start):
+            # a candidate goes to the pool as soon as its screen passes: the closed-loop fits run while the
+            # main process screens the next candidates (the result does not depend on the order)
+            jobs.append((n, sc, start))
+            if pool is not None:
+                fits_[n] = pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start)
+            model = own_reference(sc)
+            if model is not None:
+                own[n] = _submit(pool, _reference_errors, train, test, model, first.fitted, max_nfev)
+
+        # the candidates without an inverse-dynamics screen first: the axial mode's two-mass fit is the longest
+        for n in sorted(names, key=lambda n: n not in NOT_SCREENED):
+            if n == "control_delay":
+                sc = ScreenResult("control_delay", {}, *(float("nan"),) * 3, float("nan"), float("nan"), True)
+                launch(n, sc, screen_delay(train, nominal.parameters))
+                continue
+            sc = screen_effect(DRAKE_EFFECTS[n], train, test, nominal.parameters, k_se=screen_k_se) if screen else None
+            if sc is not None and not sc.passes:
+                ranking.append(RankedEffect(fit=None, gain=float("nan"), standard_error=float("nan"), passes=False,
+                                            screen=sc, effect=n))
+                say(f"{n}: screened out ({_screen_numbers(sc)})")
+                continue
+            launch(n, sc, sc.start if sc is not None and sc.start else None)
+        # the ranking's order before its sort (ties keep it): the candidates' order in ``names``
+        ranking.sort(key=lambda r: names.index(r.name))
+        jobs.sort(key=lambda job: names.index(job[0]))
+        if pool is None:
             for n, sc, start in jobs:
                 fit = fit_candidate(n, train, test, origin(n), max_nfev, start)
                 ranking.append(ranked(n, sc, fit, own[n].result() if n in own else None))
         else:
-            futures = {pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start): (n, sc)
-                       for n, sc, start in jobs}
-            done = {}
-            for future in cf.as_completed(futures):
-                n, sc = futures[future]
-                done[n] = ranked(n, sc, future.result(), own[n].result() if n in own else None)
+            done, name_of, screen_of = {}, {f: n for n, f in fits_.items()}, {n: sc for n, sc, _ in jobs}
+            for future in cf.as_completed(name_of):
+                n = name_of[future]
+                done[n] = ranked(n, screen_of[n], future.result(), own[n].result() if n in own else None)
             ranking += [done[n] for n, _, _ in jobs]
         ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
         if on_ranking is not None:

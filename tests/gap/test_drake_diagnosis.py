@@ -53,7 +53,8 @@ def test_candidates_fitted_in_worker_processes_give_the_same_diagnosis():
     truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=8.0, viscous_asym=-40.0,
                            time_ripple_cos=3.0, time_ripple_sin=0.0, ripple_frequency=7.0)
     runs = _simulated(truth, (0, 3000, 6000, 9000, 12000), 1000, "r")[0]
-    kwargs = dict(effects=("asymmetric_friction", "time_ripple"), max_nfev=3)
+    # (the delay has no screen: it goes to the pool first)
+    kwargs = dict(effects=("asymmetric_friction", "time_ripple", "control_delay"), max_nfev=3)
     serial = diagnose_drake(runs[:2], runs[2:], **kwargs)
     pooled = diagnose_drake(runs[:2], runs[2:], workers=2, **kwargs)
     assert serial.claimed == ("time_ripple", "asymmetric_friction")  # the greedy step's refit ran
