@@ -831,6 +831,8 @@ def load_spec(path, max_cases=MAX_CASES):
         points = grid(expanded, max_cases)
     else:
         points = random_sample(axes, sample.get("n"), seed=sample.get("seed", 0), max_cases=max_cases)
+    # every path and value before anything runs, and before the plot names them (a misspelt axis is named as such)
+    make_cases(base, points, scenario)
     metrics = data.get("metrics")
     known_metrics = metric_columns()
     if metrics is not None:
@@ -849,7 +851,6 @@ def load_spec(path, max_cases=MAX_CASES):
             raise InputError(f"plot.{key}", plot[key], "a swept path or scenario field: " + ", ".join(map(str, swept)))
     if "color" in plot and plot["color"] not in known_metrics:
         raise InputError("plot.color", plot["color"], "one of " + ", ".join(known_metrics))
-    make_cases(base, points, scenario)  # validates every path and value before anything runs
     return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))
 
 

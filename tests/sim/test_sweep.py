@@ -170,6 +170,12 @@ def test_cli_sweep_smoke_and_bad_spec(tmp_path, capsys):
     assert main(["sweep", str(bad), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "nut.no_such_field" in err[0]
+    # a misspelt axis that the plot names correctly is reported as the unknown path, not as a plot mismatch
+    bad.write_text("base: {preset: paper}\naxes:\n  nut.axial_stifness: [5e7, 1e8]\n"
+                   "plot: {x: nut.axial_stiffness}\n")
+    assert main(["sweep", str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "nut.axial_stifness: got" in err[0] and "plot" not in err[0]
     bad.write_text("base: {preset: paper}\naxes: {feed: [1e-3]}\nmetrics: [no_metric]\n")
     assert main(["sweep", str(bad), "--out", str(out)]) == 2
     assert "metrics" in capsys.readouterr().err
