@@ -426,9 +426,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
 
     with contextlib.ExitStack() as stack:
         # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start
-        # on the first submissions)
-        pool = None if workers == 1 else stack.enter_context(cf.ProcessPoolExecutor(
-            workers, mp_context=multiprocessing.get_context("spawn")))
+        # on the first submissions); a single candidate is fitted here, without the processes' start-up
+        pool = None if workers == 1 or len(names) < 2 else stack.enter_context(cf.ProcessPoolExecutor(
+            min(workers, len(names)), mp_context=multiprocessing.get_context("spawn")))
         fits_, own = {}, {}
 
         def launch(n, sc, start):
