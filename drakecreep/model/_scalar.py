@@ -42,7 +42,9 @@ def smax(a, b):
 
 
 def clip(x, lo, hi):
-    """Saturate ``x`` to ``[lo, hi]`` for any Drake scalar type."""
+    """Saturate ``x`` to ``[lo, hi]`` for any Drake scalar type (and numpy arrays of floats)."""
+    if isinstance(x, np.ndarray) and _numeric(lo) and _numeric(hi):
+        return np.clip(x, lo, hi)
     return smin(smax(x, lo), hi)
 
 

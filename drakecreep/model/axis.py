@@ -60,7 +60,7 @@ from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.errors import InputError
-from drakecreep.model._scalar import exp, fabs, tanh, vector
+from drakecreep.model._scalar import clip, exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
@@ -192,6 +192,11 @@ def friction_map(P, x):
     x0, x1 = P["friction_map_start"], P["friction_map_end"]
     w = (x1 - x0) / len(FRICTION_MAP)
     out = 0.0
+    if all(_off(P[name]) for name in FRICTION_MAP):
+        return out
+    # the edge values outside the travel: the outer steps are only half risen at x0 and x1 (tanh 0.5), and
+    # unclipped they would go on rising beyond it by half their amplitude (an extrapolated trend)
+    x = clip(x, x0, x1)
     for k, name in enumerate(FRICTION_MAP):
         if _off(P[name]):
             continue  # off (the default): nothing to evaluate

@@ -41,7 +41,8 @@ def test_asymmetry_ripple_and_drift_terms():
 
 def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
     """Four tanh steps over [start, end]: nothing happens while all amplitudes are 0, equal amplitudes make a
-    ramp odd about the middle, and beyond the span the level stays near its edge value."""
+    ramp odd about the middle, and beyond the span the level stays at its edge value (no extrapolated trend:
+    the outer steps are only half risen at the edges)."""
     p = dict(coulomb=20.0, regularization_velocity=1e-6, friction_map_start=0.1, friction_map_end=0.3)
     flat = axis_parameters(**p)
     ramp = axis_parameters(**p, **{f"friction_map_{k}": 0.05 for k in range(4)})
@@ -51,7 +52,17 @@ def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
     # centres 0.125 .. 0.275, width 0.05: from one end to the other step k moves by 2 tanh(k + 1/2) of its amplitude
     assert hi - lo == pytest.approx(20.0 * 0.05 * 2 * sum(math.tanh(k + 0.5) for k in range(4)), rel=1e-9)
     far = [axis_friction(0.1, ramp, x) for x in (0.5, 1.0)]
-    assert far[0] == pytest.approx(far[1], rel=1e-3) and far[0] > hi
+    assert far == pytest.approx([hi, hi], rel=1e-12)
+    assert axis_friction(0.1, ramp, -0.4) == pytest.approx(lo, rel=1e-12)
+    # the same on arrays of positions (the inverse-dynamics screen) and on symbolic ones (the compiled replay)
+    xs = np.array([-0.4, 0.1, 0.2, 0.3, 1.0])
+    np.testing.assert_allclose(axis_friction(0.1, ramp, xs), [lo, lo, mid, hi, hi], rtol=1e-12)
+    from pydrake.symbolic import Variable
+
+    x = Variable("x")
+    level = axis_friction(0.1, ramp, x)
+    for value, want in ((-0.4, lo), (0.2, mid), (1.0, hi)):
+        assert level.Evaluate({x: value}) == pytest.approx(want, rel=1e-12)
     with pytest.raises(InputError, match="friction_map_end"):
         axis_parameters(friction_map_start=0.2, friction_map_end=0.2)
 
