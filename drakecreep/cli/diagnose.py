@@ -21,7 +21,8 @@ from pathlib import Path
 
 from drakecreep.cli._common import names, print_json, workers
 from drakecreep.errors import InputError
-from drakecreep.gap.runs import load_runs, pick, train_test  # noqa: F401 (pick re-exported: the library side)
+from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
+from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
 
 __all__ = ["add_parser", "run", "load_runs", "pick"]
 
@@ -75,7 +76,8 @@ def run(args):
         runs = load_runs(args.data, args.meta, split=True if own else "half")
         if len(runs) < 3 and not (args.train or args.test):
             # too short, or too few reversals of the reference: say so, not "no training run"
-            what = "out-and-back cycles of >= 200 samples" if own else "parts between reversals of >= 500 samples"
+            what = (f"out-and-back cycles of >= {CYCLE_MIN_SAMPLES} samples" if own
+                    else f"parts between reversals of >= {HALF_CYCLE_MIN_SAMPLES} samples")
             raise InputError(f"DATA {Path(str(args.data)).name}", f"one run of {whole.n} samples "
                              f"({whole.n * whole.dt:.3g} s): {len(runs)} {what}",
                              "at least 3 parts (1 to train, 2 held out): a longer run, or several runs")

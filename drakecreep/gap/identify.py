@@ -269,14 +269,11 @@ class _Problem:
             parts.append(w * (res.force - run.force) / (np.linalg.norm(run.force) / math.sqrt(run.n)))
             xs = run.x_motor - run.x_motor.mean()
             parts.append(w * (res.x_motor - run.x_motor) / (np.linalg.norm(xs) / math.sqrt(run.n) or 1.0))
-        r = np.concatenate(parts)
         # a replay that diverged (NaN or inf samples) is a very poor fit, not an error: the least squares must
         # step back from it (held-out dataset 21011000 of run 10, a cable carrier: a candidate's closed-loop
         # replay went non-finite and the SVD of the trust-region step raised, losing the dataset)
-        bad = ~np.isfinite(r)
-        if bad.any():
-            r = np.where(bad, NONFINITE_RESIDUAL, r)
-        return r
+        big = NONFINITE_RESIDUAL
+        return np.nan_to_num(np.concatenate(parts), nan=big, posinf=big, neginf=big)
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,

@@ -10,7 +10,8 @@ import numpy as np
 
 from drakecreep.errors import InputError
 
-__all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles"]
+__all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles", "HALF_CYCLE_MIN_SAMPLES",
+           "CYCLE_MIN_SAMPLES"]
 
 
 def _reversals(run):
@@ -21,6 +22,10 @@ def _reversals(run):
     return [int(c) for c in nz[1:][np.diff(s[nz]) != 0]]
 
 
+#: shortest part kept by :func:`split_half_cycles` and by :func:`split_cycles` [samples]
+HALF_CYCLE_MIN_SAMPLES, CYCLE_MIN_SAMPLES = 500, 200
+
+
 def _cut(run, cuts, min_samples, sep):
     parts = []
     for a, b in zip(cuts[:-1], cuts[1:]):
@@ -29,12 +34,12 @@ def _cut(run, cuts, min_samples, sep):
     return parts
 
 
-def split_half_cycles(run, min_samples=500):
+def split_half_cycles(run, min_samples=HALF_CYCLE_MIN_SAMPLES):
     """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``), at least ``min_samples`` long."""
     return _cut(run, [0] + _reversals(run) + [run.n], min_samples, "@")
 
 
-def split_cycles(run, cycles_per_run=1, min_samples=200):
+def split_cycles(run, cycles_per_run=1, min_samples=CYCLE_MIN_SAMPLES):
     """Split a run at every second change of direction of the reference (one out-and-back cycle per part).
 
     Parameters
