@@ -528,6 +528,15 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     return row
 
 
+def _run_log_ratios(ranked, res, key):
+    """Per held-out run ``ln(reference / candidate)`` of a ranked candidate's ``key`` error (None without it)."""
+    reference = ranked.reference_errors or res.nominal_test_errors
+    candidate = ranked.fit.test_errors
+    if not all(key in reference[k] and key in candidate[k] for k in reference):
+        return None
+    return [float(np.log(max(reference[k][key], 1e-12) / max(candidate[k][key], 1e-12))) for k in reference]
+
+
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):
     """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
 
@@ -552,7 +561,11 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 "passes": bool(r.passes),
                 "screened_out": bool(r.screened_out),
                 "screen_gain": None if screened(r) is None else float(r.screen.gain),
-                "screen_log_error_ratio": None if screened(r) is None else float(r.screen.log_ratio)}
+                "screen_log_error_ratio": None if screened(r) is None else float(r.screen.log_ratio),
+                # each held-out run's ln(reference / candidate), plain and with the run's own friction level: the
+                # values the claim's statistic is made of, so another rule can be counted on the rows
+                "run_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force"),
+                "run_level_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force_level")}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction,
                test_force_nominal=rms_force_error(res.nominal_test_errors),

@@ -200,6 +200,11 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     assert row["expected"] == "position_ripple" and row["claimed"] == ["position_ripple"]
     assert row["audit_shrink"] > 0.3 and not row["worse"]
     assert row["true_shrink"] == pytest.approx(row["audit_shrink"])
+    # the per-run log ratios the rows carry are the ones the claim's statistic is made of
+    ranked = row["ranking"][0]
+    for key, runs in (("log_error_ratio", "run_log_error_ratios"), ("level_log_error_ratio", "run_level_log_error_ratios")):
+        assert len(ranked[runs]) == len(ds.test) and np.mean(ranked[runs]) == pytest.approx(ranked[key])
+        assert np.std(ranked[runs], ddof=1) / np.sqrt(len(ds.test)) == pytest.approx(ranked[key + "_standard_error"])
     null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
     assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
     assert null["audit"]["claimed"] == null["audit"]["nominal"]
