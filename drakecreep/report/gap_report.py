@@ -13,6 +13,11 @@ from drakecreep.gap.drake_replay import rms_force_error
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
 
 
+def _bar(threshold, fallback):
+    """The bar a ranked candidate had to exceed (``fallback`` for one made without a recorded threshold)."""
+    return fallback if np.isnan(threshold) else float(threshold)
+
+
 def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
     """JSON-ready ranking (also written alone, before the greedy augmentation and any late replay)."""
     rows = []
@@ -37,10 +42,11 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                   "train_force_error_percent": r.fit.train_force_error,
                                   "gain_points": r.gain, "standard_error_points": r.standard_error,
                                   "log_error_ratio": r.log_ratio, "log_error_ratio_standard_error": r.log_ratio_se,
-                                  "threshold_log_error_ratio": k_se * r.log_ratio_se,
+                                  "threshold_log_error_ratio": _bar(r.threshold, k_se * r.log_ratio_se),
                                   "level_log_error_ratio": r.level_log_ratio,
                                   "level_log_error_ratio_standard_error": r.level_log_ratio_se,
-                                  "threshold_level_log_error_ratio": k_se * r.level_log_ratio_se,
+                                  "threshold_level_log_error_ratio": _bar(r.level_threshold,
+                                                                          k_se * r.level_log_ratio_se),
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
         rows.append(row)
@@ -69,6 +75,7 @@ def drake_to_json_dict(diagnosis, **extra):
         "not_ranked": diagnosis.not_ranked,
         "unexplained": diagnosis.where,
         "k_se": diagnosis.k_se,
+        "training_run_null": {"log_error_ratio": diagnosis.null[0], "level_log_error_ratio": diagnosis.null[1]},
         "seconds": diagnosis.seconds,
         "summary": diagnosis.summary(),
     }))
@@ -194,7 +201,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
                  f"by more than {k:.3g} standard errors of the per-run log error ratio, both as the errors are and "
                  "with each held-out run's friction scaled to its own level (friction drifts from run to run; "
-                 "a candidate that only fits the level the held-out runs happen to have is not claimed), and its "
+                 "a candidate that only fits the level the held-out runs happen to have is not claimed), by more "
+                 f"than the nominal's held-out log error moves with one training run left out of its fit (the "
+                 f"training-run null: {diagnosis.null[0]:.3f}, {diagnosis.null[1]:.3f} with the level), and its "
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
                  "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")

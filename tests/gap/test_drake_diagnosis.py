@@ -38,6 +38,7 @@ def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
     assert isinstance(diag, DrakeDiagnosis)
     assert diag.claimed == ("asymmetric_friction",)
     assert diag.ranking[0].name == "asymmetric_friction" and diag.ranking[0].passes
+    assert diag.ranking[0].log_ratio > diag.ranking[0].threshold >= diag.null[0] > 0
     # while moving, coulomb_asym * s(v)^2 is a constant like the offset: only their sum is well determined
     p = diag.model["parameters"]
     assert abs(p["coulomb_asym"] + p["offset"] - (4.0 + PUBLISHED_IDIM["offset"])) < 0.3
@@ -125,8 +126,8 @@ def test_gains_are_measured_at_equal_effort(monkeypatch):
         fit = D.fit_candidate(name, train, test, first, 2, None)
         # on the plain error (the error with each run's own friction level also absorbs much of a poor nominal's
         # friction, so it would hide what equal effort is for)
-        assert D._passes(first_test, fit.test_errors, bar, "plain")[-1]
-        assert not D._passes(reference_test, fit.test_errors, bar, "plain")[-1]
+        assert D._passes(first_test, fit.test_errors, bar, "plain").passes
+        assert not D._passes(reference_test, fit.test_errors, bar, "plain").passes
 
     def poorly_started(runs, uncertain, **kw):
         if kw.get("fixed") is None:  # the first nominal fit (the equal-effort refit starts from its values)
@@ -151,12 +152,53 @@ def test_a_gain_that_each_run_s_own_friction_level_explains_is_not_claimed():
     drifted = errors([9.0, 9.95, 10.8], [5.0, 5.52, 5.99])
     real = errors([9.0, 9.95, 10.8], [4.5, 4.96, 5.41])
     bar = 2.92
-    assert D._passes(reference, drifted, bar, "plain")[-1]
-    assert not D._passes(reference, drifted, bar, "level")[-1] and not D._passes(reference, drifted, bar, "both")[-1]
-    assert D._passes(reference, real, bar, "both")[-1]
+    assert D._passes(reference, drifted, bar, "plain").passes
+    assert not D._passes(reference, drifted, bar, "level").passes and not D._passes(reference, drifted, bar, "both").passes
+    assert D._passes(reference, real, bar, "both").passes
     # errors without the level (a replay that has no friction parameters) decide on the plain error alone
     plain_only = {k: {"force": v["force"]} for k, v in drifted.items()}
-    assert D._passes({k: {"force": v["force"]} for k, v in reference.items()}, plain_only, bar, "both")[-1]
+    assert D._passes({k: {"force": v["force"]} for k, v in reference.items()}, plain_only, bar, "both").passes
+
+
+def test_a_consistent_gain_below_the_training_run_null_is_not_claimed():
+    """A candidate that shrinks every held-out run's error by 2 % passes the significance test (the same in every
+    run: a tiny standard error) but not a training-run null of 0.05: the nominal's held-out log error moves more
+    than that when one training run is left out. The bar it had to exceed is recorded."""
+    import drakecreep.gap.drake_diagnosis as D
+
+    def errors(force):
+        return {f"r{i}": {"force": f, "force_level": 0.6 * f} for i, f in enumerate(force)}
+
+    reference = errors([10.0, 11.0, 12.0, 9.0, 8.0])
+    sliver = errors([9.8, 10.76, 11.77, 8.81, 7.85])
+    bar = 2.13
+    t = D._passes(reference, sliver, bar)
+    assert t.passes and t.threshold == pytest.approx(bar * t.log_ratio_se)
+    t = D._passes(reference, sliver, bar, null=(0.05, 0.04))
+    assert not t.passes and t.threshold == 0.05 and t.level_threshold == 0.04
+    assert 0.015 < t.log_ratio < 0.025 and 0.015 < t.level_log_ratio < 0.025
+    real = errors([7.0, 8.0, 9.5, 6.0, 6.5])
+    assert D._passes(reference, real, bar, null=(0.05, 0.04)).passes
+
+
+def test_the_training_run_null_is_the_largest_move_of_the_nominal_with_one_training_run_left_out(runs):
+    import drakecreep.gap.drake_diagnosis as D
+    from drakecreep.gap.drake_effects import score_parameters
+    from drakecreep.gap.identify import identify
+
+    train, test = runs[:2], runs[2:]
+    nominal = identify(train, D.NOMINAL_PARAMETERS, max_nfev=3)
+    nom_test, _ = score_parameters(test, nominal.parameters)
+    null = D.training_run_null(test, nominal, nom_test)
+    assert len(nominal.jackknife) == 2 and all(v > 0 for v in null)
+    moves = []
+    for values in nominal.jackknife:
+        moved, _ = score_parameters(test, dict(nominal.parameters, **values))
+        moves.append(abs(np.mean([np.log(moved[k]["force"] / nom_test[k]["force"]) for k in nom_test])))
+    assert null[0] == pytest.approx(max(moves))
+    # one training run: no jackknife, no null (the significance test alone decides)
+    one = identify(train[:1], D.NOMINAL_PARAMETERS, max_nfev=3)
+    assert D.training_run_null(test, one, score_parameters(test, one.parameters)[0]) == (0.0, 0.0)
 
 
 def test_a_saturating_drive_is_claimed_with_its_mass_against_a_reference_of_equal_effort():
