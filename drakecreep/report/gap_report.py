@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from drakecreep.files import to_jsonable
+from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
 
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
@@ -43,6 +44,7 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                   "gain_points": r.gain, "standard_error_points": r.standard_error,
                                   "log_error_ratio": r.log_ratio, "log_error_ratio_standard_error": r.log_ratio_se,
                                   "threshold_log_error_ratio": _bar(r.threshold, k_se * r.log_ratio_se),
+                                  "sign_flip_p": r.p_sign_flip, "level_sign_flip_p": r.level_p_sign_flip,
                                   "level_log_error_ratio": r.level_log_ratio,
                                   "level_log_error_ratio_standard_error": r.level_log_ratio_se,
                                   "threshold_level_log_error_ratio": _bar(r.level_threshold,
@@ -199,7 +201,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     parts.append("<h2>Answer</h2><ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when its closed-loop replay of the held-out runs "
                  f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
-                 f"by more than {k:.3g} standard errors of the per-run log error ratio, both as the errors are and "
+                 f"by more than {k:.3g} standard errors of the per-run log error ratio (or with a sign-flip "
+                 f"permutation p value of at most {ALPHA:g}: every held-out run better when there are five), both as the "
+                 "errors are and "
                  "with each held-out run's friction scaled to its own level (friction drifts from run to run; "
                  "a candidate that only fits the level the held-out runs happen to have is not claimed), by more "
                  f"than the nominal's held-out log error moves with one training run left out of its fit (the "

@@ -16,3 +16,20 @@ def test_below_the_threshold_or_in_a_minority_of_runs_fails():
     # one run improves a lot, two get worse: the pooled shrink alone is not enough
     r = replay_test([1.0, 1.0, 10.0], [1.1, 1.1, 1.0], threshold=0.1)
     assert r["shrink"] > 0.1 and r["runs_better"] == 1 and not r["passes"]
+
+
+def test_the_sign_flip_p_value_is_the_share_of_sign_patterns_with_a_mean_at_least_the_observed():
+    import numpy as np
+
+    from drakecreep.gap.claims import sign_flip_p
+
+    # every one of five runs better: only the observed pattern reaches its mean, 1 of 32
+    assert sign_flip_p([0.6, 0.09, 0.09, 0.017, 0.016]) == pytest.approx(1 / 32)
+    # one run slightly worse: flipping it raises the mean, 2 of 32
+    assert sign_flip_p([0.834, -0.003, 0.694, 1.127, 0.108]) == pytest.approx(2 / 32)
+    # four runs cannot go below 1/16, one run is no test
+    assert sign_flip_p([1.0, 2.0, 3.0, 4.0]) == pytest.approx(1 / 16) and sign_flip_p([1.0]) == 1.0
+    # a useless candidate: on symmetric noise the p value is uniform-ish, P(p <= 0.05) about 1/32 for five runs
+    rng = np.random.default_rng(0)
+    rate = np.mean([sign_flip_p(rng.normal(size=5)) <= 0.05 for _ in range(400)])
+    assert rate < 0.06

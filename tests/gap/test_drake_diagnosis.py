@@ -219,3 +219,23 @@ def test_a_saturating_drive_is_claimed_with_its_mass_against_a_reference_of_equa
     assert {r.name: r for r in diag.ranking}["thermal_drift"].reference_errors is None
     line = next(x for x in diag.summary() if x.strip().startswith("drive_saturation"))
     assert "against its own reference: the nominal with mass" in line and "(candidate: mass" in line
+
+
+def test_skewed_gains_in_every_run_pass_by_the_sign_flip_null_and_one_run_worse_by_t():
+    """Development seed 11002's drive saturation: errors x0.55, 0.91, 0.91, 0.98, 0.98 (every run better, one much
+    more) miss the t bar and pass the sign-flip null; development seed 4003's lead error (one run a hair worse,
+    three much better) passes by t. The training-run null still applies to both."""
+    import drakecreep.gap.drake_diagnosis as D
+
+    def errors(ratios):
+        return {f"r{i}": {"force": 10.0 * r, "force_level": 6.0 * r} for i, r in enumerate(ratios)}
+
+    reference = errors([1.0] * 5)
+    bar = 2.13
+    skewed = errors(np.exp(-np.array([0.602, 0.09, 0.09, 0.017, 0.016])))
+    t = D._passes(reference, skewed, bar)
+    assert t.log_ratio < bar * t.log_ratio_se and t.p_sign_flip == pytest.approx(1 / 32) and t.passes
+    assert not D._passes(reference, skewed, bar, null=(0.2, 0.2)).passes
+    one_worse = errors(np.exp(-np.array([0.004, -0.003, 1.165, 1.115, 1.011])))
+    t = D._passes(reference, one_worse, bar)
+    assert t.p_sign_flip > 0.05 and t.log_ratio > bar * t.log_ratio_se and t.passes
