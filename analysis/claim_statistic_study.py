@@ -20,7 +20,13 @@ order, as the greedy step takes them) is the withheld effect's, another, or none
 
 * ``t``: the current rule (both errors over ``t_(1-ALPHA, n-1)`` standard errors);
 * ``permutation``: both errors' exact sign-flip p value at most ALPHA;
-* ``t_or_permutation``: either (its false-claim rate can reach twice ALPHA per candidate).
+* ``t_or_permutation``: either (its false-claim rate can reach twice ALPHA per candidate);
+* ``+null``: and each mean log ratio above the row's training-run null (``training_run_null``, written by the
+  benchmark since a23d548; added to the development rows by ``analysis/nominal_jackknife_floor.py``).
+
+Session 31's development rows (22 datasets, code of 3150c26, the t rule alone deciding their claims):
+``analysis/claim_statistic_dev.json``; what they say: docs/gap_benchmark.md, 3s. The product's rule since
+6319b43 is ``t_or_permutation+null``.
 
 Development seeds only: a rule chosen here is measured on held-out seeds afterwards. Run::
 
@@ -38,7 +44,7 @@ from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
 
-RULES = ("t", "permutation", "t_or_permutation")
+RULES = ("t", "permutation", "t_or_permutation", "t+null", "t_or_permutation+null")
 KEYS = ("run_log_error_ratios", "run_level_log_error_ratios")
 
 
@@ -56,24 +62,27 @@ def permutation_p(values):
                                         n_resamples=np.inf).pvalue)
 
 
-def passes(candidate, rule, alpha=ALPHA):
+def passes(candidate, rule, alpha=ALPHA, null=(0.0, 0.0)):
     """Does a ranked candidate (a row's ranking entry) pass ``rule`` on both errors (on the plain one when it
     has no level error, as the diagnosis)?"""
     runs = [candidate.get(k) for k in KEYS]
     if runs[0] is None:
         return False
     runs = [r for r in runs if r is not None]  # (a replay without friction parameters has no level error)
+    base, _, with_null = rule.partition("+")
     ok = []
-    for values in runs:
+    for values, floor in zip(runs, null):
         t_ok = t_passes(values, alpha)
         p_ok = permutation_p(values) <= alpha
-        ok.append({"t": t_ok, "permutation": p_ok, "t_or_permutation": t_ok or p_ok}[rule])
+        ok.append({"t": t_ok, "permutation": p_ok, "t_or_permutation": t_ok or p_ok}[base]
+                  and (not with_null or float(np.mean(values)) > floor))
     return all(ok)
 
 
 def first_passing(row, rule):
     """The first candidate of a row's ranking that passes ``rule``, or None."""
-    return next((c["effect"] for c in row["ranking"] if passes(c, rule)), None)
+    null = row.get("training_run_null") or (0.0, 0.0)
+    return next((c["effect"] for c in row["ranking"] if passes(c, rule, null=null)), None)
 
 
 def score(rows):
