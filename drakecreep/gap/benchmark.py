@@ -56,6 +56,7 @@ import numpy as np
 
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
+from drakecreep.gap.claims import log_ratios
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.screen import NOT_SCREENED, SLOW_SHARE
 from drakecreep.gap.truth import out_and_back
@@ -535,7 +536,7 @@ def _run_log_ratios(ranked, res, key):
     candidate = ranked.fit.test_errors
     if not all(key in reference[k] and key in candidate[k] for k in reference):
         return None
-    return [float(np.log(max(reference[k][key], 1e-12) / max(candidate[k][key], 1e-12))) for k in reference]
+    return [float(v) for v in log_ratios([reference[k][key] for k in reference], [candidate[k][key] for k in reference])]
 
 
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):

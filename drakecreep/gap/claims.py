@@ -69,7 +69,8 @@ def sign_flip_p(values):
     Under "the candidate is useless" each run's value is as likely negative as positive; the p value is the
     share of the ``2^n`` sign patterns whose mean is at least the observed one (``scipy.stats.permutation_test``,
     exact up to 16 runs, 19 999 random patterns with a fixed seed beyond). Unlike Student's t it does not assume
-    normal values: a real effect's per-run gains are often all positive and skewed (the slow runs gain most),
+    normal values: a real effect's per-run gains are often all positive and skewed (the runs carry it in
+    different shares),
     and their spread keeps t under its bar. With five runs its smallest value is 1/32 (every run better); with
     four or fewer it cannot go below 0.05. 1 for fewer than two runs."""
     x = np.asarray(values, dtype=float)

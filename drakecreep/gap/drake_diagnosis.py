@@ -51,7 +51,8 @@
    twice as high as this null, and the small second claims (a friction drift or a load friction of 2-4 %)
    fell under it;
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
-   augmented so far and kept only if they pass again against it (refitted alone by the same effort). A step
+   augmented so far and kept only if they pass again against it (refitted alone by the same effort; the same
+   rule, with the nominal's training-run null). A step
    refits the candidate's parameters with the nominal friction (the nominal's fitted set, plus the axial
    mode's stiffness and damping once it is in); the effects claimed before keep their values. Refitting every claimed
    parameter at every step cost EMPS 25 s for its fourth claim (17 parameters against 8), which put the
@@ -137,7 +138,7 @@ class RankedEffect:
     has ``fit = None`` and ``gain = nan`` (never fitted in closed loop). ``reference_errors``: the held-out errors
     of the candidate's own equal-effort reference when it has one (a candidate with ``screen_refits``:
     :func:`_with_values`), else None (the nominal's). ``threshold`` and ``level_threshold``: the bars its two log
-    ratios had to exceed and their sign-flip p values (:class:`ClaimTest`)."""
+    ratios had to exceed; ``p_sign_flip`` and ``level_p_sign_flip``: their sign-flip p values (:class:`ClaimTest`)."""
 
     fit: EffectFit | None
     gain: float
