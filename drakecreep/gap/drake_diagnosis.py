@@ -218,7 +218,9 @@ class DrakeDiagnosis:
                  f"{rms_force_error(self.nominal_test_errors):.3f} %; claim bar {self.k_se:.2f} standard errors of the "
                  "per-run log error ratio" + (", with and without each run's own friction level"
                                               if CLAIM_RULE == "both" else "")
-                 + f", and at least the training-run null {self.null[0]:.3f} ({self.null[1]:.3f} with the level)"]
+                 + (f", and at least the training-run null {self.null[0]:.3f} ({self.null[1]:.3f} with the level)"
+                    if getattr(self.nominal, "jackknife", ()) else
+                    "; no training-run null (it needs two or more training runs)")]
         for r in self.ranking:
             if r.screened_out:
                 sc = r.screen
@@ -555,7 +557,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             ranking += [done[n] for n, _, _ in jobs]
         ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
         say(f"training-run null: the nominal's held-out log error moves by up to {null.result()[0]:.3f} "
-            f"({null.result()[1]:.3f} with each run's friction level) with one training run left out")
+            f"({null.result()[1]:.3f} with each run's friction level) with one training run left out"
+            if nominal.jackknife else "training-run null: none (it needs two or more training runs)")
         if on_ranking is not None:
             on_ranking(nominal, nom_test, tuple(ranking))
         claimed, current, current_test = [], nominal, nom_test

@@ -205,9 +205,11 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  f"permutation p value of at most {ALPHA:g}: every held-out run better when there are five), both as the "
                  "errors are and "
                  "with each held-out run's friction scaled to its own level (friction drifts from run to run; "
-                 "a candidate that only fits the level the held-out runs happen to have is not claimed), by more "
-                 f"than the nominal's held-out log error moves with one training run left out of its fit (the "
-                 f"training-run null: {diagnosis.null[0]:.3f}, {diagnosis.null[1]:.3f} with the level), and its "
+                 "a candidate that only fits the level the held-out runs happen to have is not claimed), "
+                 + (f"by more than the nominal's held-out log error moves with one training run left out of its fit "
+                    f"(the training-run null: {diagnosis.null[0]:.3f}, {diagnosis.null[1]:.3f} with the level), "
+                    if getattr(nom, "jackknife", ()) else "")
+                 + "and its "
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
                  "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")

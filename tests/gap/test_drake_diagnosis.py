@@ -39,6 +39,7 @@ def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
     assert diag.claimed == ("asymmetric_friction",)
     assert diag.ranking[0].name == "asymmetric_friction" and diag.ranking[0].passes
     assert diag.ranking[0].log_ratio > diag.ranking[0].threshold >= diag.null[0] > 0
+    assert f"training-run null {diag.null[0]:.3f}" in diag.summary()[0]
     # while moving, coulomb_asym * s(v)^2 is a constant like the offset: only their sum is well determined
     p = diag.model["parameters"]
     assert abs(p["coulomb_asym"] + p["offset"] - (4.0 + PUBLISHED_IDIM["offset"])) < 0.3
