@@ -56,7 +56,6 @@ import numpy as np
 
 from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
-from drakecreep.gap.claims import log_ratios
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.screen import NOT_SCREENED, SLOW_SHARE
 from drakecreep.gap.truth import out_and_back
@@ -532,11 +531,13 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
 
 def _run_log_ratios(ranked, res, key):
     """Per held-out run ``ln(reference / candidate)`` of a ranked candidate's ``key`` error (None without it)."""
+    from drakecreep.gap.drake_diagnosis import run_log_ratios
+
     reference = ranked.reference_errors or res.nominal_test_errors
     candidate = ranked.fit.test_errors
     if not all(key in reference[k] and key in candidate[k] for k in reference):
         return None
-    return [float(v) for v in log_ratios([reference[k][key] for k in reference], [candidate[k][key] for k in reference])]
+    return [float(v) for v in run_log_ratios(reference, candidate, key)]
 
 
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):

@@ -88,7 +88,7 @@ from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
-           "paired_log_ratio", "training_run_null", "load_model",
+           "paired_log_ratio", "run_log_ratios", "training_run_null", "load_model",
            "NOMINAL_PARAMETERS", "NOMINAL_FRICTION", "CLAIM_RULE"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
@@ -111,6 +111,12 @@ def paired_gain(reference, candidate):
     return mean_and_standard_error([reference[k]["force"] - candidate[k]["force"] for k in reference])
 
 
+def run_log_ratios(reference, candidate, key="force"):
+    """Each held-out run's ``ln(reference / candidate)`` of the ``key`` error (the values :func:`paired_log_ratio`
+    averages and the sign-flip test permutes), in ``reference``'s run order."""
+    return log_ratios([reference[k][key] for k in reference], [candidate[k][key] for k in reference])
+
+
 def paired_log_ratio(reference, candidate, key="force"):
     """Mean and standard error of the per-run ``ln(reference / candidate)`` of the held-out force errors.
 
@@ -127,7 +133,7 @@ def paired_log_ratio(reference, candidate, key="force"):
     key : str
         Which error: ``force``, or ``force_level`` (each run with its own friction level).
     """
-    return mean_log_ratio([reference[k][key] for k in reference], [candidate[k][key] for k in reference])
+    return mean_and_standard_error(run_log_ratios(reference, candidate, key))
 
 
 @dataclass(frozen=True)
@@ -364,7 +370,7 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0)):
     has_level = all("force_level" in e for e in (*reference.values(), *candidate.values()))
 
     def test(key, floor):  # (mean, standard error, sign-flip p, bar, passes) of one error's per-run log ratios
-        x = log_ratios([reference[k][key] for k in reference], [candidate[k][key] for k in reference])
+        x = run_log_ratios(reference, candidate, key)
         m, s = mean_and_standard_error(x)
         p = sign_flip_p(x)
         return m, s, p, max(bar * s, floor), bool(m > floor and (m > bar * s or p <= ALPHA))
