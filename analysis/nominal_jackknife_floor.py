@@ -10,8 +10,9 @@ This study measures that null for the ``p_p_cascade`` diagnosis's nominal, on th
 benchmark run: the nominal identified as ``diagnose_drake`` does (``auto`` friction law, the equal-effort refit),
 its values with each training run left out (:attr:`drakecreep.gap.identify.Identified.jackknife`, one
 Gauss-Newton step), the held-out runs replayed with each, and ``floor = max_k |mean_runs ln(e_k / e)|`` on the
-plain error and with each run's own friction level. The score sets it beside each candidate's held-out log ratio
-in the benchmark rows.
+plain error and with each run's own friction level (since a23d548 the product's
+:func:`drakecreep.gap.drake_diagnosis.training_run_null`, which this script calls). The score sets it beside each
+candidate's held-out log ratio in the benchmark rows.
 
 Run (development rows from ``analysis/bench_gap_benchmark.py --seeds dev``)::
 
@@ -23,11 +24,9 @@ Run (development rows from ``analysis/bench_gap_benchmark.py --seeds dev``)::
 import argparse
 import json
 
-import numpy as np
-
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark as B
-from drakecreep.gap.drake_diagnosis import NOMINAL_FRICTION, _refit
+from drakecreep.gap.drake_diagnosis import NOMINAL_FRICTION, _refit, training_run_null
 from drakecreep.gap.drake_effects import score_parameters
 from drakecreep.gap.identify import identify
 
@@ -37,15 +36,7 @@ def floors(ds, max_nfev=6):
     fits = {law: identify(ds.train, NOMINAL_FRICTION[law], max_nfev=max_nfev) for law in NOMINAL_FRICTION}
     first = min(fits.values(), key=lambda f: f.cost)
     nominal = _refit(ds.train, first, first.fitted, max_nfev)
-    ref, _ = score_parameters(ds.test, nominal.parameters)
-    out = []
-    for key in ("force", "force_level"):
-        moves = []
-        for values in nominal.jackknife:
-            errs, _ = score_parameters(ds.test, dict(nominal.parameters, **values))
-            moves.append(abs(np.mean([np.log(errs[k][key] / ref[k][key]) for k in ref])))
-        out.append(float(max(moves)) if moves else 0.0)
-    return out
+    return list(training_run_null(ds.test, nominal, score_parameters(ds.test, nominal.parameters)[0]))
 
 
 def _rows(paths):

@@ -78,7 +78,7 @@ import yaml
 from scipy import stats
 
 from drakecreep.errors import InputError
-from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, mean_log_ratio, sign_flip_p
+from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
 from drakecreep.gap.drake_replay import rms_force_error
@@ -234,10 +234,7 @@ class DrakeDiagnosis:
                 continue
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, "
-                         + _verdict(ClaimTest(r.gain, r.standard_error, r.log_ratio, r.log_ratio_se,
-                                              r.level_log_ratio, r.level_log_ratio_se, r.threshold,
-                                              r.level_threshold, r.passes, r.p_sign_flip,
-                                              r.level_p_sign_flip))
+                         + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
                              f"{k} {v:.4g} {AXIS_UNITS[k]}" for k, v in own.items())
                             + " (candidate: " + ", ".join(f"{k} {r.fit.parameters[k]:.4g} {AXIS_UNITS[k]}"
@@ -391,17 +388,11 @@ def training_run_null(test, nominal, nominal_test_errors):
     docstring, 3), as the ``drakecreep`` kind's diagnosis asks of its candidates
     (:mod:`drakecreep.gap.drive_fit`). ``(0, 0)`` with one training run (no jackknife). Module level, for a
     process pool."""
-    out = []
     moved = [score_parameters(test, dict(nominal.parameters, **values), flexible=nominal.flexible,
                               delay=nominal.delay)[0] for values in nominal.jackknife]
-    for key in ("force", "force_level"):
-        if not moved or not all(key in e for e in nominal_test_errors.values()):
-            out.append(0.0)
-            continue
-        out.append(max(abs(mean_log_ratio([e[k][key] for k in nominal_test_errors],
-                                          [nominal_test_errors[k][key] for k in nominal_test_errors])[0])
-                       for e in moved))
-    return tuple(float(v) for v in out)
+    has = {key: bool(moved) and all(key in e for e in nominal_test_errors.values()) for key in ("force", "force_level")}
+    return tuple(float(max(abs(paired_log_ratio(nominal_test_errors, e, key)[0]) for e in moved)) if has[key] else 0.0
+                 for key in ("force", "force_level"))
 
 
 def _screen_numbers(sc):
@@ -418,7 +409,8 @@ def _screen_numbers(sc):
 
 
 def _verdict(t):
-    """One line of a candidate's held-out numbers (a :class:`ClaimTest`)."""
+    """One line of a candidate's held-out numbers (a :class:`ClaimTest`, or a :class:`RankedEffect`: the same
+    fields)."""
     level = "" if math.isnan(t.level_log_ratio) else \
         (f"; with each run's friction level {t.level_log_ratio:+.3f} vs bar {t.level_threshold:.3f}, "
          f"sign-flip p {t.level_p_sign_flip:.2g}")
@@ -503,11 +495,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     def ranked(n, sc, fit, own=None):
         t = _passes(own or nom_test, fit.test_errors, k_se, null=null.result())
         say(f"{n}: held-out {_verdict(t)}")
-        return RankedEffect(fit=fit, gain=t.gain, standard_error=t.standard_error, passes=t.passes, screen=sc,
-                            effect=n, log_ratio=t.log_ratio, log_ratio_se=t.log_ratio_se,
-                            level_log_ratio=t.level_log_ratio, level_log_ratio_se=t.level_log_ratio_se,
-                            reference_errors=own, threshold=t.threshold, level_threshold=t.level_threshold,
-                            p_sign_flip=t.p_sign_flip, level_p_sign_flip=t.level_p_sign_flip)
+        return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
 
     def origin(n):  # the model a candidate starts from: see _refit
         return first if _refits(n) else nominal

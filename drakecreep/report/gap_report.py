@@ -14,12 +14,7 @@ from drakecreep.gap.drake_replay import rms_force_error
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
 
 
-def _bar(threshold, fallback):
-    """The bar a ranked candidate had to exceed (``fallback`` for one made without a recorded threshold)."""
-    return fallback if np.isnan(threshold) else float(threshold)
-
-
-def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
+def ranking_json(nominal, nominal_test_errors, ranking):
     """JSON-ready ranking (also written alone, before the greedy augmentation and any late replay)."""
     rows = []
     for r in ranking:
@@ -43,12 +38,11 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
                                   "train_force_error_percent": r.fit.train_force_error,
                                   "gain_points": r.gain, "standard_error_points": r.standard_error,
                                   "log_error_ratio": r.log_ratio, "log_error_ratio_standard_error": r.log_ratio_se,
-                                  "threshold_log_error_ratio": _bar(r.threshold, k_se * r.log_ratio_se),
+                                  "threshold_log_error_ratio": r.threshold,
                                   "sign_flip_p": r.p_sign_flip, "level_sign_flip_p": r.level_p_sign_flip,
                                   "level_log_error_ratio": r.level_log_ratio,
                                   "level_log_error_ratio_standard_error": r.level_log_ratio_se,
-                                  "threshold_level_log_error_ratio": _bar(r.level_threshold,
-                                                                          k_se * r.level_log_ratio_se),
+                                  "threshold_level_log_error_ratio": r.level_threshold,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
         rows.append(row)
@@ -65,7 +59,7 @@ def ranking_json(nominal, nominal_test_errors, ranking, k_se=2.0):
 def drake_to_json_dict(diagnosis, **extra):
     """JSON-ready form of a :class:`~drakecreep.gap.drake_diagnosis.DrakeDiagnosis` (plus ``extra`` keys:
     ``data``, ``train_runs``, ``test_runs``, ``scored``, ...)."""
-    d = ranking_json(diagnosis.nominal, diagnosis.nominal_test_errors, diagnosis.ranking, diagnosis.k_se)
+    d = ranking_json(diagnosis.nominal, diagnosis.nominal_test_errors, diagnosis.ranking)
     d.update(to_jsonable({
         "model_kind": "drakecreep.measured_axis (Drake replay: P-P cascade + MeasuredAxis)",
         "nominal_friction": diagnosis.friction,
