@@ -74,7 +74,7 @@ def test_exponent_without_sign_is_a_float(tmp_path):
         ({"screw": {"lead": 0.0}}, "screw.lead", "(0.0, 0.1]"),
         ({"friction": {"viscous": float("nan")}}, "friction.viscous", "finite"),
         ({"motor": {"rotor_inertia": "big"}}, "motor.rotor_inertia", "finite number"),
-        ({"table": {"mas": 3}}, "table.mas", "no such field"),
+        ({"table": {"mas": 3}}, "table.mas", "an unknown field"),
         ({"controller": {"sampled": "yes"}}, "controller.sampled", "true or false"),
         ({"friction": {"law": "maxwell"}}, "friction.law", "one of coulomb, stribeck, lugre, gms"),
         ({"loads": {"cases": [{"fx": 1.0}, {"fz": "x"}]}}, "loads.cases[1].fz", "finite"),

@@ -69,7 +69,7 @@ PARAM_TEXTS = {
     "scalar_top": ("42\n", "a mapping"),
     "text_file": (PASSWD_LIKE, "YAML"),
     "unknown_group": ("tabel: {mass: 3}\n", "tabel"),
-    "integer_key": ("1: {mass: 3}\n", "no such field"),
+    "integer_key": ("1: {mass: 3}\n", "an unknown field"),
     "alias_bomb": (_bomb(), "aliases"),
     "bomb_in_value": ("table:\n  mass: &m [1, 2, 3]\n" + _bomb_in_value().replace("x0:", "junk:"), "table.mass"),
     "bad_syntax": ("table: {mass: [1, 2}\n", "invalid YAML"),
