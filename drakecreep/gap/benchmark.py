@@ -568,7 +568,10 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 # each held-out run's ln(reference / candidate), plain and with the run's own friction level: the
                 # values the claim's statistic is made of, so another rule can be counted on the rows
                 "run_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force"),
-                "run_level_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force_level")}
+                "run_level_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force_level"),
+                # and in the regime the candidate must show in too (DrakeEffect.regime), for every candidate
+                "run_constant_speed_log_error_ratios": None if r.screened_out else _run_log_ratios(
+                    r, res, "force_constant_speed")}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction, training_run_null=[float(v) for v in res.null],
                test_force_nominal=rms_force_error(res.nominal_test_errors),

@@ -49,7 +49,14 @@
    ``drakecreep`` kind's diagnosis asks the same of its candidates (:mod:`drakecreep.gap.drive_fit`). On the
    development benchmark rows of docs/gap_benchmark.md, 3s, every first claim that was right stood at least
    twice as high as this null, and the small second claims (a friction drift or a load friction of 2-4 %)
-   fell under it;
+   fell under it.
+   A candidate that names a regime where it must show too (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.regime`:
+   the time ripple, at constant speed) must also shrink the held-out force error over that regime's samples
+   (``force_constant_speed``), positively and significantly by the same t or sign-flip test. Runs that share
+   their timing repeat a model error that follows the reference at the same instants, and a sinusoid of
+   fixed phase fits part of it during the moves: held-out run 13's one false claim on a null was a 5.6 Hz
+   ripple of 0.3 N that shrank the whole runs' errors by 6 % and the constant-speed error not at all, where
+   every withheld ripple studied shrank it by more than the whole runs' (docs/gap_benchmark.md, 3u);
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
    augmented so far and kept only if they pass again against it (refitted alone by the same effort; the same
    rule, with the nominal's training-run null). A step
@@ -144,7 +151,8 @@ class RankedEffect:
     has ``fit = None`` and ``gain = nan`` (never fitted in closed loop). ``reference_errors``: the held-out errors
     of the candidate's own equal-effort reference when it has one (a candidate with ``screen_refits``:
     :func:`_with_values`), else None (the nominal's). ``threshold`` and ``level_threshold``: the bars its two log
-    ratios had to exceed; ``p_sign_flip`` and ``level_p_sign_flip``: their sign-flip p values (:class:`ClaimTest`)."""
+    ratios had to exceed; ``p_sign_flip`` and ``level_p_sign_flip``: their sign-flip p values; ``regime`` and
+    ``regime_*``: the log ratio in the candidate's own regime, when it has one (:class:`ClaimTest`)."""
 
     fit: EffectFit | None
     gain: float
@@ -161,6 +169,10 @@ class RankedEffect:
     level_threshold: float = float("nan")
     p_sign_flip: float = float("nan")
     level_p_sign_flip: float = float("nan")
+    regime: str = ""
+    regime_log_ratio: float = float("nan")
+    regime_log_ratio_se: float = float("nan")
+    regime_p_sign_flip: float = float("nan")
 
     @property
     def error_ratio(self):
@@ -353,15 +365,23 @@ class ClaimTest:
     passes: bool
     p_sign_flip: float = float("nan")
     level_p_sign_flip: float = float("nan")
+    regime: str = ""
+    regime_log_ratio: float = float("nan")
+    regime_log_ratio_se: float = float("nan")
+    regime_p_sign_flip: float = float("nan")
 
 
-def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0)):
+def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime=""):
     """The claim rule of the module docstring (3) as a :class:`ClaimTest`; gains in points of %. ``bar``: the
     Student quantile; ``null``: the training-run null ``(plain, level)`` (:func:`training_run_null`) each log
     ratio must also exceed. Each log ratio passes when its mean is above the training-run null and significant:
     above ``bar`` standard errors, or with a sign-flip p value (:func:`~drakecreep.gap.claims.sign_flip_p`) of at
     most :data:`~drakecreep.gap.claims.ALPHA`. ``rule`` (default :data:`CLAIM_RULE`): ``plain`` decides on the
-    force error, ``level`` on the force error with each run's own friction level, ``both`` on both."""
+    force error, ``level`` on the force error with each run's own friction level, ``both`` on both. ``regime``
+    (the candidate's :attr:`~drakecreep.gap.drake_effects.DrakeEffect.regime`, or empty): the log ratio of the
+    force error in that regime must also be positive and significant (the same t or sign-flip test; the
+    training-run null is of the whole runs, so it is not asked there); a held-out run without samples of the
+    regime fails it."""
     rule = rule or CLAIM_RULE
     gain, se = paired_gain(reference, candidate)
     has_level = all("force_level" in e for e in (*reference.values(), *candidate.values()))
@@ -375,7 +395,14 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0)):
     lr, lr_se, p, thr, plain_ok = test("force", null[0])
     lv, lv_se, lp, lthr, level_ok = test("force_level", null[1]) if has_level else (float("nan"),) * 4 + (plain_ok,)
     ok = {"plain": plain_ok, "level": level_ok, "both": plain_ok and level_ok}[rule]
-    return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok, p, lp)
+    if not regime:
+        return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok, p, lp)
+    key = f"force_{regime}"
+    if all(key in e for e in (*reference.values(), *candidate.values())):
+        rm, rs, rp, _, regime_ok = test(key, 0.0)
+    else:
+        rm, rs, rp, regime_ok = float("nan"), float("nan"), float("nan"), False
+    return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok and regime_ok, p, lp, regime, rm, rs, rp)
 
 
 def training_run_null(test, nominal, nominal_test_errors):
@@ -393,6 +420,11 @@ def training_run_null(test, nominal, nominal_test_errors):
     has = {key: bool(moved) and all(key in e for e in nominal_test_errors.values()) for key in ("force", "force_level")}
     return tuple(float(max(abs(paired_log_ratio(nominal_test_errors, e, key)[0]) for e in moved)) if has[key] else 0.0
                  for key in ("force", "force_level"))
+
+
+def _regime(name):
+    """The regime a candidate must also show in (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.regime`)."""
+    return DRAKE_EFFECTS[name].regime if name in DRAKE_EFFECTS else ""
 
 
 def _screen_numbers(sc):
@@ -414,6 +446,10 @@ def _verdict(t):
     level = "" if math.isnan(t.level_log_ratio) else \
         (f"; with each run's friction level {t.level_log_ratio:+.3f} vs bar {t.level_threshold:.3f}, "
          f"sign-flip p {t.level_p_sign_flip:.2g}")
+    if t.regime:
+        level += (f"; at {t.regime.replace('_', ' ')} {t.regime_log_ratio:+.3f} (standard error "
+                  f"{t.regime_log_ratio_se:.3f}, sign-flip p {t.regime_p_sign_flip:.2g})"
+                  if not math.isnan(t.regime_log_ratio) else f"; no {t.regime.replace('_', ' ')} in every held-out run")
     return (f"gain {t.gain:+.3f} points of %, error x{math.exp(-t.log_ratio):.3f} (log ratio {t.log_ratio:+.3f} vs bar "
             f"{t.threshold:.3f}, sign-flip p {t.p_sign_flip:.2g}{level})" + ("  passes" if t.passes else ""))
 
@@ -493,7 +529,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     ranking, jobs = [], []
 
     def ranked(n, sc, fit, own=None):
-        t = _passes(own or nom_test, fit.test_errors, k_se, null=null.result())
+        t = _passes(own or nom_test, fit.test_errors, k_se, null=null.result(), regime=_regime(n))
         say(f"{n}: held-out {_verdict(t)}")
         return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
 
@@ -578,7 +614,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 fit = f_fit.result()
                 if f_ref is not None:
                     reference = f_ref.result()
-            t = _passes(reference, fit.test_errors, k_se, null=null.result())
+            t = _passes(reference, fit.test_errors, k_se, null=null.result(), regime=_regime(r.name))
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(t)}")
             if t.passes:
                 claimed.append(r.name)

@@ -37,6 +37,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
+from drakecreep.gap.residuals import classify_regimes
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, applied_force,
                                    axis_friction, axis_parameters, axis_ripple, has_bristles, lead_error, nut_load)
 from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
@@ -48,6 +49,8 @@ __all__ = [
     "DrakeReplayResult",
     "drake_replay",
     "drake_replay_errors",
+    "REGIME_ERRORS",
+    "MIN_REGIME_SAMPLES",
     "rms_force_error",
     "axis_from_idim",
     "replay_drakecreep",
@@ -610,12 +613,23 @@ def drake_replay(run, parameters, flexible=False, delay=0.0, quantize=True):
     return DrakeReplay(run, flexible=flexible, delay=delay, quantize=quantize).simulate(parameters)
 
 
+#: time regimes (:func:`drakecreep.gap.residuals.classify_regimes`) whose force error
+#: :func:`drake_replay_errors` adds as ``force_<regime>`` (a candidate's ``regime``:
+#: :class:`drakecreep.gap.drake_effects.DrakeEffect`)
+REGIME_ERRORS = ("constant_speed",)
+#: fewest samples of a regime for its force error (fewer: the key is left out)
+MIN_REGIME_SAMPLES = 20
+
+
 def drake_replay_errors(result, cutoff=100.0, order=4):
     """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
 
     Velocity and acceleration of the measured and simulated motor positions go through the same IDIM
     processing (Butterworth ``cutoff`` forward-backward, central differences); ``x_table`` is added when the
-    run has a linear scale.
+    run has a linear scale; ``force_level`` (the run's own friction level) when the result carries its
+    parameters; ``force_constant_speed`` (for each regime of :data:`REGIME_ERRORS`) the force error over the
+    samples of that regime (:func:`drakecreep.gap.residuals.classify_regimes` of the reference and the measured
+    speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them.
     """
     run = result.run
     _, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
@@ -630,6 +644,11 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
         out["table_position"] = relative_error(run.x_table, result.x_table)
     if result.parameters:
         out["force_level"] = _force_level_error(result, cutoff, order)
+    regimes = classify_regimes(np.arange(run.n) * run.dt, run.x_ref, dq)
+    for regime in REGIME_ERRORS:
+        sel = regimes == regime
+        if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(np.asarray(run.force)[sel] != 0):
+            out[f"force_{regime}"] = relative_error(np.asarray(run.force)[sel], np.asarray(result.force)[sel])
     return out
 
 

@@ -45,6 +45,10 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "threshold_level_log_error_ratio": r.level_threshold,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
+            if r.regime:  # the regime the candidate must show in too (DrakeEffect.regime)
+                row["closed_loop"]["regime"] = {"name": r.regime, "log_error_ratio": r.regime_log_ratio,
+                                                "log_error_ratio_standard_error": r.regime_log_ratio_se,
+                                                "sign_flip_p": r.regime_p_sign_flip}
         rows.append(row)
     shown = ("mass",) + tuple(n for n in nominal.fitted if n != "mass")
     return to_jsonable({"nominal": {"parameters": {n: nominal.parameters[n] for n in shown},
@@ -203,7 +207,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  + (f"by more than the nominal's held-out log error moves with one training run left out of its fit "
                     f"(the training-run null: {diagnosis.null[0]:.3f}, {diagnosis.null[1]:.3f} with the level), "
                     if getattr(nom, "jackknife", ()) else "")
-                 + "and its "
+                 + "where the candidate names a regime it must show in (a time ripple: at constant speed), "
+                 "with a positive and significant log ratio of the force error in that regime too, "
+                 "and its "
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
                  "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")

@@ -240,3 +240,34 @@ def test_skewed_gains_in_every_run_pass_by_the_sign_flip_null_and_one_run_worse_
     one_worse = errors(np.exp(-np.array([0.004, -0.003, 1.165, 1.115, 1.011])))
     t = D._passes(reference, one_worse, bar)
     assert t.p_sign_flip > 0.05 and t.log_ratio > bar * t.log_ratio_se and t.passes
+
+
+def test_a_time_ripple_must_shrink_the_error_at_constant_speed_too():
+    """Held-out run 13's null (seed 27013004; docs/gap_benchmark.md, 3u): a 5.6 Hz ripple fitted a model error
+    that repeats at the same instants of every run (the runs share their timing), shrinking the whole runs'
+    errors by 4-10 % but not the error at constant speed, where a force at a fixed time frequency is as well.
+    With its regime the candidate fails; shrinking both, it passes; a held-out run without constant-speed
+    samples fails it; a candidate without a regime is decided as before."""
+    import drakecreep.gap.drake_diagnosis as D
+
+    def errors(ratios, cruise):
+        return {f"r{i}": {"force": 10.0 * r, "force_level": 6.0 * r, "force_constant_speed": 4.0 * c}
+                for i, (r, c) in enumerate(zip(ratios, cruise))}
+
+    reference = errors([1.0] * 5, [1.0] * 5)
+    bar = 2.13
+    moves = np.exp(-np.array([0.077, 0.105, 0.086, 0.050, 0.04]))
+    locked = errors(moves, np.exp(-np.array([0.01, -0.02, 0.0, -0.03, 0.01])))
+    assert D._passes(reference, locked, bar).passes
+    t = D._passes(reference, locked, bar, regime="constant_speed")
+    assert not t.passes and t.regime == "constant_speed" and abs(t.regime_log_ratio) < 0.01
+    real = errors(moves, moves ** 1.2)
+    t = D._passes(reference, real, bar, regime="constant_speed")
+    assert t.passes and t.regime_log_ratio > 0.05 and t.regime_p_sign_flip == pytest.approx(1 / 32)
+    missing = {k: dict(v) for k, v in real.items()}
+    del missing["r3"]["force_constant_speed"]
+    t = D._passes(reference, missing, bar, regime="constant_speed")
+    assert not t.passes and np.isnan(t.regime_log_ratio)
+    assert "no constant speed in every held-out run" in D._verdict(t)
+    assert D.DRAKE_EFFECTS["time_ripple"].regime == "constant_speed"
+    assert not any(e.regime for n, e in D.DRAKE_EFFECTS.items() if n != "time_ripple")

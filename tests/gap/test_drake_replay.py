@@ -77,6 +77,26 @@ def test_force_level_error_removes_a_friction_level_and_nothing_else(run):
     assert err["force"] > 1.0 and err["force_level"] > 0.7 * err["force"]
 
 
+def test_force_error_at_constant_speed_is_over_those_samples_alone(run, nominal):
+    """``force_constant_speed``: the force error over the samples the regime classifier labels constant speed;
+    a force error elsewhere changes ``force`` and not it; a run that never cruises has no such key."""
+    from drakecreep.gap.idim import filtered_derivatives, relative_error
+    from drakecreep.gap.residuals import classify_regimes
+
+    err = drake_replay_errors(nominal)
+    _, dq, _ = filtered_derivatives(run.x_motor, run.dt, 100.0, 4)
+    sel = classify_regimes(np.arange(run.n) * run.dt, run.x_ref, dq) == "constant_speed"
+    assert 100 < np.count_nonzero(sel) < run.n
+    assert err["force_constant_speed"] == pytest.approx(relative_error(run.force[sel], nominal.force[sel]))
+    off = dataclasses.replace(nominal, force=np.where(sel, nominal.force, nominal.force + 5.0))
+    moved = drake_replay_errors(off)
+    assert moved["force"] > err["force"] + 1.0
+    assert moved["force_constant_speed"] == pytest.approx(err["force_constant_speed"])
+    t = np.arange(run.n) * run.dt
+    swinging = dataclasses.replace(run, x_ref=run.x_ref[0] + 0.01 * np.sin(2 * np.pi * 2.0 * t))
+    assert "force_constant_speed" not in drake_replay_errors(dataclasses.replace(nominal, run=swinging))
+
+
 @pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
 def test_computation_delay_holds_older_outputs(run, delay, shift):
     """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later."""
