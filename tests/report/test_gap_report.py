@@ -10,3 +10,32 @@ def test_parameters_are_shown_in_the_units_feed_drive_engineers_read():
     assert _edge("lead", 5e-3) == (pytest.approx(5.0), "mm")
     assert _edge("stiffness", 2e8) == (pytest.approx(200.0), "N/um")
     assert _edge("coulomb", 20.0) == (20.0, "N")
+
+
+def test_the_ranking_json_carries_a_candidate_s_regime_test():
+    """A candidate with a regime (the time ripple: constant speed) has its log ratio there in ``ranking.json``;
+    one without has no such entry."""
+    import math
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import RankedEffect
+    from drakecreep.report.gap_report import ranking_json
+
+    values = {"time_ripple_cos": 0.1, "time_ripple_sin": 0.3, "ripple_frequency": 5.6, "coulomb_asym": 0.0,
+              "viscous_asym": 0.0}
+
+    def fit(name):
+        return SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
+                               seconds=1.0)
+
+    ripple = RankedEffect(fit=fit("time_ripple"), gain=0.4, standard_error=0.1, passes=False, effect="time_ripple", log_ratio=0.06,
+                          log_ratio_se=0.02, regime="constant_speed", regime_log_ratio=-0.004,
+                          regime_log_ratio_se=0.018, regime_p_sign_flip=0.62)
+    asym = RankedEffect(fit=fit("asymmetric_friction"), gain=0.4, standard_error=0.1, passes=False, effect="asymmetric_friction")
+    nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
+    rows = {r["effect"]: r for r in ranking_json(nominal, {"r0": {"force": 9.0}}, (ripple, asym))["ranking"]}
+    assert rows["time_ripple"]["closed_loop"]["regime"] == {
+        "name": "constant_speed", "log_error_ratio": -0.004, "log_error_ratio_standard_error": 0.018,
+        "sign_flip_p": 0.62}
+    assert "regime" not in rows["asymmetric_friction"]["closed_loop"]
+    assert math.isnan(asym.regime_log_ratio)
