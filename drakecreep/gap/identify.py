@@ -52,8 +52,8 @@ LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness
 PRESLIDING_START = 5e-6
 #: |correlation| above which two fitted parameters are reported as not separable
 CORRELATION_LIMIT = 0.95
-#: residual put in place of each non-finite sample of a diverged replay (a normalised residual of a good fit is
-#: of order 0.01-1 per sample)
+#: residual put in place of each non-finite sample of a diverged replay, and the largest magnitude a sample's
+#: residual is given (a normalised residual of a good fit is of order 0.01-1 per sample)
 NONFINITE_RESIDUAL = 1e3
 _ONE_WAY_SHARE = 0.02
 
@@ -272,8 +272,11 @@ class _Problem:
         # a replay that diverged (NaN or inf samples) is a very poor fit, not an error: the least squares must
         # step back from it (held-out dataset 21011000 of run 10, a cable carrier: a candidate's closed-loop
         # replay went non-finite and the SVD of the trust-region step raised, losing the dataset)
+        # A replay on its way to diverging can still be finite but huge (1e200): its square overflows the cost
+        # to inf and the SVD raised just the same (held-out dataset 29010000 of run 14, a drive saturation), so
+        # the residual is also clipped to +-NONFINITE_RESIDUAL per sample
         big = NONFINITE_RESIDUAL
-        return np.nan_to_num(np.concatenate(parts), nan=big, posinf=big, neginf=big)
+        return np.clip(np.nan_to_num(np.concatenate(parts), nan=big, posinf=big, neginf=-big), -big, big)
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,

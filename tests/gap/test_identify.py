@@ -113,5 +113,10 @@ def test_a_diverged_replay_is_a_poor_fit_not_a_crash():
     r = _Problem.residual_of([SimpleNamespace(run=run, force=force, x_motor=x)])
     assert r.size == 2 * n and np.all(np.isfinite(r))
     assert np.count_nonzero(r == NONFINITE_RESIDUAL) == (n - 10) + 1
+    # finite but on its way out (held-out dataset 29010000): clipped, so that the cost r @ r stays finite
+    huge = run.x_motor.copy()
+    huge[5:] = -1e200
+    r = _Problem.residual_of([SimpleNamespace(run=run, force=run.force, x_motor=huge)])
+    assert np.count_nonzero(r == -NONFINITE_RESIDUAL) == n - 5 and np.isfinite(r @ r)
     good = _Problem.residual_of([SimpleNamespace(run=run, force=run.force, x_motor=run.x_motor)])
     assert np.all(good == 0.0)
