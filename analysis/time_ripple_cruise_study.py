@@ -1,12 +1,15 @@
 """Where does a fitted fixed-time-frequency force ripple help: at cruise or in the time-locked moves?
 
-Development seeds only. Every run of the benchmark's truth has the same timing (out leg from 0.2 s, back
+Development seeds, and seeds of held-out runs already looked into (never a run's own seeds before it is
+scored). Every run of the benchmark's truth has the same timing (out leg from 0.2 s, back
 leg from 1.7 s, 20 % raised-cosine ramps; :func:`drakecreep.gap.truth.draw_profiles`), so a model error that
 follows the reference (a mass, a lag, a friction law) repeats at the same instants in every run, and a
 sinusoid of fixed phase can fit part of it. A true force ripple at a fixed time frequency is there at cruise
 as well. For each dataset this script fits only the ``time_ripple`` candidate with the product diagnosis, then
 replays the nominal and the ripple model on the held-out and the audit runs and splits each run's log error
-ratio between the cruise samples (reference speed within 2 % of its peak) and the rest.
+ratio between the cruise samples (reference speed within 2 % of its peak) and the rest. The product's test
+(``DrakeEffect.regime``) came after this study and uses the regime classifier's ``constant_speed`` samples
+(:func:`drakecreep.gap.residuals.classify_regimes`) instead of this script's cruise.
 
 Usage: ``PYTHONPATH=. python analysis/time_ripple_cruise_study.py OUT.json SEED:EFFECT [...]``
 (``EFFECT`` is ``null`` or a withheld effect, e.g. ``14000:null 9000:time_ripple``).
