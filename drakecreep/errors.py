@@ -47,3 +47,8 @@ class InputError(DrakecreepError, ValueError):
         self.allowed = allowed
         super().__init__(f"{short_repr(field, 200) if not isinstance(field, str) else field[:200]}: "
                          f"got {short_repr(value)}; allowed: {str(allowed)[:600]}")
+
+    @classmethod
+    def unknown_field(cls, field, known):
+        """A key that names no field of a mapping whose fields are ``known`` (the value is not echoed)."""
+        return cls(field, "an unknown field", "one of the known fields " + ", ".join(sorted(known)))

@@ -541,7 +541,7 @@ def _from_dict(cls, data, path):
     for key, value in data.items():
         dotted = f"{path}.{key}" if path else str(key)
         if key not in names:
-            raise InputError(dotted[:80], "an unknown field", "one of the known fields " + ", ".join(sorted(names)))
+            raise InputError.unknown_field(dotted[:80], names)
         kind = hints[key]
         if dataclasses.is_dataclass(kind):
             kwargs[key] = _from_dict(kind, value, dotted)

@@ -384,7 +384,9 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime=""):
     regime fails it."""
     rule = rule or CLAIM_RULE
     gain, se = paired_gain(reference, candidate)
-    has_level = all("force_level" in e for e in (*reference.values(), *candidate.values()))
+
+    def has(key):  # every run of both has this error
+        return all(key in e for e in (*reference.values(), *candidate.values()))
 
     def test(key, floor):  # (mean, standard error, sign-flip p, bar, passes) of one error's per-run log ratios
         x = run_log_ratios(reference, candidate, key)
@@ -393,12 +395,13 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime=""):
         return m, s, p, max(bar * s, floor), bool(m > floor and (m > bar * s or p <= ALPHA))
 
     lr, lr_se, p, thr, plain_ok = test("force", null[0])
-    lv, lv_se, lp, lthr, level_ok = test("force_level", null[1]) if has_level else (float("nan"),) * 4 + (plain_ok,)
+    lv, lv_se, lp, lthr, level_ok = (test("force_level", null[1]) if has("force_level")
+                                     else (float("nan"),) * 4 + (plain_ok,))
     ok = {"plain": plain_ok, "level": level_ok, "both": plain_ok and level_ok}[rule]
     if not regime:
         return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok, p, lp)
     key = f"force_{regime}"
-    if all(key in e for e in (*reference.values(), *candidate.values())):
+    if has(key):
         rm, rs, rp, _, regime_ok = test(key, 0.0)
     else:
         rm, rs, rp, regime_ok = float("nan"), float("nan"), float("nan"), False

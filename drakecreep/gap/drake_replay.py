@@ -645,10 +645,11 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     if result.parameters:
         out["force_level"] = _force_level_error(result, cutoff, order)
     regimes = classify_regimes(np.arange(run.n) * run.dt, run.x_ref, dq)
+    force, force_sim = np.asarray(run.force), np.asarray(result.force)
     for regime in REGIME_ERRORS:
         sel = regimes == regime
-        if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(np.asarray(run.force)[sel] != 0):
-            out[f"force_{regime}"] = relative_error(np.asarray(run.force)[sel], np.asarray(result.force)[sel])
+        if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(force[sel] != 0):
+            out[f"force_{regime}"] = relative_error(force[sel], force_sim[sel])
     return out
 
 

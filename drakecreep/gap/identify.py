@@ -276,7 +276,7 @@ class _Problem:
         # to inf and the SVD raised just the same (held-out dataset 29010000 of run 14, a drive saturation), so
         # the residual is also clipped to +-NONFINITE_RESIDUAL per sample
         big = NONFINITE_RESIDUAL
-        return np.clip(np.nan_to_num(np.concatenate(parts), nan=big, posinf=big, neginf=-big), -big, big)
+        return np.clip(np.nan_to_num(np.concatenate(parts), nan=big), -big, big)  # +-inf: clipped to +-big
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,

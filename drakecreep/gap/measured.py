@@ -189,7 +189,7 @@ class ControllerMeta:
         names = {f.name for f in dataclasses.fields(cls)}
         for key in data:
             if key not in names:
-                raise InputError(f"controller.{key}", "an unknown field", "one of the known fields " + ", ".join(sorted(names)))
+                raise InputError.unknown_field(f"controller.{key}", names)
         data = dict(data)
         if data.get("saturation") in (".inf", "inf", "none", None) and "saturation" in data:
             data["saturation"] = math.inf
