@@ -51,7 +51,12 @@ class DrakeEffect:
     ``regime``: a time regime of :func:`drakecreep.gap.residuals.classify_regimes` where the effect must show
     too: its held-out force error in that regime (``force_<regime>`` of
     :func:`drakecreep.gap.drake_replay.drake_replay_errors`) must shrink significantly as well, or it is not
-    claimed (:func:`drakecreep.gap.drake_diagnosis.diagnose_drake`).
+    claimed (:func:`drakecreep.gap.drake_diagnosis.diagnose_drake`). ``claim_rule``: which held-out force
+    errors decide the claim (:func:`drakecreep.gap.drake_diagnosis._passes`); empty for the diagnosis's
+    ``CLAIM_RULE`` (the plain error and the error with each run's own friction level, both), ``either`` for an
+    effect that each of the two tests is blind to in its own way (a friction along the travel: the plain test
+    where a held-out run's drifted level cancels the map at its place, the level test on a run of a few
+    millimetres, where the map *is* a level).
     """
 
     name: str
@@ -66,6 +71,7 @@ class DrakeEffect:
     screen_refits: tuple = ()
     start_floor: dict = field(default_factory=dict)
     regime: str = ""
+    claim_rule: str = ""
 
     def fixed_by(self, runs):
         """Axis parameters the candidate takes from the training ``runs``, not from a fit: for a map along the
@@ -105,10 +111,15 @@ DRAKE_EFFECTS = {
                                  bounds={"load_friction_coefficient": (0.0, 1.0)}, shifts_nominal=True),
     # four smooth steps over the training travel (drakecreep.model.axis.friction_map), not a sinusoid: on
     # development data a sinusoid of 0.9 m period at its amplitude bound stood in for a friction ramp, and one
-    # held-out run got worse (docs/gap_benchmark.md); |a_k| <= 0.2 keeps the friction level above 0.2 of nominal
+    # held-out run got worse (docs/gap_benchmark.md); |a_k| <= 0.2 keeps the friction level above 0.2 of nominal.
+    # Over a run of a few millimetres the map is a friction level, which the level test's per-run level takes
+    # over: with it, the held-out log ratios of withheld position frictions swung -0.41..+0.82 where the plain
+    # ones were all positive; the plain test fails where a held-out run's drift cancels the map (3q). Either
+    # test passing suffices (docs/gap_benchmark.md, 3w)
     "position_friction": DrakeEffect("position_friction", FRICTION_MAP,
                                      signature="friction level that varies smoothly along the travel",
-                                     bounds={n: (-0.2, 0.2) for n in FRICTION_MAP}, spans_travel=True),
+                                     bounds={n: (-0.2, 0.2) for n in FRICTION_MAP}, spans_travel=True,
+                                     claim_rule="either"),
     "position_ripple": DrakeEffect("position_ripple", ("position_ripple_cos", "position_ripple_sin", "position_period"),
                                    tuple({"position_period": p} for p in (1.25e-3, 2.5e-3, 5e-3)),
                                    signature="force ripple periodic in position (cogging, a bearing)",

@@ -271,3 +271,33 @@ def test_a_time_ripple_must_shrink_the_error_at_constant_speed_too():
     assert "no constant speed in every held-out run" in D._verdict(t)
     assert D.DRAKE_EFFECTS["time_ripple"].regime == "constant_speed"
     assert not any(e.regime for n, e in D.DRAKE_EFFECTS.items() if n != "time_ripple")
+
+
+def test_a_friction_along_the_travel_passes_with_either_test():
+    """Each of the two held-out tests is blind to a friction along the travel in its own way (docs/gap_benchmark.md,
+    3q and 3w). Held-out run 14's seed 29002001: every run's plain error shrank (log ratios 0.58-1.63) while, with
+    each run's own friction level, the short runs (6 and 11 mm, where the map is a level) swung negative. Held-out
+    run 13's seed 27002001: the level test passed (every run positive) and the plain one did not (two runs whose
+    drifted level cancels the map). The candidate's rule is ``either``, and both pass under it, each still above
+    its training-run null; every other candidate keeps :data:`CLAIM_RULE`, under which both fail; useless on both
+    tests fails either."""
+    import drakecreep.gap.drake_diagnosis as D
+
+    def errors(plain, level):
+        return {f"r{i}": {"force": 10.0 * np.exp(-a), "force_level": 6.0 * np.exp(-b)}
+                for i, (a, b) in enumerate(zip(plain, level))}
+
+    reference = errors([0.0] * 5, [0.0] * 5)
+    short_runs = errors([0.64, 1.63, 1.00, 0.58, 0.87], [-0.41, 0.82, -0.09, 0.74, -0.27])
+    drifted = errors([0.84, 1.36, 0.26, -0.17, -0.31], [0.89, 1.15, 0.35, 0.26, 0.63])
+    useless = errors([0.05, -0.04, 0.02, -0.01, 0.0], [0.03, -0.02, 0.01, 0.0, -0.01])
+    bar, rule = 2.13, D._rule("position_friction")
+    assert rule == "either"
+    for along, null in ((short_runs, (0.20, 0.43)), (drifted, (0.035, 0.098))):
+        t = D._passes(reference, along, bar, rule=rule, null=null)
+        assert t.passes and t.rule == "either" and "(either test suffices)" in D._verdict(t)
+        assert not D._passes(reference, along, bar, rule=D.CLAIM_RULE, null=null).passes
+    assert not D._passes(reference, short_runs, bar, rule=rule, null=(1.7, 0.43)).passes
+    assert not D._passes(reference, useless, bar, rule=rule).passes
+    assert [n for n in D.DRAKE_EFFECTS if D._rule(n) != D.CLAIM_RULE] == ["position_friction"]
+    assert D._rule("control_delay") == D.CLAIM_RULE

@@ -39,3 +39,26 @@ def test_the_ranking_json_carries_a_candidate_s_regime_test():
         "sign_flip_p": 0.62}
     assert "regime" not in rows["asymmetric_friction"]["closed_loop"]
     assert math.isnan(asym.regime_log_ratio)
+
+
+def test_the_ranking_json_carries_the_rule_a_candidate_was_decided_on():
+    """``claim_rule`` in ``ranking.json``: ``either`` for a candidate that passes with either held-out test (a
+    friction along the travel), the diagnosis's ``CLAIM_RULE`` for the others."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import CLAIM_RULE, RankedEffect
+    from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+    from drakecreep.report.gap_report import ranking_json
+
+    values = dict.fromkeys(DRAKE_EFFECTS["position_friction"].parameters + DRAKE_EFFECTS["stribeck"].parameters, 0.1)
+
+    def ranked(name, **kw):
+        fit = SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
+                              seconds=1.0)
+        return RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, effect=name, **kw)
+
+    nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
+    out = ranking_json(nominal, {"r0": {"force": 9.0}},
+                       (ranked("position_friction", rule="either"), ranked("stribeck")))
+    rows = {r["effect"]: r["closed_loop"]["claim_rule"] for r in out["ranking"]}
+    assert rows == {"position_friction": "either", "stribeck": CLAIM_RULE}
