@@ -279,8 +279,9 @@ def test_a_friction_along_the_travel_passes_with_either_test():
     each run's own friction level, the short runs (6 and 11 mm, where the map is a level) swung negative. Held-out
     run 13's seed 27002001: the level test passed (every run positive) and the plain one did not (two runs whose
     drifted level cancels the map). The candidate's rule is ``either``, and both pass under it, each still above
-    its training-run null; every other candidate keeps :data:`CLAIM_RULE`, under which both fail; useless on both
-    tests fails either."""
+    its training-run null; every other candidate keeps :data:`CLAIM_RULE`, under which both fail. Useless on both
+    tests fails, and so does held-out run 10's null 21013001: the map passed the level test and made the plain
+    error worse on average."""
     import drakecreep.gap.drake_diagnosis as D
 
     def errors(plain, level):
@@ -291,6 +292,7 @@ def test_a_friction_along_the_travel_passes_with_either_test():
     short_runs = errors([0.64, 1.63, 1.00, 0.58, 0.87], [-0.41, 0.82, -0.09, 0.74, -0.27])
     drifted = errors([0.84, 1.36, 0.26, -0.17, -0.31], [0.89, 1.15, 0.35, 0.26, 0.63])
     useless = errors([0.05, -0.04, 0.02, -0.01, 0.0], [0.03, -0.02, 0.01, 0.0, -0.01])
+    worse = errors([0.05, -0.2, 0.03, -0.06, -0.07], [0.10, 0.18, 0.09, 0.14, 0.12])
     bar, rule = 2.13, D._rule("position_friction")
     assert rule == "either"
     for along, null in ((short_runs, (0.20, 0.43)), (drifted, (0.035, 0.098))):
@@ -299,5 +301,6 @@ def test_a_friction_along_the_travel_passes_with_either_test():
         assert not D._passes(reference, along, bar, rule=D.CLAIM_RULE, null=null).passes
     assert not D._passes(reference, short_runs, bar, rule=rule, null=(1.7, 0.43)).passes
     assert not D._passes(reference, useless, bar, rule=rule).passes
+    assert D._passes(reference, worse, bar, rule="level").passes and not D._passes(reference, worse, bar, rule=rule).passes
     assert [n for n in D.DRAKE_EFFECTS if D._rule(n) != D.CLAIM_RULE] == ["position_friction"]
     assert D._rule("control_delay") == D.CLAIM_RULE
