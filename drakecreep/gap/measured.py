@@ -403,7 +403,7 @@ def _meta_from_dict(data, meta_path):
     known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "file"}
     for key in data:
         if key not in known:
-            raise InputError(f"{where}: {key}", data[key], "no such key; known: " + ", ".join(sorted(known)))
+            raise InputError.unknown_field(f"{where}: {key}", known)
     if "u_units" not in data:
         raise InputError(f"{where}: u_units", None, "one of " + ", ".join(U_UNITS) + " (required)")
     params = data.get("params")

@@ -120,6 +120,14 @@ def test_unknown_unit_of_u(tmp_path):
     assert err.value.field == "u_units"
 
 
+def test_an_unknown_metadata_key_is_named_with_the_known_ones(tmp_path):
+    """A misspelt top-level key of the metadata YAML gets the same one line as an unknown params field: the key,
+    and the known keys."""
+    with pytest.raises(InputError, match="an unknown field") as err:
+        load_measured(_write(tmp_path, meta={**META, "u_gian": 35.0}))
+    assert err.value.field.endswith(": u_gian") and "u_gain" in str(err.value) and "u_units" in str(err.value)
+
+
 def test_unit_of_u_in_header_must_match_metadata(tmp_path):
     path = _write(tmp_path, header=["t", "x_ref", "x_motor", "u[A]", "f_ext"])
     with pytest.raises(InputError, match="u is in the metadata's u_units") as err:
