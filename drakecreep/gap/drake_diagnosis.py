@@ -37,14 +37,13 @@
    error, log ratio 0.24 against a bar of 0.10, and failed with the runs' own levels, 0.15 against 0.16:
    ``analysis/claim_study.py``). A friction that varies along the travel passes with either test, the other's
    mean log ratio positive (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.claim_rule`): each is blind to it
-   in its own way. Over a
-   run of a few millimetres it *is* a friction level, the run's own level takes all of it, and the two models'
-   ratio there swings either way (held-out run 14 missed two withheld position frictions whose plain log ratios
-   were positive in every run: ``analysis/position_friction_level_study.py``); a held-out run whose drifted
-   level cancels the map at its place is better served by the nominal's constant level, which the plain test
-   sees (docs/gap_benchmark.md, 3q and 3w). Neither blindness makes the other error worse on average: on
-   held-out run 10's null 21013001 the map passed the level test (0.126 +- 0.035) and made the plain error
-   worse (-0.049). The reference has had the same fitting effort: a candidate refits the nominal
+   in its own way. Over a run of a few millimetres it *is* a friction level, the run's own level takes all of
+   it, and the two models' ratio there swings either way (held-out run 14 missed two withheld position
+   frictions whose plain log ratios were positive in every run: ``analysis/position_friction_level_study.py``);
+   a held-out run whose drifted level cancels the map at its place is better served by the nominal's constant
+   level, which the plain test sees (docs/gap_benchmark.md, 3q and 3w). Neither blindness makes the other error
+   worse on average: on held-out run 10's null 21013001 the map passed the level test (0.126 +- 0.035) and made
+   the plain error worse (-0.049). The reference has had the same fitting effort: a candidate refits the nominal
    friction with its own parameters from the first fit by ``max_nfev`` evaluations, and the nominal model it
    is compared with is that first fit refitted alone by the same ``max_nfev`` evaluations (:func:`_refit`;
    candidates that refit nothing, the axial mode and the delay, start from this refitted nominal). Against the unrefitted
