@@ -204,7 +204,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  f"permutation p value of at most {ALPHA:g}: every held-out run better when there are five), both as the "
                  "errors are and "
                  "with each held-out run's friction scaled to its own level (friction drifts from run to run; "
-                 "a candidate that only fits the level the held-out runs happen to have is not claimed), "
+                 "a candidate that only fits the level the held-out runs happen to have is not claimed; a friction "
+                 "along the travel, which is a level over a short run, needs one of the two, with the other's mean "
+                 "log ratio positive), "
                  + (f"by more than the nominal's held-out log error moves with one training run left out of its fit "
                     f"(the training-run null: {diagnosis.null[0]:.3f}, {diagnosis.null[1]:.3f} with the level), "
                     if getattr(nom, "jackknife", ()) else "")

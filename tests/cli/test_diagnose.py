@@ -54,6 +54,7 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     html = (out / "diagnosis.html").read_text()
     assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
     assert "Unexplained: where" in html and "Residual-input independence" in html
+    assert "a friction along the travel, which is a level over a short run, needs one of the two" in html
     # two training runs: the nominal's values with each left out, their spread in the table and the JSON
     assert "leave one training run out" in html
     assert set(data["nominal"]["leave_one_run_out_std"]) == set(data["nominal"]["ci95"])
