@@ -4,7 +4,9 @@
    pre-processing: Butterworth, central differences, decimation, borders) on all training runs stacked:
    ``tau = M ddq + Fv dq + Fc sign(dq) + offset``. When every run moves one way ``sign(dq)`` and the
    constant column are the same regressor: Coulomb and offset cannot be told apart; the offset is then
-   fixed at 0 and a warning says so.
+   fixed at 0 and a warning says so. Then IDIM-IV (``instruments``): the same equation with the closed-loop
+   replay of that model as instruments, consistent where a force the model lacks shakes the measured axis
+   (a lead error's ripple made least squares halve the mass; docs/gap_benchmark.md, 3x).
 2. **Refinement** (:func:`identify`): the parameters the user marks as uncertain (any of
    :data:`drakecreep.model.axis.AXIS_PARAMETERS`: friction levels, asymmetry, Stribeck level and speed,
    axial stiffness and damping, ...) are fitted by :func:`scipy.optimize.least_squares` on the closed-loop
@@ -29,6 +31,7 @@ Parameters that must stay positive are fitted on a log scale; the others on a sc
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time as _time
 from dataclasses import dataclass, field
@@ -56,24 +59,37 @@ CORRELATION_LIMIT = 0.95
 #: residual is given (a normalised residual of a good fit is of order 0.01-1 per sample)
 NONFINITE_RESIDUAL = 1e3
 _ONE_WAY_SHARE = 0.02
+#: the inverse-dynamics parameters of the IDIM start (:func:`idim_start`), by their names in the axis
+_IDIM_NAMES = ("mass", "viscous", "coulomb", "offset")
 
 
 @dataclass(frozen=True)
 class IdimStart:
-    """IDIM-LS on the stacked training runs: values in :data:`AXIS_PARAMETERS` names, std, warnings."""
+    """IDIM on the stacked training runs: values in :data:`AXIS_PARAMETERS` names, std, warnings; ``method``
+    ``"LS"`` (least squares) or ``"IV"`` (instrumental variables, :func:`idim_start`)."""
 
     parameters: dict
     std: dict
     fit_error_percent: float
     warnings: tuple = ()
+    method: str = "LS"
 
 
-def idim_start(runs, **preprocess):
-    """IDIM-LS start values from all training runs (one pre-processing, :func:`drakecreep.gap.idim.idim_signals`).
+def idim_start(runs, instruments=None, **preprocess):
+    """IDIM-LS start values from all training runs (one pre-processing, :func:`drakecreep.gap.idim.idim_signals`),
+    or IDIM-IV with ``instruments``.
 
     Parameters
     ----------
     runs : sequence of drakecreep.gap.measured.MeasuredRun
+    instruments : sequence of numpy.ndarray, optional
+        Simulated motor positions [m] of ``runs`` (one array per run, on its samples): the closed-loop replay of
+        a model. Their regressor, through the same pre-processing, is the instrument ``Z`` of the instrumental
+        variable estimate ``theta = (Z^T W)^-1 Z^T tau`` (IDIM-IV: Janot, Vandanjon and Gautier 2014, IEEE Trans.
+        Control Syst. Technol. 22(1), on the EMPS axis). A force the model lacks (a lead error's ``e''(x) v^2``
+        at 60 Hz) moves the measured axis too, so the measured acceleration is correlated with the equation error
+        and least squares shrinks the mass (held-out dataset 31003011: 42.8 kg for a 94.3 kg axis); the
+        simulated acceleration is not (95.3 kg). None: least squares.
     **preprocess
         Options of :func:`~drakecreep.gap.idim.idim_signals`.
 
@@ -89,6 +105,14 @@ def idim_start(runs, **preprocess):
     ddq = np.concatenate([s.ddq for s in sig])
     tau = np.concatenate([s.tau for s in sig])
     W = regressor(dq, ddq)
+    Z = None
+    if instruments is not None:
+        instruments = list(instruments)
+        if len(instruments) != len(runs):
+            raise InputError("instruments", f"{len(instruments)} arrays", f"one per run ({len(runs)})")
+        zs = [idim_signals(dataclasses.replace(r, x_motor=np.asarray(x, dtype=float)), **preprocess)
+              for r, x in zip(runs, instruments)]
+        Z = regressor(np.concatenate([z.dq for z in zs]), np.concatenate([z.ddq for z in zs]))
     warnings = []
     moving = np.abs(dq) > 1e-3 * max(np.max(np.abs(dq)), 1e-12)
     forward = float(np.mean(dq[moving] > 0)) if moving.any() else 0.5
@@ -100,10 +124,20 @@ def idim_start(runs, **preprocess):
     Ws = W[:, cols]
     if np.linalg.matrix_rank(Ws) < Ws.shape[1]:
         raise InputError("runs", [r.label for r in runs], "motions that excite acceleration and speed")
-    theta, *_ = np.linalg.lstsq(Ws, tau, rcond=None)
-    r = tau - Ws @ theta
     n, p = Ws.shape
-    cov = float(r @ r) / (n - p) * np.linalg.inv(Ws.T @ Ws)
+    if Z is not None:
+        Zs = Z[:, cols]
+        A = Zs.T @ Ws
+        if np.linalg.matrix_rank(A) < p:
+            raise InputError("instruments", "a simulated motion", "one that excites acceleration and speed")
+        theta = np.linalg.solve(A, Zs.T @ tau)
+        r = tau - Ws @ theta
+        Ai = np.linalg.inv(A)
+        cov = float(r @ r) / (n - p) * Ai @ (Zs.T @ Zs) @ Ai.T
+    else:
+        theta, *_ = np.linalg.lstsq(Ws, tau, rcond=None)
+        r = tau - Ws @ theta
+        cov = float(r @ r) / (n - p) * np.linalg.inv(Ws.T @ Ws)
     full = np.zeros(len(PARAMETER_NAMES))
     std = np.zeros(len(PARAMETER_NAMES))
     full[cols] = theta
@@ -117,7 +151,8 @@ def idim_start(runs, **preprocess):
         full[1] = 0.0
     return IdimStart(parameters={names[k]: float(v) for k, v in zip(PARAMETER_NAMES, full)},
                      std={names[k]: float(v) for k, v in zip(PARAMETER_NAMES, std)},
-                     fit_error_percent=relative_error(tau, Ws @ theta), warnings=tuple(warnings))
+                     fit_error_percent=relative_error(tau, Ws @ theta), warnings=tuple(warnings),
+                     method="LS" if Z is None else "IV")
 
 
 @dataclass(frozen=True)
@@ -280,7 +315,7 @@ class _Problem:
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,
-             bounds=None, max_nfev=20, quantize=True, replays=None, diff_step=0.05, **preprocess):
+             bounds=None, max_nfev=20, quantize=True, replays=None, diff_step=0.05, instruments=True, **preprocess):
     """Identify the replay axis on training runs (see the module docstring).
 
     Parameters
@@ -310,6 +345,12 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         Absolute finite-difference step of the Jacobian in the scaled variables (5 % of a log-scaled value, or
         5 % of a typical size): large enough to step over the encoder's counts (the replay with a counted position
         is only piecewise smooth in the parameters).
+    instruments : bool
+        Replace the IDIM-LS start of the inverse-dynamics parameters (mass, viscous, Coulomb, offset) that
+        ``fixed`` does not give by IDIM-IV (:func:`idim_start`), its instruments the closed-loop replay of the
+        IDIM-LS model (one replay of each run; the least-squares start is kept, with a warning, when that
+        replay fails). The mass is never refined by output error unless marked uncertain, so its start is what
+        the model keeps.
     **preprocess
         Options of the IDIM pre-processing.
 
@@ -330,16 +371,33 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     base = dict(AXIS_PARAMETERS)
     base.update(start.parameters)
     base["regularization_velocity"] = _regularization(runs)
-    if "bristle_stiffness" in uncertain:
-        # LuGre bristles from a presliding displacement of PRESLIDING_START at the Coulomb level
-        base["bristle_stiffness"] = max(abs(base["coulomb"]), 1.0) / PRESLIDING_START
     base.update(fixed or {})
     warnings = list(start.warnings)
     if any("offset fixed at 0" in w for w in warnings) and "offset" in uncertain and "coulomb" in uncertain:
         warnings.append("'coulomb' and 'offset' both marked uncertain on one-way data: 'offset' left at 0")
         uncertain = tuple(n for n in uncertain if n != "offset")
+    iv = tuple(n for n in _IDIM_NAMES if n not in (fixed or {})) if instruments else ()
     if replays is None:
-        replays = [make_replay(r, flexible=flexible, delay=delay, quantize=quantize, free=uncertain) for r in runs]
+        # the mass stays symbolic when the IV start moves it: one build serves the instruments' replay and the fit
+        free = uncertain + (("mass",) if "mass" in iv and "mass" not in uncertain else ())
+        replays = [make_replay(r, flexible=flexible, delay=delay, quantize=quantize, free=free) for r in runs]
+    if iv:
+        sims = [rep.simulate(base) for rep in replays]
+        xs = [res.x_motor for res in sims]
+        if all(np.all(np.isfinite(x)) for x in xs):
+            iv_start = idim_start(runs, instruments=xs, **preprocess)
+        else:
+            iv_start = None
+        if iv_start is None or not iv_start.parameters["mass"] > 0:
+            warnings.append("IDIM-IV: the replay of the least-squares start failed; the least-squares start kept")
+        else:
+            start = dataclasses.replace(iv_start, warnings=tuple(w for w in iv_start.warnings
+                                                                  if w not in start.warnings))
+            warnings += list(start.warnings)
+            base.update({n: start.parameters[n] for n in iv})
+    if "bristle_stiffness" in uncertain and "bristle_stiffness" not in (fixed or {}):
+        # LuGre bristles from a presliding displacement of PRESLIDING_START at the Coulomb level
+        base["bristle_stiffness"] = max(abs(base["coulomb"]), 1.0) / PRESLIDING_START
     prob = _Problem(replays, base, uncertain)
     r0 = prob.residual_of(prob.simulate(base))
     cost_start = 0.5 * float(r0 @ r0)
