@@ -214,6 +214,10 @@ class Identified:
             jack = (f" (leave one run out: std {self.jackknife_std[name]:.3g})" if name in self.jackknife_std else "")
             lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}"
                          + jack)
+        if "mass" not in self.fitted:
+            src = (f"IDIM-{self.start.method} start" if self.parameters["mass"] == self.start.parameters.get("mass")
+                   else "given")
+            lines.append(f"  {'mass':24s} {self.parameters['mass']:12.5g} kg ({src}, not refined)")
         lines += [f"  warning: {w}" for w in self.warnings]
         return lines
 

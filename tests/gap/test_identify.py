@@ -143,7 +143,33 @@ def test_the_iv_start_keeps_the_mass_that_a_lead_error_ripple_takes_from_least_s
     assert iv.parameters["offset"] == pytest.approx(truth["offset"], abs=0.5)
     assert abs(ls.parameters["offset"] - truth["offset"]) > 1.0
     assert iv.cost < ls.cost
+    assert any(line.split()[:2] == ["mass", f"{iv.parameters['mass']:.5g}"] and "IDIM-IV start, not refined" in line
+               for line in iv.summary())
     # a value the caller fixes is kept (the closed-loop fits of the candidates start from the nominal's)
     assert identify(runs, uncertain=(), fixed=dict(fixed, mass=80.0)).parameters["mass"] == 80.0
     with pytest.raises(InputError, match="instruments"):
         idim_start(runs, instruments=[runs[0].x_motor])
+
+
+def test_a_failed_instruments_replay_keeps_the_least_squares_start(runs):
+    """When the replay of the IDIM-LS model (the instruments) does not stay finite, the least-squares start is
+    kept and a warning says so; the fit goes on."""
+    from drakecreep.gap.drake_replay import make_replay
+
+    class FirstDiverges:
+        def __init__(self, rep):
+            self.rep, self.calls = rep, 0
+
+        def __getattr__(self, name):
+            return getattr(self.rep, name)
+
+        def simulate(self, parameters):
+            res = self.rep.simulate(parameters)
+            self.calls += 1
+            return dataclasses.replace(res, x_motor=np.full_like(res.x_motor, np.nan)) if self.calls == 1 else res
+
+    replays = [FirstDiverges(make_replay(r, free=())) for r in runs]
+    idf = identify(runs, uncertain=(), fixed={"regularization_velocity": 1e-3}, replays=replays)
+    assert idf.start.method == "LS"
+    assert any("IDIM-IV" in w and "least-squares start kept" in w for w in idf.warnings)
+    assert idf.parameters["mass"] == pytest.approx(idim_start(runs).parameters["mass"])
