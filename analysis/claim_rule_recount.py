@@ -1,0 +1,107 @@
+"""Recount the first claim of stored benchmark rows under another claim rule (no diagnosis is rerun).
+
+Spent held-out rows only (runs already scored and looked into, never a run's own seeds before it is scored). Each
+row of ``analysis/gap_benchmark_heldout*.json`` (runs 14 onwards) keeps, per ranked candidate, the per-held-out-run
+log error ratios (plain, with each run's own friction level, at constant speed) and the dataset's training-run
+null. This script feeds them to the product's own test (:func:`drakecreep.gap.drake_diagnosis._passes`, through
+error dicts whose log ratios are the stored values) under
+
+* ``current``: each candidate's own rule (``both``; ``either`` for the position friction), the product today;
+* ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive).
+
+and reports the first candidate in ranking order that passes: top-1 where SNR >= 3, claims on nulls and on effects
+outside the library. It recounts the first claim only (the greedy steps after it are refitted on top of it and
+cannot be recounted from the rows), so its top-1 is the benchmark's ``first_passing`` score.
+
+Usage: ``PYTHONPATH=. python analysis/claim_rule_recount.py analysis/gap_benchmark_heldout16.json [...]``
+"""
+
+import json
+import math
+import sys
+
+from scipy import stats
+
+from drakecreep.gap.claims import ALPHA
+from drakecreep.gap.drake_diagnosis import _passes, _regime, _rule
+
+RULES = ("current", "either")
+_KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ratios",
+         "force_constant_speed": "run_constant_speed_log_error_ratios"}
+
+
+def _errors(entry):
+    """(reference, candidate) error dicts whose per-run ``ln(reference / candidate)`` are the stored values."""
+    n = len(entry["run_log_error_ratios"])
+    ref = {f"r{i}": {} for i in range(n)}
+    cand = {f"r{i}": {} for i in range(n)}
+    for key, field in _KEYS.items():
+        values = entry.get(field)
+        if values is None:
+            continue
+        for i, v in enumerate(values):
+            ref[f"r{i}"][key] = 1.0
+            cand[f"r{i}"][key] = math.exp(-v)
+    return ref, cand
+
+
+def first_claim(row, rule):
+    """The first candidate of ``row``'s ranking that passes under ``rule`` (None if none)."""
+    null = tuple(row.get("training_run_null") or (0.0, 0.0))
+    for entry in row["ranking"]:
+        if entry.get("screened_out") or not entry.get("run_log_error_ratios"):
+            continue
+        ref, cand = _errors(entry)
+        bar = float(stats.t.ppf(1.0 - ALPHA, len(entry["run_log_error_ratios"]) - 1))
+        name = entry["effect"]
+        t = _passes(ref, cand, bar, rule=_rule(name) if rule == "current" else rule, null=null, regime=_regime(name))
+        if t.passes:
+            return name
+    return None
+
+
+def recount(rows):
+    """Per rule: top-1 right / scored (SNR >= 3), claims on nulls, claims on out-of-library effects, and the rows
+    whose first claim differs between the rules."""
+    out = {}
+    for rule in RULES:
+        top = [0, 0]
+        null = [0, 0]
+        ool = [0, 0]
+        firsts = {}
+        for r in rows:
+            f = first_claim(r, rule)
+            firsts[r["seed"]] = f
+            if r["category"] == "library" and (r["snr"] or 0) >= 3:
+                top[1] += 1
+                top[0] += f == r["expected"]
+            elif r["category"] == "null":
+                null[1] += 1
+                null[0] += f is not None
+            elif r["category"] in ("out_of_library", "no_candidate"):
+                ool[1] += 1
+                ool[0] += f is not None
+        out[rule] = {"top1": top, "null_claims": null, "out_of_library_claims": ool, "first": firsts}
+    return out
+
+
+def main(paths):
+    for path in paths:
+        with open(path) as fh:
+            rows = json.load(fh)["datasets"]
+        res = recount(rows)
+        print(path)
+        for rule in RULES:
+            x = res[rule]
+            print(f"  {rule:8s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null_claims'][0]}/"
+                  f"{x['null_claims'][1]}  out of library claimed {x['out_of_library_claims'][0]}/"
+                  f"{x['out_of_library_claims'][1]}")
+        for r in rows:
+            a, b = res["current"]["first"][r["seed"]], res["either"]["first"][r["seed"]]
+            if a != b or a != r["first_passing"]:
+                print(f"    {r['seed']} {r['category']:15s} expected {r['expected'] or '-':20s} SNR {r['snr'] or 0:5.1f} "
+                      f"stored {r['first_passing'] or '-':20s} current {a or '-':20s} either {b or '-'}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
