@@ -60,6 +60,10 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert "a friction along the travel, which is a level over a short run, needs one of the two" in html
     # the training runs: the nominal's values with each left out, their spread in the table and the JSON
     assert "leave one training run out" in html
+    # the mass, which output error does not refine, is in the nominal's table with its source
+    assert data["nominal"]["mass_source"] == "IDIM-IV start"
+    assert f"<td>mass</td><td>{data['nominal']['parameters']['mass']:.5g}</td>" in html
+    assert "The mass is from inverse dynamics with the closed-loop replay" in html
     assert set(data["nominal"]["leave_one_run_out_std"]) == set(data["nominal"]["ci95"])
     assert {"regimes", "bands", "independence", "split"} <= set(data["unexplained"])
     params, flexible, delay = load_model(out / "augmented_model.yaml")
