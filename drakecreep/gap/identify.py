@@ -206,6 +206,16 @@ class Identified:
     jackknife: tuple = ()
     jackknife_std: dict = field(default_factory=dict)
 
+    @property
+    def mass_source(self):
+        """Where the mass comes from: ``output error`` (refined), ``IDIM-IV start`` / ``IDIM-LS start`` (never
+        refined unless marked uncertain), or ``given`` (a value the caller fixed)."""
+        if "mass" in self.fitted:
+            return "output error"
+        if self.start is not None and self.parameters["mass"] == self.start.parameters.get("mass"):
+            return f"IDIM-{self.start.method} start"
+        return "given"
+
     def summary(self):
         """Lines of text: the fitted values with their intervals, the warnings."""
         lines = [f"identified ({'two-mass' if self.flexible else 'rigid'} axis, delay {self.delay:g} samples, "
@@ -215,9 +225,7 @@ class Identified:
             lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}"
                          + jack)
         if "mass" not in self.fitted:
-            src = (f"IDIM-{self.start.method} start" if self.parameters["mass"] == self.start.parameters.get("mass")
-                   else "given")
-            lines.append(f"  {'mass':24s} {self.parameters['mass']:12.5g} kg ({src}, not refined)")
+            lines.append(f"  {'mass':24s} {self.parameters['mass']:12.5g} kg ({self.mass_source}, not refined)")
         lines += [f"  warning: {w}" for w in self.warnings]
         return lines
 

@@ -56,7 +56,7 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                     "ci95": nominal.ci95,
                                     "leave_one_run_out_std": nominal.jackknife_std,
                                     "warnings": list(nominal.warnings),
-                                    "mass_source": _mass_source(nominal),
+                                    "mass_source": getattr(nominal, "mass_source", None),
                                     "held_out_force_error_percent": rms_force_error(nominal_test_errors),
                                     "held_out_errors": nominal_test_errors},
                         "ranking": rows})
@@ -151,17 +151,6 @@ def _drake_figures(diagnosis, residuals=None):
 _EDGE_UNITS = {"m/s": (1e3, "mm/s"), "m": (1e3, "mm"), "N/m": (1e-6, "N/um")}
 
 
-def _mass_source(nominal):
-    """Where the nominal's mass comes from: ``output error`` (refined), ``IDIM-IV start`` / ``IDIM-LS start``
-    (:func:`drakecreep.gap.identify.identify` never refines it unless marked uncertain), or ``given``."""
-    if "mass" in nominal.fitted:
-        return "output error"
-    start = getattr(nominal, "start", None)
-    if start is not None and nominal.parameters["mass"] == start.parameters.get("mass"):
-        return f"IDIM-{start.method} start"
-    return "given"
-
-
 def _edge(name, value):
     """``(value, unit)`` of MeasuredAxis parameter ``name`` in the report's units (mm/s, mm, N/um; a lead error's
     amplitudes in um; else SI)."""
@@ -239,7 +228,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     if "mass" not in nom.fitted:
         how = {"IDIM-IV start": "from inverse dynamics with the closed-loop replay of the least-squares model as "
                                 "instruments (IDIM-IV)",
-               "IDIM-LS start": "from inverse-dynamics least squares (IDIM-LS)"}.get(_mass_source(nom), "given")
+               "IDIM-LS start": "from inverse-dynamics least squares (IDIM-LS)"}
+        how = how.get(getattr(nom, "mass_source", None), "given")
         parts.append(f"<p>The mass is {how}; output error does not refine it.</p>")
     if nom.warnings:
         parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in nom.warnings) + "</ul>")
