@@ -41,6 +41,7 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     captured = capsys.readouterr()
     data = json.loads(captured.out)
     assert data["claimed"] == ["asymmetric_friction"]
+    assert "volatile bar" not in " ".join(data["summary"])  # three training runs: no warning on the null
     assert data["train_runs"] == ["w0", "w1", "w2"] and data["test_runs"] == ["w3", "w4", "w5"]
     assert [r["effect"] for r in data["ranking"]][0] == "asymmetric_friction"
     assert data["held_out_force_error_percent"]["augmented"] < data["held_out_force_error_percent"]["nominal"]
@@ -79,6 +80,7 @@ def test_text_output(csv_file, capsys):
                      "thermal_drift", "-q"]) == 0
     out = capsys.readouterr().out
     assert "nominal (regularized friction) held-out force error" in out and "claimed:" in out
+    assert "from two training runs, each left-out fit seeing one run alone: a volatile bar" in out
 
 
 @pytest.mark.parametrize("argv, word", [
