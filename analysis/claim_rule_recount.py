@@ -61,8 +61,8 @@ def first_claim(row, rule):
 
 
 def recount(rows):
-    """Per rule: top-1 right / scored (SNR >= 3), claims on nulls, claims on out-of-library effects, and the rows
-    whose first claim differs between the rules."""
+    """Per rule: top-1 right / scored (SNR >= 3), claims on nulls, claims on out-of-library effects, and each
+    row's first claim (``first``: seed -> candidate or None)."""
     out = {}
     for rule in RULES:
         top = [0, 0]

@@ -242,17 +242,17 @@ class DrakeDiagnosis:
 
     def summary(self):
         """Lines of text."""
+        jack = getattr(self.nominal, "jackknife", ())
         lines = [f"nominal ({self.friction} friction) held-out force error "
                  f"{rms_force_error(self.nominal_test_errors):.3f} %; claim bar {self.k_se:.2f} standard errors of the "
                  "per-run log error ratio" + (", with and without each run's own friction level"
                                               if CLAIM_RULE == "both" else "")
                  + (f", and at least the training-run null {self.null[0]:.3f} ({self.null[1]:.3f} with the level)"
-                    if getattr(self.nominal, "jackknife", ()) else
-                    "; no training-run null (it needs two or more training runs)")
+                    if jack else "; no training-run null (it needs two or more training runs)")
                  # with two, each left-out fit sees one run: on 1 s EMPS slices the null moved 0.45 -> 0.56 when
                  # the nominal moved by 0.01 kg, where three runs gave 0.06 (docs/gap_benchmark.md, 3x)
                  + (" from two training runs, each left-out fit seeing one run alone: a volatile bar (three or "
-                    "more steady it)" if len(getattr(self.nominal, "jackknife", ())) == 2 else "")]
+                    "more steady it)" if len(jack) == 2 else "")]
         for r in self.ranking:
             if r.screened_out:
                 sc = r.screen
@@ -326,7 +326,7 @@ def _refit(train, model, names, max_nfev):
     """
     idf = identify(train, tuple(names), flexible=model.flexible, delay=model.delay, fixed=dict(model.parameters),
                    max_nfev=max_nfev)
-    start = getattr(model, "start", None) or getattr(getattr(model, "identified", None), "start", None)
+    start = getattr(model, "start", None)  # an EffectFit has none (its refit is only replayed, never reported)
     return dataclasses.replace(idf, start=start) if start is not None else idf
 
 
