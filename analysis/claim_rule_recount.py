@@ -6,7 +6,9 @@ log error ratios (plain, with each run's own friction level, at constant speed) 
 null. This script feeds them to the product's own test (:func:`drakecreep.gap.drake_diagnosis._passes`, through
 error dicts whose log ratios are the stored values) under
 
-* ``current``: each candidate's own rule (``both``; ``either`` for the position friction), the product today;
+* ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), the product
+  today;
+* ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
 * ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive).
 
 and reports the first candidate in ranking order that passes: top-1 where SNR >= 3, claims on nulls and on effects
@@ -25,7 +27,7 @@ from scipy import stats
 from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_diagnosis import _passes, _regime, _rule
 
-RULES = ("current", "either")
+RULES = ("current", "both", "either")
 _KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ratios",
          "force_constant_speed": "run_constant_speed_log_error_ratios"}
 
@@ -54,7 +56,9 @@ def first_claim(row, rule):
         ref, cand = _errors(entry)
         bar = float(stats.t.ppf(1.0 - ALPHA, len(entry["run_log_error_ratios"]) - 1))
         name = entry["effect"]
-        t = _passes(ref, cand, bar, rule=_rule(name) if rule == "current" else rule, null=null, regime=_regime(name))
+        own = _rule(name)
+        chosen = {"current": own, "both": "both" if own == "drift_robust" else own}.get(rule, rule)
+        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime(name))
         if t.passes:
             return name
     return None
@@ -97,10 +101,11 @@ def main(paths):
                   f"{x['null_claims'][1]}  out of library claimed {x['out_of_library_claims'][0]}/"
                   f"{x['out_of_library_claims'][1]}")
         for r in rows:
-            a, b = res["current"]["first"][r["seed"]], res["either"]["first"][r["seed"]]
-            if a != b or a != r["first_passing"]:
+            a, o, b = (res[rule]["first"][r["seed"]] for rule in RULES)
+            if len({a, o, b, r["first_passing"]}) > 1:
                 print(f"    {r['seed']} {r['category']:15s} expected {r['expected'] or '-':20s} SNR {r['snr'] or 0:5.1f} "
-                      f"stored {r['first_passing'] or '-':20s} current {a or '-':20s} either {b or '-'}")
+                      f"stored {r['first_passing'] or '-':20s} current {a or '-':20s} both {o or '-':20s} "
+                      f"either {b or '-'}")
 
 
 if __name__ == "__main__":

@@ -53,7 +53,8 @@ class DrakeEffect:
     :func:`drakecreep.gap.drake_replay.drake_replay_errors`) must shrink significantly as well, or it is not
     claimed (:func:`drakecreep.gap.drake_diagnosis.diagnose_drake`). ``claim_rule``: which held-out force
     errors decide the claim (:func:`drakecreep.gap.drake_diagnosis._passes`); empty for the diagnosis's
-    ``CLAIM_RULE`` (the plain error and the error with each run's own friction level, both), ``either`` (one of
+    ``CLAIM_RULE`` (the plain error and the error with each run's own friction level, both, or the level alone
+    with the plain mean above its training-run null), ``either`` (one of
     them, the other's mean log ratio positive) for an effect that each test is blind to in its own way (a
     friction along the travel: the plain test where a held-out run's drifted level cancels the map at its
     place, the level test on a run of a few millimetres, where the map *is* a level).

@@ -161,6 +161,34 @@ def test_a_gain_that_each_run_s_own_friction_level_explains_is_not_claimed():
     assert D._passes({k: {"force": v["force"]} for k, v in reference.items()}, plain_only, bar, "both").passes
 
 
+def test_the_level_test_alone_claims_when_the_plain_mean_is_above_its_null():
+    """``drift_robust`` (:data:`CLAIM_RULE`), on per-run log ratios of spent held-out rows: held-out run 16's
+    bearing defect 33007005 (level ratios positive in every run, plain ones of mixed sign, plain mean 0.29 above
+    its null 0.027) passes, where ``both`` missed it; run 16's backlash 33012003, outside the library (level test
+    passes, plain mean 0.032 under its null 0.063), and run 14's null 29013006 (the plain test alone passes: an
+    asymmetric friction fitting the held-out runs' levels) do not."""
+    import drakecreep.gap.drake_diagnosis as D
+
+    def errors(plain, level):
+        return {f"r{i}": {"force": 10.0 * np.exp(-a), "force_level": 6.0 * np.exp(-b)}
+                for i, (a, b) in enumerate(zip(plain, level))}
+
+    reference = errors([0.0] * 5, [0.0] * 5)
+    bar = 2.13
+    bearing = errors([0.061, 0.358, -0.059, 1.11, -0.017], [0.458, 0.662, 0.144, 1.588, 0.293])
+    backlash = errors([0.049, 0.042, 0.068, 0.004, -0.003], [0.225, 0.124, 0.173, 0.05, 0.042])
+    null_asym = errors([0.244, 0.349, 0.037, 0.083, 0.307], [0.197, 0.323, -0.294, 0.081, 0.278])
+    assert D.CLAIM_RULE == "drift_robust"
+    t = D._passes(reference, bearing, bar, null=(0.027, 0.006))
+    assert t.passes and not D._passes(reference, bearing, bar, "both", null=(0.027, 0.006)).passes
+    assert "it suffices with the plain mean above its null" in D._verdict(t)
+    assert not D._passes(reference, bearing, bar, null=(0.30, 0.006)).passes  # plain mean 0.29 under the null
+    assert D._passes(reference, backlash, bar, "level", null=(0.063, 0.059)).passes
+    assert not D._passes(reference, backlash, bar, null=(0.063, 0.059)).passes
+    assert D._passes(reference, null_asym, bar, "plain", null=(0.046, 0.021)).passes
+    assert not D._passes(reference, null_asym, bar, null=(0.046, 0.021)).passes
+
+
 def test_a_consistent_gain_below_the_training_run_null_is_not_claimed():
     """A candidate that shrinks every held-out run's error by 2 % passes the significance test (the same in every
     run: a tiny standard error) but not a training-run null of 0.05: the nominal's held-out log error moves more
@@ -298,7 +326,11 @@ def test_a_friction_along_the_travel_passes_with_either_test():
     for along, null in ((short_runs, (0.20, 0.43)), (drifted, (0.035, 0.098))):
         t = D._passes(reference, along, bar, rule=rule, null=null)
         assert t.passes and t.rule == "either" and "(either test suffices)" in D._verdict(t)
-        assert not D._passes(reference, along, bar, rule=D.CLAIM_RULE, null=null).passes
+        assert not D._passes(reference, along, bar, rule="both", null=null).passes
+    # the other candidates' rule takes the level test alone only with the plain mean above its null (drifted);
+    # the plain test alone (short runs) is not enough for them
+    assert not D._passes(reference, short_runs, bar, rule=D.CLAIM_RULE, null=(0.20, 0.43)).passes
+    assert D._passes(reference, drifted, bar, rule=D.CLAIM_RULE, null=(0.035, 0.098)).passes
     assert not D._passes(reference, short_runs, bar, rule=rule, null=(1.7, 0.43)).passes
     assert not D._passes(reference, useless, bar, rule=rule).passes
     assert D._passes(reference, worse, bar, rule="level").passes
