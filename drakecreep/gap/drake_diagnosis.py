@@ -42,8 +42,8 @@
    claims and no claim on the 29 nulls or the 28 effects outside the library (docs/gap_benchmark.md, 3y). The
    plain test alone is still not enough: that is the false claim this test exists for (asymmetric frictions on
    two nulls of run 14 and on a cable carrier of run 15). A friction that varies along the travel passes with
-   either test, the other's mean log ratio positive (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.claim_rule`): each is blind to it
-   in its own way. Over a run of a few millimetres it *is* a friction level, the run's own level takes all of
+   either test, the other's mean log ratio positive
+   (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.claim_rule`): each is blind to it in its own way. Over a run of a few millimetres it *is* a friction level, the run's own level takes all of
    it, and the two models' ratio there swings either way (held-out run 14 missed two withheld position
    frictions whose plain log ratios were positive in every run: ``analysis/position_friction_level_study.py``);
    a held-out run whose drifted level cancels the map at its place is better served by the nominal's constant

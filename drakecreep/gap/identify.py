@@ -400,8 +400,12 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
             iv_start = idim_start(runs, instruments=xs, **preprocess)
         else:
             iv_start = None
-        if iv_start is None or not iv_start.parameters["mass"] > 0:
-            warnings.append("IDIM-IV: the replay of the least-squares start failed; the least-squares start kept")
+        if iv_start is None:
+            warnings.append("IDIM-IV: the replay of the least-squares start did not stay finite; the least-squares "
+                            "start kept")
+        elif not iv_start.parameters["mass"] > 0:
+            warnings.append(f"IDIM-IV: the instrumental-variable mass is {iv_start.parameters['mass']:.3g} kg, not "
+                            "positive; the least-squares start kept")
         else:
             start = dataclasses.replace(iv_start, warnings=tuple(w for w in iv_start.warnings
                                                                   if w not in start.warnings))

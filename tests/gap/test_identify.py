@@ -171,5 +171,26 @@ def test_a_failed_instruments_replay_keeps_the_least_squares_start(runs):
     replays = [FirstDiverges(make_replay(r, free=())) for r in runs]
     idf = identify(runs, uncertain=(), fixed={"regularization_velocity": 1e-3}, replays=replays)
     assert idf.start.method == "LS"
-    assert any("IDIM-IV" in w and "least-squares start kept" in w for w in idf.warnings)
+    assert any("IDIM-IV" in w and "did not stay finite" in w and "least-squares start kept" in w for w in idf.warnings)
     assert idf.parameters["mass"] == pytest.approx(idim_start(runs).parameters["mass"])
+
+
+def test_a_non_positive_instrumental_mass_keeps_the_least_squares_start(runs, monkeypatch):
+    """An IDIM-IV solution whose mass is not positive is not used: the least-squares start is kept, and the
+    warning names the mass (not a failed replay)."""
+    import drakecreep.gap.identify as identify_module
+
+    real = identify_module.idim_start
+
+    def negative_mass(rs, instruments=None, **kw):
+        start = real(rs, instruments=instruments, **kw)
+        if instruments is None:
+            return start
+        return dataclasses.replace(start, parameters=dict(start.parameters, mass=-3.0))
+
+    monkeypatch.setattr(identify_module, "idim_start", negative_mass)
+    idf = identify(runs, uncertain=(), fixed={"regularization_velocity": 1e-3})
+    assert idf.start.method == "LS"
+    assert idf.parameters["mass"] == pytest.approx(real(runs).parameters["mass"])
+    assert any("instrumental-variable mass is -3 kg, not positive" in w for w in idf.warnings)
+    assert not any("did not stay finite" in w for w in idf.warnings)
