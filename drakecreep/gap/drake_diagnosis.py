@@ -490,8 +490,8 @@ def _verdict(t):
     level = "" if math.isnan(t.level_log_ratio) else \
         (f"; with each run's friction level {t.level_log_ratio:+.3f} vs bar {t.level_threshold:.3f}, "
          f"sign-flip p {t.level_p_sign_flip:.2g}" + {"plain": " (not asked of it)", "either": " (either test suffices)",
-                                                       "drift_robust": " (it suffices with the plain mean above its "
-                                                                       "null)"}
+                                                       "drift_robust": " (enough alone when the plain mean is above the "
+                                                                       "training-run null)"}
          .get(t.rule, ""))
     if t.regime:
         level += (f"; at {t.regime.replace('_', ' ')} {t.regime_log_ratio:+.3f} (standard error "

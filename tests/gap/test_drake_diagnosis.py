@@ -181,7 +181,7 @@ def test_the_level_test_alone_claims_when_the_plain_mean_is_above_its_null():
     assert D.CLAIM_RULE == "drift_robust"
     t = D._passes(reference, bearing, bar, null=(0.027, 0.006))
     assert t.passes and not D._passes(reference, bearing, bar, "both", null=(0.027, 0.006)).passes
-    assert "it suffices with the plain mean above its null" in D._verdict(t)
+    assert "(enough alone when the plain mean is above the training-run null)" in D._verdict(t)
     assert not D._passes(reference, bearing, bar, null=(0.30, 0.006)).passes  # plain mean 0.29 under the null
     assert D._passes(reference, backlash, bar, "level", null=(0.063, 0.059)).passes
     assert not D._passes(reference, backlash, bar, null=(0.063, 0.059)).passes
