@@ -168,7 +168,7 @@ class RankedEffect:
     :func:`_with_values`), else None (the nominal's). ``threshold`` and ``level_threshold``: the bars its two log
     ratios had to exceed; ``p_sign_flip`` and ``level_p_sign_flip``: their sign-flip p values; ``regime`` and
     ``regime_*``: the log ratio in the candidate's own regime, when it has one; ``rule``: the claim rule it was
-    decided on (:class:`ClaimTest`)."""
+    decided on; ``level_alone``: it passes by the level test alone (``drift_robust``: :class:`ClaimTest`)."""
 
     fit: EffectFit | None
     gain: float
@@ -190,6 +190,7 @@ class RankedEffect:
     regime_log_ratio_se: float = float("nan")
     regime_p_sign_flip: float = float("nan")
     rule: str = CLAIM_RULE
+    level_alone: bool = False
 
     @property
     def error_ratio(self):
@@ -377,7 +378,8 @@ class ClaimTest:
     friction level with their standard errors and sign-flip p values (:func:`~drakecreep.gap.claims.sign_flip_p`),
     the bar each log ratio had to exceed (``max(t * standard error, training-run null)``; the sign-flip test,
     when it passes, replaces the first term), whether the candidate passes, and the rule it was decided on
-    (:func:`_rule`)."""
+    (:func:`_rule`); ``level_alone``: it passes by the level test alone, the plain mean above its training-run
+    null (``drift_robust``)."""
 
     gain: float
     standard_error: float
@@ -395,6 +397,7 @@ class ClaimTest:
     regime_log_ratio_se: float = float("nan")
     regime_p_sign_flip: float = float("nan")
     rule: str = CLAIM_RULE
+    level_alone: bool = False
 
 
 def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime=""):
@@ -433,14 +436,16 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime=""):
     drift_robust = level_ok and (plain_ok or lr > null[0])
     ok = {"plain": plain_ok, "level": level_ok, "both": plain_ok and level_ok, "either": either,
           "drift_robust": drift_robust}[rule]
+    alone = rule == "drift_robust" and ok and not plain_ok
     if not regime:
-        return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok, p, lp, rule=rule)
+        return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok, p, lp, rule=rule, level_alone=alone)
     key = f"force_{regime}"
     if has(key):
         rm, rs, rp, _, regime_ok = test(key, 0.0)
     else:
         rm, rs, rp, regime_ok = float("nan"), float("nan"), float("nan"), False
-    return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok and regime_ok, p, lp, regime, rm, rs, rp, rule)
+    return ClaimTest(gain, se, lr, lr_se, lv, lv_se, thr, lthr, ok and regime_ok, p, lp, regime, rm, rs, rp, rule,
+                     alone and regime_ok)
 
 
 def training_run_null(test, nominal, nominal_test_errors):
@@ -489,10 +494,9 @@ def _verdict(t):
     fields)."""
     level = "" if math.isnan(t.level_log_ratio) else \
         (f"; with each run's friction level {t.level_log_ratio:+.3f} vs bar {t.level_threshold:.3f}, "
-         f"sign-flip p {t.level_p_sign_flip:.2g}" + {"plain": " (not asked of it)", "either": " (either test suffices)",
-                                                       "drift_robust": " (enough alone when the plain mean is above the "
-                                                                       "training-run null)"}
-         .get(t.rule, ""))
+         f"sign-flip p {t.level_p_sign_flip:.2g}" + {"plain": " (not asked of it)", "either": " (either test suffices)"}
+         .get(t.rule, "") + (" (passes alone: the plain mean is above the training-run null, its runs' signs mixed)"
+                             if getattr(t, "level_alone", False) else ""))
     if t.regime:
         level += (f"; at {t.regime.replace('_', ' ')} {t.regime_log_ratio:+.3f} (standard error "
                   f"{t.regime_log_ratio_se:.3f}, sign-flip p {t.regime_p_sign_flip:.2g})"

@@ -43,7 +43,7 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "level_log_error_ratio": r.level_log_ratio,
                                   "level_log_error_ratio_standard_error": r.level_log_ratio_se,
                                   "threshold_level_log_error_ratio": r.level_threshold,
-                                  "claim_rule": r.rule,
+                                  "claim_rule": r.rule, "level_test_alone": r.level_alone,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
             if r.regime:  # the regime the candidate must show in too (DrakeEffect.regime)

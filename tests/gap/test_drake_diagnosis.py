@@ -180,8 +180,11 @@ def test_the_level_test_alone_claims_when_the_plain_mean_is_above_its_null():
     null_asym = errors([0.244, 0.349, 0.037, 0.083, 0.307], [0.197, 0.323, -0.294, 0.081, 0.278])
     assert D.CLAIM_RULE == "drift_robust"
     t = D._passes(reference, bearing, bar, null=(0.027, 0.006))
-    assert t.passes and not D._passes(reference, bearing, bar, "both", null=(0.027, 0.006)).passes
-    assert "(enough alone when the plain mean is above the training-run null)" in D._verdict(t)
+    assert t.passes and t.level_alone and not D._passes(reference, bearing, bar, "both", null=(0.027, 0.006)).passes
+    assert "(passes alone: the plain mean is above the training-run null" in D._verdict(t)
+    real = errors([0.3, 0.35, 0.32, 0.4, 0.28], [0.3, 0.35, 0.32, 0.4, 0.28])  # both tests pass: not alone
+    t = D._passes(reference, real, bar, null=(0.027, 0.006))
+    assert t.passes and not t.level_alone and "passes alone" not in D._verdict(t)
     assert not D._passes(reference, bearing, bar, null=(0.30, 0.006)).passes  # plain mean 0.29 under the null
     assert D._passes(reference, backlash, bar, "level", null=(0.063, 0.059)).passes
     assert not D._passes(reference, backlash, bar, null=(0.063, 0.059)).passes

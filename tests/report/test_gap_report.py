@@ -43,7 +43,8 @@ def test_the_ranking_json_carries_a_candidate_s_regime_test():
 
 def test_the_ranking_json_carries_the_rule_a_candidate_was_decided_on():
     """``claim_rule`` in ``ranking.json``: ``either`` for a candidate that passes with either held-out test (a
-    friction along the travel), the diagnosis's ``CLAIM_RULE`` for the others."""
+    friction along the travel), the diagnosis's ``CLAIM_RULE`` for the others; ``level_test_alone``: whether the
+    level test alone carried the claim."""
     from types import SimpleNamespace
 
     from drakecreep.gap.drake_diagnosis import CLAIM_RULE, RankedEffect
@@ -59,6 +60,9 @@ def test_the_ranking_json_carries_the_rule_a_candidate_was_decided_on():
 
     nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
     out = ranking_json(nominal, {"r0": {"force": 9.0}},
-                       (ranked("position_friction", rule="either"), ranked("stribeck")))
+                       (ranked("position_friction", rule="either"), ranked("stribeck", level_alone=True)))
     rows = {r["effect"]: r["closed_loop"]["claim_rule"] for r in out["ranking"]}
     assert rows == {"position_friction": "either", "stribeck": CLAIM_RULE}
+    # whether the level test alone carried it (drift_robust)
+    assert {r["effect"]: r["closed_loop"]["level_test_alone"] for r in out["ranking"]} == \
+        {"position_friction": False, "stribeck": True}
