@@ -65,3 +65,16 @@ def test_a_corrupt_binary_file_is_one_line_exit_2(tmp_path, suffix, what, capsys
         assert len(err) == 1 and "needs the 'tables' package" in err[0]
         return
     assert len(err) == 1 and f"not a readable {what} file" in err[0]
+
+
+def test_one_training_run_has_no_null_so_the_level_test_alone_claims_nothing(capsys):
+    """The example segment's default split has one training run, so no training-run null: the control delay,
+    whose error with each run's own friction level shrinks significantly (+0.011 against a bar of 0.005) while
+    the plain one barely moves (+0.005), is not claimed (``drift_robust`` needs the null as the plain mean's
+    bar; it claimed this before the fix)."""
+    out = _diagnose(capsys, EXAMPLE, "--effects", "control_delay")
+    assert out["claimed"] == []
+    (row,) = [r for r in out["ranking"] if r["effect"] == "control_delay"]
+    loop = row["closed_loop"]
+    assert loop["level_log_error_ratio"] > loop["threshold_level_log_error_ratio"]  # the level test passes
+    assert not loop["level_test_alone"]

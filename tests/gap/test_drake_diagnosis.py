@@ -186,6 +186,8 @@ def test_the_level_test_alone_claims_when_the_plain_mean_is_above_its_null():
     t = D._passes(reference, real, bar, null=(0.027, 0.006))
     assert t.passes and not t.level_alone and "passes alone" not in D._verdict(t)
     assert not D._passes(reference, bearing, bar, null=(0.30, 0.006)).passes  # plain mean 0.29 under the null
+    # no training-run null (one training run): no bar for the plain mean, both tests must pass
+    assert not D._passes(reference, bearing, bar, null=(0.0, 0.0)).passes
     assert D._passes(reference, backlash, bar, "level", null=(0.063, 0.059)).passes
     assert not D._passes(reference, backlash, bar, null=(0.063, 0.059)).passes
     assert D._passes(reference, null_asym, bar, "plain", null=(0.046, 0.021)).passes
