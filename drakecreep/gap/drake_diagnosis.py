@@ -499,7 +499,7 @@ def _verdict(t):
         (f"; with each run's friction level {t.level_log_ratio:+.3f} vs bar {t.level_threshold:.3f}, "
          f"sign-flip p {t.level_p_sign_flip:.2g}" + {"plain": " (not asked of it)", "either": " (either test suffices)"}
          .get(t.rule, "") + (" (passes alone: the plain mean is above the training-run null, its runs' signs mixed)"
-                             if getattr(t, "level_alone", False) else ""))
+                             if t.level_alone else ""))
     if t.regime:
         level += (f"; at {t.regime.replace('_', ' ')} {t.regime_log_ratio:+.3f} (standard error "
                   f"{t.regime_log_ratio_se:.3f}, sign-flip p {t.regime_p_sign_flip:.2g})"
