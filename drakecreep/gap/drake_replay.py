@@ -45,6 +45,7 @@ from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 __all__ = [
     "DrakeReplay",
     "SampledReplay",
+    "MAX_SUBSTEPS",
     "make_replay",
     "DrakeReplayResult",
     "drake_replay",
@@ -93,6 +94,13 @@ def _table_position(x_motor, vec):
 def _lead_offset(x0, vec):
     """The lead error at ``x0`` [m] for ``vec``: the two-mass axis's table starts there, on its relaxed spring."""
     return float(lead_error(float(x0), vec)[0])
+
+
+#: The most ticks per sample :class:`SampledReplay` takes. A parameter vector that needs more (a least-squares
+#: step to an astronomically stiff friction or bristle) is replayed as diverged, all samples NaN, at once: one
+#: asked for more than 1e18 ticks per sample and hung held-out run 18's nominal fit. Physical axes need 1-30
+#: (LuGre bristles of 2e7 N/m on a 95 kg axis: 5; an axial mode at 9 kHz, 30 times the search's top: about 230).
+MAX_SUBSTEPS = 256
 
 
 @dataclass(frozen=True)
@@ -403,7 +411,10 @@ class SampledReplay:
             red = 1.0 / m_m + 1.0 / m_t
             # an oscillation needs finer steps than a decay: the mode's rate counts twice
             rate = max(rate, 2.0 * math.sqrt(k * red), c * red)
-        return max(self.min_substeps, int(math.ceil(self.h * rate / self.rate_step)))
+        ticks = self.h * rate / self.rate_step
+        if not ticks <= 1e18:  # inf or NaN from an overflowing parameter: far beyond MAX_SUBSTEPS either way
+            ticks = 1e18
+        return max(self.min_substeps, int(math.ceil(ticks)))
 
     def _key(self, vec):
         fixed = tuple(float(v) for n, v in zip(AXIS_PARAMETERS, vec) if n not in self.free)
@@ -538,9 +549,16 @@ class SampledReplay:
         Returns
         -------
         DrakeReplayResult
+            All samples NaN, at once, when the parameters need more than :data:`MAX_SUBSTEPS` ticks per sample
+            (a diverged replay, which the fits step back from).
         """
         start = _time.perf_counter()
         vec = axis_parameters(**parameters)
+        if self.substeps_for(vec) > MAX_SUBSTEPS:  # diverged: see MAX_SUBSTEPS
+            nan = np.full(self.run.n, np.nan)
+            return DrakeReplayResult(run=self.run, x_motor=nan, x_table=nan.copy(), u=nan.copy(), force=nan.copy(),
+                                     parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
+                                     wall_time=_time.perf_counter() - start)
         m, sysm, simulator, context, default, log, layout = self._system(vec)
         self.substeps = m
         context.SetTimeStateAndParametersFrom(default)

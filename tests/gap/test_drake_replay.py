@@ -231,6 +231,35 @@ def test_sampled_replay_rebuilds_for_new_fixed_values_and_finer_steps(run):
         SampledReplay(run, free=("no_such",))
 
 
+def test_a_replay_that_needs_more_than_max_substeps_is_returned_diverged_at_once(run):
+    """A least-squares step to an astronomically stiff bristle asks for more ticks
+    per sample than any axis needs: the replay returns all-NaN samples at once instead of hanging (held-out run
+    18's nominal fit asked for more than 1e18 ticks per sample), and the identification's residual treats that as
+    a very poor fit. Physical values stay under :data:`MAX_SUBSTEPS`: LuGre bristles of 2e7 N/m, an axial mode
+    at 9 kHz (30 times the mode search's top)."""
+    import time
+
+    from drakecreep.gap.drake_replay import MAX_SUBSTEPS, SampledReplay, axis_parameters
+    from drakecreep.gap.identify import _Problem
+
+    p = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3)
+    rep = SampledReplay(run, free=("bristle_stiffness",))
+    assert rep.substeps_for(axis_parameters(**dict(p, bristle_stiffness=2e7))) <= 10
+    m_red = p["mass"] * 0.2 * 0.8
+    k9 = (2 * np.pi * 9e3) ** 2 * m_red
+    flex = SampledReplay(run, flexible=True, free=())
+    assert flex.substeps_for(axis_parameters(**dict(p, stiffness=k9, motor_mass_fraction=0.2))) <= MAX_SUBSTEPS
+    for stiff in (1e40, 1e300):
+        start = time.perf_counter()
+        res = rep.simulate(dict(p, bristle_stiffness=stiff))
+        assert time.perf_counter() - start < 1.0  # not a timing benchmark: a hang would take hours
+        assert res.x_motor.shape == (run.n,) and np.all(np.isnan(res.x_motor)) and np.all(np.isnan(res.force))
+    ok = rep.simulate(dict(p, bristle_stiffness=2e7))
+    assert np.all(np.isfinite(ok.force))
+    residual = _Problem.residual_of([rep.simulate(dict(p, bristle_stiffness=1e40))])
+    assert np.all(np.isfinite(residual)) and np.all(np.abs(residual) > 0)
+
+
 def test_sampled_replay_keeps_a_limit_cycle_the_default_accuracy_misses():
     """A stiff two-mass axis (212 Hz mode) under the P-P loop limit-cycles at saturation: the sampled replay and the
     error-controlled replay at accuracy 1e-6 agree on it, the error-controlled replay at its default 1e-4 does not
