@@ -46,6 +46,7 @@ __all__ = [
     "DrakeReplay",
     "SampledReplay",
     "MAX_SUBSTEPS",
+    "diverged_result",
     "make_replay",
     "DrakeReplayResult",
     "drake_replay",
@@ -101,6 +102,14 @@ def _lead_offset(x0, vec):
 #: asked for more than 1e18 ticks per sample and hung held-out run 18's nominal fit. Physical axes need 1-30
 #: (LuGre bristles of 2e7 N/m on a 95 kg axis: 5; an axial mode at 9 kHz, 30 times the search's top: about 230).
 MAX_SUBSTEPS = 256
+
+
+def diverged_result(run, parameters=None, wall_time=0.0):
+    """A :class:`DrakeReplayResult` of ``run`` whose samples are all NaN: a replay that diverged, or was not run
+    because its parameters could not be (:data:`MAX_SUBSTEPS`, non-finite values)."""
+    nan = np.full(run.n, np.nan)
+    return DrakeReplayResult(run=run, x_motor=nan, x_table=nan.copy(), u=nan.copy(), force=nan.copy(),
+                             parameters=dict(parameters or {}), wall_time=wall_time)
 
 
 @dataclass(frozen=True)
@@ -555,10 +564,8 @@ class SampledReplay:
         start = _time.perf_counter()
         vec = axis_parameters(**parameters)
         if self.substeps_for(vec) > MAX_SUBSTEPS:  # diverged: see MAX_SUBSTEPS
-            nan = np.full(self.run.n, np.nan)
-            return DrakeReplayResult(run=self.run, x_motor=nan, x_table=nan.copy(), u=nan.copy(), force=nan.copy(),
-                                     parameters={k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
-                                     wall_time=_time.perf_counter() - start)
+            return diverged_result(self.run, {k: float(v) for k, v in zip(AXIS_PARAMETERS, vec)},
+                                   _time.perf_counter() - start)
         m, sysm, simulator, context, default, log, layout = self._system(vec)
         self.substeps = m
         context.SetTimeStateAndParametersFrom(default)

@@ -40,7 +40,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import drake_replay_errors, make_replay
+from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR
 
@@ -271,14 +271,18 @@ class _Problem:
         return value / self.scale[i]
 
     def to_values(self, x):
-        v = np.where(self.log, np.exp(x), x * self.scale)
+        with np.errstate(over="ignore"):  # past exp's range: inf, replayed as diverged (simulate)
+            v = np.where(self.log, np.exp(x), x * self.scale)
         out = dict(self.base)
         out.update(zip(self.names, (float(a) for a in v)))
         return out
 
     def simulate(self, values):
         start = _time.perf_counter()
-        results = [rep.simulate(values) for rep in self.replays]
+        if all(math.isfinite(v) for v in values.values()):
+            results = [rep.simulate(values) for rep in self.replays]
+        else:  # a log-scaled step past exp's range (inf): a replay that cannot be run is a diverged one
+            results = [diverged_result(rep.run, values) for rep in self.replays]
         self.evaluations += 1
         self.seconds += _time.perf_counter() - start
         return results

@@ -258,6 +258,15 @@ def test_a_replay_that_needs_more_than_max_substeps_is_returned_diverged_at_once
     assert np.all(np.isfinite(ok.force))
     residual = _Problem.residual_of([rep.simulate(dict(p, bristle_stiffness=1e40))])
     assert np.all(np.isfinite(residual)) and np.all(np.abs(residual) > 0)
+    # a log-scaled step past exp's range gives inf, which the axis refuses: the fit's problem replays it as
+    # diverged instead of raising mid-fit
+    from drakecreep.model.axis import AXIS_PARAMETERS
+
+    base = dict(zip(AXIS_PARAMETERS, axis_parameters(**dict(p, bristle_stiffness=2e7))))
+    prob = _Problem([rep], base, ("bristle_stiffness",))
+    far = prob.residual(np.array([800.0]))  # exp(800) = inf
+    assert far.shape == prob.residual(prob.to_x(base)).shape
+    assert np.all(np.isfinite(far)) and np.max(np.abs(far)) > 100.0
 
 
 def test_sampled_replay_keeps_a_limit_cycle_the_default_accuracy_misses():
