@@ -443,9 +443,11 @@ class DisturbanceParams(_Params):
     """Periodic disturbances of a real rig that the base model leaves out; all amplitudes 0 = off.
 
     ``lead_error``: a kinematic error of the screw-nut pair, the nut advancing
-    ``theta Ph / 2 pi + a sin(2 pi (theta Ph / 2 pi) / period)`` (lead-error harmonic, ball-passage
-    waviness); the motor encoder cannot see it. ``load_ripple``: the axial load of the load case
-    (the paper's air cylinders) pulsates as ``Fx (1 + r sin(2 pi f t))``. See
+    ``x + a sin(2 pi x / period + phase)`` for a travel ``x = theta Ph / 2 pi`` (lead-error harmonic,
+    ball-passage waviness); the motor encoder cannot see it. The error is fixed to the screw: ``phase`` is its
+    phase at the screw position a measured run's ``x_motor`` counts from; a simulation starts there.
+    ``load_ripple``: the axial load of the load case (the paper's air cylinders) pulsates as
+    ``Fx (1 + r sin(2 pi f t))``. See
     :mod:`drakecreep.model.disturbances`.
     """
 
@@ -453,6 +455,8 @@ class DisturbanceParams(_Params):
     lead_error_period: float = _q(
         5.0e-3 / 12.0, "m", 0.0, 0.1, lo_open=True, doc="travel per cycle of the lead error"
     )
+    lead_error_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
+                                 doc="phase of the lead error at the screw's position 0")
     force_ripple: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude A of a fixed-frequency force ripple on the table")
     load_ripple: float = _q(0.0, "-", 0.0, 1.0, doc="relative amplitude r of the axial load pulsation")
     ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")

@@ -744,6 +744,18 @@ def replay_params(run, params=None, quantize=True):
     return dataclasses.replace(params, sensors=sensors)
 
 
+def _lead_error_at(params, x_origin):
+    """``params`` with the lead error's phase moved from the screw's position 0 to ``x_origin`` [m] (the run's
+    first motor position, where the replayed diagram starts): the error is fixed to the screw, not to the run."""
+    d = params.disturbance
+    if not d.lead_error_amplitude > 0.0 or x_origin == 0.0:
+        return params
+    from drakecreep.params import with_value
+
+    phase = math.remainder(d.lead_error_phase + 2.0 * math.pi * x_origin / d.lead_error_period, 2.0 * math.pi)
+    return with_value(params, "disturbance.lead_error_phase", phase)
+
+
 def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="compiled"):
     """Replay ``run`` through the project's feed-drive diagram (``controller: {kind: drakecreep}``).
 
@@ -753,7 +765,9 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     elastic screw and table with their friction law and disturbances; the ramp reference is replaced by the
     measured one (``TrajectorySource`` of a first-order hold, the speed its slope) and ``f_ext`` (a
     zero-order hold) is added to the push on the table. Positions are relative to the first sample (the
-    diagram starts at rest at 0, in equilibrium under ``load_case``).
+    diagram starts at rest at 0, in equilibrium under ``load_case``); the lead error, fixed to the screw, keeps
+    its phase at the run's absolute start position ``x_motor[0]`` (``disturbance.lead_error_phase`` is its
+    phase at the screw's position 0).
 
     ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem`` systems
     (:func:`drakecreep.sim.compiled.compile_diagram`, the reference and ``f_ext`` its ``inputs`` port, fed
@@ -787,6 +801,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     start = _time.perf_counter()
     t = run.t - run.t[0]
     x_origin = float(run.x_motor[0])
+    params = _lead_error_at(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)
     reference = TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr])))
@@ -868,7 +883,7 @@ def quick_replay_params(params):
 
 
 def simulated_runs(truth, speeds, *, declared=None, n=500, dt=1e-3, noise=0.0, seed=0, leg=0.2,
-                   starts=(0.03, 0.26), f_ext=None, label="r"):
+                   starts=(0.03, 0.26), f_ext=None, label="r", origins=None):
     """Runs of the project's controller as a measurement of the rig ``truth`` would record them.
 
     Each run is an out-and-back reference (:func:`drakecreep.gap.truth.out_and_back`) at one of ``speeds``,
@@ -895,6 +910,9 @@ def simulated_runs(truth, speeds, *, declared=None, n=500, dt=1e-3, noise=0.0, s
         Known external force on the table, the same for every run [N].
     label : str
         Run labels are ``label + index``.
+    origins : sequence of float, optional
+        Position where each run starts [m] (default 0 for all): where a lead error fixed to the screw is in
+        its period.
 
     Returns
     -------
@@ -910,8 +928,11 @@ def simulated_runs(truth, speeds, *, declared=None, n=500, dt=1e-3, noise=0.0, s
     t = np.arange(n) * dt
     force = None if f_ext is None else np.asarray(f_ext, dtype=float)
     runs = []
+    origins = [0.0] * len(speeds) if origins is None else [float(o) for o in origins]
+    if len(origins) != len(speeds):
+        raise InputError("origins", len(origins), f"one start position per speed ({len(speeds)})")
     for i, v in enumerate(speeds):
-        x_ref = out_and_back(v, 0.0, n=n, dt=dt, leg=leg, starts=starts)
+        x_ref = out_and_back(v, origins[i], n=n, dt=dt, leg=leg, starts=starts)
         blank = MeasuredRun(t=t, x_ref=x_ref, x_motor=x_ref, u=np.zeros(n), meta=meta, f_ext=force,
                             label=f"{label}{i}")
         sim = replay_drakecreep(blank, truth)

@@ -113,7 +113,7 @@ LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude",), "force_ripple": ("disturbance.force_ripple",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
-    "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude, period lead/k)",
+    "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k)",
     "force_ripple": "force ripple on the table at a fixed frequency (disturbance.force_ripple, ripple_frequency)",
     "stribeck": "velocity weakening: the Stribeck law with fitted friction.static_ratio and stribeck_velocity",
     "law_coulomb": "friction law switched to coulomb (same levels)",
@@ -559,6 +559,45 @@ def _amplitude_effect(runs, base, amp_path, grid_path, grid, trial, replayer, ba
     return {grid_path: g, amp_path: a}, sse
 
 
+def _lead_error_effect(runs, base, grid, trial, replayer, base_sims, scale):
+    """The lead error's period, amplitude and phase: ``(values, sse)``.
+
+    The error is fixed to the screw, ``e(x) = a sin(2 pi x / P + phi)`` (``x`` the absolute motor position), so
+    runs that start at other positions see it at other phases. To first order the residual is linear in the
+    quadratures ``(a cos phi, a sin phi)``: two replays per period at a trial amplitude (``phi`` = 0 and pi / 2)
+    give its two slopes, linear least squares the optimum; the best period is replayed there and a secant step
+    along the amplitude refines it (measured, not predicted, SSE)."""
+    amp, period, phase = ("disturbance.lead_error_amplitude", "disturbance.lead_error_period",
+                          "disturbance.lead_error_phase")
+    r0 = _residual(runs, base_sims, scale)
+    jobs = [(runs, _with(base, {period: g, amp: trial, phase: ph})) for g in grid for ph in (0.0, 0.5 * math.pi)]
+    many = getattr(replayer, "many", None)  # every replay at once (in parallel over a pool)
+    sims = many(jobs) if many is not None else [replayer(*job) for job in jobs]
+    best = None
+    for i, g in enumerate(grid):
+        slopes = np.column_stack([(r0 - _residual(runs, s, scale)) / trial for s in sims[2 * i: 2 * i + 2]])
+        if not np.any(slopes):
+            continue
+        (c, s_), *_ = np.linalg.lstsq(slopes, r0, rcond=None)
+        a = float(min(math.hypot(c, s_), 50 * trial))
+        ph = float(math.atan2(s_, c))
+        lin = r0 - slopes @ (a * np.array([math.cos(ph), math.sin(ph)]))
+        if best is None or float(lin @ lin) < best[0]:
+            best = (float(lin @ lin), g, a, ph)
+    if best is None or best[2] == 0.0:
+        return {}, float(r0 @ r0)
+    _, g, a, ph = best
+    at = _with(base, {period: g, phase: ph})
+    r_a = _residual(runs, replayer(runs, _with(at, {amp: a})), scale)
+    a2, _, _ = _screen(at, a, r_a, r0)  # the linear optimum along the ray 0 -> a at this phase
+    out = (a, float(r_a @ r_a))
+    if abs(a2 - a) > 1e-3 * a and a2 > 0.0:
+        r_2 = _residual(runs, replayer(runs, _with(at, {amp: a2})), scale)
+        if float(r_2 @ r_2) < out[1]:
+            out = (a2, float(r_2 @ r_2))
+    return {period: g, amp: out[0], phase: ph}, out[1]
+
+
 def _ripple_frequencies(runs, sims, k=2):
     """The ``k`` largest peaks of the training force residual's spectrum between 1 and 300 Hz."""
     n = min(r.n for r in runs)
@@ -579,8 +618,10 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
     scale = _force_scale(runs)
     lead = base.screw.lead
     if name == "lead_error":
-        values, sse = _amplitude_effect(runs, base, "disturbance.lead_error_amplitude", "disturbance.lead_error_period",
-                                        [lead / k for k in LEAD_HARMONICS], 1e-6, replayer, base_sims, scale)
+        values, sse = _lead_error_effect(runs, base, [lead / k for k in LEAD_HARMONICS], 1e-6, replayer, base_sims,
+                                         scale)
+        if not values:
+            return {}, 0.0
     elif name == "force_ripple":
         values, sse = _amplitude_effect(runs, base, "disturbance.force_ripple", "disturbance.ripple_frequency",
                                         _ripple_frequencies(runs, base_sims), 0.1 * scale, replayer, base_sims,

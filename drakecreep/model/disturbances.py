@@ -6,8 +6,9 @@ working; :func:`add_disturbances` wires them into the diagram only when their am
 
 LeadError
     Kinematic error of the screw-nut pair: the nut advances ``u(theta) = r theta + e(theta)`` with
-    ``r = Ph / 2 pi`` and ``e = a sin(2 pi r (theta - theta0) / P)`` (a lead-error harmonic of travel
-    period ``P``, e.g. the waviness left by ball passage in the nut). The screw's spring sees ``u``
+    ``r = Ph / 2 pi`` and ``e = a [sin(2 pi r (theta - theta0) / P + phi) - sin(phi)]`` (a lead-error harmonic
+    of travel period ``P``, e.g. the waviness left by ball passage in the nut; ``phi`` its phase at the start
+    angle ``theta0``, where ``e`` is counted from so the screw starts relaxed). The screw's spring sees ``u``
     instead of ``r theta``, and by virtual work the motor carries ``F du/dtheta = F (r + e')``; the
     screw already returns ``F r``, this system adds ``F e'``. A semi-closed loop (motor encoder)
     cannot see the error, so the table speed carries a ripple ``2 pi a / P`` of the feed, whatever
@@ -58,12 +59,13 @@ def LeadError_(T):
         torque : 1, ``F e'(theta)`` (N m), the reaction torque the screw's ``F r`` leaves out
         """
 
-        def _construct(self, amplitude, period, lead, angle0=0.0, converter=None):
+        def _construct(self, amplitude, period, lead, angle0=0.0, phase=0.0, converter=None):
             LeafSystem_[T].__init__(self, converter=converter)
             self.amplitude = float(amplitude)
             self.period = float(period)
             self.lead = float(lead)
             self.angle0 = float(angle0)
+            self.phase = float(phase)
             self.ratio = self.lead / (2.0 * math.pi)
             self._u_motor_state = self.DeclareVectorInputPort("motor_state", 2)
             self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
@@ -71,10 +73,11 @@ def LeadError_(T):
             self.DeclareVectorOutputPort("torque", 1, self._calc_torque)
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.amplitude, other.period, other.lead, other.angle0, converter=converter)
+            Impl._construct(self, other.amplitude, other.period, other.lead, other.angle0, other.phase,
+                            converter=converter)
 
         def _phase(self, theta):
-            return 2.0 * math.pi * self.ratio * (theta - self.angle0) / self.period
+            return 2.0 * math.pi * self.ratio * (theta - self.angle0) / self.period + self.phase
 
         def slope(self, theta):
             """``de/dtheta`` (m/rad)."""
@@ -82,7 +85,7 @@ def LeadError_(T):
 
         def _calc_motion(self, context, output):
             theta, omega = self._u_motor_state.Eval(context)
-            error = self.amplitude * sin(self._phase(theta))
+            error = self.amplitude * (sin(self._phase(theta)) - math.sin(self.phase))
             output.SetFromVector(vector([theta + error / self.ratio, omega * (1.0 + self.slope(theta) / self.ratio)]))
 
         def _calc_torque(self, context, output):
@@ -142,7 +145,8 @@ def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
     d = params.disturbance
     ports = dict(ports)
     if d.lead_error_amplitude > 0.0:
-        lead = builder.AddSystem(LeadError(d.lead_error_amplitude, d.lead_error_period, params.screw.lead, angle0))
+        lead = builder.AddSystem(LeadError(d.lead_error_amplitude, d.lead_error_period, params.screw.lead, angle0,
+                                           d.lead_error_phase))
         lead.set_name("lead_error")
         torque_sum = builder.AddSystem(Adder(2, 1))
         torque_sum.set_name("load_torque_sum")

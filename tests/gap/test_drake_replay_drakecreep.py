@@ -76,3 +76,27 @@ def test_coarser_declared_encoder_changes_the_replay():
     count = rig.screw.lead / 2**10
     assert np.max(np.abs(coarse.u - fine.u)) > rig.controller.velocity_gain * count / rig.controller.velocity_period
     assert math.isfinite(coarse.wall_time) and dataclasses.is_dataclass(coarse)
+
+
+def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
+    """A run that starts at ``x0`` meets the lead error at phase ``phi + 2 pi x0 / P``: its replay is the replay of
+    the same run started at 0 with that phase, and differs from a run at another position."""
+    from drakecreep.gap.drake_replay import _lead_error_at
+
+    rig = with_value(_rig(), "disturbance.lead_error_phase", 0.4)
+    period = rig.disturbance.lead_error_period
+    x0 = 0.123 * period + 3 * period  # a quarter-ish period off, three periods along
+    at0 = _run(rig)
+    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
+    shifted = with_value(rig, "disturbance.lead_error_phase",
+                         math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi))
+    a = replay_drakecreep(moved, rig)
+    b = replay_drakecreep(at0, shifted)
+    assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
+    plain = replay_drakecreep(at0, rig)
+    assert np.max(np.abs(plain.x_table - b.x_table)) > 0.2 * rig.disturbance.lead_error_amplitude
+    assert _lead_error_at(rig, 0.0) is rig
+    off = with_value(rig, "disturbance.lead_error_amplitude", 0.0)
+    assert _lead_error_at(off, x0) is off
+    with pytest.raises(InputError, match="disturbance.lead_error_phase"):
+        with_value(rig, "disturbance.lead_error_phase", 7.0)

@@ -7,6 +7,7 @@ loop, so that a 0.5 s run replays in well under a second.
 """
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -51,6 +52,16 @@ def lead_case():
     return truth, diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=CANDIDATES)
 
 
+@pytest.fixture(scope="module")
+def lead_phase_case():
+    """Truth: a 2 um lead error fixed to the screw at phase -2.3 rad; the runs start at four positions, so each
+    meets it at another phase."""
+    truth = with_value(with_value(RIG, "disturbance.lead_error_amplitude", 2e-6), "disturbance.lead_error_phase", -2.3)
+    runs = simulated_runs(truth, SPEEDS, declared=RIG, n=N, noise=NOISE, seed=300,
+                          origins=(0.0071, 0.0502, 0.0264, 0.0933))
+    return truth, diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=CANDIDATES)
+
+
 def test_coulomb_change_is_recovered_within_its_interval(coulomb_case):
     truth, result = coulomb_case
     assert isinstance(result, DriveDiagnosis)
@@ -62,6 +73,20 @@ def test_coulomb_change_is_recovered_within_its_interval(coulomb_case):
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.nominal_test_errors) < 0.2 * rms(result.prior_test_errors)
     assert result.claimed == ()  # the change is a fitted level, not a missing effect
+
+
+def test_lead_error_phase_is_fitted_on_runs_that_start_at_other_positions(lead_phase_case):
+    """The lead error's quadratures are fitted, so runs at other positions line up: amplitude and phase recovered,
+    and the held-out force error falls to a fraction of the nominal's (a phase-less fit of such runs halved the
+    amplitude and left 5.1 % of 5.7 % on a development seed)."""
+    truth, result = lead_phase_case
+    assert result.claimed == ("lead_error",)
+    d = result.params.disturbance
+    assert d.lead_error_period == pytest.approx(truth.screw.lead / 12)
+    assert d.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
+    assert abs(math.remainder(d.lead_error_phase - (-2.3), 2 * math.pi)) < 0.1
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(result.test_errors) < 0.3 * rms(result.nominal_test_errors)
 
 
 def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):

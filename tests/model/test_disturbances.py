@@ -44,3 +44,32 @@ def test_disturbed_diagram_compiles_and_matches_the_leaf_systems(short_paper):
     fast = simulate(p, scenario, backend="compiled").metrics
     leaf = simulate(p, scenario, backend="leaf").metrics
     assert fast.max_fluctuation == pytest.approx(leaf.max_fluctuation, rel=0.02)
+
+
+def test_lead_error_phase_counts_from_the_start_angle_and_survives_scalar_conversion():
+    """``e = a [sin(2 pi r (theta - theta0) / P + phi) - sin(phi)]``: zero at the start (the screw starts
+    relaxed), its slope ``a 2 pi / P cos(...)`` in the torque; AutoDiffXd and symbolic copies keep the phase."""
+    import numpy as np
+
+    from drakecreep.model.disturbances import LeadError
+
+    a, period, lead, theta0, phi = 2e-6, 5e-3 / 12, 5e-3, 0.7, 1.1
+    r = lead / (2 * math.pi)
+    sys_ = LeadError(a, period, lead, theta0, phi)
+    for copy in (sys_, sys_.ToAutoDiffXd(), sys_.ToSymbolic()):
+        assert copy.phase == phi and copy.angle0 == theta0
+    for theta in (theta0, theta0 + 0.3, theta0 - 2.0):
+        ctx = sys_.CreateDefaultContext()
+        sys_.GetInputPort("motor_state").FixValue(ctx, [theta, 10.0])
+        sys_.GetInputPort("axial_force").FixValue(ctx, [50.0])
+        arg = 2 * math.pi * r * (theta - theta0) / period + phi
+        e = a * (math.sin(arg) - math.sin(phi))
+        motion = sys_.GetOutputPort("nut_motion").Eval(ctx)
+        assert motion[0] == pytest.approx(theta + e / r, abs=1e-12)
+        slope = a * 2 * math.pi * r / period * math.cos(arg)
+        assert motion[1] == pytest.approx(10.0 * (1 + slope / r), rel=1e-12)
+        assert sys_.GetOutputPort("torque").Eval(ctx)[0] == pytest.approx(50.0 * slope, rel=1e-12)
+    ctx = sys_.CreateDefaultContext()
+    sys_.GetInputPort("motor_state").FixValue(ctx, [theta0, 0.0])
+    sys_.GetInputPort("axial_force").FixValue(ctx, [0.0])
+    assert np.isclose(sys_.GetOutputPort("nut_motion").Eval(ctx)[0], theta0, rtol=0, atol=1e-15)
