@@ -11,9 +11,9 @@ and the true effect fitted with its expected label.
 Controller kinds (:data:`BENCHMARK_KINDS`): ``p_p_cascade`` is diagnosed with ``diagnose_drake``; ``drakecreep``
 with its own product path, :func:`drakecreep.gap.drive_fit.diagnose_drive`, on the params file the truth's
 user would write (:func:`declared_params`: the truth's effect-free physics mapped onto ``DriveParams``, its
-friction levels off by a drawn factor). For that kind only Stribeck, lead error and the time ripple have a
-``DriveParams`` candidate (:data:`EXPECTED_DRIVE`); every other withheld effect is out of its library (the
-right answer is "unexplained"), and its audit has no true-effect fit (no relative shrink).
+friction levels off by a drawn factor). For that kind only Stribeck, lead error, the time ripple and the
+control delay have a ``DriveParams`` candidate (:data:`EXPECTED_DRIVE`); every other withheld effect is out of
+its library (the right answer is "unexplained"), and its audit has no true-effect fit (no relative shrink).
 
 Kinds of dataset (:attr:`Dataset.category`):
 
@@ -124,9 +124,11 @@ EXPECTED = {
 }
 #: The candidate of :data:`drakecreep.gap.drive_fit.EFFECTS` that should win for each withheld effect on
 #: ``kind: drakecreep`` data. The truth's time ripple acts on the motor side, the params file's
-#: ``force_ripple`` on the table: the same force below the axial mode. The other library effects have no
-#: ``DriveParams`` field (``drive_fit.NOT_IN_MODEL``): for this kind they are out of library.
-EXPECTED_DRIVE = {"stribeck": "stribeck", "lead_error": "lead_error", "time_ripple": "force_ripple"}
+#: ``force_ripple`` on the table: the same force below the axial mode. The truth's control delay (1-3 recording
+#: samples, 4-12 speed-loop ticks) is ``controller.computation_delay``'s (session 36). The other library effects
+#: have no ``DriveParams`` field (``drive_fit.NOT_IN_MODEL``): for this kind they are out of library.
+EXPECTED_DRIVE = {"stribeck": "stribeck", "lead_error": "lead_error", "time_ripple": "force_ripple",
+                  "control_delay": "control_delay"}
 #: Controller kinds the benchmark diagnoses, each with its product path (``diagnose_drake``, ``diagnose_drive``).
 BENCHMARK_KINDS = ("p_p_cascade", "drakecreep")
 #: Kinds a benchmark runs when none are given.

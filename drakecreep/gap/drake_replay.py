@@ -772,7 +772,9 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem`` systems
     (:func:`drakecreep.sim.compiled.compile_diagram`, the reference and ``f_ext`` its ``inputs`` port, fed
     by C++ ``TrajectorySource`` systems: no Python in the loop); ``"leaf"`` the Python leaf systems (same
-    equations, same integrator; kept as the cross-check, ``tests/gap/test_drake_replay.py``).
+    equations, same integrator; kept as the cross-check, ``tests/gap/test_drake_replay.py``). A fractional
+    ``controller.computation_delay`` is replayed on the leaf systems whatever ``backend`` says (the compiled path
+    takes one sampling offset; about 10 times slower).
 
     Parameters
     ----------
@@ -798,6 +800,9 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     if backend not in ("compiled", "leaf"):
         raise InputError("backend", backend, "compiled or leaf")
     params = replay_params(run, params, quantize)
+    ctrl = params.controller
+    if backend == "compiled" and ctrl.sampled and not float(ctrl.computation_delay).is_integer():
+        backend = "leaf"  # a fractional delay is a second sampling offset, which the compiled path refuses
     start = _time.perf_counter()
     t = run.t - run.t[0]
     x_origin = float(run.x_motor[0])
@@ -814,7 +819,6 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     # (the last tick of the previous sample): with the position loop at 1 kHz and the speed loop at 4 kHz that
     # tick's force lags the sample's by an acceleration-dependent step (+-7 kg of apparent mass on a 72 kg
     # axis, docs/gap_benchmark.md, 3d). So the log runs at the speed loop's period and u is read one tick later.
-    ctrl = params.controller
     tick = min(ctrl.velocity_period, run.dt) if ctrl.sampled else run.dt
     b = DiagramBuilder()
     if backend == "compiled":

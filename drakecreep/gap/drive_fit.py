@@ -121,7 +121,13 @@ EFFECTS = {
     "law_lugre": "friction law switched to lugre (same levels and shape)",
     "law_gms": "friction law switched to gms (same levels and shape)",
     "nut_friction_side": "the nut's friction moved between the table and the screw (friction.nut_friction_on)",
+    "control_delay": "computation delay of the sampled controller (controller.computation_delay, whole velocity "
+                     "samples) fitted by a search over the delay",
 }
+#: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
+#: replay takes no fractional delay: a fraction adds a second sampling offset), up to 4 ms at a 4 kHz speed loop;
+#: the best is refined by halving the gaps to its neighbours down to one sample.
+DELAY_GRID = (0, 1, 2, 4, 8, 12, 16)
 #: Effects of issue 16 that DriveParams cannot express: never ranked, with the reason.
 NOT_IN_MODEL = {
     "asymmetric_friction": "DriveParams has one friction level for both directions",
@@ -130,7 +136,6 @@ NOT_IN_MODEL = {
     "cogging": "no motor cogging field in DriveParams",
     "backlash": "no lost-motion field in DriveParams",
     "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
-    "control_delay": "no computation-delay field in ControllerParams",
     "quantization": "the sensor resolutions are declared in the run metadata (replayed as declared), not fitted",
     "friction_drift": "no time-dependent friction field in DriveParams",
     "drive_gain": "u_gain is declared in the run metadata, not a DriveParams field",
@@ -598,6 +603,37 @@ def _lead_error_effect(runs, base, grid, trial, replayer, base_sims, scale):
     return {period: g, amp: out[0], phase: ph}, out[1]
 
 
+def _delay_effect(runs, base, replayer, base_sims, scale):
+    """The computation delay that replays the training ``runs`` best: ``({path: delay}, sse)``.
+
+    A delay is not a small change of a smooth model (each whole sample shifts the command by a step), so it is
+    searched, not fitted: every delay of :data:`DELAY_GRID`, then, while the best delay's nearest tried
+    neighbours (the params file's delay among them) are more than a sample away, the whole samples halfway to
+    them. The params file's own delay is never the answer (it is the nominal): the best other one is."""
+    path = "controller.computation_delay"
+    declared = float(base.controller.computation_delay)
+    r0 = _residual(runs, base_sims, scale)
+    tried = {declared: float(r0 @ r0)}
+
+    def replay(delays):
+        delays = sorted({float(d) for d in delays} - set(tried))
+        for d, sims in zip(delays, replayer.many([(runs, _with(base, {path: d})) for d in delays])):
+            r = _residual(runs, sims, scale)
+            tried[d] = float(r @ r)
+
+    replay(DELAY_GRID)
+    while True:
+        best = min((d for d in tried if d != declared), key=tried.get)
+        lower = [d for d in tried if d < best]
+        upper = [d for d in tried if d > best]
+        halfway = ([math.floor(0.5 * (best + max(lower)))] if lower else []) + \
+                  ([math.ceil(0.5 * (best + min(upper)))] if upper else [])
+        new = [d for d in halfway if d not in tried and d != best]
+        if not new:
+            return {path: best}, tried[best]
+        replay(new)
+
+
 def _ripple_frequencies(runs, sims, k=2):
     """The ``k`` largest peaks of the training force residual's spectrum between 1 and 300 Hz."""
     n = min(r.n for r in runs)
@@ -644,6 +680,10 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
         values = {"friction.law": law}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
         sse = float(r @ r)
+    elif name == "control_delay":
+        if not base.controller.sampled:
+            return None, 0.0  # a continuous controller has no computation delay
+        values, sse = _delay_effect(runs, base, replayer, base_sims, scale)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)

@@ -33,3 +33,12 @@ def test_the_sign_flip_p_value_is_the_share_of_sign_patterns_with_a_mean_at_leas
     rng = np.random.default_rng(0)
     rate = np.mean([sign_flip_p(rng.normal(size=5)) <= 0.05 for _ in range(400)])
     assert rate < 0.06
+
+
+def test_a_nominal_that_replays_exactly_leaves_nothing_to_shrink():
+    """Noise-free synthetic runs replayed by their own model: zero nominal energy is no shrink, not a division by
+    zero, and the candidate that adds error is refused."""
+    r = replay_test([0.0, 0.0], [0.0, 0.0], threshold=0.0)
+    assert r["shrink"] == 0.0 and not r["passes"]
+    worse = replay_test([0.0, 0.0], [1e-6, 0.0], threshold=0.0)
+    assert worse["shrink"] < 0 and not worse["passes"]

@@ -100,3 +100,16 @@ def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
     assert _lead_error_at(off, x0) is off
     with pytest.raises(InputError, match="disturbance.lead_error_phase"):
         with_value(rig, "disturbance.lead_error_phase", 7.0)
+
+
+def test_a_fractional_computation_delay_is_replayed_on_the_leaf_systems():
+    """The compiled path takes one sampling offset; a params file with 1.5 samples of delay is replayed anyway,
+    on the leaf systems (same result as asking for them), and differs from 1 and 2 samples."""
+    rig = with_value(_rig(), "controller.computation_delay", 1.5)
+    run = _run(rig)
+    auto = replay_drakecreep(run)
+    leaf = replay_drakecreep(run, backend="leaf")
+    assert np.array_equal(auto.u, leaf.u)
+    for whole in (1.0, 2.0):
+        other = replay_drakecreep(run, with_value(rig, "controller.computation_delay", whole))
+        assert np.max(np.abs(other.u - auto.u)) > 1.0

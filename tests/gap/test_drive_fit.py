@@ -62,6 +62,15 @@ def lead_phase_case():
     return truth, diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=CANDIDATES)
 
 
+@pytest.fixture(scope="module")
+def delay_case():
+    """Truth: the command applied 5 speed-loop samples after the encoder is read; the params file says 1."""
+    truth = with_value(RIG, "controller.computation_delay", 5.0)
+    runs = _runs(truth, seed=4)
+    return truth, diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
+                                 effects=CANDIDATES + ("control_delay",))
+
+
 def test_coulomb_change_is_recovered_within_its_interval(coulomb_case):
     truth, result = coulomb_case
     assert isinstance(result, DriveDiagnosis)
@@ -87,6 +96,17 @@ def test_lead_error_phase_is_fitted_on_runs_that_start_at_other_positions(lead_p
     assert abs(math.remainder(d.lead_error_phase - (-2.3), 2 * math.pi)) < 0.1
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.test_errors) < 0.3 * rms(result.nominal_test_errors)
+
+
+def test_control_delay_is_found_between_the_grid_points(delay_case):
+    """5 samples is not on the delay grid (4, 8): the search halves the gaps down to one sample and finds it; the
+    claimed params file replays the held-out runs at the noise level."""
+    truth, result = delay_case
+    assert 5 not in drive_fit.DELAY_GRID and "control_delay" not in drive_fit.NOT_IN_MODEL
+    assert result.claimed == ("control_delay",)
+    assert result.params.controller.computation_delay == 5.0
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(result.test_errors) < 0.2 * rms(result.nominal_test_errors)
 
 
 def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
