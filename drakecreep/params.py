@@ -447,7 +447,8 @@ class DisturbanceParams(_Params):
     ball-passage waviness); the motor encoder cannot see it. The error is fixed to the screw: ``phase`` is its
     phase at the screw position a measured run's ``x_motor`` counts from; a simulation starts there.
     ``load_ripple``: the axial load of the load case (the paper's air cylinders) pulsates as
-    ``Fx (1 + r sin(2 pi f t))``. See
+    ``Fx (1 + r sin(2 pi f t + ripple_phase))``; ``force_ripple`` adds ``-A sin(2 pi f t + ripple_phase)`` to the
+    push on the table. See
     :mod:`drakecreep.model.disturbances`.
     """
 
@@ -460,6 +461,8 @@ class DisturbanceParams(_Params):
     force_ripple: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude A of a fixed-frequency force ripple on the table")
     load_ripple: float = _q(0.0, "-", 0.0, 1.0, doc="relative amplitude r of the axial load pulsation")
     ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")
+    ripple_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
+                             doc="phase of both ripples at t = 0, a simulation's start (a replayed run's first sample)")
 
 
 #: friction compensation methods (:mod:`drakecreep.studies.compensation`)

@@ -109,12 +109,17 @@ _BOUND = 4.0
 #: Lead-error periods tried: the lead divided by these harmonics.
 LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
 
+#: The periodic effects' amplitude, period or frequency, and phase fields (:func:`_quadrature_effect`).
+_PERIODIC = {"lead_error": ("disturbance.lead_error_amplitude", "disturbance.lead_error_period",
+                            "disturbance.lead_error_phase"),
+             "force_ripple": ("disturbance.force_ripple", "disturbance.ripple_frequency", "disturbance.ripple_phase")}
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude",), "force_ripple": ("disturbance.force_ripple",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k)",
-    "force_ripple": "force ripple on the table at a fixed frequency (disturbance.force_ripple, ripple_frequency)",
+    "force_ripple": "force ripple on the table at a fixed frequency (disturbance.force_ripple, ripple_frequency and "
+                    "ripple_phase: its phase at each run's first sample)",
     "stribeck": "velocity weakening: the Stribeck law with fitted friction.static_ratio and stribeck_velocity",
     "law_coulomb": "friction law switched to coulomb (same levels)",
     "law_stribeck": "friction law switched to stribeck (same levels and shape)",
@@ -514,100 +519,49 @@ class _Fit:
 
 # --------------------------------------------------------------------------- candidate effects
 
-def _screen(params, trial, r_a, r0):
-    """The residual ``r_a`` of one replay of ``params`` at a trial amplitude: its slope in the amplitude and the
-    linear optimum.
-
-    Returns ``(amplitude, predicted_sse, state)``; ``state`` continues in :func:`_refine`.
-    """
-    d = (r0 - r_a) / trial  # the residual decreases by d per unit amplitude (first order)
-    dd = float(d @ d)
-    if dd == 0.0:
-        return 0.0, float(r0 @ r0), None
-    a = float(np.clip((r0 @ d) / dd, 0.0, 50 * trial))
-    r_lin = r0 - a * d
-    return a, float(r_lin @ r_lin), (params, trial, r_a)
-
-
-def _refine(runs, amp_path, a, state, replayer, r0, scale):
-    """Replay at the screened amplitude and take one secant step; ``(amplitude, sse)`` (measured, not predicted)."""
-    if state is None or a == 0.0:
-        return 0.0, float(r0 @ r0)
-    params, trial, r_t = state
-    r_a = _residual(runs, replayer(runs, _with(params, {amp_path: a})), scale)
-    if abs(a - trial) > 1e-3 * trial:
-        d = (r_t - r_a) / (a - trial)
-        if float(d @ d) > 0:
-            a2 = float(np.clip(a + (r_a @ d) / float(d @ d), 0.0, 50 * trial))
-            r_2 = _residual(runs, replayer(runs, _with(params, {amp_path: a2})), scale)
-            if float(r_2 @ r_2) < float(r_a @ r_a):
-                return a2, float(r_2 @ r_2)
-    return a, float(r_a @ r_a)
-
-
-def _amplitude_effect(runs, base, amp_path, grid_path, grid, trial, replayer, base_sims, scale):
-    """Screen every grid value with one replay, refine the best: ``(values, sse)``."""
-    r0 = _residual(runs, base_sims, scale)
-    best = None
-    at = [_with(base, {grid_path: g}) for g in grid]
-    jobs = [(runs, _with(params, {amp_path: trial})) for params in at]
-    sims = _replay_many(replayer, jobs)  # every grid value's replays at once (in parallel over a pool)
-    for g, params, s in zip(grid, at, sims):
-        a, sse, state = _screen(params, trial, _residual(runs, s, scale), r0)
-        if best is None or sse < best[1]:
-            best = (g, sse, a, state)
-    if best is None:
-        return {}, float(r0 @ r0)
-    g, _, a, state = best
-    a, sse = _refine(runs, amp_path, a, state, replayer, r0, scale)
-    return {grid_path: g, amp_path: a}, sse
-
-
 def _replay_many(replayer, jobs):
     """Replays of each ``(runs, params)`` of ``jobs``: at once over the replayer's pool when it has one."""
     many = getattr(replayer, "many", None)
     return many(jobs) if many is not None else [replayer(*job) for job in jobs]
 
 
-def _lead_error_effect(runs, base, grid, trial, replayer, base_sims, scale):
-    """The lead error's period, amplitude and phase: ``(values, sse)``.
+def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scale):
+    """A periodic effect's period (or frequency), amplitude and phase: ``(values, sse)``.
 
-    The error is fixed to the screw, ``e(x) = a sin(2 pi x / P + phi)`` (``x`` the absolute motor position), so
-    runs that start at other positions see it at other phases. To first order the residual is linear in the
-    quadratures ``(a cos phi, a sin phi)``: two replays per period at a trial amplitude (``phi`` = 0 and pi / 2)
-    give its two slopes, linear least squares the optimum; about the best period's optimum one Gauss-Newton step
-    in the quadratures refines it (three replays), kept if its measured SSE is lower."""
-    amp, period, phase = ("disturbance.lead_error_amplitude", "disturbance.lead_error_period",
-                          "disturbance.lead_error_phase")
-    if base.disturbance.lead_error_amplitude > 0.0:  # a declared error is replaced: linearise about none
+    ``paths``: the amplitude, grid (period or frequency) and phase fields. To first order the residual is linear
+    in the quadratures ``(a cos phi, a sin phi)``: two replays per grid value at a trial amplitude (``phi`` = 0 and
+    pi / 2) give its two slopes, linear least squares the optimum; about the best grid value's optimum one
+    Gauss-Newton step in the quadratures refines it (three replays), kept if its measured SSE is lower. An
+    amplitude the params file declares is replaced, not added to: the fit linearises about none."""
+    amp, grid_path, phase = paths
+    if get_value(base, amp) > 0.0:
         base = _with(base, {amp: 0.0})
         base_sims = replayer(runs, base)
     r0 = _residual(runs, base_sims, scale)
-    jobs = [(runs, _with(base, {period: g, amp: trial, phase: ph})) for g in grid for ph in (0.0, 0.5 * math.pi)]
+    jobs = [(runs, _with(base, {grid_path: g, amp: trial, phase: ph})) for g in grid for ph in (0.0, 0.5 * math.pi)]
     sims = _replay_many(replayer, jobs)
     best = None
     for i, g in enumerate(grid):
         slopes = np.column_stack([(r0 - _residual(runs, s, scale)) / trial for s in sims[2 * i: 2 * i + 2]])
         if not np.any(slopes):
             continue
-        (c, s_), *_ = np.linalg.lstsq(slopes, r0, rcond=None)
-        a = float(min(math.hypot(c, s_), 50 * trial))
-        ph = float(math.atan2(s_, c))
-        lin = r0 - slopes @ (a * np.array([math.cos(ph), math.sin(ph)]))
+        q, *_ = np.linalg.lstsq(slopes, r0, rcond=None)
+        if math.hypot(*q) > 50 * trial:
+            q = q * (50 * trial / math.hypot(*q))
+        lin = r0 - slopes @ q
         if best is None or float(lin @ lin) < best[0]:
-            best = (float(lin @ lin), g, a, ph)
-    if best is None or best[2] == 0.0:
+            best = (float(lin @ lin), g, q)
+    if best is None or not np.any(best[2]):
         return {}, float(r0 @ r0)
-    _, g, a, ph = best
+    _, g, q1 = best
 
-    def residual_at(q):  # q: the quadratures (a cos phi, a sin phi) [m]
-        values = {period: g, amp: float(math.hypot(*q)), phase: float(math.atan2(q[1], q[0]))}
+    def residual_at(q):  # q: the quadratures (a cos phi, a sin phi)
+        values = {grid_path: g, amp: float(math.hypot(*q)), phase: float(math.atan2(q[1], q[0]))}
         return values, _residual(runs, replayer(runs, _with(base, values)), scale)
 
     # one Gauss-Newton step about the linear optimum, its slopes from two replays a trial amplitude away in each
-    # quadrature: the residual is not linear in the error over a few micrometres (without the step a 2 um error
-    # at -0.7 rad came out at -0.61 rad, tests/gap/test_drive_fit.py, a declared error replaced)
-    q1 = a * np.array([math.cos(ph), math.sin(ph)])
+    # quadrature: the residual is not linear in a lead error over a few micrometres (without the step a 2 um
+    # error at -0.7 rad came out at -0.61 rad, tests/gap/test_drive_fit.py, a declared error replaced)
     v1, r1 = residual_at(q1)
     slopes = np.column_stack([(r1 - residual_at(q1 + trial * e)[1]) / trial for e in np.eye(2)])
     out = (v1, float(r1 @ r1))
@@ -652,19 +606,35 @@ def _delay_effect(runs, base, replayer, base_sims, scale):
         replay(new)
 
 
-def _ripple_frequencies(runs, sims, k=2):
-    """The ``k`` largest peaks of the training force residual's spectrum between 1 and 300 Hz."""
+def _ripple_frequencies(runs, sims, k=2, pad=8):
+    """The ``k`` largest peaks of the training force residual's spectrum between 1 and 300 Hz.
+
+    Hann window, zero-padded ``pad`` times, each peak refined by a parabola through the log power at it and its
+    two neighbours; peaks closer than two bins of the unpadded spectrum are one peak. A run of 0.5 s has 2 Hz bins,
+    and a ripple's frequency 1 Hz off turns its phase by pi over such a run."""
     n = min(r.n for r in runs)
     dt = runs[0].dt
+    m = pad * n
     power = 0.0
     for r, s in zip(runs, sims):
         e = (r.force - s.force)[:n]
-        power = power + np.abs(np.fft.rfft((e - e.mean()) * np.hanning(n))) ** 2
-    f = np.fft.rfftfreq(n, dt)
+        power = power + np.abs(np.fft.rfft((e - e.mean()) * np.hanning(n), m)) ** 2
+    f = np.fft.rfftfreq(m, dt)
+    df = f[1]
     ok = np.flatnonzero((f >= 1.0) & (f <= min(300.0, 0.45 / dt)))
-    peaks = [i for i in ok if power[i] >= power[max(i - 1, 0)] and power[i] >= power[min(i + 1, f.size - 1)]]
+    ok = ok[(ok > 0) & (ok < f.size - 1)]
+    peaks = [i for i in ok if power[i] >= power[i - 1] and power[i] >= power[i + 1] and power[i] > 0]
     peaks.sort(key=lambda i: -power[i])
-    return [float(f[i]) for i in peaks[:k]]
+    out = []
+    for i in peaks:
+        a, b, c = np.log(np.maximum(power[i - 1: i + 2], 1e-300))
+        curve = a - 2 * b + c
+        fi = float(f[i] + (0.5 * (a - c) / curve * df if curve < 0 else 0.0))
+        if all(abs(fi - g) >= 2.0 / (n * dt) for g in out):
+            out.append(fi)
+        if len(out) == k:
+            break
+    return out
 
 
 def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
@@ -672,14 +642,13 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
     scale = _force_scale(runs)
     lead = base.screw.lead
     if name == "lead_error":
-        values, sse = _lead_error_effect(runs, base, [lead / k for k in LEAD_HARMONICS], 1e-6, replayer, base_sims,
-                                         scale)
+        values, sse = _quadrature_effect(runs, base, _PERIODIC["lead_error"], [lead / k for k in LEAD_HARMONICS], 1e-6,
+                                         replayer, base_sims, scale)
         if not values:
             return {}, 0.0
     elif name == "force_ripple":
-        values, sse = _amplitude_effect(runs, base, "disturbance.force_ripple", "disturbance.ripple_frequency",
-                                        _ripple_frequencies(runs, base_sims), 0.1 * scale, replayer, base_sims,
-                                        scale)
+        values, sse = _quadrature_effect(runs, base, _PERIODIC["force_ripple"], _ripple_frequencies(runs, base_sims),
+                                         0.1 * scale, replayer, base_sims, scale)
         if not values:
             return {}, 0.0
     elif name == "stribeck":

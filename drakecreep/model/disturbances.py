@@ -14,7 +14,7 @@ LeadError
     cannot see the error, so the table speed carries a ripple ``2 pi a / P`` of the feed, whatever
     the feed.
 LoadRipple
-    A force ``-(A + r_l Fx) sin(2 pi f t)`` added to the screw's push on the table: ``A`` a vibration of
+    A force ``-(A + r_l Fx) sin(2 pi f t + phi)`` added to the screw's push on the table: ``A`` a vibration of
     fixed frequency that does not depend on the load, ``r_l Fx`` a pulsation of the axial load of the
     load case (the paper's air cylinders). The table-speed ripple it causes does not depend on the feed.
 """
@@ -99,20 +99,22 @@ def LeadError_(T):
 @TemplateSystem.define("LoadRipple_")
 def LoadRipple_(T):
     class Impl(LeafSystem_[T]):
-        """Force ripple on the table: output ``force`` (1, N) ``= -amplitude sin(2 pi f t)``, added to the push."""
+        """Force ripple on the table: output ``force`` (1, N) ``= -amplitude sin(2 pi f t + phase)``, added to the
+        push."""
 
-        def _construct(self, amplitude, frequency, converter=None):
+        def _construct(self, amplitude, frequency, phase=0.0, converter=None):
             LeafSystem_[T].__init__(self, converter=converter)
             self.amplitude = float(amplitude)
             self.frequency = float(frequency)
+            self.phase = float(phase)
             self.DeclareVectorOutputPort("force", 1, self._calc, prerequisites_of_calc={self.time_ticket()})
 
         def _construct_copy(self, other, converter=None):
-            Impl._construct(self, other.amplitude, other.frequency, converter=converter)
+            Impl._construct(self, other.amplitude, other.frequency, other.phase, converter=converter)
 
         def _calc(self, context, output):
             t = context.get_time()
-            output.SetAtIndex(0, -self.amplitude * sin(2.0 * math.pi * self.frequency * t))
+            output.SetAtIndex(0, -self.amplitude * sin(2.0 * math.pi * self.frequency * t + self.phase))
 
     return Impl
 
@@ -159,7 +161,7 @@ def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
         ports["load_torque"] = torque_sum.get_input_port(0)
     amplitude = d.force_ripple + d.load_ripple * abs(params.load_case(scenario.load_case).fx)
     if amplitude > 0.0:
-        ripple = builder.AddSystem(LoadRipple(amplitude, d.ripple_frequency))
+        ripple = builder.AddSystem(LoadRipple(amplitude, d.ripple_frequency, d.ripple_phase))
         ripple.set_name("load_ripple")
         push_sum = builder.AddSystem(Adder(2, 1))
         push_sum.set_name("push_sum")

@@ -484,7 +484,7 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
     amplitude = d.force_ripple + d.load_ripple * abs(load.fx)
     if amplitude > 0.0:
         # the two-mass model's force ripple (model.disturbances.LoadRipple), on the table along x
-        ripple = put("load_ripple", LoadRipple(amplitude, d.ripple_frequency))
+        ripple = put("load_ripple", LoadRipple(amplitude, d.ripple_frequency, d.ripple_phase))
         builder.Connect(ripple.get_output_port(0), mux.get_input_port(3))
     else:
         zero = zero or put("no_friction", ConstantVectorSource([0.0]))

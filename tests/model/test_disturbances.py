@@ -73,3 +73,17 @@ def test_lead_error_phase_counts_from_the_start_angle_and_survives_scalar_conver
     sys_.GetInputPort("motor_state").FixValue(ctx, [theta0, 0.0])
     sys_.GetInputPort("axial_force").FixValue(ctx, [0.0])
     assert np.isclose(sys_.GetOutputPort("nut_motion").Eval(ctx)[0], theta0, rtol=0, atol=1e-15)
+
+
+def test_load_ripple_phase_and_scalar_copies():
+    """``force = -A sin(2 pi f t + phi)``; the AutoDiffXd and symbolic copies keep the phase."""
+    from drakecreep.model.disturbances import LoadRipple
+
+    ripple = LoadRipple(3.0, 17.0, -1.2)
+    for copy in (ripple, ripple.ToAutoDiffXd(), ripple.ToSymbolic()):
+        assert copy.phase == -1.2 and copy.frequency == 17.0
+    for t in (0.0, 0.0123, 0.4):
+        ctx = ripple.CreateDefaultContext()
+        ctx.SetTime(t)
+        assert ripple.get_output_port(0).Eval(ctx)[0] == pytest.approx(-3.0 * math.sin(2 * math.pi * 17.0 * t - 1.2),
+                                                                       rel=1e-12)
