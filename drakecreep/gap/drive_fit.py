@@ -531,7 +531,8 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     ``paths``: the amplitude, grid (period or frequency) and phase fields. To first order the residual is linear
     in the quadratures ``(a cos phi, a sin phi)``: two replays per grid value at a trial amplitude (``phi`` = 0 and
     pi / 2) give its two slopes, linear least squares the optimum; about the best grid value's optimum one
-    Gauss-Newton step in the quadratures refines it (three replays), kept if its measured SSE is lower. An
+    Gauss-Newton step in the quadratures refines it (three replays), kept if its measured SSE is lower; an answer
+    worse than no effect falls back along the line to none (amplitude 0 when nothing on it is better). An
     amplitude the params file declares is replaced, not added to: the fit linearises about none."""
     amp, grid_path, phase = paths
     if get_value(base, amp) > 0.0:
@@ -572,6 +573,17 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
             v2, r2 = residual_at(q2)
             if float(r2 @ r2) < out[1]:
                 out = (v2, float(r2 @ r2))
+    sse0 = float(r0 @ r0)
+    if out[1] >= sse0:
+        # worse than no effect (slopes of replays that differ by more than the effect, e.g. integration error):
+        # the best point on the line from none to the linear optimum, through the two measured residuals
+        d = r0 - r1
+        k = float(np.clip((r0 @ d) / float(d @ d), 0.0, 1.0)) if float(d @ d) > 0 else 0.0
+        if k > 0.0:
+            vk, rk = residual_at(k * q1)
+            if float(rk @ rk) < min(out[1], sse0):
+                return vk, float(rk @ rk)
+        return {grid_path: g, amp: 0.0, phase: 0.0}, sse0  # no gain: the candidate is reported as such
     return out
 
 

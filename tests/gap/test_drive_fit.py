@@ -289,3 +289,29 @@ def test_leave_one_out_step_is_close_to_the_refit():
     assert not any("before converging" in w for w in drive_fit.fit_drive(runs, RIG, paths, replayer, max_nfev=20)[2])
     warnings = drive_fit.fit_drive(runs, RIG, paths, replayer, max_nfev=1)[2]
     assert any("stopped after 1 evaluations" in w and "table.seal_force" in w for w in warnings), warnings
+
+
+def test_a_periodic_fit_is_never_worse_than_no_effect():
+    """Replays whose differences are dominated by something else than the effect (here a large pseudo-random error
+    that changes with every parameter value, as an integrator's step sequence does) give meaningless slopes: the
+    fit falls back along the line to none and never returns values whose measured residual exceeds the
+    nominal's."""
+    from types import SimpleNamespace
+
+    t = np.arange(400) * 1e-3
+    runs = [SimpleNamespace(force=np.sin(2 * np.pi * 20 * t + 0.5))]
+
+    def replayer(runs_, params):
+        d = params.disturbance
+        key = hash((d.force_ripple, d.ripple_frequency, d.ripple_phase)) % 2**32
+        jitter = 3.0 * np.random.default_rng(key).standard_normal(t.size) if d.force_ripple else 0.0
+        return [SimpleNamespace(force=d.force_ripple * np.sin(2 * np.pi * d.ripple_frequency * t + d.ripple_phase)
+                                + jitter) for _ in runs_]
+
+    paths = drive_fit._PERIODIC["force_ripple"]
+    base_sims = replayer(runs, RIG)
+    r0 = drive_fit._residual(runs, base_sims, 1.0)
+    values, sse = drive_fit._quadrature_effect(runs, RIG, paths, [20.0], 0.1, replayer, base_sims, 1.0)
+    assert sse <= float(r0 @ r0)
+    replayed = drive_fit._residual(runs, replayer(runs, drive_fit._with(RIG, values)), 1.0)
+    assert sse == pytest.approx(float(replayed @ replayed))
