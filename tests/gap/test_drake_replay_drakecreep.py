@@ -85,7 +85,7 @@ def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
 
     rig = with_value(_rig(), "disturbance.lead_error_phase", 0.4)
     period = rig.disturbance.lead_error_period
-    x0 = 0.123 * period + 3 * period  # a quarter-ish period off, three periods along
+    x0 = 0.123 * period + 3 * period  # an eighth of a period off, three periods along
     at0 = _run(rig)
     moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
     shifted = with_value(rig, "disturbance.lead_error_phase",
