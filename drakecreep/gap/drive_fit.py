@@ -31,11 +31,12 @@ Steps:
    The diagram is recompiled for every evaluation: compiling it takes about 0.03 s, against 0.1-1.1 s CPU to
    replay a 0.5 s run (test rig to ``paper`` preset, ``analysis/bench_drive_fit.py``), so symbolic parameters
    (``SymbolicVectorSystem(parameter=...)``) would save a few per cent.
-2. **Candidate effects that are parts of the Drake model** (:data:`EFFECTS`): lead error (amplitude fitted,
-   period a harmonic of the lead), force ripple at a fixed frequency (frequency from the peaks of the
-   training residual's spectrum), Stribeck weakening (static ratio and Stribeck velocity fitted), the
-   friction law switched (coulomb, stribeck, lugre, gms), the nut's friction moved between the table and
-   the screw. What ``DriveParams`` cannot express is never ranked (:data:`NOT_IN_MODEL`).
+2. **Candidate effects that are parts of the Drake model** (:data:`EFFECTS`): lead error (amplitude and phase
+   fitted, fixed to the screw, period a harmonic of the lead), force ripple at a fixed frequency (frequency
+   from the peaks of the training residual's spectrum, amplitude and phase fitted), Stribeck weakening (static
+   ratio and Stribeck velocity fitted), the friction law switched (coulomb, stribeck, lugre, gms), the nut's
+   friction moved between the table and the screw, the controller's computation delay (searched over whole
+   samples). What ``DriveParams`` cannot express is never ranked (:data:`NOT_IN_MODEL`).
 3. **Claims on held-out runs only**: each candidate, fitted on the training runs, is replayed with fixed
    values on the held-out runs; its per-run decrease of the force error (points of %) must exceed
    ``t_(1-alpha, n-1)`` standard errors of those paired differences
@@ -661,15 +662,12 @@ def _ripple_frequencies(runs, sims, k=2, pad=8):
 def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
     """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain)``."""
     scale = _force_scale(runs)
-    lead = base.screw.lead
-    if name == "lead_error":
-        values, sse = _quadrature_effect(runs, base, _PERIODIC["lead_error"], [lead / k for k in LEAD_HARMONICS], 1e-6,
-                                         replayer, base_sims, scale)
-        if not values:
-            return {}, 0.0
-    elif name == "force_ripple":
-        values, sse = _quadrature_effect(runs, base, _PERIODIC["force_ripple"], _ripple_frequencies(runs, base_sims),
-                                         0.1 * scale, replayer, base_sims, scale)
+    if name in _PERIODIC:  # the lead error over the lead's harmonics, the ripple at the residual's peaks
+        if name == "lead_error":
+            grid, trial = [base.screw.lead / k for k in LEAD_HARMONICS], 1e-6
+        else:
+            grid, trial = _ripple_frequencies(runs, base_sims), 0.1 * scale
+        values, sse = _quadrature_effect(runs, base, _PERIODIC[name], grid, trial, replayer, base_sims, scale)
         if not values:
             return {}, 0.0
     elif name == "stribeck":
