@@ -25,11 +25,21 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _passes, _regime, _rule
+from drakecreep.gap.drake_diagnosis import _passes, _rule
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
 RULES = ("current", "both", "either")
 _KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ratios",
          "force_constant_speed": "run_constant_speed_log_error_ratios"}
+
+
+def _regime_of(entry):
+    """The regime a ranked candidate was decided in: stored with rows from session 37 on; before, the effect's
+    static one (an axial mode's band, resolved per fit, was not stored then: such rows recount without it)."""
+    if "regime" in entry:
+        return entry["regime"]
+    regime = DRAKE_EFFECTS[entry["effect"]].regime if entry["effect"] in DRAKE_EFFECTS else ""
+    return "" if regime == "mode_band" else regime
 
 
 def _errors(entry):
@@ -37,7 +47,10 @@ def _errors(entry):
     n = len(entry["run_log_error_ratios"])
     ref = {f"r{i}": {} for i in range(n)}
     cand = {f"r{i}": {} for i in range(n)}
-    for key, field in _KEYS.items():
+    keys = dict(_KEYS)
+    if _regime_of(entry) and entry.get("run_regime_log_error_ratios") is not None:
+        keys[f"force_{_regime_of(entry)}"] = "run_regime_log_error_ratios"
+    for key, field in keys.items():
         values = entry.get(field)
         if values is None:
             continue
@@ -58,7 +71,7 @@ def first_claim(row, rule):
         name = entry["effect"]
         own = _rule(name)
         chosen = {"current": own, "both": "both" if own == "drift_robust" else own}.get(rule, rule)
-        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime(name))
+        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry))
         if t.passes:
             return name
     return None

@@ -574,7 +574,11 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 "run_level_log_error_ratios": None if r.screened_out else _run_log_ratios(r, res, "force_level"),
                 # and in the regime the candidate must show in too (DrakeEffect.regime), for every candidate
                 "run_constant_speed_log_error_ratios": None if r.screened_out else _run_log_ratios(
-                    r, res, "force_constant_speed")}
+                    r, res, "force_constant_speed"),
+                # the candidate's own regime as its fit resolved it (an axial mode: the band around its frequency)
+                "regime": r.regime,
+                "run_regime_log_error_ratios": None if r.screened_out or not r.regime else _run_log_ratios(
+                    r, res, f"force_{r.regime}")}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction, training_run_null=[float(v) for v in res.null],
                test_force_nominal=rms_force_error(res.nominal_test_errors),

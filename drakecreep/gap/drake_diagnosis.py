@@ -102,7 +102,8 @@ from scipy import stats
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
-from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED, EffectFit, fit_delay, fit_effect, score_parameters
+from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, effect_regime, fit_delay, fit_effect,
+                                         score_parameters)
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
@@ -468,9 +469,10 @@ def training_run_null(test, nominal, nominal_test_errors):
                  for key in ("force", "force_level"))
 
 
-def _regime(name):
-    """The regime a candidate must also show in (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.regime`)."""
-    return DRAKE_EFFECTS[name].regime if name in DRAKE_EFFECTS else ""
+def _regime(name, fit):
+    """The regime a candidate must also show in, for its ``fit`` (:func:`~drakecreep.gap.drake_effects.effect_regime`:
+    a fitted axial mode's own band)."""
+    return effect_regime(name, fit.parameters)
 
 
 def _rule(name):
@@ -583,7 +585,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     ranking, jobs = [], []
 
     def ranked(n, sc, fit, own=None):
-        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null.result(), regime=_regime(n))
+        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null.result(), regime=_regime(n, fit))
         say(f"{n}: held-out {_verdict(t)}")
         return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
 
@@ -669,7 +671,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 if f_ref is not None:
                     reference = f_ref.result()
             t = _passes(reference, fit.test_errors, k_se, rule=_rule(r.name), null=null.result(),
-                        regime=_regime(r.name))
+                        regime=_regime(r.name, fit))
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(t)}")
             if t.passes:
                 claimed.append(r.name)

@@ -29,6 +29,7 @@ import time as _time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import signal
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.symbolic import Expression, MakeVectorVariable, Variable
@@ -53,6 +54,8 @@ __all__ = [
     "drake_replay_errors",
     "REGIME_ERRORS",
     "MIN_REGIME_SAMPLES",
+    "MODE_BANDS_HZ",
+    "mode_band",
     "rms_force_error",
     "axis_from_idim",
     "replay_drakecreep",
@@ -646,6 +649,44 @@ REGIME_ERRORS = ("constant_speed",)
 MIN_REGIME_SAMPLES = 20
 
 
+#: octave bands [Hz] centred half an octave apart, 5 * 2^(k/2) from 5 to 320 Hz (the axial mode's search range
+#: with a quarter octave to spare): :func:`drake_replay_errors` adds the force error in each as
+#: ``force_band_<lo>-<hi>_Hz``, the signature band of a fitted mode (:func:`mode_band`)
+MODE_BANDS_HZ = tuple((5.0 * 2.0 ** ((k - 1) / 2.0), 5.0 * 2.0 ** ((k + 1) / 2.0)) for k in range(13))
+#: highest band edge, as a share of the sample rate (the Butterworth band-pass below Nyquist)
+BAND_EDGE_SHARE = 0.45
+
+
+def _band_name(lo, hi):
+    return f"band_{lo:.3g}-{hi:.3g}_Hz"
+
+
+def mode_band(frequency):
+    """The band of :data:`MODE_BANDS_HZ` a mode at ``frequency`` [Hz] is the signature of: the one whose centre is
+    nearest on a log scale (the mode at least a quarter octave inside it), as the regime name
+    ``band_<lo>-<hi>_Hz`` whose force error is ``force_band_<lo>-<hi>_Hz``."""
+    k = int(np.clip(round(2.0 * math.log2(max(float(frequency), 1e-9) / 5.0)), 0, len(MODE_BANDS_HZ) - 1))
+    return _band_name(*MODE_BANDS_HZ[k])
+
+
+def _band_errors(measured, simulated, dt):
+    """Force error [%] in each band of :data:`MODE_BANDS_HZ` below :data:`BAND_EDGE_SHARE` of the sample rate:
+    measured and simulated force band-passed alike (4th-order Butterworth, forward-backward), so a simulated
+    oscillation out of phase with the measured one counts against the model."""
+    fs = 1.0 / dt
+    out = {}
+    if measured.size < 64:  # shorter than the filters' padding
+        return out
+    for lo, hi in MODE_BANDS_HZ:
+        if lo >= BAND_EDGE_SHARE * fs:
+            continue
+        sos = signal.butter(4, [lo, min(hi, BAND_EDGE_SHARE * fs)], btype="bandpass", fs=fs, output="sos")
+        y = signal.sosfiltfilt(sos, measured)
+        if np.any(y != 0):
+            out["force_" + _band_name(lo, hi)] = relative_error(y, signal.sosfiltfilt(sos, simulated))
+    return out
+
+
 def drake_replay_errors(result, cutoff=100.0, order=4):
     """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
 
@@ -654,7 +695,8 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     run has a linear scale; ``force_level`` (the run's own friction level) when the result carries its
     parameters; ``force_constant_speed`` (for each regime of :data:`REGIME_ERRORS`) the force error over the
     samples of that regime (:func:`drakecreep.gap.residuals.classify_regimes` of the reference and the measured
-    speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them.
+    speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them; ``force_band_<lo>-<hi>_Hz`` the force
+    error in each band of :data:`MODE_BANDS_HZ` (:func:`mode_band`).
     """
     run = result.run
     _, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
@@ -675,6 +717,7 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
         sel = regimes == regime
         if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(force[sel] != 0):
             out[f"force_{regime}"] = relative_error(force[sel], force_sim[sel])
+    out.update(_band_errors(force, force_sim, run.dt))
     return out
 
 

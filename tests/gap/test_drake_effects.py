@@ -63,3 +63,21 @@ def test_compiled_axis_carries_every_effect_term():
         c = DrakeReplay(run, flexible=flexible).simulate(dict(NOMINAL, stiffness=3e6, damping=300.0))
         assert np.max(np.abs(a.x_motor - b.x_motor)) < 1e-9
         assert np.max(np.abs(a.u - c.u)) > 1e-3  # the terms act
+
+
+def test_a_fitted_axial_mode_resolves_to_the_band_around_its_own_frequency():
+    """``axial_mode_frequency`` inverts the start's ``k = w^2 s (1 - s) m``; ``effect_regime`` gives an axial mode
+    the band around that frequency, the time ripple its constant speed, the others none."""
+    import math
+
+    from drakecreep.gap.drake_effects import axial_mode_frequency, effect_regime
+
+    m, s = 90.0, 0.3
+    k = (2 * math.pi * 75.0) ** 2 * s * (1 - s) * m
+    p = {"mass": m, "motor_mass_fraction": s, "stiffness": k, "damping": 2 * 0.04 * math.sqrt(k * s * (1 - s) * m)}
+    assert axial_mode_frequency(p) == pytest.approx((75.0, 0.04))
+    assert DRAKE_EFFECTS["axial_mode"].regime == "mode_band"
+    assert effect_regime("axial_mode", p) == "band_56.6-113_Hz"
+    assert effect_regime("axial_mode", dict(p, stiffness=k / 4)) == "band_28.3-56.6_Hz"  # half the frequency
+    assert effect_regime("time_ripple", p) == "constant_speed"
+    assert effect_regime("stribeck", p) == effect_regime("control_delay", p) == ""

@@ -97,6 +97,37 @@ def test_force_error_at_constant_speed_is_over_those_samples_alone(run, nominal)
     assert "force_constant_speed" not in drake_replay_errors(dataclasses.replace(nominal, run=swinging))
 
 
+def test_force_error_in_a_mode_band_sees_an_oscillation_there_and_nothing_else(run, nominal):
+    """``force_band_<lo>-<hi>_Hz``: the force error in each octave of ``MODE_BANDS_HZ``. A 40 Hz oscillation the
+    simulation adds moves the error of the band around 40 Hz (``mode_band(40)``) and hardly that of a band two
+    octaves away; the same oscillation out of phase with one in the measurement counts twice, not zero; bands
+    above 0.45 of a slower run's sample rate are left out."""
+    from drakecreep.gap.drake_replay import MODE_BANDS_HZ, mode_band
+
+    assert mode_band(40.0) == "band_28.3-56.6_Hz" and mode_band(1.0) == "band_3.54-7.07_Hz"
+    assert mode_band(5000.0) == "band_226-453_Hz"
+    for f in (5.0, 12.0, 40.0, 150.0, 300.0):  # each mode at least a quarter octave inside its band
+        lo, hi = (float(x) for x in mode_band(f)[5:-3].split("-"))
+        assert lo * 2 ** 0.25 <= f * 1.01 and f <= hi / 2 ** 0.25 * 1.01
+    err = drake_replay_errors(nominal)
+    keys = [k for k in err if k.startswith("force_band_")]
+    assert len(keys) == len(MODE_BANDS_HZ)
+    t = np.arange(run.n) * run.dt
+    wave = 3.0 * np.sin(2 * np.pi * 40.0 * t)
+    moved = drake_replay_errors(dataclasses.replace(nominal, force=nominal.force + wave))
+    at, far = "force_" + mode_band(40.0), "force_" + mode_band(10.0)
+    assert moved[at] > err[at] + 10.0 and moved[far] == pytest.approx(err[far], abs=0.5)
+    # the measurement oscillates too: the model's oscillation in phase shrinks that band's error, out of phase grows it
+    shaken = dataclasses.replace(run, u=run.u + wave / run.u_gain)
+    in_phase = drake_replay_errors(dataclasses.replace(nominal, run=shaken, force=nominal.force + wave))
+    opposed = drake_replay_errors(dataclasses.replace(nominal, run=shaken, force=nominal.force - wave))
+    without = drake_replay_errors(dataclasses.replace(nominal, run=shaken))
+    assert in_phase[at] < 0.5 * without[at] < 0.5 * opposed[at]
+    slow = dataclasses.replace(nominal, run=dataclasses.replace(run, t=4.0 * (run.t - run.t[0])))
+    assert {k for k in drake_replay_errors(slow) if k.startswith("force_band_")} == \
+        {"force_band_" + f"{lo:.3g}-{hi:.3g}_Hz" for lo, hi in MODE_BANDS_HZ if lo < 0.45 * 250.0}
+
+
 @pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
 def test_computation_delay_holds_older_outputs(run, delay, shift):
     """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later."""
