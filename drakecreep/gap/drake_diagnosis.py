@@ -102,8 +102,8 @@ from scipy import stats
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
-from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, effect_regime, fit_delay, fit_effect,
-                                         score_parameters)
+from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency, effect_regime,
+                                         fit_delay, fit_effect, score_parameters)
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
@@ -269,7 +269,9 @@ class DrakeDiagnosis:
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
-            lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %, "
+            mode = (" (mode {:.3g} Hz, damping ratio {:.2g})".format(*axial_mode_frequency(r.fit.parameters))
+                    if r.name == "axial_mode" else "")
+            lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{mode}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
                              f"{k} {v:.4g} {AXIS_UNITS[k]}" for k, v in own.items())

@@ -371,7 +371,8 @@ def test_an_axial_mode_is_claimed_when_it_shrinks_the_error_at_its_own_frequency
     f, zeta = axial_mode_frequency(mode.fit.parameters)
     assert diag.claimed == ("axial_mode",) and 36.0 < f < 44.0 and zeta < 0.2
     assert mode.regime == mode_band(40.0) and mode.regime_log_ratio > mode.log_ratio > 0.5
-    assert f"at band {mode.regime[5:-3]} Hz" in next(x for x in diag.summary() if x.strip().startswith("axial_mode"))
+    line = next(x for x in diag.summary() if x.strip().startswith("axial_mode"))
+    assert f"at band {mode.regime[5:-3]} Hz" in line and f"(mode {f:.3g} Hz, damping ratio {zeta:.2g})" in line
 
     def errors(whole, band):
         return {f"r{i}": {"force": 10.0 * w, "force_level": 6.0 * w, f"force_{mode.regime}": 3.0 * b}
