@@ -71,7 +71,11 @@
    their timing repeat a model error that follows the reference at the same instants, and a sinusoid of
    fixed phase fits part of it during the moves: held-out run 13's one false claim on a null was a 5.6 Hz
    ripple of 0.3 N that shrank the whole runs' errors by 6 % and the constant-speed error not at all, where
-   every withheld ripple studied shrank it by more than the whole runs' (docs/gap_benchmark.md, 3u);
+   every withheld ripple studied shrank it by more than the whole runs' (docs/gap_benchmark.md, 3u). An axial
+   mode's regime is the octave around its fitted frequency (``force_band_<lo>-<hi>_Hz``,
+   :func:`~drakecreep.gap.drake_effects.effect_regime`): a mode is an oscillation, and the only claims on
+   effects outside the library in held-out runs 14-19 were backlashes answered by a compliance that shrank the
+   whole runs' error and grew the band's (docs/gap_benchmark.md, 3ab);
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
    augmented so far and kept only if they pass again against it (refitted alone by the same effort; the same
    rule, with the nominal's training-run null). A step

@@ -161,7 +161,7 @@ DRAKE_EFFECTS = {
     # a mode is an oscillation: its fit must also shrink the held-out force error in the octave around its own
     # frequency (regime "mode_band", resolved per fit by effect_regime). A compliance fitted to a lost motion
     # shrinks the whole runs' error and not that band: every claim outside the library in held-out runs 14-19 was a
-    # backlash answered so (fits at 88-290 Hz whose band error grew by factors of 1.1-5 on development seeds:
+    # backlash answered so (on development seeds, fits at 88-294 Hz whose band error grew in every held-out run:
     # analysis/axial_mode_band_study.py, docs/gap_benchmark.md, 3ab)
     "axial_mode": DrakeEffect("axial_mode", ("stiffness", "damping"), _mode_starts(), flexible=True,
                               signature="oscillation at a structural frequency (5-300 Hz)",
