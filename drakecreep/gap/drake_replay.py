@@ -687,7 +687,7 @@ def _band_errors(measured, simulated, dt):
     return out
 
 
-def drake_replay_errors(result, cutoff=100.0, order=4):
+def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
     """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
 
     Velocity and acceleration of the measured and simulated motor positions go through the same IDIM
@@ -696,7 +696,8 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
     parameters; ``force_constant_speed`` (for each regime of :data:`REGIME_ERRORS`) the force error over the
     samples of that regime (:func:`drakecreep.gap.residuals.classify_regimes` of the reference and the measured
     speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them; ``force_band_<lo>-<hi>_Hz`` the force
-    error in each band of :data:`MODE_BANDS_HZ` (:func:`mode_band`).
+    error in each band of :data:`MODE_BANDS_HZ` (:func:`mode_band`) unless ``bands`` is false (a fit's training
+    errors and the ``drakecreep`` kind's, which no band test reads: the bands are most of this function's cost).
     """
     run = result.run
     _, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
@@ -717,7 +718,8 @@ def drake_replay_errors(result, cutoff=100.0, order=4):
         sel = regimes == regime
         if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(force[sel] != 0):
             out[f"force_{regime}"] = relative_error(force[sel], force_sim[sel])
-    out.update(_band_errors(force, force_sim, run.dt))
+    if bands:
+        out.update(_band_errors(force, force_sim, run.dt))
     return out
 
 

@@ -358,7 +358,7 @@ class _Replayer:
 
     def many_errors(self, jobs):
         """``{label: replay errors}`` of each ``(runs, params)`` of ``jobs``, replayed at once (:meth:`many`)."""
-        return [{r.label: drake_replay_errors(s) for r, s in zip(runs, sims)}
+        return [{r.label: drake_replay_errors(s, bands=False) for r, s in zip(runs, sims)}
                 for (runs, _), sims in zip(jobs, self.many(jobs))]
 
 

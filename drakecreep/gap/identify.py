@@ -444,7 +444,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         jack, jack_std = _leave_one_run_out(sol, prob, lo, hi)
     results = prob.simulate(values)
     errors = {res.run.label + (f"#{i}" if sum(r.run.label == res.run.label for r in results) > 1 else ""):
-              drake_replay_errors(res) for i, res in enumerate(results)}
+              drake_replay_errors(res, bands=False) for i, res in enumerate(results)}
     rate = prob.evaluations / prob.seconds if prob.seconds > 0 else float("nan")
     return Identified(parameters=values, fitted=uncertain, std=std, ci95=ci, correlation=corr,
                       warnings=tuple(warnings), start=start, train_errors=errors, cost_start=cost_start, cost=cost,

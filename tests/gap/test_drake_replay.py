@@ -112,6 +112,7 @@ def test_force_error_in_a_mode_band_sees_an_oscillation_there_and_nothing_else(r
     err = drake_replay_errors(nominal)
     keys = [k for k in err if k.startswith("force_band_")]
     assert len(keys) == len(MODE_BANDS_HZ)
+    assert drake_replay_errors(nominal, bands=False) == {k: v for k, v in err.items() if k not in keys}
     t = np.arange(run.n) * run.dt
     wave = 3.0 * np.sin(2 * np.pi * 40.0 * t)
     moved = drake_replay_errors(dataclasses.replace(nominal, force=nominal.force + wave))
