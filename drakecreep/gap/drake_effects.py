@@ -167,6 +167,8 @@ DRAKE_EFFECTS = {
                               signature="oscillation at a structural frequency (5-300 Hz)",
                               bounds={"stiffness": (1e3, 1e11)}, regime="mode_band"),
 }
+
+
 def axial_mode_frequency(parameters):
     """Frequency [Hz] and damping ratio of the axial mode of two-mass axis ``parameters`` (``mass``,
     ``motor_mass_fraction``, ``stiffness``, ``damping``): the motor side against the table on the spring."""
