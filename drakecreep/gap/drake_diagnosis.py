@@ -125,7 +125,7 @@ NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
 CLAIM_RULE = "drift_robust"
 #: Friction laws of the nominal model: ``lugre`` adds the bristle stiffness to :data:`NOMINAL_PARAMETERS` (the axis
 #: sticks below the breakaway force), ``regularized`` is ``Fc tanh(v / v_reg)`` (it creeps under any force).
-NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness",), "regularized": NOMINAL_PARAMETERS}
+NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness", "bristle_share"), "regularized": NOMINAL_PARAMETERS}
 
 
 def paired_gain(reference, candidate):

@@ -44,7 +44,8 @@ from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, ma
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR
 
-__all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT", "PRESLIDING_START"]
+__all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT",
+           "PRESLIDING_START", "DEFAULT_BOUNDS"]
 
 #: parameters fitted on a log scale (they must stay > 0)
 LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "damping", "viscous",
@@ -53,6 +54,10 @@ LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness
 #: an assumption, the middle of the 1-10 um that ball-screw and guide contacts show (Armstrong-Helouvry et al.
 #: 1994, Automatica 30(7), section 3.1); the fit moves it
 PRESLIDING_START = 5e-6
+#: bounds [SI] a refined parameter keeps when the caller gives none: the share of the friction that sticks
+#: (``bristle_share``, :mod:`drakecreep.model.axis`) in (0, 1]; at least 5 % of it, or the bristles' rate
+#: ``sigma0 |v| / (b g)`` would outrun any step
+DEFAULT_BOUNDS = {"bristle_share": (0.05, 1.0)}
 #: |correlation| above which two fitted parameters are reported as not separable
 CORRELATION_LIMIT = 0.95
 #: residual put in place of each non-finite sample of a diverged replay, and the largest magnitude a sample's
@@ -348,7 +353,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     fixed : dict, optional
         Values that override the IDIM start (and the axis defaults) before refinement.
     bounds : dict, optional
-        ``name -> (lo, hi)`` in SI for the refined parameters.
+        ``name -> (lo, hi)`` in SI for the refined parameters (:data:`DEFAULT_BOUNDS` where not given).
     max_nfev : int
         Largest number of residual evaluations of the least squares (each replays every run).
     quantize : bool
@@ -428,6 +433,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
     if uncertain:
         x0 = prob.to_x(base)
         lo, hi = np.full(x0.size, -np.inf), np.full(x0.size, np.inf)
+        bounds = {**{n: b for n, b in DEFAULT_BOUNDS.items() if n in uncertain}, **(bounds or {})}
         for i, name in enumerate(uncertain):
             if bounds and name in bounds:
                 lo[i], hi[i] = (prob.scalar_x(i, b) for b in bounds[name])

@@ -221,6 +221,8 @@ SAMPLED_CASES = {
                                         stribeck_velocity=2e-3)),
     "lugre_two_mass": (True, 0.0, dict(regularization_velocity=1e-3, stiffness=2e6, damping=300.0,
                                        bristle_stiffness=2e7, bristle_damping_ratio=0.5)),
+    # 70 % of the friction sticks, the rest is the regularized law (the bristles' rate 1 / 0.7 faster)
+    "lugre_share": (False, 0.0, dict(regularization_velocity=1e-3, bristle_stiffness=5e6, bristle_share=0.7)),
 }
 
 

@@ -167,6 +167,27 @@ def test_lugre_bristles_stick_where_the_regularized_law_creeps():
     assert abs(_push(22.0, **common, bristle_stiffness=1e7, stribeck_extra=5.0, stribeck_velocity=1e-3)[1]) < 1e-5
 
 
+def test_a_bristle_share_sticks_only_that_share_and_slides_as_before():
+    """``bristle_share`` b: the bristles carry ``b g`` and a regularized law the rest. Under 16 N of a 20 N
+    Coulomb level, b = 1 holds the table; b = 0.6 (12 N sticks, 8 N creeps) does not hold it, the regularized
+    share creeping at ``v_reg atanh((16 - 12) / 8)`` once the bristles are saturated; 10 N, below the sticking 12
+    N, is held with the regularized part adding nothing at standstill. Sliding at 30 N is the same for every b,
+    and b = 1 is the law it was (the same derivatives to the last bit)."""
+    common = dict(mass=50.0, coulomb=20.0, viscous=400.0, regularization_velocity=1e-4, bristle_stiffness=1e7)
+    assert abs(_push(16.0, **common)[1]) < 1e-6
+    creeping = _push(16.0, 1.0, **common, bristle_share=0.6)
+    assert creeping[1] == pytest.approx(1e-4 * math.atanh(4.0 / 8.0), rel=0.05)
+    held = _push(10.0, 1.0, **common, bristle_share=0.6)
+    assert abs(held[1]) < 1e-6 and 1e7 * held[2] == pytest.approx(10.0, rel=1e-3)
+    for share in (1.0, 0.6, 0.2):
+        assert _push(30.0, 1.5, **common, bristle_share=share)[1] == pytest.approx(0.025, rel=1e-4)
+    vec, vec1 = axis_parameters(**common), axis_parameters(**common, bristle_share=1.0)
+    assert bristle_rates(0.01, 1e-6, vec, 40.0) == bristle_rates(0.01, 1e-6, vec1, 40.0)
+    for bad in (0.0, 1.5, -0.2):
+        with pytest.raises(InputError, match="bristle_share"):
+            axis_parameters(bristle_share=bad)
+
+
 def test_the_load_scales_the_bristle_force_and_not_its_target():
     """Normal-load-scaled LuGre: at the steady deflection ``z = g0 / sigma0`` the friction is ``g0 + mu |load|``
     (the regularized law's level) and the bristles do not move (``dz/dt = 0``) whatever the load does; with the
