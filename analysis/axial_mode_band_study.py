@@ -116,7 +116,8 @@ def main(argv):
                   f"held-out all {np.round([x['all'] for x in t], 3)} band "
                   f"{np.round([x.get('band', np.nan) for x in t], 3)} share "
                   f"{np.round([x.get('band_share', np.nan) for x in t], 3)} energy "
-                  f"{np.round([x.get('energy', np.nan) for x in t], 3)} f_axial {r['truth']['f_axial']:.0f}", flush=True)
+                  f"{np.round([x.get('energy', np.nan) for x in t], 3)} f_axial {r['truth']['f_axial']:.0f}",
+                  flush=True)
         else:
             print(f"{seed} {effect} {axis} screened out", flush=True)
         write_text(out, json.dumps({"rows": rows}, indent=1))

@@ -46,7 +46,8 @@ def add_parser(subparsers):
                    "lead_error, force_ripple, stribeck, law_coulomb, ...)")
     p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
                    "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "
-                   "sticks below the breakaway force, the share of the friction that sticks fitted; slower), auto (both, the lower training cost kept)")
+                   "sticks below the breakaway force, the share of the friction that sticks fitted; slower), "
+                   "auto (both, the lower training cost kept)")
     p.add_argument("--score", metavar="FILE", help="after the diagnosis, replay the augmented model (parameters "
                    "fixed) on this file")
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "

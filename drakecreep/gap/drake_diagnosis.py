@@ -3,11 +3,14 @@
 :func:`diagnose_drake` returns a typed :class:`DrakeDiagnosis` (no dict with private keys):
 
 1. nominal: :func:`drakecreep.gap.identify.identify` of viscous, Coulomb and offset on the training runs, with
-   the friction law (``friction``) regularized Coulomb (default) or LuGre (bristle stiffness fitted too), or
-   both identified and the one with the lower training cost kept (``auto``). A measured axis that sticks at
-   standstill and after reversals needs the bristles (a regularized law creeps under any force, and the
-   candidates then absorb the stiction: ``docs/gap_benchmark.md``); one without stiction fits the regularized
-   law better;
+   the friction law (``friction``) regularized Coulomb (default) or LuGre (bristle stiffness and the share of
+   the friction that sticks fitted too), or both identified and the one with the lower training cost kept
+   (``auto``). A measured axis that sticks at standstill and after reversals needs the bristles (a regularized
+   law creeps under any force, and the candidates then absorb the stiction: ``docs/gap_benchmark.md``); one
+   without stiction fits the regularized law better. Not all of a drive's friction sticks (bearings and seals
+   do not hold a presliding deflection as guideways do): with all of it in the bristles the nominal held too
+   much in the dwells, and ``asymmetric_friction`` took up the difference as a force present only at standstill
+   (docs/gap_benchmark.md, 3ac);
 2. ranking: every candidate of :data:`~drakecreep.gap.drake_effects.DRAKE_EFFECTS` (and the computation
    delay) is first fitted on the training runs' inverse dynamics (:mod:`drakecreep.gap.screen`, the axis's
    own force terms, seconds): a candidate whose held-out inverse-dynamics log error ratio is not above one
@@ -124,8 +127,11 @@ NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
 #: ratio above its training-run null; module docstring, 3).
 CLAIM_RULE = "drift_robust"
 #: Friction laws of the nominal model: ``lugre`` adds the bristle stiffness to :data:`NOMINAL_PARAMETERS` (the axis
-#: sticks below the breakaway force), ``regularized`` is ``Fc tanh(v / v_reg)`` (it creeps under any force).
-NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness", "bristle_share"), "regularized": NOMINAL_PARAMETERS}
+#: sticks below the breakaway force) and the share of the friction that sticks (``bristle_share``: the rest is
+#: regularized, as a drive's bearing and seal friction; docs/gap_benchmark.md, 3ac), ``regularized`` is
+#: ``Fc tanh(v / v_reg)`` (it creeps under any force).
+NOMINAL_FRICTION = {"lugre": NOMINAL_PARAMETERS + ("bristle_stiffness", "bristle_share"),
+                    "regularized": NOMINAL_PARAMETERS}
 
 
 def paired_gain(reference, candidate):
