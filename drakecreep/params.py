@@ -587,6 +587,12 @@ def load_params(path):
         If ``path`` does not exist.
     """
     data = load_yaml_file(path, str(path), "a YAML mapping of parameter groups")
+    if isinstance(data, dict) and data.get("kind") == "drakecreep.measured_axis":
+        # the augmented_model.yaml of a p_p_cascade diagnosis is an axis of the replay model, not a drive
+        raise InputError(f"{path}: kind", data["kind"],
+                         "a drakecreep params file (parameter groups motor, screw, nut, table, friction, ...); this "
+                         "file is the measured axis that drakecreep diagnose fitted to P-P cascade runs, read by "
+                         "drakecreep.gap.drake_diagnosis.load_model")
     return params_from_dict(data)
 
 

@@ -113,3 +113,18 @@ def test_defaults_are_valid_and_integers_accepted_for_floats():
     assert isinstance(p.table.mass, float) and p.table.mass == 50.0
     assert DriveParams() == params_from_dict({})
     assert math.isfinite(params_to_dict(preset())["motor"]["rotor_inertia"])
+
+
+def test_a_measured_axis_model_is_refused_as_params_with_what_it_is(tmp_path):
+    """The ``augmented_model.yaml`` of a P-P cascade diagnosis (``drakecreep.measured_axis``) is not a drive's
+    params file: one error naming its kind and what reads it, not "kind: an unknown field"."""
+    from drakecreep.gap.drake_diagnosis import DrakeDiagnosis
+
+    model = tmp_path / "augmented_model.yaml"
+    diag = DrakeDiagnosis(nominal=None, nominal_test_errors={}, ranking=(), claimed=(),
+                          model={"parameters": {"mass": 90.0, "bristle_share": 0.7}, "flexible": False, "delay": 0.0},
+                          test_errors={}, seconds=0.0, k_se=2.0)
+    diag.save_model(model)
+    with pytest.raises(InputError, match="drakecreep.measured_axis.*load_model") as err:
+        load_params(model)
+    assert "unknown field" not in str(err.value)
