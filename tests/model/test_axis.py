@@ -181,8 +181,10 @@ def test_a_bristle_share_sticks_only_that_share_and_slides_as_before():
     assert abs(held[1]) < 1e-6 and 1e7 * held[2] == pytest.approx(10.0, rel=1e-3)
     for share in (1.0, 0.6, 0.2):
         assert _push(30.0, 1.5, **common, bristle_share=share)[1] == pytest.approx(0.025, rel=1e-4)
-    vec, vec1 = axis_parameters(**common), axis_parameters(**common, bristle_share=1.0)
-    assert bristle_rates(0.01, 1e-6, vec, 40.0) == bristle_rates(0.01, 1e-6, vec1, 40.0)
+    # b = 1: the law before the share, written out (g = Fc; sigma1 = 2 zeta sqrt(sigma0 m_t), zeta = 1)
+    v, z, sigma1 = 0.01, 1e-6, 2.0 * 1.0 * (1e7 * 40.0) ** 0.5
+    zdot = v - 1e7 * abs(v) * z / (abs(20.0) + 1e-9)
+    assert bristle_rates(v, z, axis_parameters(**common), 40.0) == (zdot, 1e7 * z + sigma1 * zdot + 400.0 * v)
     for bad in (0.0, 1.5, -0.2):
         with pytest.raises(InputError, match="bristle_share"):
             axis_parameters(bristle_share=bad)
