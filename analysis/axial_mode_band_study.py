@@ -28,19 +28,11 @@ from scipy import signal
 
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
+from drakecreep.gap.drake_effects import axial_mode_frequency
 from drakecreep.gap.drake_replay import drake_replay
 
 
 _DRAW = benchmark.T.draw_truth
-
-
-def mode_frequency(p):
-    """Fitted axial mode: frequency [Hz] and damping ratio of the two-mass axis of parameters ``p``."""
-    m = float(p["mass"])
-    mm = float(p["motor_mass_fraction"]) * m
-    mu = mm * (m - mm) / m
-    k, c = float(p["stiffness"]), float(p["damping"])
-    return math.sqrt(k / mu) / (2 * math.pi), c / (2 * math.sqrt(k * mu))
 
 
 def band_log_ratios(runs, nominal, candidate, f):
@@ -97,7 +89,7 @@ def study(seed, effect, axis):
         row["screened_out"] = True
         return row
     cand = {"parameters": dict(r.fit.parameters), "flexible": r.fit.flexible, "delay": r.fit.delay}
-    f, zeta = mode_frequency(r.fit.parameters)
+    f, zeta = axial_mode_frequency(r.fit.parameters)
     row.update(frequency_Hz=f, zeta=zeta, log_error_ratio=r.log_ratio, passes=bool(r.passes),
                test=band_log_ratios(ds.test, nom, cand, f), audit=band_log_ratios(ds.audit, nom, cand, f))
     return row

@@ -481,12 +481,6 @@ def training_run_null(test, nominal, nominal_test_errors):
                  for key in ("force", "force_level"))
 
 
-def _regime(name, fit):
-    """The regime a candidate must also show in, for its ``fit`` (:func:`~drakecreep.gap.drake_effects.effect_regime`:
-    a fitted axial mode's own band)."""
-    return effect_regime(name, fit.parameters)
-
-
 def _rule(name):
     """The claim rule of a candidate: its :attr:`~drakecreep.gap.drake_effects.DrakeEffect.claim_rule`, else
     :data:`CLAIM_RULE`."""
@@ -597,7 +591,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     ranking, jobs = [], []
 
     def ranked(n, sc, fit, own=None):
-        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null.result(), regime=_regime(n, fit))
+        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null.result(),
+                    regime=effect_regime(n, fit.parameters))
         say(f"{n}: held-out {_verdict(t)}")
         return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
 
@@ -683,7 +678,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 if f_ref is not None:
                     reference = f_ref.result()
             t = _passes(reference, fit.test_errors, k_se, rule=_rule(r.name), null=null.result(),
-                        regime=_regime(r.name, fit))
+                        regime=effect_regime(r.name, fit.parameters))
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(t)}")
             if t.passes:
                 claimed.append(r.name)

@@ -24,6 +24,7 @@ sample by sample: ``u``, ``x_motor``, ``x_table`` and ``force = u_gain u + f_ext
 
 from __future__ import annotations
 
+import functools
 import math
 import time as _time
 from dataclasses import dataclass, field
@@ -669,21 +670,26 @@ def mode_band(frequency):
     return _band_name(*MODE_BANDS_HZ[k])
 
 
+@functools.lru_cache(maxsize=8)
+def _band_filters(fs):
+    """``(name, sos)`` of each band of :data:`MODE_BANDS_HZ` below :data:`BAND_EDGE_SHARE` of the sample rate
+    ``fs`` (designed once per rate: every replay's errors use them)."""
+    return tuple((_band_name(lo, hi), signal.butter(4, [lo, min(hi, BAND_EDGE_SHARE * fs)], btype="bandpass", fs=fs,
+                                                    output="sos"))
+                 for lo, hi in MODE_BANDS_HZ if lo < BAND_EDGE_SHARE * fs)
+
+
 def _band_errors(measured, simulated, dt):
     """Force error [%] in each band of :data:`MODE_BANDS_HZ` below :data:`BAND_EDGE_SHARE` of the sample rate:
     measured and simulated force band-passed alike (4th-order Butterworth, forward-backward), so a simulated
     oscillation out of phase with the measured one counts against the model."""
-    fs = 1.0 / dt
     out = {}
     if measured.size < 64:  # shorter than the filters' padding
         return out
-    for lo, hi in MODE_BANDS_HZ:
-        if lo >= BAND_EDGE_SHARE * fs:
-            continue
-        sos = signal.butter(4, [lo, min(hi, BAND_EDGE_SHARE * fs)], btype="bandpass", fs=fs, output="sos")
+    for name, sos in _band_filters(1.0 / dt):
         y = signal.sosfiltfilt(sos, measured)
         if np.any(y != 0):
-            out["force_" + _band_name(lo, hi)] = relative_error(y, signal.sosfiltfilt(sos, simulated))
+            out["force_" + name] = relative_error(y, signal.sosfiltfilt(sos, simulated))
     return out
 
 
