@@ -52,6 +52,7 @@ __all__ = [
     "U_UNITS",
     "MIN_U_GAIN",
     "MAX_U_GAIN",
+    "MAX_SPEED",
     "COLUMNS",
     "CONTROLLER_KINDS",
     "ControllerMeta",
@@ -85,6 +86,12 @@ _ARRAYS = ("t", "x_ref", "x_motor", "x_table", "u", "f_ext")
 #: Range of ``u_gain`` [N per unit of u]: drives span about 1e-3 to 1e5 N/A or N/V; outside these bounds the
 #: forces overflow or vanish in the identification
 MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
+#: Fastest plausible axis speed [m/s]: ball-screw feed drives traverse at up to about 2 m/s and linear motors at
+#: about 5. A position column faster than this is in the wrong unit (millimetres labelled ``m`` move a thousand
+#: times too fast), which would otherwise run a whole diagnosis on a model that cannot follow it
+MAX_SPEED = 10.0
+#: Share of a run's samples whose speed may exceed :data:`MAX_SPEED` (a reference step, an encoder glitch)
+_FAST_SHARE = 0.01
 #: Controller kinds of the metadata schema.
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
@@ -319,6 +326,15 @@ class MeasuredRun:
         if not isinstance(self.meta, MeasuredMeta):
             raise InputError("meta", type(self.meta).__name__, "a MeasuredMeta")
         _check_time(t, self.dt_rtol, f"t (run {self.label})")
+        for name in ("x_ref", "x_motor", "x_table"):
+            a = getattr(self, name)
+            if a is None:
+                continue
+            speed = float(np.quantile(np.abs(np.diff(a)) / np.diff(t), 1.0 - _FAST_SHARE))
+            if speed > MAX_SPEED:
+                raise InputError(f"{name} (run {self.label})", f"speeds of {speed:.3g} m/s (the {1 - _FAST_SHARE:.0%} quantile)",
+                                 f"speeds up to {MAX_SPEED:g} m/s, a feed axis's (is the unit right? millimetres "
+                                 "labelled m move a thousand times too fast)")
         for name in _ARRAYS:
             a = getattr(self, name)
             if a is not None:

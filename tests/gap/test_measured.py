@@ -107,6 +107,27 @@ def test_nan(tmp_path):
     assert "x_motor" in err.value.field
 
 
+def test_positions_in_the_wrong_unit_are_refused_by_their_speed(tmp_path):
+    n, dt = 400, 1e-3
+    t = np.arange(n) * dt
+    x = 0.05 * np.sin(2 * np.pi * t)  # 0.31 m/s peak: a feed axis
+    cols = {"t": t, "x_ref": x, "x_motor": x - 1e-6, "u": np.sin(t)}
+    assert load_measured(_write(tmp_path, cols)).run().n == n
+    # the same run in millimetres, labelled m: 314 m/s
+    with pytest.raises(InputError, match="m/s") as err:
+        load_measured(_write(tmp_path, {**cols, "x_ref": 1e3 * x, "x_motor": 1e3 * x}, name="mm.csv"))
+    assert err.value.field.endswith("mm.csv: x_ref (run mm)") and "unit" in err.value.allowed
+    # one encoder glitch (a single sample of 50 m/s) is not a unit error
+    glitch = cols["x_motor"].copy()
+    glitch[200] += 0.05
+    assert load_measured(_write(tmp_path, {**cols, "x_motor": glitch}, name="glitch.csv")).run().n == n
+    # ... but 2 % of such samples is
+    fast = cols["x_motor"].copy()
+    fast[::50] += 0.05
+    with pytest.raises(InputError, match="x_motor"):
+        load_measured(_write(tmp_path, {**cols, "x_motor": fast}, name="fast.csv"))
+
+
 def test_not_a_number(tmp_path):
     cols = {k: list(v) for k, v in _rows().items()}
     cols["u"][2] = "abc"
