@@ -48,12 +48,16 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         ``regimes`` (:func:`~drakecreep.gap.residuals.regime_shares` over all runs), ``bands``
         (:func:`~drakecreep.gap.residuals.frequency_bands`), ``independence`` (per input: ``max_abs``, ``band``,
         ``lag_of_max`` [samples], ``independent``, worst over the runs), ``split`` (per run with a scale), and
-        ``force_rms_N`` of the residual.
+        ``force_rms_N`` of the residual; ``diverged``: the labels of runs whose replay diverged (non-finite), left
+        out of the rest (all of them: no regimes, bands or independence, and ``force_rms_N`` NaN).
     """
-    residuals, labels, tests, split = [], [], {}, {}
+    residuals, labels, tests, split, diverged = [], [], {}, {}, []
     for run in runs:
         sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters)
         e = run.force - sim.force
+        if not np.all(np.isfinite(e)):
+            diverged.append(run.label)
+            continue
         residuals.append(e)
         labels.append(classify_regimes(run.t, run.x_ref, np.gradient(run.x_motor, run.dt)))
         inputs = {"reference speed": np.gradient(run.x_ref, run.dt)}
@@ -70,17 +74,27 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         worst = max(results, key=lambda r: r["max_abs"] / r["band"])
         indep[name] = {"max_abs": worst["max_abs"], "band": worst["band"], "lag_of_max": worst["lag_of_max"],
                        "independent": all(r["independent"] for r in results), "run": worst["run"]}
+    if not residuals:
+        return {"regimes": {}, "bands": None, "independence": {}, "split": {}, "force_rms_N": float("nan"),
+                "diverged": diverged}
     flat = np.concatenate(residuals)
     return {"regimes": regime_shares(flat, np.concatenate(labels)), "bands": frequency_bands(residuals, runs[0].dt),
-            "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2)))}
+            "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2))),
+            "diverged": diverged}
 
 
 def where_lines(where):
     """Lines of text (edge units: N, Hz, %)."""
+    diverged = where.get("diverged") or []
+    gone = (f"the model's replay diverged on held-out run{'s' * (len(diverged) > 1)} {', '.join(diverged)}"
+            if diverged else "")
+    if where.get("bands") is None:
+        return [f"unexplained: not located ({gone})"]
     reg = sorted(where["regimes"].items(), key=lambda kv: -kv[1]["energy_share"])
     lines = [f"unexplained: held-out force residual {where['force_rms_N']:.3g} N rms; by regime "
              + ", ".join(f"{k.replace('_', ' ')} {100 * v['energy_share']:.0f} % of the energy in "
-                         f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] >= 0.005)]
+                         f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] >= 0.005)
+             + (f" ({gone}: left out)" if gone else "")]
     b = where["bands"]
     lines.append("  by frequency: " + ", ".join(f"{r['lo_Hz']:g}-{r['hi_Hz']:.0f} Hz {100 * r['share']:.0f} %"
                                                 for r in b["bands"]) + f" (peak {b['peak_hz']:.3g} Hz)")

@@ -274,6 +274,10 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     where = diagnosis.where
     if where:
         parts.append("<h2>Unexplained: where the augmented model's held-out residual lies</h2>")
+        if where.get("diverged"):
+            parts.append("<p>The model's replay diverged on held-out run(s) "
+                         f"{escape(', '.join(where['diverged']))}; they are left out below.</p>")
+    if where and where.get("bands") is not None:
         parts.append(f"<p>Measured minus replayed force, {where['force_rms_N']:.3g} N rms over the held-out runs.</p>")
         parts.append(table(["regime", "share of the residual energy [%]", "share of the time [%]", "rms [N]"],
                            [[k.replace("_", " "), f"{100 * v['energy_share']:.1f}", f"{100 * v['time_share']:.1f}",

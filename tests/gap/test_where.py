@@ -1,6 +1,7 @@
 """drakecreep.gap.where: what a fixed Drake model leaves unexplained on held-out runs, and where."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -47,3 +48,28 @@ def test_a_scale_that_reads_the_motor_puts_the_gap_before_the_screw(runs):
     assert all(s["where"] == "before the screw" for s in w["split"].values())
     text = "\n".join(where_lines(w))
     assert "unexplained" in text and "Hz" in text and "before the screw" in text
+
+
+def test_runs_whose_replay_diverged_are_named_and_left_out(runs, monkeypatch):
+    import drakecreep.gap.where as where_module
+    from drakecreep.gap.drake_replay import diverged_result
+
+    real = where_module.make_replay
+
+    def replay(run, **kw):  # the second run's replay diverges (all samples NaN)
+        r = real(run, **kw)
+        if run.label == runs[1].label:
+            r.simulate = lambda parameters: diverged_result(run, parameters)
+        return r
+
+    monkeypatch.setattr(where_module, "make_replay", replay)
+    w = where_gap(runs, TRUTH)
+    assert w["diverged"] == [runs[1].label]
+    assert np.isfinite(w["force_rms_N"]) and w["force_rms_N"] < 1.5 * NOISE
+    assert sum(v["energy_share"] for v in w["regimes"].values()) == pytest.approx(1.0)
+    lines = where_lines(w)
+    assert "nan" not in "\n".join(lines) and f"diverged on held-out run {runs[1].label}" in lines[0]
+    gone = where_gap(runs[1:2], TRUTH)
+    assert gone["bands"] is None and math.isnan(gone["force_rms_N"])
+    assert where_lines(gone) == [f"unexplained: not located (the model's replay diverged on held-out run "
+                                 f"{runs[1].label})"]
