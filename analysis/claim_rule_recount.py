@@ -6,8 +6,8 @@ log error ratios (plain, with each run's own friction level, at constant speed) 
 null. This script feeds them to the product's own test (:func:`drakecreep.gap.drake_diagnosis._passes`, through
 error dicts whose log ratios are the stored values) under
 
-* ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), the product
-  today;
+* ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction) and its
+  fallback regime (the asymmetric friction's constant speed, from session 38), the product today;
 * ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
 * ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive).
 
@@ -25,7 +25,7 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _passes, _rule
+from drakecreep.gap.drake_diagnosis import _fallback, _passes, _rule
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
 RULES = ("current", "both", "either")
@@ -34,11 +34,14 @@ _KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ra
 
 
 def _regime_of(entry):
-    """The regime a ranked candidate was decided in: stored with rows from session 37 on; before, the effect's
-    static one (an axial mode's band, resolved per fit, was not stored then: such rows recount without it)."""
+    """The regime a ranked candidate must also show in: stored with rows from session 37 on; before, the effect's
+    static one (an axial mode's band, resolved per fit, was not stored then: such rows recount without it). A
+    stored fallback regime (session 38 on) is not one it must show in."""
+    effect = DRAKE_EFFECTS.get(entry["effect"])
     if "regime" in entry:
-        return entry["regime"]
-    regime = DRAKE_EFFECTS[entry["effect"]].regime if entry["effect"] in DRAKE_EFFECTS else ""
+        return "" if effect is not None and effect.fallback_regime and entry["regime"] == effect.fallback_regime \
+            else entry["regime"]
+    regime = effect.regime if effect is not None else ""
     return "" if regime == "mode_band" else regime
 
 
@@ -50,6 +53,11 @@ def _errors(entry):
     keys = dict(_KEYS)
     if _regime_of(entry) and entry.get("run_regime_log_error_ratios") is not None:
         keys[f"force_{_regime_of(entry)}"] = "run_regime_log_error_ratios"
+    # the constant-speed ratios are stored under their own name (the key above); any other fallback regime's are
+    # the regime ratios
+    fb = _fallback(entry["effect"])
+    if fb and f"force_{fb}" not in keys and entry.get("run_regime_log_error_ratios") is not None:
+        keys[f"force_{fb}"] = "run_regime_log_error_ratios"
     for key, field in keys.items():
         values = entry.get(field)
         if values is None:
@@ -71,7 +79,8 @@ def first_claim(row, rule):
         name = entry["effect"]
         own = _rule(name)
         chosen = {"current": own, "both": "both" if own == "drift_robust" else own}.get(rule, rule)
-        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry))
+        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry),
+                    fallback_regime=_fallback(name) if rule == "current" else "")
         if t.passes:
             return name
     return None

@@ -575,8 +575,10 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 # and in the regime the candidate must show in too (DrakeEffect.regime), for every candidate
                 "run_constant_speed_log_error_ratios": None if r.screened_out else _run_log_ratios(
                     r, res, "force_constant_speed"),
-                # the candidate's own regime as its fit resolved it (an axial mode: the band around its frequency)
+                # the candidate's own regime as its fit resolved it (an axial mode: the band around its frequency),
+                # or its fallback regime (DrakeEffect.fallback_regime), and whether it passed by that
                 "regime": r.regime,
+                "fallback": bool(r.fallback),
                 "run_regime_log_error_ratios": None if r.screened_out or not r.regime else _run_log_ratios(
                     r, res, f"force_{r.regime}")}
                for r in res.ranking]

@@ -44,9 +44,10 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "level_log_error_ratio_standard_error": r.level_log_ratio_se,
                                   "threshold_level_log_error_ratio": r.level_threshold,
                                   "claim_rule": r.rule, "level_test_alone": r.level_alone,
+                                  "by_fallback_regime": r.fallback,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
-            if r.regime:  # the regime the candidate must show in too (DrakeEffect.regime)
+            if r.regime:  # the regime it must show in too, or may pass by (DrakeEffect.regime, fallback_regime)
                 row["closed_loop"]["regime"] = {"name": r.regime, "log_error_ratio": r.regime_log_ratio,
                                                 "log_error_ratio_standard_error": r.regime_log_ratio_se,
                                                 "sign_flip_p": r.regime_p_sign_flip}
