@@ -92,6 +92,8 @@ def main():
                     help="only print the scores of JSON files written by this script (the shards of one run together)")
     ap.add_argument("--shard", default="0/1", metavar="I/N",
                     help="diagnose only every N-th dataset from the I-th (0-based): N processes share one run")
+    ap.add_argument("--library", nargs="+", metavar="EFFECT",
+                    help="withheld library effects to draw (default all; nulls and effects outside the library as set)")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
     args = ap.parse_args()
@@ -125,7 +127,7 @@ def main():
                                               "datasets": rows}, indent=1, default=str))
 
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
-                        progress=True, tries=args.tries, on_row=write, done=done, shard=shard)
+                        progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, {', '.join(args.kinds)}, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "

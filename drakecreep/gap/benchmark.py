@@ -601,22 +601,32 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
     return row
 
 
-def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_null=10, n_ool=6, n_no_candidate=None):
+def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_null=10, n_ool=6, n_no_candidate=None,
+                    library=None):
     """The candidate dataset list of a benchmark: ``(seed, withheld, kind, axis)``, round-robin over effects.
 
     Per controller kind: up to ``ceil(tries * n_per_effect)`` candidates per library effect (the first
     ``n_per_effect`` with SNR >= 3 are diagnosed, see :func:`run_benchmark`), ``n_ool`` per out-of-library
     effect, ``n_no_candidate`` (default ``n_ool``) per no-candidate effect and ``n_null`` nulls; axes
-    alternate. Seeds are ``seed + 100000 * kind + 1000 * slot + j``.
+    alternate. Seeds are ``seed + 100000 * kind + 1000 * slot + j``. ``library``: the withheld library effects
+    to draw (default all); a dataset keeps its seed whichever are drawn, so a run of a few effects holds the
+    same datasets as the whole benchmark.
     """
     n_nc = n_ool if n_no_candidate is None else n_no_candidate
     slots = _slots() + [()]
+    if library is not None:
+        known = sorted({w[0] for w in slots if w and any(category_of(k, w) == "library" for k in BENCHMARK_KINDS)})
+        unknown = [e for e in library if e not in known]
+        if unknown or not library:
+            raise InputError("library", unknown or library, "names among " + ", ".join(known))
 
     def count(kind, w):
         category = category_of(kind, w)
         if category == "null":
             return n_null
         if category == "library":
+            if library is not None and not set(w) <= set(library):
+                return 0
             return int(math.ceil(tries * n_per_effect))
         return n_nc if category == "no_candidate" else n_ool
 
@@ -633,7 +643,7 @@ def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_nul
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
-                  done=(), shard=(0, 1)):
+                  done=(), shard=(0, 1), library=None):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -653,6 +663,8 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         ``(i, n)``: diagnose only every ``n``-th dataset of the order, from the ``i``-th (0-based), so that ``n``
         processes or machines share one benchmark; their rows together are the whole (``score_rows`` of the
         concatenation). Default ``(0, 1)``: all.
+    library : sequence of str, optional
+        Withheld library effects to draw (:func:`benchmark_specs`); default all.
 
     Returns
     -------
@@ -668,7 +680,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
             or not 0 <= shard[0] < shard[1]):
         raise InputError("shard", shard, "(i, n) with integers 0 <= i < n")
     say = (lambda line: print(f"[gap-benchmark] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None)
-    specs = benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool, n_no_candidate)
+    specs = benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool, n_no_candidate, library)
     kept, skipped, pos = {}, {}, 0
     while pos < len(specs):
         part = []

@@ -26,6 +26,19 @@ def test_specs_cover_every_effect_and_axis_and_keep_seed_sets_apart():
         assert sum(1 for s in specs if s[1] == (e,)) == 2
 
 
+def test_a_run_of_some_library_effects_holds_the_same_datasets_as_the_whole_benchmark():
+    kw = dict(n_per_effect=2, tries=2, n_null=3, n_ool=2)
+    whole = benchmark_specs(HELDOUT_SEEDS, **kw)
+    some = benchmark_specs(HELDOUT_SEEDS, library=("asymmetric_friction",), **kw)
+    assert set(some) <= set(whole)
+    assert {s for s in whole if s[1] in ((), ("asymmetric_friction",)) or category_of(s[2], s[1]) != "library"} \
+        == set(some)
+    assert sum(1 for s in some if s[1] == ("asymmetric_friction",)) == 4
+    for bad in (("coulomb",), ("cable_carrier",), ()):  # not a library effect (the cable carrier is outside it)
+        with pytest.raises(InputError, match="library"):
+            benchmark_specs(HELDOUT_SEEDS, library=bad, **kw)
+
+
 def test_every_library_effect_has_an_expected_drake_candidate():
     from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 
