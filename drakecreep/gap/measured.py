@@ -332,7 +332,8 @@ class MeasuredRun:
                 continue
             speed = float(np.quantile(np.abs(np.diff(a)) / np.diff(t), 1.0 - _FAST_SHARE))
             if speed > MAX_SPEED:
-                raise InputError(f"{name} (run {self.label})", f"speeds of {speed:.3g} m/s (the {1 - _FAST_SHARE:.0%} quantile)",
+                raise InputError(f"{name} (run {self.label})",
+                                 f"speeds of {speed:.3g} m/s (the {1 - _FAST_SHARE:.0%} quantile)",
                                  f"speeds up to {MAX_SPEED:g} m/s, a feed axis's (is the unit right? millimetres "
                                  "labelled m move a thousand times too fast)")
         for name in _ARRAYS:
