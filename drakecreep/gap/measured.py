@@ -87,8 +87,9 @@ _ARRAYS = ("t", "x_ref", "x_motor", "x_table", "u", "f_ext")
 #: forces overflow or vanish in the identification
 MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
 #: Fastest plausible axis speed [m/s]: ball-screw feed drives traverse at up to about 2 m/s and linear motors at
-#: about 5. A position column faster than this is in the wrong unit (millimetres labelled ``m`` move a thousand
-#: times too fast), which would otherwise run a whole diagnosis on a model that cannot follow it
+#: about 5. A position column faster than this, or its time, is in the wrong unit (millimetres labelled ``m``, or
+#: milliseconds labelled ``us``, move a thousand times too fast), which would otherwise run a whole diagnosis on a
+#: model that cannot follow it
 MAX_SPEED = 10.0
 #: Share of a run's samples whose speed may exceed :data:`MAX_SPEED` (a reference step, an encoder glitch)
 _FAST_SHARE = 0.01
@@ -334,8 +335,8 @@ class MeasuredRun:
             if speed > MAX_SPEED:
                 raise InputError(f"{name} (run {self.label})",
                                  f"speeds of {speed:.3g} m/s (the {1 - _FAST_SHARE:.0%} quantile)",
-                                 f"speeds up to {MAX_SPEED:g} m/s, a feed axis's (is the unit right? millimetres "
-                                 "labelled m move a thousand times too fast)")
+                                 f"speeds up to {MAX_SPEED:g} m/s, a feed axis's (is a unit wrong? millimetres "
+                                 "labelled m, or milliseconds labelled us, move a thousand times too fast)")
         for name in _ARRAYS:
             a = getattr(self, name)
             if a is not None:
