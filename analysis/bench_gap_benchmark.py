@@ -25,7 +25,9 @@ import json
 import time
 
 from drakecreep.files import write_text
-from drakecreep.gap.benchmark import BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, run_benchmark, score_rows
+from drakecreep.errors import InputError
+from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
+                                      run_benchmark, score_rows)
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
            "median_relative_shrink_snr3": ">= 70 %", "claims_making_audit_worse": "0"}
@@ -93,7 +95,8 @@ def main():
     ap.add_argument("--shard", default="0/1", metavar="I/N",
                     help="diagnose only every N-th dataset from the I-th (0-based): N processes share one run")
     ap.add_argument("--library", nargs="+", metavar="EFFECT",
-                    help="withheld library effects to draw (default all; nulls and effects outside the library as set)")
+                    help="withheld library effects to draw (default all; nulls and effects outside the library as "
+                         "--n-null and --n-ool set)")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
     args = ap.parse_args()
@@ -112,6 +115,11 @@ def main():
     except ValueError:
         ap.error(f"--shard: got {args.shard!r}; allowed: I/N with integers 0 <= I < N")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
+    if args.library is not None:
+        try:  # before any dataset is generated
+            benchmark_specs(seed, args.kinds, library=args.library)
+        except InputError as err:
+            ap.error(str(err))
     done = []
     if args.resume:
         with open(args.resume) as fh:
