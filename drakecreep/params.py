@@ -22,6 +22,7 @@ from drakecreep.errors import InputError, short_repr
 from drakecreep.files import MAX_INPUT_BYTES, read_input_text, write_text
 
 __all__ = [
+    "MEASURED_AXIS_KIND",
     "MotorParams",
     "ScrewParams",
     "NutParams",
@@ -575,6 +576,11 @@ def params_to_dict(params):
     return dataclasses.asdict(params)
 
 
+#: ``kind`` of the model file a ``p_p_cascade`` diagnosis writes (``augmented_model.yaml``,
+#: :meth:`drakecreep.gap.drake_diagnosis.DrakeDiagnosis.save_model`): an axis of the replay model, not a drive
+MEASURED_AXIS_KIND = "drakecreep.measured_axis"
+
+
 def load_params(path):
     """Load and validate :class:`DriveParams` from a YAML file.
 
@@ -587,8 +593,7 @@ def load_params(path):
         If ``path`` does not exist.
     """
     data = load_yaml_file(path, str(path), "a YAML mapping of parameter groups")
-    if isinstance(data, dict) and data.get("kind") == "drakecreep.measured_axis":
-        # the augmented_model.yaml of a p_p_cascade diagnosis is an axis of the replay model, not a drive
+    if isinstance(data, dict) and data.get("kind") == MEASURED_AXIS_KIND:
         raise InputError(f"{path}: kind", data["kind"],
                          "a drakecreep params file (parameter groups motor, screw, nut, table, friction, ...); this "
                          "file is the measured axis that drakecreep diagnose fitted to P-P cascade runs, read by "

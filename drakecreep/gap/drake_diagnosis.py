@@ -122,6 +122,7 @@ from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
 from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
+from drakecreep.params import MEASURED_AXIS_KIND
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
            "paired_log_ratio", "run_log_ratios", "training_run_null", "load_model",
@@ -306,7 +307,7 @@ class DrakeDiagnosis:
 
     def save_model(self, path):
         """Write the augmented model as YAML (SI values with units; ``flexible``, ``delay`` [samples])."""
-        data = {"kind": "drakecreep.measured_axis", "flexible": bool(self.model["flexible"]),
+        data = {"kind": MEASURED_AXIS_KIND, "flexible": bool(self.model["flexible"]),
                 "delay_samples": float(self.model["delay"]), "claimed": list(self.claimed),
                 "parameters": {k: float(v) for k, v in self.model["parameters"].items()},
                 "units": {k: AXIS_UNITS[k] for k in self.model["parameters"]}}
@@ -317,7 +318,7 @@ class DrakeDiagnosis:
 def load_model(path):
     """Read a model written by :meth:`DrakeDiagnosis.save_model`: ``(parameters, flexible, delay)``."""
     data = yaml.safe_load(Path(path).read_text())
-    if not isinstance(data, dict) or data.get("kind") != "drakecreep.measured_axis":
+    if not isinstance(data, dict) or data.get("kind") != MEASURED_AXIS_KIND:
         raise InputError("model", str(path), "a YAML written by DrakeDiagnosis.save_model")
     params = data.get("parameters") or {}
     for k in params:

@@ -435,7 +435,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         lo, hi = np.full(x0.size, -np.inf), np.full(x0.size, np.inf)
         bounds = {**{n: b for n, b in DEFAULT_BOUNDS.items() if n in uncertain}, **(bounds or {})}
         for i, name in enumerate(uncertain):
-            if bounds and name in bounds:
+            if name in bounds:
                 lo[i], hi[i] = (prob.scalar_x(i, b) for b in bounds[name])
                 if not lo[i] < hi[i]:
                     raise InputError(f"bounds.{name}", bounds[name], "(lo, hi) with lo < hi (lo > 0 on a log scale)")

@@ -41,43 +41,15 @@ def test_the_ranking_json_carries_a_candidate_s_regime_test():
     assert math.isnan(asym.regime_log_ratio)
 
 
-def test_the_ranking_json_carries_the_rule_a_candidate_was_decided_on():
-    """``claim_rule`` in ``ranking.json``: ``either`` for a candidate that passes with either held-out test (a
-    friction along the travel), the diagnosis's ``CLAIM_RULE`` for the others; ``level_test_alone``: whether the
-    level test alone carried the claim."""
-    from types import SimpleNamespace
-
-    from drakecreep.gap.drake_diagnosis import CLAIM_RULE, RankedEffect
-    from drakecreep.gap.drake_effects import DRAKE_EFFECTS
-    from drakecreep.report.gap_report import ranking_json
-
-    values = dict.fromkeys(DRAKE_EFFECTS["position_friction"].parameters + DRAKE_EFFECTS["stribeck"].parameters, 0.1)
-
-    def ranked(name, **kw):
-        fit = SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
-                              seconds=1.0)
-        return RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, effect=name, **kw)
-
-    nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
-    out = ranking_json(nominal, {"r0": {"force": 9.0}},
-                       (ranked("position_friction", rule="either"), ranked("stribeck", level_alone=True)))
-    rows = {r["effect"]: r["closed_loop"]["claim_rule"] for r in out["ranking"]}
-    assert rows == {"position_friction": "either", "stribeck": CLAIM_RULE}
-    # whether the level test alone carried it (drift_robust)
-    assert {r["effect"]: r["closed_loop"]["level_test_alone"] for r in out["ranking"]} == \
-        {"position_friction": False, "stribeck": True}
-
-
-def test_the_ranking_json_says_when_a_candidate_passed_by_its_fallback_regime():
-    """``by_fallback_regime``: an asymmetric friction claimed through its constant-speed fallback says so, with
-    the regime's numbers; a candidate decided by its rule does not."""
+def _ranking(*candidates):
+    """``ranking.json``'s rows, by effect, of passing candidates ``(name, RankedEffect fields)`` on a stub nominal."""
     from types import SimpleNamespace
 
     from drakecreep.gap.drake_diagnosis import RankedEffect
     from drakecreep.gap.drake_effects import DRAKE_EFFECTS
     from drakecreep.report.gap_report import ranking_json
 
-    values = dict.fromkeys(DRAKE_EFFECTS["asymmetric_friction"].parameters + DRAKE_EFFECTS["stribeck"].parameters, 0.1)
+    values = dict.fromkeys([p for name, _ in candidates for p in DRAKE_EFFECTS[name].parameters], 0.1)
 
     def ranked(name, **kw):
         fit = SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
@@ -85,10 +57,28 @@ def test_the_ranking_json_says_when_a_candidate_passed_by_its_fallback_regime():
         return RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, effect=name, **kw)
 
     nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
-    out = ranking_json(nominal, {"r0": {"force": 9.0}},
-                       (ranked("asymmetric_friction", fallback=True, regime="constant_speed", regime_log_ratio=0.26,
-                               regime_log_ratio_se=0.08, regime_p_sign_flip=1 / 32), ranked("stribeck")))
-    rows = {r["effect"]: r["closed_loop"] for r in out["ranking"]}
+    out = ranking_json(nominal, {"r0": {"force": 9.0}}, tuple(ranked(name, **kw) for name, kw in candidates))
+    return {r["effect"]: r["closed_loop"] for r in out["ranking"]}
+
+
+def test_the_ranking_json_carries_the_rule_a_candidate_was_decided_on():
+    """``claim_rule`` in ``ranking.json``: ``either`` for a candidate that passes with either held-out test (a
+    friction along the travel), the diagnosis's ``CLAIM_RULE`` for the others; ``level_test_alone``: whether the
+    level test alone carried the claim."""
+    from drakecreep.gap.drake_diagnosis import CLAIM_RULE
+
+    rows = _ranking(("position_friction", {"rule": "either"}), ("stribeck", {"level_alone": True}))
+    assert {n: r["claim_rule"] for n, r in rows.items()} == {"position_friction": "either", "stribeck": CLAIM_RULE}
+    # whether the level test alone carried it (drift_robust)
+    assert {n: r["level_test_alone"] for n, r in rows.items()} == {"position_friction": False, "stribeck": True}
+
+
+def test_the_ranking_json_says_when_a_candidate_passed_by_its_fallback_regime():
+    """``by_fallback_regime``: an asymmetric friction claimed through its constant-speed fallback says so, with
+    the regime's numbers; a candidate decided by its rule does not."""
+    rows = _ranking(("asymmetric_friction", {"fallback": True, "regime": "constant_speed", "regime_log_ratio": 0.26,
+                                             "regime_log_ratio_se": 0.08, "regime_p_sign_flip": 1 / 32}),
+                    ("stribeck", {}))
     assert rows["asymmetric_friction"]["by_fallback_regime"] is True
     assert rows["asymmetric_friction"]["regime"]["name"] == "constant_speed"
     assert rows["stribeck"]["by_fallback_regime"] is False and "regime" not in rows["stribeck"]
