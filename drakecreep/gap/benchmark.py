@@ -430,11 +430,13 @@ def true_effect_fit(result, ds, max_nfev=6):
     r = ranked.get(label)
     if r is not None and r.fit is not None:
         return r.fit
+    alternative = None
     if label == "control_delay":
         start = screen_delay(ds.train, result.nominal.parameters)
     else:
         start = r.screen.start if r is not None and r.screen is not None and r.screen.start else None
-    return fit_candidate(label, ds.train, ds.test, result.nominal, max_nfev, start)
+        alternative = r.screen.alternative_start if start else None
+    return fit_candidate(label, ds.train, ds.test, result.nominal, max_nfev, start, alternative)
 
 
 def audit_replay(runs, models):

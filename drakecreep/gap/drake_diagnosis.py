@@ -16,7 +16,14 @@
    own force terms, seconds): a candidate whose held-out inverse-dynamics log error ratio is not above one
    standard error is not fitted further (the claim needs both gains); the others are fitted by closed-loop output error on the
    training runs from the screen's best start and replayed, fixed, on the held-out runs
-   (:class:`~drakecreep.gap.drake_effects.EffectFit`);
+   (:class:`~drakecreep.gap.drake_effects.EffectFit`). A candidate that refits nominal parameters outside the
+   friction (the drive saturation's mass) has a second start, the friction at its own inverse-dynamics values
+   instead of the nominal's shifted by what the screen moved them, and its fit starts from whichever of the two
+   replays the training runs with the lower error; its equal-effort reference chooses between its own two
+   starts the same way. A drive that saturates biases the nominal's friction too, and the shift then started
+   it far off: on spent held-out dataset 45010001 (SNR 76) a viscous friction of -417 N s/m, whose fit made the
+   held-out replay 4 times worse than the nominal's, where the inverse-dynamics values made it better
+   (docs/gap_benchmark.md, 3ah);
 3. a candidate *passes* when its held-out force error is below the reference model's, on the log scale
    (:func:`paired_log_ratio`: the factor by which it shrinks each run's error, the same in runs of different
    speeds where the gain in points is not), by more than
@@ -115,8 +122,8 @@ from scipy import stats
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
-from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency, effect_regime,
-                                         fit_delay, fit_effect, score_parameters)
+from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency, best_start,
+                                         effect_regime, fit_delay, fit_effect, score_parameters)
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
@@ -290,6 +297,9 @@ class DrakeDiagnosis:
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
             mode = (" (mode {:.3g} Hz, damping ratio {:.2g})".format(*axial_mode_frequency(r.fit.parameters))
                     if r.name == "axial_mode" else "")
+            if getattr(r.screen, "alternative_start", None) and r.fit.start_index == 1:
+                mode += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
+                        "the nominal's shifted)"
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{mode}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
@@ -327,16 +337,20 @@ def load_model(path):
     return dict(params), bool(data.get("flexible", False)), float(data.get("delay_samples", 0.0))
 
 
-def fit_candidate(name, train, test, nominal, max_nfev, start):
+def fit_candidate(name, train, test, nominal, max_nfev, start, alternative=None):
     """Closed-loop fit of candidate ``name`` (or ``"control_delay"``) on ``train`` against ``nominal``, replayed
-    fixed on ``test``, from ``start`` (the screen's best start, or None): an
-    :class:`~drakecreep.gap.drake_effects.EffectFit`. Module level, so a process pool can run it."""
+    fixed on ``test``, from ``start`` (the screen's best start, or None), or from ``alternative`` (the screen's
+    :attr:`~drakecreep.gap.screen.ScreenResult.alternative_start`) when its fixed replay of ``train`` has the
+    lower force error: an :class:`~drakecreep.gap.drake_effects.EffectFit`. Module level, so a process pool can
+    run it."""
     if name == "control_delay":
         return fit_delay(train, test, nominal, start=start)
     # the two-mass replay is the costly one (its mode sets the sub-steps): rank the mode with the nominal
     # friction fixed (2 parameters, not 5); the greedy step refits the friction with it if it passes
     refit = () if name == "axial_mode" else tuple(nominal.fitted)
-    return fit_effect(name, train, test, nominal, max_nfev=max_nfev, starts=(start,) if start else None, refit=refit)
+    starts = tuple(s for s in (start, alternative) if s) or None
+    return fit_effect(name, train, test, nominal, max_nfev=max_nfev, starts=starts, refit=refit,
+                      choose=bool(start and alternative))
 
 
 def _refits(name):
@@ -369,9 +383,16 @@ def _greedy_fit(name, train, test, current, fitted, start, max_nfev):
     return fit_effect(name, train, test, current, max_nfev=max_nfev, refit=tuple(fitted), starts=(start,))
 
 
-def _reference_errors(train, test, current, fitted, max_nfev):
+def _reference_errors(train, test, current, fitted, max_nfev, alternative=None):
     """Held-out errors of the greedy step's equal-effort reference: ``current`` with ``fitted`` refitted
-    (:func:`_refit`) and replayed fixed on ``test``. Module level, for a process pool."""
+    (:func:`_refit`) and replayed fixed on ``test``; from ``current`` with ``alternative`` values instead when
+    their fixed replay of ``train`` has the lower force error (the same choice as its candidate's,
+    :func:`fit_candidate`). Module level, for a process pool."""
+    if alternative:
+        other = _with_values(current, alternative)
+        start = best_start(train, [current.parameters, other.parameters], flexible=current.flexible,
+                           delay=current.delay)
+        current = current if start is current.parameters else other
     return score_parameters(test, _refit(train, current, fitted, max_nfev).parameters, flexible=current.flexible,
                             delay=current.delay)[0]
 
@@ -630,6 +651,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         values = getattr(sc, "reference_values", None)
         return _with_values(first, values) if values else None
 
+    def alternative(sc):  # the screen's second closed-loop start (ScreenResult.alternative_start), or None
+        return getattr(sc, "alternative_start", None) or None
+
     with contextlib.ExitStack() as stack:
         # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start
         # on the first submissions); a single candidate is fitted here, without the processes' start-up
@@ -644,10 +668,11 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             # main process screens the next candidates (the result does not depend on the order)
             jobs.append((n, sc, start))
             if pool is not None:
-                fits_[n] = pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start)
+                fits_[n] = pool.submit(fit_candidate, n, train, test, origin(n), max_nfev, start, alternative(sc))
             model = own_reference(sc)
             if model is not None:
-                own[n] = _submit(pool, _reference_errors, train, test, model, first.fitted, max_nfev)
+                own[n] = _submit(pool, _reference_errors, train, test, model, first.fitted, max_nfev,
+                                 getattr(sc, "reference_alternative", None))
 
         # the candidates without an inverse-dynamics screen first: the axial mode's two-mass fit is the longest
         for n in sorted(names, key=lambda n: n not in NOT_SCREENED):
@@ -667,7 +692,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         jobs.sort(key=lambda job: names.index(job[0]))
         if pool is None:
             for n, sc, start in jobs:
-                fit = fit_candidate(n, train, test, origin(n), max_nfev, start)
+                fit = fit_candidate(n, train, test, origin(n), max_nfev, start, alternative(sc))
                 ranking.append(ranked(n, sc, fit, own[n].result() if n in own else None))
         else:
             done, name_of, screen_of = {}, {f: n for n, f in fits_.items()}, {n: sc for n, sc, _ in jobs}

@@ -29,7 +29,7 @@ from drakecreep.gap.identify import identify
 from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
-           "score_parameters", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
+           "score_parameters", "best_start", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
 
 
 @dataclass(frozen=True)
@@ -225,6 +225,8 @@ class EffectFit:
     test_errors : dict
         Held-out run label -> replay errors [%].
     seconds : float
+    start_index : int
+        Which of the starts the fit came from (with ``choose``, the one chosen; :func:`fit_effect`).
     """
 
     name: str
@@ -236,6 +238,7 @@ class EffectFit:
     test_force_error: float
     test_errors: dict
     seconds: float
+    start_index: int = 0
 
 
 def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=None):
@@ -246,6 +249,19 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
         label = rep.run.label if rep.run.label not in errors else f"{rep.run.label}#{i}"
         errors[label] = drake_replay_errors(rep.simulate(parameters))
     return errors, rms_force_error(errors)
+
+
+def best_start(runs, starts, *, flexible=False, delay=0.0, replays=None):
+    """The one of ``starts`` (parameter dicts) whose fixed replay of ``runs`` has the lowest RMS force error
+    (:func:`score_parameters`; a start whose replay fails counts as worst); the first on a tie."""
+    def error(values):
+        try:
+            rms = score_parameters(runs, values, flexible=flexible, delay=delay, replays=replays)[1]
+        except InputError:
+            return math.inf
+        return rms if math.isfinite(rms) else math.inf
+    errors = [error(s) for s in starts]
+    return starts[errors.index(min(errors))]
 
 
 def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0, prominent=False):
@@ -293,7 +309,8 @@ def physical_bounds(effect, base, fmin=5.0, fmax=300.0):
     return out
 
 
-def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset"), starts=None):
+def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "coulomb", "offset"), starts=None,
+               choose=False):
     """Fit ``effect`` on ``train`` (with the nominal friction ``refit`` refined too) and score it on ``test``.
 
     Parameters
@@ -310,6 +327,10 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
     starts : sequence of dict, optional
         Start values instead of the effect's own starts (e.g. the best start of the inverse-dynamics screen,
         :func:`drakecreep.gap.screen.screen_effect`).
+    choose : bool
+        Fit from only the one of ``starts`` whose fixed replay of ``train`` has the lowest force error (one replay
+        per start, instead of ``max_nfev`` evaluations from each): the closed-loop start of a candidate whose
+        screen offers two (:attr:`drakecreep.gap.screen.ScreenResult.alternative_start`).
 
     Returns
     -------
@@ -339,7 +360,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
     bounds = dict(effect.bounds)
     bounds.update(physical_bounds(effect, base))
     replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
-    best = None
+    fixeds = []
     for start in starts:
         fixed = dict(base)
         start = dict(start)
@@ -351,15 +372,22 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
             fixed.update(stiffness=k, damping=0.05 * 2 * math.sqrt(k * share * (1 - share) * m))
         fixed.update(start)
         fixed.update({n: max(fixed[n], lo) for n, lo in effect.start_floor.items()})
-        idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixed,
+        fixeds.append(fixed)
+    indices = list(range(len(fixeds)))
+    if choose and len(fixeds) > 1:
+        chosen = best_start(train, fixeds, flexible=flexible, delay=nominal.delay, replays=replays)
+        indices = [next(i for i, f in enumerate(fixeds) if f is chosen)]
+    best, index = None, 0
+    for i in indices:
+        idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixeds[i],
                        bounds=bounds, max_nfev=max_nfev, replays=replays)
         if best is None or idf.cost < best.cost:
-            best = idf
+            best, index = idf, i
     train_rms = rms_force_error(best.train_errors)
     test_errors, test_rms = score_parameters(test, best.parameters, flexible=flexible, delay=nominal.delay)
     return EffectFit(name=effect.name, parameters=best.parameters, identified=best, delay=nominal.delay,
                      flexible=flexible, train_force_error=train_rms, test_force_error=test_rms,
-                     test_errors=test_errors, seconds=_time.perf_counter() - t0)
+                     test_errors=test_errors, seconds=_time.perf_counter() - t0, start_index=index)
 
 
 def fit_delay(train, test, nominal, *, max_delay=3.0, start=None):

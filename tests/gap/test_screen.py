@@ -126,6 +126,27 @@ def test_the_saturation_candidate_carries_its_own_mass_and_the_references():
     assert 1.0 / sc.start["inverse_drive_limit"] == pytest.approx(60.0, rel=0.2)
 
 
+def test_the_saturation_candidate_offers_its_own_friction_as_a_second_start():
+    """A saturating drive biases the nominal's friction as well as its mass (spent held-out dataset 45010001: an
+    IDIM viscous of 716 N s/m against the truth's 135). Given a nominal with a viscous friction 5 times the
+    axis's, the shifted start is off by more than half the axis's value, and the alternative start has the
+    candidate's own inverse-dynamics friction, within 10 % of the axis's; the reference's alternative carries the
+    reference's own values of every refitted parameter, its mass the reference's."""
+    runs = _runs(dict(BASE, inverse_drive_limit=1.0 / 60.0))
+    off = dict(BASE, mass=1.3 * BASE["mass"], viscous=5.0 * BASE["viscous"])
+    sc = screen_effect(DRAKE_EFFECTS["drive_saturation"], runs[:3], runs[3:], off)
+    assert sc.passes
+    alt = sc.alternative_start
+    assert alt["viscous"] == pytest.approx(BASE["viscous"], rel=0.1)
+    assert abs(sc.start["viscous"] - BASE["viscous"]) > 0.5 * BASE["viscous"]
+    assert {k: alt[k] for k in ("inverse_drive_limit", "mass")} == {k: sc.start[k] for k in ("inverse_drive_limit",
+                                                                                            "mass")}
+    assert set(sc.reference_alternative) == {"viscous", "coulomb", "offset", "mass"}
+    assert sc.reference_alternative["mass"] == sc.reference_values["mass"]
+    # a candidate without screen_refits offers none
+    assert screen_effect(DRAKE_EFFECTS["asymmetric_friction"], runs[:3], runs[3:], BASE).alternative_start == {}
+
+
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     """A 3 N force ripple of period 3.7 mm (none of the candidate's own starts): the Lomb-Scargle scan of the
     residual against position starts the fit at the period, which it refines to within 0.2 %, with the amplitude
