@@ -1,0 +1,58 @@
+"""Spent held-out datasets of a saturating drive, diagnosed again with the product path: one row each.
+
+Seeds of held-out runs already scored and looked into (never a run's own seeds before it is scored). The
+heavily saturated drives of runs 10-23 (SNR 27-84) were missed or claimed as another effect, and the true
+effect's own fit made the audit replay worse (45010001: 80 % -> 299 %). The cause was the closed-loop start:
+the nominal's friction shifted by what the candidate moved it on inverse dynamics, when the saturation had
+biased the nominal itself (docs/gap_benchmark.md, 3ah). This script reruns ``benchmark.evaluate`` on such
+datasets, and on cable carriers and nulls where the candidate's fit was far off the same way, and writes the
+rows as the benchmark does (``--score`` of ``analysis/bench_gap_benchmark.py`` reads them).
+
+Usage: ``PYTHONPATH=. python analysis/drive_saturation_start_study.py OUT.json SEED:WITHHELD:AXIS [...]``
+(``WITHHELD`` is ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``; e.g. ``21010002:drive_saturation:flexible``).
+The rows of session 39 are in ``analysis/drive_saturation_start_dev.json``.
+"""
+
+import json
+import sys
+import time
+
+from drakecreep.files import write_text
+from drakecreep.gap import benchmark
+
+
+def _refuse(line):
+    print(line, file=sys.stderr)
+    sys.exit(2)
+
+
+def _spec(arg):
+    try:
+        seed, withheld, axis = arg.split(":")
+        seed = int(seed)
+    except ValueError:
+        _refuse(f"dataset: got {arg!r}; allowed: SEED:WITHHELD:AXIS, e.g. 21010002:drive_saturation:flexible")
+    if axis not in ("rigid", "flexible"):
+        _refuse(f"axis: got {axis!r}; allowed: rigid, flexible")
+    return seed, () if withheld == "null" else (withheld,), axis
+
+
+def main(argv):
+    if len(argv) < 2:
+        _refuse("usage: analysis/drive_saturation_start_study.py OUT.json SEED:WITHHELD:AXIS [...]")
+    out, specs = argv[0], [_spec(a) for a in argv[1:]]
+    rows = []
+    for seed, withheld, axis in specs:
+        t0 = time.perf_counter()
+        ds = benchmark.generate_dataset(seed, withheld=withheld, kind="p_p_cascade", axis=axis)
+        row = benchmark.evaluate(ds)
+        rows.append(row)
+        print(f"{seed} {'+'.join(withheld) or 'null'} {axis}: SNR {row['snr']:.1f}, claimed {row['claimed']}, "
+              f"audit shrink {row['audit_shrink']:.2f} (true fit {row['true_shrink']}), "
+              f"{time.perf_counter() - t0:.0f} s", flush=True)
+        write_text(out, json.dumps({"note": "spent held-out datasets rerun as development (session 39)",
+                                    "datasets": rows}, indent=1, default=str))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
