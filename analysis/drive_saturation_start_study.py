@@ -9,7 +9,8 @@ datasets, and on cable carriers and nulls where the candidate's fit was far off 
 rows as the benchmark does (``--score`` of ``analysis/bench_gap_benchmark.py`` reads them).
 
 Usage: ``PYTHONPATH=. python analysis/drive_saturation_start_study.py OUT.json SEED:WITHHELD:AXIS [...]``
-(``WITHHELD`` is ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``; e.g. ``21010002:drive_saturation:flexible``).
+(``WITHHELD`` is ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``; e.g.
+``21010002:drive_saturation:flexible``).
 The rows of session 39 are in ``analysis/drive_saturation_start_dev.json``.
 """
 
