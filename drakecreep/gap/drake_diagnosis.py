@@ -235,6 +235,15 @@ class RankedEffect:
         """True when the inverse-dynamics screen ruled it out (no closed-loop fit)."""
         return self.fit is None
 
+    @property
+    def closed_loop_start(self):
+        """Where the closed-loop fit started when the screen offered two starts
+        (:attr:`~drakecreep.gap.screen.ScreenResult.alternative_start`): ``inverse_dynamics`` (the candidate's own
+        inverse-dynamics friction) or ``shifted_nominal``; empty otherwise."""
+        if self.fit is None or not getattr(self.screen, "alternative_start", None):
+            return ""
+        return "inverse_dynamics" if getattr(self.fit, "start_index", 0) == 1 else "shifted_nominal"
+
 
 @dataclass(frozen=True)
 class DrakeDiagnosis:
@@ -297,7 +306,7 @@ class DrakeDiagnosis:
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
             mode = (" (mode {:.3g} Hz, damping ratio {:.2g})".format(*axial_mode_frequency(r.fit.parameters))
                     if r.name == "axial_mode" else "")
-            if getattr(r.screen, "alternative_start", None) and r.fit.start_index == 1:
+            if r.closed_loop_start == "inverse_dynamics":
                 mode += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
                         "the nominal's shifted)"
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{mode}, "

@@ -26,6 +26,8 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                        "log_error_ratio": sc.log_ratio, "log_error_ratio_standard_error": sc.log_ratio_se,
                                        "passes": bool(sc.passes),
                                        "start": sc.start}
+            if getattr(sc, "alternative_start", None):  # the second closed-loop start (ScreenResult)
+                row["inverse_dynamics"]["alternative_start"] = sc.alternative_start
             c = getattr(sc, "constancy", None)
             if c is not None:
                 row["inverse_dynamics"]["constancy"] = {"per_run": list(c.per_run), "chi2": c.chi2, "dof": c.dof,
@@ -45,6 +47,7 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "threshold_level_log_error_ratio": r.level_threshold,
                                   "claim_rule": r.rule, "level_test_alone": r.level_alone,
                                   "by_fallback_regime": r.fallback,
+                                  "started_from": r.closed_loop_start or None,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
             if r.regime:  # the regime it must show in too, or may pass by (DrakeEffect.regime, fallback_regime)

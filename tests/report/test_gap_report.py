@@ -82,3 +82,29 @@ def test_the_ranking_json_says_when_a_candidate_passed_by_its_fallback_regime():
     assert rows["asymmetric_friction"]["by_fallback_regime"] is True
     assert rows["asymmetric_friction"]["regime"]["name"] == "constant_speed"
     assert rows["stribeck"]["by_fallback_regime"] is False and "regime" not in rows["stribeck"]
+
+
+def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
+    """A drive saturation whose screen offered two closed-loop starts: ``ranking.json`` carries the second one
+    beside the first, and ``started_from`` says which one its fit came from (``inverse_dynamics`` or
+    ``shifted_nominal``); a candidate with one start has neither."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import RankedEffect
+    from drakecreep.gap.screen import ScreenResult
+    from drakecreep.report.gap_report import ranking_json
+
+    start = {"inverse_drive_limit": 0.016, "viscous": -417.0, "mass": 74.0}
+    offered = ScreenResult("drive_saturation", start, 1.0, 1.0, 2.0, 1.0, 0.1, True,
+                           alternative_start=dict(start, viscous=122.0))
+    rows = _ranking(("drive_saturation", {"screen": offered}), ("stribeck", {}))
+    assert rows["drive_saturation"]["started_from"] == "shifted_nominal"  # the stub fit has no start_index: the first
+    assert rows["stribeck"]["started_from"] is None
+    fit = SimpleNamespace(name="drive_saturation", test_force_error=8.0, train_force_error=7.0, start_index=1,
+                          parameters={"inverse_drive_limit": 0.016}, delay=0.0, seconds=1.0)
+    ranked = RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, screen=offered)
+    assert ranked.closed_loop_start == "inverse_dynamics"
+    nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
+    row = ranking_json(nominal, {"r0": {"force": 9.0}}, (ranked,))["ranking"][0]
+    assert row["inverse_dynamics"]["alternative_start"]["viscous"] == 122.0
+    assert row["closed_loop"]["started_from"] == "inverse_dynamics"
