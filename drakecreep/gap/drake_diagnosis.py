@@ -122,8 +122,8 @@ from scipy import stats
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
-from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency, best_start,
-                                         effect_regime, fit_delay, fit_effect, score_parameters)
+from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency,
+                                         best_start_index, effect_regime, fit_delay, fit_effect, score_parameters)
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
@@ -399,9 +399,9 @@ def _reference_errors(train, test, current, fitted, max_nfev, alternative=None):
     :func:`fit_candidate`). Module level, for a process pool."""
     if alternative:
         other = _with_values(current, alternative)
-        start = best_start(train, [current.parameters, other.parameters], flexible=current.flexible,
-                           delay=current.delay)
-        current = current if start is current.parameters else other
+        if best_start_index(train, [current.parameters, other.parameters], flexible=current.flexible,
+                            delay=current.delay) == 1:
+            current = other
     return score_parameters(test, _refit(train, current, fitted, max_nfev).parameters, flexible=current.flexible,
                             delay=current.delay)[0]
 

@@ -29,7 +29,7 @@ from drakecreep.gap.identify import identify
 from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
-           "score_parameters", "best_start", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
+           "score_parameters", "best_start_index", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
 
 
 @dataclass(frozen=True)
@@ -251,9 +251,9 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
     return errors, rms_force_error(errors)
 
 
-def best_start(runs, starts, *, flexible=False, delay=0.0, replays=None):
-    """The one of ``starts`` (parameter dicts) whose fixed replay of ``runs`` has the lowest RMS force error
-    (:func:`score_parameters`; a start whose replay fails counts as worst); the first on a tie."""
+def best_start_index(runs, starts, *, flexible=False, delay=0.0, replays=None):
+    """Index of the one of ``starts`` (parameter dicts) whose fixed replay of ``runs`` has the lowest RMS force
+    error (:func:`score_parameters`; a start whose replay fails counts as worst); the first on a tie."""
     def error(values):
         try:
             rms = score_parameters(runs, values, flexible=flexible, delay=delay, replays=replays)[1]
@@ -261,7 +261,7 @@ def best_start(runs, starts, *, flexible=False, delay=0.0, replays=None):
             return math.inf
         return rms if math.isfinite(rms) else math.inf
     errors = [error(s) for s in starts]
-    return starts[errors.index(min(errors))]
+    return errors.index(min(errors))
 
 
 def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0, prominent=False):
@@ -375,8 +375,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
         fixeds.append(fixed)
     indices = list(range(len(fixeds)))
     if choose and len(fixeds) > 1:
-        chosen = best_start(train, fixeds, flexible=flexible, delay=nominal.delay, replays=replays)
-        indices = [next(i for i, f in enumerate(fixeds) if f is chosen)]
+        indices = [best_start_index(train, fixeds, flexible=flexible, delay=nominal.delay, replays=replays)]
     best, index = None, 0
     for i in indices:
         idf = identify(train, uncertain, flexible=flexible, delay=nominal.delay, fixed=fixeds[i],

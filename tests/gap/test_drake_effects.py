@@ -43,18 +43,18 @@ def test_a_time_ripple_is_found_at_its_frequency_and_shrinks_the_held_out_replay
 
 
 def test_a_fit_that_chooses_its_start_fits_from_the_one_with_the_lower_training_error():
-    """``best_start`` picks the parameters whose fixed replay of the runs has the lower force error (the axis's own
+    """``best_start_index`` picks the parameters whose fixed replay of the runs has the lower force error (the axis's own
     against a viscous friction 3 times too large; a start whose replay fails counts as worst), and
     ``fit_effect(choose=True)`` fits from only that start: the same fit as from the good start alone, not the one
     from the bad start alone."""
-    from drakecreep.gap.drake_effects import best_start
+    from drakecreep.gap.drake_effects import best_start_index
 
     truth = dict(NOMINAL, inverse_drive_limit=1.0 / 60.0)
     runs = _runs(truth, starts=(0, 5000, 10000), n=800)
     train, test = runs[:2], runs[2:]
     bad = dict(truth, viscous=3.0 * truth["viscous"])
-    assert best_start(train, [bad, truth]) is truth
-    assert best_start(train, [dict(truth, mass=-1.0), bad]) is bad
+    assert best_start_index(train, [bad, truth]) == 1
+    assert best_start_index(train, [dict(truth, mass=-1.0), bad]) == 1
     nominal = identify(train, (), fixed=dict(NOMINAL, regularization_velocity=1e-3))
     good_start = {"inverse_drive_limit": 1.0 / 60.0, "viscous": truth["viscous"]}
     bad_start = {"inverse_drive_limit": 1.0 / 60.0, "viscous": 3.0 * truth["viscous"]}
