@@ -304,12 +304,12 @@ class DrakeDiagnosis:
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None
-            mode = (" (mode {:.3g} Hz, damping ratio {:.2g})".format(*axial_mode_frequency(r.fit.parameters))
+            note = (" (mode {:.3g} Hz, damping ratio {:.2g})".format(*axial_mode_frequency(r.fit.parameters))
                     if r.name == "axial_mode" else "")
             if r.closed_loop_start == "inverse_dynamics":
-                mode += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
+                note += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
                         "the nominal's shifted)"
-            lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{mode}, "
+            lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{note}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
                              f"{k} {v:.4g} {AXIS_UNITS[k]}" for k, v in own.items())
@@ -660,8 +660,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         values = getattr(sc, "reference_values", None)
         return _with_values(first, values) if values else None
 
-    def alternative(sc):  # the screen's second closed-loop start (ScreenResult.alternative_start), or None
-        return getattr(sc, "alternative_start", None) or None
+    def alternative(sc):  # the screen's second closed-loop start (ScreenResult.alternative_start; empty: none)
+        return getattr(sc, "alternative_start", None)
 
     with contextlib.ExitStack() as stack:
         # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start

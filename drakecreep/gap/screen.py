@@ -384,11 +384,12 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     # nominal's value would not do: the IDIM mass on the whole runs and the screen's on the sliding samples
     # differ by 40 % on a saturated dataset, 236 kg against 165 kg on development seed 32004)
     start.update({n: best[n] for n in effect.screen_refits})
-    alternative = dict(start, **{n: best[n] for n in refit}) if effect.screen_refits else {}
+    # the second closed-loop starts (ScreenResult.alternative_start): each model's own inverse-dynamics values
+    own, reference_own = ({**start, **{n: best[n] for n in refit}}, {n: reference[n] for n in refit}) \
+        if effect.screen_refits else ({}, {})
     return ScreenResult(effect.name, start, _rms(train_err), _rms(test_err),
                         _rms(nom_test), gain, se, bool(ok), inside, lr, lr_se, const,
-                        {n: reference[n] for n in effect.screen_refits}, alternative,
-                        {n: reference[n] for n in refit} if effect.screen_refits else {})
+                        {n: reference[n] for n in effect.screen_refits}, own, reference_own)
 
 
 #: parameters that set a candidate's shape, not its size (held at the pooled fit in the constancy test)
