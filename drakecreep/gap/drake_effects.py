@@ -391,10 +391,10 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
 
 def fit_delay(train, test, nominal, *, max_delay=3.0, start=None):
     """The computation delay [samples]: the training replay's cost at every whole delay ``0 .. max_delay``
-    (the sampled fast path) and at ``start`` (a fractional value, e.g. the inverse-dynamics scan of
-    :func:`drakecreep.gap.screen.screen_delay`, replayed by :class:`~drakecreep.gap.drake_replay.DrakeReplay`); the lowest cost wins and is
-    scored on ``test``. (A full continuous search rebuilds a leaf-controller diagram per value: about 10x
-    the cost; see docs/gap_diagnosis.md.)
+    and at ``start`` (a fractional value, e.g. the inverse-dynamics scan of
+    :func:`drakecreep.gap.screen.screen_delay`), all on the sampled fast path (a fraction's switch is averaged
+    over the tick it falls in); the lowest cost wins and is scored on ``test``. (A full continuous search
+    costs one replay set per value; see docs/gap_diagnosis.md.)
 
     Returns
     -------

@@ -129,15 +129,22 @@ def test_force_error_in_a_mode_band_sees_an_oscillation_there_and_nothing_else(r
         {"force_band_" + f"{lo:.3g}-{hi:.3g}_Hz" for lo, hi in MODE_BANDS_HZ if lo < 0.45 * 250.0}
 
 
+@pytest.mark.parametrize("sampled", [False, True], ids=["error_controlled", "sampled"])
 @pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
-def test_computation_delay_holds_older_outputs(run, delay, shift):
-    """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later."""
+def test_computation_delay_holds_older_outputs(run, delay, shift, sampled):
+    """At the end of sample interval k the applied force is u[k - floor(delay)]; a fraction switches it later
+    (both replays: the leaf controller's second event, and the sampled replay's averaged tick)."""
+    from drakecreep.gap.drake_replay import make_replay
+
     short = run.slice(0, 300)
-    res = DrakeReplay(short, delay=delay).simulate(axis_from_idim(PUBLISHED_IDIM))
+
+    def replay(d):
+        return make_replay(short, delay=d, free=(), sampled=sampled).simulate(axis_from_idim(PUBLISHED_IDIM))
+
+    res = replay(delay)
     assert np.allclose(res.force[shift:], run.u_gain * res.u[:res.u.size - shift])
     if delay % 1:
-        whole = DrakeReplay(short, delay=delay - 0.5).simulate(axis_from_idim(PUBLISHED_IDIM))
-        later = DrakeReplay(short, delay=delay + 0.5).simulate(axis_from_idim(PUBLISHED_IDIM))
+        whole, later = replay(delay - 0.5), replay(delay + 0.5)
         gap_lo = np.abs(res.x_motor - whole.x_motor).max()
         gap_hi = np.abs(res.x_motor - later.x_motor).max()
         assert 0 < gap_lo < np.abs(later.x_motor - whole.x_motor).max()
@@ -223,6 +230,11 @@ SAMPLED_CASES = {
                                        bristle_stiffness=2e7, bristle_damping_ratio=0.5)),
     # 70 % of the friction sticks, the rest is the regularized law (the bristles' rate 1 / 0.7 faster)
     "lugre_share": (False, 0.0, dict(regularization_velocity=1e-3, bristle_stiffness=5e6, bristle_share=0.7)),
+    # a fractional delay: the switch at t_k + f h falls inside a tick, which takes the two outputs' average
+    "fractional_delay": (False, 2.35, dict(regularization_velocity=1e-3)),
+    "fractional_delay_two_mass": (True, 0.35, dict(regularization_velocity=1e-3, stiffness=2e6, damping=300.0)),
+    "fractional_delay_lugre": (False, 1.7, dict(regularization_velocity=1e-3, bristle_stiffness=5e6,
+                                                stribeck_extra=4.0, stribeck_velocity=2e-3)),
 }
 
 
@@ -259,8 +271,9 @@ def test_sampled_replay_rebuilds_for_new_fixed_values_and_finer_steps(run):
     again = rep.simulate(p)
     assert np.max(np.abs(again.x_motor - a.x_motor)) < 1e-5 * np.ptp(run.x_motor)
     assert drake_replay_errors(b)["force"] != drake_replay_errors(a)["force"]
-    with pytest.raises(InputError):
-        SampledReplay(run, delay=0.5)
+    for bad in (-0.5, float("nan"), True):
+        with pytest.raises(InputError, match="delay"):
+            SampledReplay(run, delay=bad)
     with pytest.raises(InputError):
         SampledReplay(run, free=("no_such",))
 
