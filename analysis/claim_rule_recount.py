@@ -6,8 +6,9 @@ log error ratios (plain, with each run's own friction level, at constant speed) 
 null. This script feeds them to the product's own test (:func:`drakecreep.gap.drake_diagnosis._passes`, through
 error dicts whose log ratios are the stored values) under
 
-* ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction) and its
-  fallback regime (the asymmetric friction's constant speed, from session 38), the product today;
+* ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), its
+  fallback regime (the asymmetric friction's constant speed, from session 38) and its piece test (the lead error,
+  from session 40; rows stored before have no pieces, so it never passes there), the product today;
 * ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
 * ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive).
 
@@ -25,7 +26,8 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _fallback, _passes, _rule
+from drakecreep.gap.drake_diagnosis import _fallback, _passes, _piece_test, _rule
+from drakecreep.gap.drake_replay import piece_keys
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
 RULES = ("current", "both", "either")
@@ -65,6 +67,11 @@ def _errors(entry):
         for i, v in enumerate(values):
             ref[f"r{i}"][key] = 1.0
             cand[f"r{i}"][key] = math.exp(-v)
+    # each held-out run's pieces (rows from session 40 on): the piece test of DrakeEffect.piece_test
+    for i, pieces in enumerate(entry.get("piece_log_error_ratios") or ()):
+        for key, v in zip(piece_keys(), pieces):
+            ref[f"r{i}"][key] = 1.0
+            cand[f"r{i}"][key] = math.exp(-v)
     return ref, cand
 
 
@@ -80,7 +87,8 @@ def first_claim(row, rule):
         own = _rule(name)
         chosen = {"current": own, "both": "both" if own == "drift_robust" else own}.get(rule, rule)
         t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry),
-                    fallback_regime=_fallback(name) if rule == "current" else "")
+                    fallback_regime=_fallback(name) if rule == "current" else "",
+                    pieces=_piece_test(name) if rule == "current" else False)
         if t.passes:
             return name
     return None

@@ -18,6 +18,7 @@ import json
 import sys
 import time
 
+from drakecreep.errors import InputError
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 
@@ -29,13 +30,9 @@ def _refuse(line):
 
 def _spec(arg):
     try:
-        seed, withheld, axis = arg.split(":")
-        seed = int(seed)
-    except ValueError:
-        _refuse(f"dataset: got {arg!r}; allowed: SEED:WITHHELD:AXIS, e.g. 21010002:drive_saturation:flexible")
-    if axis not in ("rigid", "flexible"):
-        _refuse(f"axis: got {axis!r}; allowed: rigid, flexible")
-    return seed, () if withheld == "null" else (withheld,), axis
+        return benchmark.dataset_spec(arg)
+    except InputError as e:
+        _refuse(str(e))
 
 
 def main(argv):

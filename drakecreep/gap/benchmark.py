@@ -62,6 +62,7 @@ from drakecreep.gap.truth import out_and_back
 
 __all__ = [
     "DEV_SEEDS",
+    "dataset_spec",
     "HELDOUT_SEEDS",
     "N_TRAIN",
     "N_TEST",
@@ -338,6 +339,21 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
     return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples)[0]
 
 
+def dataset_spec(text):
+    """``(seed, withheld, axis)`` of ``SEED:WITHHELD:AXIS`` (``WITHHELD`` ``null`` or a withheld effect of
+    :data:`drakecreep.gap.truth.WITHHELD`, ``AXIS`` one of :data:`drakecreep.gap.truth.AXES`): one dataset of a
+    study, e.g. ``29003009:lead_error:rigid``; :class:`~drakecreep.errors.InputError` naming the bad part."""
+    parts = str(text).split(":")
+    if len(parts) != 3 or not parts[0].isdigit():
+        raise InputError("dataset", text, "SEED:WITHHELD:AXIS, e.g. 29003009:lead_error:rigid")
+    seed, withheld, axis = parts
+    if withheld != "null" and withheld not in T.WITHHELD:
+        raise InputError("withheld", withheld, "null or one of " + ", ".join(T.WITHHELD))
+    if axis not in T.AXES:
+        raise InputError("axis", axis, "one of " + ", ".join(T.AXES))
+    return int(seed), () if withheld == "null" else (withheld,), axis
+
+
 def _idim_energy(runs):
     """Mean square residual [N^2] of the nominal inverse-dynamics least squares of the Drake path on ``runs``.
 
@@ -546,6 +562,14 @@ def _run_log_ratios(ranked, res, key):
     return [float(v) for v in run_log_ratios(reference, candidate, key)]
 
 
+def _piece_log_ratios(ranked, res):
+    """Per held-out run, its pieces' ``ln(reference / candidate)`` of the force error (None without them)."""
+    from drakecreep.gap.drake_replay import piece_keys
+
+    per_key = [_run_log_ratios(ranked, res, k) for k in piece_keys()]
+    return None if any(v is None for v in per_key) else [list(v) for v in zip(*per_key)]
+
+
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):
     """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
 
@@ -582,6 +606,10 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 # or its fallback regime (DrakeEffect.fallback_regime), and whether it passed by that
                 "regime": r.regime,
                 "fallback": bool(r.fallback),
+                # the test over the held-out runs' pieces (DrakeEffect.piece_test): every piece's log ratio, run
+                # by run, and whether it passed by them
+                "pieces": bool(r.pieces),
+                "piece_log_error_ratios": None if r.screened_out else _piece_log_ratios(r, res),
                 "run_regime_log_error_ratios": None if r.screened_out or not r.regime else _run_log_ratios(
                     r, res, f"force_{r.regime}")}
                for r in res.ranking]

@@ -62,6 +62,11 @@ class DrakeEffect:
     regime through which a candidate that fails its claim rule may still be claimed, by ``either`` and a
     significant shrink of its error in that regime (the asymmetric friction at constant speed:
     :func:`drakecreep.gap.drake_diagnosis._passes`); only for a candidate without a ``regime`` of its own.
+    ``piece_test``: a candidate whose force grows so steeply with the speed that one or two fast held-out runs
+    carry it (the lead error: the table's inertia times ``e''(x) v^2``) and that fails its claim rule is still
+    claimed when both its mean log ratios exceed their training-run nulls and the mean log ratio over the
+    pieces of the held-out runs (:data:`~drakecreep.gap.drake_replay.RUN_PIECES` each) is significant by the
+    sign-flip test (:func:`drakecreep.gap.drake_diagnosis._passes`; docs/gap_benchmark.md, 3ai).
     """
 
     name: str
@@ -78,6 +83,7 @@ class DrakeEffect:
     regime: str = ""
     claim_rule: str = ""
     fallback_regime: str = ""
+    piece_test: bool = False
 
     def fixed_by(self, runs):
         """Axis parameters the candidate takes from the training ``runs``, not from a fit: for a map along the
@@ -138,12 +144,15 @@ DRAKE_EFFECTS = {
     # a kinematic lead error, first and second harmonic of the lead (drakecreep.model.axis.lead_error): on a
     # motor-encoder loop its force is the table's inertia times e''(x) v^2, a position ripple growing with the
     # square of the speed (the position_ripple candidate, of constant amplitude, cannot serve runs at 5-150 mm/s).
+    # The held-out runs at 5-150 mm/s carry it in proportion to their squared speed, often one or two of five: it
+    # may pass by the test over the runs' pieces (piece_test; docs/gap_benchmark.md, 3ag and 3ai).
     # Starts: the periodogram's peaks and twice them (screen); amplitudes up to 0.1 mm, far beyond any screw's
     "lead_error": DrakeEffect("lead_error", LEAD_ERROR + ("lead",),
                               tuple({"lead": x} for x in (2.5e-3, 5e-3, 1e-2, 2e-2)),
                               signature="force ripple periodic in position whose amplitude grows with the square of "
                                         "the speed (the table's inertia behind a periodic lead error)",
-                              bounds=dict({n: (-1e-4, 1e-4) for n in LEAD_ERROR}, lead=(1e-3, 0.05))),
+                              bounds=dict({n: (-1e-4, 1e-4) for n in LEAD_ERROR}, lead=(1e-3, 0.05)),
+                              piece_test=True),
     # a force at a fixed time frequency is there at constant speed as well; runs that share their timing (a
     # repeated program) repeat any model error that follows the reference at the same instants, and a sinusoid
     # of fixed phase fits part of it in the moves alone (docs/gap_benchmark.md, 3u): the regime test tells them

@@ -57,6 +57,8 @@ __all__ = [
     "REGIME_ERRORS",
     "MIN_REGIME_SAMPLES",
     "MODE_BANDS_HZ",
+    "RUN_PIECES",
+    "piece_keys",
     "mode_band",
     "rms_force_error",
     "axis_from_idim",
@@ -671,6 +673,14 @@ def drake_replay(run, parameters, flexible=False, delay=0.0, quantize=True):
 REGIME_ERRORS = ("constant_speed",)
 #: fewest samples of a regime for its force error (fewer: the key is left out)
 MIN_REGIME_SAMPLES = 20
+#: Pieces of equal length a run's force error is also given over (``force_piece_<i>``): the claim test's pieces for
+#: an effect that one or two fast held-out runs carry (:attr:`drakecreep.gap.drake_effects.DrakeEffect.piece_test`).
+RUN_PIECES = 4
+
+
+def piece_keys(pieces=RUN_PIECES):
+    """The error keys of a run's pieces (:func:`drake_replay_errors`), in time order."""
+    return tuple(f"force_piece_{i}" for i in range(pieces))
 
 
 #: octave bands [Hz] centred half an octave apart, 5 * 2^(k/2) from 5 to 320 Hz (the axial mode's search range
@@ -726,7 +736,10 @@ def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
     samples of that regime (:func:`drakecreep.gap.residuals.classify_regimes` of the reference and the measured
     speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them; ``force_band_<lo>-<hi>_Hz`` the force
     error in each band of :data:`MODE_BANDS_HZ` (:func:`mode_band`) unless ``bands`` is false (a fit's training
-    errors and the ``drakecreep`` kind's, which no band test reads: the bands are most of this function's cost).
+    errors and the ``drakecreep`` kind's, which no band test reads: the bands are most of this function's cost);
+    ``force_piece_<i>`` (:func:`piece_keys`) the force error over each of :data:`RUN_PIECES` windows of equal
+    length, in time order, when the run has at least ``RUN_PIECES * MIN_REGIME_SAMPLES`` samples and a force in
+    every piece.
     """
     run = result.run
     _, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
@@ -747,6 +760,11 @@ def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
         sel = regimes == regime
         if np.count_nonzero(sel) >= MIN_REGIME_SAMPLES and np.any(force[sel] != 0):
             out[f"force_{regime}"] = relative_error(force[sel], force_sim[sel])
+    if run.n >= RUN_PIECES * MIN_REGIME_SAMPLES:
+        edges = np.linspace(0, run.n, RUN_PIECES + 1).astype(int)
+        if all(np.any(force[a:b] != 0) for a, b in zip(edges[:-1], edges[1:])):
+            for key, a, b in zip(piece_keys(), edges[:-1], edges[1:]):
+                out[key] = relative_error(force[a:b], force_sim[a:b])
     if bands:
         out.update(_band_errors(force, force_sim, run.dt))
     return out

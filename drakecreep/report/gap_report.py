@@ -47,6 +47,8 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "threshold_level_log_error_ratio": r.level_threshold,
                                   "claim_rule": r.rule, "level_test_alone": r.level_alone,
                                   "by_fallback_regime": r.fallback,
+                                  "piece_log_error_ratio": r.piece_log_ratio,
+                                  "piece_sign_flip_p": r.piece_p_sign_flip, "by_pieces": r.pieces,
                                   "started_from": r.closed_loop_start or None,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
@@ -220,7 +222,10 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  + "where the candidate names a regime it must show in (a time ripple: at constant speed), "
                  "with a positive and significant log ratio of the force error in that regime too (an asymmetric "
                  "friction that fails the tests above is still claimed when one of the two passes, the other's mean "
-                 "log ratio positive, and its error at constant speed shrinks so: its fallback regime), "
+                 "log ratio positive, and its error at constant speed shrinks so: its fallback regime; a lead "
+                 "error, which one or two fast held-out runs may carry alone, is claimed when both its mean log "
+                 "ratios exceed their training-run nulls and its log ratio over the quarters of the held-out runs "
+                 "is significant), "
                  "and its "
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
                  "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
@@ -261,6 +266,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                         f"; own level {r.level_log_ratio:+.3f} vs {r.level_threshold:.3f}"),
                      ("yes" if r.passes else "no")
                      + (f" (by the {r.regime.replace('_', ' ')} fallback)" if r.fallback else "")
+                     + (" (by the held-out runs' pieces)" if r.pieces else "")
                      + ("" if r.name in diagnosis.claimed or not r.passes else " (not kept by the greedy step)"),
                      params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")

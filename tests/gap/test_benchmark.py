@@ -259,3 +259,15 @@ def test_shards_split_one_run_without_overlap(monkeypatch):
     assert len(whole) == 5 and parts[0] == whole[0::2] and parts[1] == whole[1::2]
     with pytest.raises(InputError, match="shard"):
         run_benchmark(shard=(2, 2), **kw)
+
+
+def test_a_study_names_a_dataset_by_seed_withheld_effect_and_axis():
+    """``SEED:WITHHELD:AXIS`` (the development studies' datasets): ``null`` for none; a bad part is named."""
+    from drakecreep.gap.benchmark import dataset_spec
+
+    assert dataset_spec("29003009:lead_error:rigid") == (29003009, ("lead_error",), "rigid")
+    assert dataset_spec("45013000:null:flexible") == (45013000, (), "flexible")
+    for bad, field in (("29003009:lead_error", "dataset"), ("x1:null:rigid", "dataset"), ("1:nope:rigid", "withheld"),
+                       ("1:null:wobbly", "axis"), ("-1:null:rigid", "dataset")):
+        with pytest.raises(InputError, match=field):
+            dataset_spec(bad)

@@ -427,3 +427,53 @@ def test_an_axial_mode_is_claimed_when_it_shrinks_the_error_at_its_own_frequency
     compliance = errors(gain, np.exp(np.array([0.116, 0.28, 0.078, 0.168, 0.147])))
     assert D._passes(reference, compliance, 2.13).passes
     assert not D._passes(reference, compliance, 2.13, regime=mode.regime).passes
+
+
+def test_a_lead_error_carried_by_two_fast_runs_passes_by_the_held_out_runs_pieces():
+    """Spent held-out dataset 35003007 (a lead error at SNR 7.0, rerun as development; docs/gap_benchmark.md, 3ai):
+    two fast held-out runs of five carry it, so neither Student's t nor the sign-flip test over the runs passes,
+    while both means are far above their training-run nulls and its 20 pieces give a sign-flip p of 0.001. It is
+    claimed by its pieces. The same pieces are not enough without the piece test, with a mean under the null, with
+    no training-run null (one training run), or without the pieces' errors; spent null 35013001's load friction,
+    whose pieces' p is 0.013, stays under its null. A candidate that passes its rule is not marked as passing by
+    its pieces."""
+    keys = [f"force_piece_{i}" for i in range(4)]
+
+    def errors(plain, level, pieces):
+        return {f"r{i}": {"force": 10.0 * math.exp(-a), "force_level": 6.0 * math.exp(-b),
+                          **{k: 10.0 * math.exp(-c) for k, c in zip(keys, cs)}}
+                for i, (a, b, cs) in enumerate(zip(plain, level, pieces))}
+
+    reference = errors([0.0] * 5, [0.0] * 5, [[0.0] * 4] * 5)
+    bar, null = 2.13, (0.062, 0.012)
+    pieces = [[1.216, 1.635, 1.121, 1.704], [0.258, 0.218, 0.087, 0.172], [0.006, -0.028, 0.007, 0.002],
+              [-0.02, 0.067, -0.023, -0.065], [0.11, 0.052, 0.018, -0.017]]
+    lead = errors([1.413, 0.163, -0.001, -0.014, 0.04], [1.597, 0.157, 0.009, -0.003, 0.022], pieces)
+    assert not D._passes(reference, lead, bar, null=null).passes  # the rule over whole runs misses it
+    t = D._passes(reference, lead, bar, null=null, pieces=True)
+    assert t.passes and t.pieces and t.piece_p_sign_flip <= 0.01 and t.piece_log_ratio > 0.3
+    assert "passes by its pieces" in D._verdict(t)
+    assert not D._passes(reference, lead, bar, null=(0.4, 0.012), pieces=True).passes  # plain mean 0.32 under it
+    assert not D._passes(reference, lead, bar, null=(0.062, 0.4), pieces=True).passes  # level mean 0.36 under it
+    assert not D._passes(reference, lead, bar, null=(0.0, 0.0), pieces=True).passes  # no training-run null
+    bare = {k: {n: v for n, v in e.items() if n not in keys} for k, e in lead.items()}
+    t = D._passes(reference, bare, bar, null=null, pieces=True)
+    assert not t.passes and math.isnan(t.piece_log_ratio)
+    # pieces of mixed sign: the mean over whole runs is the same, the pieces' p is not small
+    mixed = errors([1.413, 0.163, -0.001, -0.014, 0.04], [1.597, 0.157, 0.009, -0.003, 0.022],
+                   [[2.5, -1.0, 2.0, 2.152], [0.8, -0.5, 0.6, -0.248], [0.3, -0.3, 0.2, -0.2],
+                    [-0.3, 0.3, -0.2, 0.2], [0.3, -0.3, 0.2, -0.2]])
+    t = D._passes(reference, mixed, bar, null=null, pieces=True)
+    assert not t.passes and t.piece_p_sign_flip > 0.05
+    # spent null 35013001's load friction: pieces p 0.013, mean log ratio 0.002 against a null of 0.073
+    load = errors([0.0042, 0.0012, 0.002, -0.0003, 0.0016], [0.002, 0.001, 0.002, 0.0, 0.001],
+                  [[-0.0009, 0.0052, 0.0089, 0.0061], [-0.0025, 0.0027, -0.0015, 0.0042],
+                   [-0.0009, 0.0031, -0.0001, 0.0047], [-0.002, -0.0001, -0.0005, 0.001],
+                   [-0.0006, 0.002, 0.0016, 0.0025]])
+    t = D._passes(reference, load, bar, null=(0.073, 0.032), pieces=True)
+    assert not t.passes and t.piece_p_sign_flip < 0.05
+    strong = errors([0.8] * 4 + [0.9], [0.7] * 4 + [0.75], [[0.8] * 4] * 5)
+    t = D._passes(reference, strong, bar, null=null, pieces=True)
+    assert t.passes and not t.pieces
+    assert D._piece_test("lead_error") and not D._piece_test("control_delay")
+    assert not any(e.piece_test for n, e in D.DRAKE_EFFECTS.items() if n != "lead_error")

@@ -97,6 +97,29 @@ def test_force_error_at_constant_speed_is_over_those_samples_alone(run, nominal)
     assert "force_constant_speed" not in drake_replay_errors(dataclasses.replace(nominal, run=swinging))
 
 
+def test_force_error_over_each_piece_of_a_run_is_over_that_quarter_alone(run, nominal):
+    """``force_piece_<i>``: the force error over the i-th of RUN_PIECES equal windows; the pieces' squared errors,
+    weighted by their force's energy, add up to the whole run's; a force error in one quarter moves that piece and
+    no other; a run too short for the pieces has none."""
+    from drakecreep.gap.drake_replay import RUN_PIECES, piece_keys
+
+    err = drake_replay_errors(nominal)
+    keys = piece_keys()
+    assert len(keys) == RUN_PIECES == 4 and all(k in err for k in keys)
+    edges = np.linspace(0, run.n, RUN_PIECES + 1).astype(int)
+    energy = [float(np.sum(np.asarray(run.force[a:b]) ** 2)) for a, b in zip(edges[:-1], edges[1:])]
+    whole = sum(err[k] ** 2 * w for k, w in zip(keys, energy)) / sum(energy)
+    assert whole == pytest.approx(err["force"] ** 2, rel=1e-9)
+    third = np.zeros(run.n, dtype=bool)
+    third[edges[2]:edges[3]] = True
+    moved = drake_replay_errors(dataclasses.replace(nominal, force=np.where(third, nominal.force + 5.0, nominal.force)))
+    assert moved["force_piece_2"] > err["force_piece_2"] + 1.0
+    assert all(moved[k] == pytest.approx(err[k]) for k in keys if k != "force_piece_2")
+    short = run.slice(0, 60)
+    res = DrakeReplay(short).simulate(axis_from_idim(PUBLISHED_IDIM))
+    assert not any(k in drake_replay_errors(res) for k in keys)
+
+
 def test_force_error_in_a_mode_band_sees_an_oscillation_there_and_nothing_else(run, nominal):
     """``force_band_<lo>-<hi>_Hz``: the force error in each octave of ``MODE_BANDS_HZ``. A 40 Hz oscillation the
     simulation adds moves the error of the band around 40 Hz (``mode_band(40)``) and hardly that of a band two

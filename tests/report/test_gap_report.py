@@ -84,6 +84,16 @@ def test_the_ranking_json_says_when_a_candidate_passed_by_its_fallback_regime():
     assert rows["stribeck"]["by_fallback_regime"] is False and "regime" not in rows["stribeck"]
 
 
+def test_the_ranking_json_says_when_a_lead_error_passed_by_the_held_out_runs_pieces():
+    """``by_pieces`` with the pieces' mean log ratio and sign-flip p: a lead error claimed through its pieces says
+    so; a candidate without a piece test has none (NaN, written as null) and ``by_pieces`` false."""
+    rows = _ranking(("lead_error", {"pieces": True, "piece_log_ratio": 0.33, "piece_p_sign_flip": 0.001}),
+                    ("stribeck", {}))
+    assert rows["lead_error"]["by_pieces"] is True
+    assert (rows["lead_error"]["piece_log_error_ratio"], rows["lead_error"]["piece_sign_flip_p"]) == (0.33, 0.001)
+    assert rows["stribeck"]["by_pieces"] is False and rows["stribeck"]["piece_sign_flip_p"] is None
+
+
 def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
     """A drive saturation whose screen offered two closed-loop starts: ``ranking.json`` carries the second one
     beside the first, and ``started_from`` says which one its fit came from (``inverse_dynamics`` or

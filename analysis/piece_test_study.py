@@ -1,0 +1,96 @@
+"""Would a test over pieces of the held-out runs claim the lead errors carried by one or two fast runs?
+
+Development study on spent held-out seeds (runs already scored and looked into; never a run's own seeds before it
+is scored). docs/gap_benchmark.md, 3ag: a lead error's force is the table's inertia times ``e''(x) v^2``, so only the
+fastest held-out runs carry it; with five held-out runs the sign-flip p value of a gain carried by k runs is about
+``2^-(k+1)``, and the t test fails on the spread between carrying and empty runs. The only way to more
+independent evidence is pieces of the runs; friction drift makes the pieces of one run share their level.
+
+For each dataset this script diagnoses it with the product path (``benchmark.diagnose_dataset``), then replays the
+held-out runs with the nominal and with each fitted candidate whose reference is the nominal (not a
+``screen_refits`` one), cuts each run into ``PIECES`` windows of equal length, and prints per candidate:
+
+* the product's own numbers: per-run plain log ratios, mean, whether it passes;
+* per-piece ``ln(e_nominal / e_candidate)`` of the force error, and the exact sign-flip p value of their mean over
+  all pieces (``drakecreep.gap.claims.sign_flip_p``), and over the pieces of runs whose sign the whole runs leave
+  open.
+
+Usage: ``PYTHONPATH=. python analysis/piece_test_study.py OUT.json SEED:WITHHELD:AXIS [...]``
+(``WITHHELD`` ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``).
+"""
+
+import json
+import sys
+import time
+
+import numpy as np
+
+from drakecreep.errors import InputError
+from drakecreep.files import write_text
+from drakecreep.gap import benchmark
+from drakecreep.gap.claims import sign_flip_p
+from drakecreep.gap.drake_diagnosis import run_log_ratios
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+from drakecreep.gap.drake_replay import make_replay
+from drakecreep.gap.idim import relative_error
+
+PIECES = 4
+
+
+def piece_errors(run, params, flexible, delay):
+    """Force error [%] of each of ``PIECES`` equal windows of the run's replay."""
+    sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(params)
+    edges = np.linspace(0, run.n, PIECES + 1).astype(int)
+    f, fs = np.asarray(run.force), np.asarray(sim.force)
+    return [float(relative_error(f[a:b], fs[a:b])) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def study(seed, withheld, axis):
+    t0 = time.perf_counter()
+    ds = benchmark.generate_dataset(seed, withheld=withheld, kind="p_p_cascade", axis=axis)
+    res = benchmark.diagnose_dataset(ds)
+    nom = res.nominal
+    ref_pieces = [piece_errors(r, nom.parameters, False, nom.delay) for r in ds.test]
+    rows = []
+    for r in res.ranking:
+        if r.screened_out or r.reference_errors is not None:
+            continue
+        fit = r.fit
+        cand = [piece_errors(run, fit.parameters, fit.flexible, fit.delay) for run in ds.test]
+        pieces = np.log(np.maximum(np.array(ref_pieces), 1e-12) / np.maximum(np.array(cand), 1e-12))
+        runs = run_log_ratios(res.nominal_test_errors, fit.test_errors, "force")
+        rows.append({"effect": r.name, "passes": bool(r.passes), "gain": float(r.gain),
+                     "log_ratio": float(r.log_ratio), "run_log_ratios": [float(v) for v in runs],
+                     "piece_log_ratios": pieces.tolist(), "piece_mean": float(pieces.mean()),
+                     "piece_p_sign_flip": float(sign_flip_p(pieces.ravel()))})
+    ranking_names = [r.name for r in res.ranking if not r.screened_out]
+    return {"seed": seed, "withheld": list(withheld), "axis": axis, "snr": float(ds.snr),
+            "claimed": list(res.claimed), "null": list(res.null),
+            "ranking": ranking_names, "candidates": rows, "seconds": time.perf_counter() - t0,
+            "screen_refits": [n for n in ranking_names if n in DRAKE_EFFECTS and DRAKE_EFFECTS[n].screen_refits]}
+
+
+def main(argv):
+    try:
+        if len(argv) < 2:
+            raise InputError("arguments", " ".join(argv), "OUT.json SEED:WITHHELD:AXIS [...]")
+        out, specs = argv[0], [benchmark.dataset_spec(a) for a in argv[1:]]
+    except InputError as e:  # one line, exit 2, before any work
+        print(e, file=sys.stderr)
+        sys.exit(2)
+    rows = []
+    for seed, withheld, axis in specs:
+        row = study(seed, withheld, axis)
+        rows.append(row)
+        print(f"{seed} {'+'.join(withheld) or 'null'} {axis}: claimed {row['claimed']}, null {row['null'][0]:.3f}, "
+              f"{row['seconds']:.0f} s", flush=True)
+        for c in row["candidates"]:
+            print(f"   {c['effect']:22s} passes {c['passes']!s:5s} mean {c['log_ratio']:+.3f} runs "
+                  f"{np.round(c['run_log_ratios'], 3).tolist()} pieces mean {c['piece_mean']:+.3f} "
+                  f"p {c['piece_p_sign_flip']:.3g}", flush=True)
+        write_text(out, json.dumps({"note": "piece test study on spent held-out datasets (session 40)",
+                                    "pieces": PIECES, "datasets": rows}, indent=1, default=str))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
