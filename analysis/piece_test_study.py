@@ -16,7 +16,8 @@ held-out runs with the nominal and with each fitted candidate whose reference is
   open.
 
 Usage: ``PYTHONPATH=. python analysis/piece_test_study.py OUT.json SEED:WITHHELD:AXIS [...]``
-(``WITHHELD`` ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``).
+(``WITHHELD`` ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``). The rows of session 40 (code before the
+piece test) are in ``analysis/piece_test_dev.json``.
 """
 
 import json
