@@ -100,8 +100,8 @@
    can reject chance then (sign-flip p about ``2^-(k+1)`` for k carrying runs). The pieces of one run share its
    friction drift, which makes their p value too small on effect-free data; the training-run nulls are the
    guard. Recounted on the 421 spent rows of held-out runs 13-25 with the means alone, this rescues eight missed
-   lead errors and changes no other first claim; on the two lead errors rerun with pieces, p was 0.001 and
-   0.0007 (docs/gap_benchmark.md, 3ai);
+   lead errors and changes no other first claim; on the three lead errors rerun with pieces, p was 0.0007-0.0012
+   (docs/gap_benchmark.md, 3ai);
 4. greedy forward selection: the passing candidates, best first, are refitted on top of the model
    augmented so far and kept only if they pass again against it (refitted alone by the same effort; the same
    rule, with the nominal's training-run null). A step
