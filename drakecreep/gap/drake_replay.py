@@ -48,6 +48,7 @@ from drakecreep.model.pp_cascade import PPCascade, pp_initial_state
 __all__ = [
     "DrakeReplay",
     "SampledReplay",
+    "FRACTIONAL_DELAY_TICKS",
     "MAX_SUBSTEPS",
     "diverged_result",
     "make_replay",
