@@ -6,9 +6,11 @@ fastest held-out runs carry it; with five held-out runs the sign-flip p value of
 ``2^-(k+1)``, and the t test fails on the spread between carrying and empty runs. The only way to more
 independent evidence is pieces of the runs; friction drift makes the pieces of one run share their level.
 
-For each dataset this script diagnoses it with the product path (``benchmark.diagnose_dataset``), then replays the
-held-out runs with the nominal and with each fitted candidate whose reference is the nominal (not a
-``screen_refits`` one), cuts each run into ``PIECES`` windows of equal length, and prints per candidate:
+For each dataset this script diagnoses it with the product path (``benchmark.diagnose_dataset``) and, for each
+fitted candidate whose reference is the nominal (not a ``screen_refits`` one), reads the held-out errors of each
+run's quarters the diagnosis already has (``force_piece_<i>`` of
+:func:`drakecreep.gap.drake_replay.drake_replay_errors`, :data:`~drakecreep.gap.drake_replay.RUN_PIECES` per run),
+and prints per candidate:
 
 * the product's own numbers: per-run plain log ratios, mean, whether it passes;
 * per-piece ``ln(e_nominal / e_candidate)`` of the force error, and the sign-flip p value of their mean over all
@@ -16,7 +18,8 @@ held-out runs with the nominal and with each fitted candidate whose reference is
 
 Usage: ``PYTHONPATH=. python analysis/piece_test_study.py OUT.json SEED:WITHHELD:AXIS [...]``
 (``WITHHELD`` ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``). The rows of session 40 (code before the
-piece test) are in ``analysis/piece_test_dev.json``.
+piece test) are in ``analysis/piece_test_dev.json``; the product had no piece errors then, and this script
+replayed the held-out runs again for them, over the same equal windows.
 """
 
 import json
@@ -31,33 +34,20 @@ from drakecreep.gap import benchmark
 from drakecreep.gap.claims import sign_flip_p
 from drakecreep.gap.drake_diagnosis import run_log_ratios
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
-from drakecreep.gap.drake_replay import make_replay
-from drakecreep.gap.idim import relative_error
-
-PIECES = 4
-
-
-def piece_errors(run, params, flexible, delay):
-    """Force error [%] of each of ``PIECES`` equal windows of the run's replay."""
-    sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(params)
-    edges = np.linspace(0, run.n, PIECES + 1).astype(int)
-    f, fs = np.asarray(run.force), np.asarray(sim.force)
-    return [float(relative_error(f[a:b], fs[a:b])) for a, b in zip(edges[:-1], edges[1:])]
+from drakecreep.gap.drake_replay import RUN_PIECES, piece_keys
 
 
 def study(seed, withheld, axis):
     t0 = time.perf_counter()
     ds = benchmark.generate_dataset(seed, withheld=withheld, kind="p_p_cascade", axis=axis)
     res = benchmark.diagnose_dataset(ds)
-    nom = res.nominal
-    ref_pieces = [piece_errors(r, nom.parameters, False, nom.delay) for r in ds.test]
     rows = []
     for r in res.ranking:
         if r.screened_out or r.reference_errors is not None:
             continue
         fit = r.fit
-        cand = [piece_errors(run, fit.parameters, fit.flexible, fit.delay) for run in ds.test]
-        pieces = np.log(np.maximum(np.array(ref_pieces), 1e-12) / np.maximum(np.array(cand), 1e-12))
+        # rows: held-out runs; columns: their quarters in time order
+        pieces = np.column_stack([run_log_ratios(res.nominal_test_errors, fit.test_errors, k) for k in piece_keys()])
         runs = run_log_ratios(res.nominal_test_errors, fit.test_errors, "force")
         rows.append({"effect": r.name, "passes": bool(r.passes), "gain": float(r.gain),
                      "log_ratio": float(r.log_ratio), "run_log_ratios": [float(v) for v in runs],
@@ -89,7 +79,7 @@ def main(argv):
                   f"{np.round(c['run_log_ratios'], 3).tolist()} pieces mean {c['piece_mean']:+.3f} "
                   f"p {c['piece_p_sign_flip']:.3g}", flush=True)
         write_text(out, json.dumps({"note": "piece test study on spent held-out datasets (session 40)",
-                                    "pieces": PIECES, "datasets": rows}, indent=1, default=str))
+                                    "pieces": RUN_PIECES, "datasets": rows}, indent=1, default=str))
 
 
 if __name__ == "__main__":
