@@ -11,7 +11,9 @@ rows as the benchmark does (``--score`` of ``analysis/bench_gap_benchmark.py`` r
 Usage: ``PYTHONPATH=. python analysis/drive_saturation_start_study.py OUT.json SEED:WITHHELD:AXIS [...]``
 (``WITHHELD`` is ``null`` or an effect, ``AXIS`` ``rigid`` or ``flexible``; e.g.
 ``21010002:drive_saturation:flexible``).
-The rows of session 39 are in ``analysis/drive_saturation_start_dev.json``.
+The rows of session 39 are in ``analysis/drive_saturation_start_dev.json``; it reruns any spent dataset, and the
+Stribeck rows of session 41 (the start floor and the Stribeck's own start, docs/gap_benchmark.md, 3aj) are in
+``analysis/stribeck_start_dev.json``.
 """
 
 import json
@@ -48,7 +50,7 @@ def main(argv):
         print(f"{seed} {'+'.join(withheld) or 'null'} {axis}: SNR {row['snr']:.1f}, claimed {row['claimed']}, "
               f"audit shrink {row['audit_shrink']:.2f} (true fit {row['true_shrink']}), "
               f"{time.perf_counter() - t0:.0f} s", flush=True)
-        write_text(out, json.dumps({"note": "spent held-out datasets rerun as development (session 39)",
+        write_text(out, json.dumps({"note": "spent held-out datasets rerun as development (benchmark.evaluate)",
                                     "datasets": rows}, indent=1, default=str))
 
 

@@ -23,7 +23,9 @@
    starts the same way. A drive that saturates biases the nominal's friction too, and the shift then started
    it far off: on spent held-out dataset 45010001 (SNR 76) a viscous friction of -417 N s/m, whose fit made the
    held-out replay 4 times worse than the nominal's, where the inverse-dynamics values made it better
-   (docs/gap_benchmark.md, 3ah);
+   (docs/gap_benchmark.md, 3ah). The Stribeck friction has the same second start (``own_start``): over slow
+   training runs its friction falls with speed, and the nominal fitted without it has no viscous friction
+   (docs/gap_benchmark.md, 3aj);
 3. a candidate *passes* when its held-out force error is below the reference model's, on the log scale
    (:func:`paired_log_ratio`: the factor by which it shrinks each run's error, the same in runs of different
    speeds where the gain in points is not), by more than
@@ -253,10 +255,14 @@ class RankedEffect:
     def closed_loop_start(self):
         """Where the closed-loop fit started when the screen offered two starts
         (:attr:`~drakecreep.gap.screen.ScreenResult.alternative_start`): ``inverse_dynamics`` (the candidate's own
-        inverse-dynamics friction) or ``shifted_nominal``; empty otherwise."""
+        inverse-dynamics friction), ``shifted_nominal`` (the nominal's, moved by what the screen moved it: a
+        candidate with ``shifts_nominal``) or ``nominal``; empty otherwise."""
         if self.fit is None or not getattr(self.screen, "alternative_start", None):
             return ""
-        return "inverse_dynamics" if getattr(self.fit, "start_index", 0) == 1 else "shifted_nominal"
+        if getattr(self.fit, "start_index", 0) == 1:
+            return "inverse_dynamics"
+        effect = DRAKE_EFFECTS.get(self.name)
+        return "shifted_nominal" if effect is None or effect.shifts_nominal else "nominal"
 
 
 @dataclass(frozen=True)
@@ -322,7 +328,7 @@ class DrakeDiagnosis:
                     if r.name == "axial_mode" else "")
             if r.closed_loop_start == "inverse_dynamics":
                 note += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
-                        "the nominal's shifted)"
+                        + ("the nominal's shifted)" if DRAKE_EFFECTS[r.name].shifts_nominal else "the nominal's)")
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{note}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
@@ -703,9 +709,13 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     def origin(n):  # the model a candidate starts from: see _refit
         return first if _refits(n) else nominal
 
-    def own_reference(sc):  # the reference model of a candidate with screen_refits (_with_values), or None
+    def own_reference(sc):
+        # the reference model of a candidate with screen_refits (_with_values), or of one with a second start
+        # alone (own_start: its reference may start from its own inverse-dynamics values too), or None
         values = getattr(sc, "reference_values", None)
-        return _with_values(first, values) if values else None
+        if values:
+            return _with_values(first, values)
+        return first if getattr(sc, "reference_alternative", None) else None
 
     def alternative(sc):  # the screen's second closed-loop start (ScreenResult.alternative_start; empty: none)
         return getattr(sc, "alternative_start", None)

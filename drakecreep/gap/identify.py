@@ -45,7 +45,7 @@ from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relati
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT",
-           "PRESLIDING_START", "DEFAULT_BOUNDS"]
+           "PRESLIDING_START", "DEFAULT_BOUNDS", "START_FLOOR_SHARE", "start_floors"]
 
 #: parameters fitted on a log scale (they must stay > 0)
 LOG_SCALED = ("mass", "stribeck_velocity", "regularization_velocity", "stiffness", "damping", "viscous",
@@ -58,6 +58,16 @@ PRESLIDING_START = 5e-6
 #: (``bristle_share``, :mod:`drakecreep.model.axis`) in (0, 1]; at least 5 % of it, or the bristles' rate
 #: ``sigma0 |v| / (b g)`` would outrun any step
 DEFAULT_BOUNDS = {"bristle_share": (0.05, 1.0)}
+#: share of the training runs' RMS drive force that the start of a refined Coulomb level, or of a refined viscous
+#: force at their RMS moving speed, is given when its start is 0 (:func:`start_floors`). IDIM sets a negative value
+#: to 0, and a log-scaled parameter started at 0 sits at ``log(1e-300)``, 690 units from any physical value: it is
+#: never refined, and neither is it by any candidate fitted from that nominal (a Stribeck's friction falling with
+#: speed over slow training runs gives a negative IDIM viscous; the held-out fast runs then replay without any
+#: viscous force: docs/gap_benchmark.md, 3aj). A tenth, the geometric middle of a term worth 1-100 % of the force;
+#: a start that is positive, however small, is kept, and the fit may go below the floor again.
+START_FLOOR_SHARE = 0.1
+#: a start below this share of its floor counts as 0 (a millionth of it: a force of 1e-7 of the drive's)
+_AT_ZERO = 1e-6
 #: |correlation| above which two fitted parameters are reported as not separable
 CORRELATION_LIMIT = 0.95
 #: residual put in place of each non-finite sample of a diverged replay, and the largest magnitude a sample's
@@ -398,6 +408,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         warnings.append("'coulomb' and 'offset' both marked uncertain on one-way data: 'offset' left at 0")
         uncertain = tuple(n for n in uncertain if n != "offset")
     iv = tuple(n for n in _IDIM_NAMES if n not in (fixed or {})) if instruments else ()
+    floors = start_floors(runs)
     if replays is None:
         # the mass stays symbolic when the IV start moves it: one build serves the instruments' replay and the fit
         free = uncertain + (("mass",) if "mass" in iv and "mass" not in uncertain else ())
@@ -420,6 +431,11 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
                                                                   if w not in start.warnings))
             warnings += list(start.warnings)
             base.update({n: start.parameters[n] for n in iv})
+    for name, floor in floors.items():
+        if name in uncertain and not base[name] > _AT_ZERO * floor:
+            warnings.append(f"{name} starts at {floor:.3g} {AXIS_UNITS[name]} instead of {base[name]:.3g}: a log-scaled "
+                            f"value cannot start at 0 ({100 * START_FLOOR_SHARE:g} % of the training runs' RMS force)")
+            base[name] = floor
     if "bristle_stiffness" in uncertain and "bristle_stiffness" not in (fixed or {}):
         # LuGre bristles from a presliding displacement of PRESLIDING_START at the Coulomb level
         base["bristle_stiffness"] = max(abs(base["coulomb"]), 1.0) / PRESLIDING_START
@@ -480,6 +496,23 @@ def _leave_one_run_out(sol, prob, lo, hi):
     # jackknife: sqrt((n-1)/n sum (v_k - mean)^2) = sqrt(n-1) times the population standard deviation
     spread = math.sqrt(len(out) - 1) * np.array([[v[n] for n in prob.names] for v in out]).std(axis=0)
     return tuple(out), dict(zip(prob.names, (float(s) for s in spread)))
+
+
+def start_floors(runs):
+    """The start values [SI] of a refined ``coulomb`` and ``viscous`` on ``runs`` whose start is 0: the Coulomb
+    level and the viscous force at the runs' RMS moving speed each :data:`START_FLOOR_SHARE` of their RMS drive
+    force.
+
+    Both are fitted on a log scale (:data:`LOG_SCALED`), where a start of 0 cannot move."""
+    force = np.concatenate([np.asarray(r.force, dtype=float) for r in runs])
+    speed = np.concatenate([np.abs(np.diff(r.x_motor)) / r.dt for r in runs])
+    moving = speed[speed > 1e-3 * max(float(np.max(speed)), 1e-12)] if speed.size else speed
+    f = START_FLOOR_SHARE * float(np.sqrt(np.mean(force ** 2))) if force.size else 0.0
+    v = float(np.sqrt(np.mean(moving ** 2))) if moving.size else 0.0
+    floors = {"coulomb": f}
+    if v > 0:
+        floors["viscous"] = f / v
+    return {n: x for n, x in floors.items() if x > 0 and math.isfinite(x)}
 
 
 def _regularization(runs):

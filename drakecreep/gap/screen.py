@@ -96,7 +96,7 @@ class ScreenResult:
         nominal parameters as the reference's inverse-dynamics fit found them (the closed-loop reference of the
         candidate starts there; ``start`` has the candidate's own values).
     alternative_start, reference_alternative : dict
-        For a candidate with ``screen_refits``: ``start`` with the refitted nominal friction at the candidate's
+        For a candidate with ``screen_refits`` or ``own_start``: ``start`` with the refitted nominal friction at the candidate's
         own inverse-dynamics values instead of shifted, and the reference's inverse-dynamics values of every
         refitted parameter. The closed-loop fit starts from whichever of the two has the lower training error,
         and its reference the same way (:func:`drakecreep.gap.drake_effects.fit_effect` ``choose``): a drive that
@@ -386,7 +386,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     start.update({n: best[n] for n in effect.screen_refits})
     # the second closed-loop starts (ScreenResult.alternative_start): each model's own inverse-dynamics values
     own, reference_own = ({**start, **{n: best[n] for n in refit}}, {n: reference[n] for n in refit}) \
-        if effect.screen_refits else ({}, {})
+        if effect.screen_refits or effect.own_start else ({}, {})
     return ScreenResult(effect.name, start, _rms(train_err), _rms(test_err),
                         _rms(nom_test), gain, se, bool(ok), inside, lr, lr_se, const,
                         {n: reference[n] for n in effect.screen_refits}, own, reference_own)

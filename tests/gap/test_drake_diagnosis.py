@@ -270,6 +270,25 @@ def test_a_saturating_drive_is_claimed_with_its_mass_against_a_reference_of_equa
     assert "against its own reference: the nominal with mass" in line and "(candidate: mass" in line
 
 
+def test_a_stribeck_fit_may_start_from_its_own_friction_against_a_reference_that_may_too():
+    """A Stribeck candidate offers its own inverse-dynamics friction as a second closed-loop start (``own_start``;
+    the nominal's friction, fitted without it, can lack any viscous term). Its fit starts from whichever of the two
+    replays the training runs better, and so does its equal-effort reference, from the nominal's own
+    inverse-dynamics values or the nominal: the candidate is measured against that reference
+    (``reference_errors``), not against the nominal. A candidate without a second start has no such reference."""
+    truth = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, stribeck_extra=30.0,
+                           stribeck_velocity=0.01)
+    runs = _simulated(truth, (0, 3000, 6000, 9000, 12000), 1000, "s")[0]
+    diag = diagnose_drake(runs[:2], runs[2:], effects=("stribeck", "thermal_drift"), max_nfev=3)
+    rows = {r.name: r for r in diag.ranking}
+    strib = rows["stribeck"]
+    assert strib.screen.alternative_start and strib.screen.reference_alternative
+    assert strib.closed_loop_start in ("inverse_dynamics", "nominal")
+    assert strib.reference_errors is not None and set(strib.reference_errors) == set(diag.nominal_test_errors)
+    assert diag.claimed[:1] == ("stribeck",)
+    assert rows["thermal_drift"].reference_errors is None
+
+
 def test_skewed_gains_in_every_run_pass_by_the_sign_flip_null_and_one_run_worse_by_t():
     """Development seed 11002's drive saturation: errors x0.55, 0.91, 0.91, 0.98, 0.98 (every run better, one much
     more) miss the t bar and pass the sign-flip null; development seed 4003's lead error (one run a hair worse,

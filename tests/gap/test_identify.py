@@ -97,6 +97,27 @@ def test_a_drive_limit_started_at_zero_is_still_found():
     assert 1.0 / fit.parameters["inverse_drive_limit"] == pytest.approx(150.0, rel=0.1)
 
 
+def test_a_viscous_started_at_zero_is_refined_from_its_floor(runs, monkeypatch):
+    """IDIM sets a negative viscous coefficient to 0 (a Stribeck friction falling with speed over slow runs). On
+    its log scale a start of 0 sits at log(1e-300) and never moves; from the floor (10 % of the runs' RMS force at
+    their RMS speed) the fit finds the known axis's 180 N s/m again. A positive start, however small, is kept."""
+    import drakecreep.gap.identify as identify_module
+
+    fixed = {"mass": PUBLISHED_IDIM["M"], "regularization_velocity": 1e-3, "viscous": 0.0}
+    floors = identify_module.start_floors(runs)
+    force = np.concatenate([r.force for r in runs])
+    assert floors["coulomb"] == pytest.approx(0.1 * np.sqrt(np.mean(force ** 2)))
+    assert 0.0 < floors["viscous"] < 0.5 * TRUTH["viscous"]
+    idf = identify(runs, uncertain=("viscous", "coulomb", "offset"), max_nfev=8, fixed=fixed)
+    assert idf.parameters["viscous"] == pytest.approx(TRUTH["viscous"], rel=0.1)
+    assert any(w.startswith("viscous starts at") for w in idf.warnings)
+    small = identify(runs, uncertain=("viscous",), max_nfev=1, fixed=dict(fixed, viscous=1e-3 * floors["viscous"]))
+    assert not any("starts at" in w for w in small.warnings)
+    monkeypatch.setattr(identify_module, "START_FLOOR_SHARE", 0.0)
+    stuck = identify(runs, uncertain=("viscous", "coulomb", "offset"), max_nfev=8, fixed=fixed)
+    assert stuck.parameters["viscous"] < 1e-100  # (why the floor)
+
+
 def test_a_diverged_replay_is_a_poor_fit_not_a_crash():
     """A replay whose samples went non-finite (a candidate's closed loop diverged) gives a large finite residual
     the least squares steps back from; before, the trust-region SVD raised and the dataset was lost."""

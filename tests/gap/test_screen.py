@@ -147,6 +147,26 @@ def test_the_saturation_candidate_offers_its_own_friction_as_a_second_start():
     assert screen_effect(DRAKE_EFFECTS["asymmetric_friction"], runs[:3], runs[3:], BASE).alternative_start == {}
 
 
+def test_the_stribeck_candidate_offers_its_own_friction_as_a_second_start():
+    """A Stribeck friction falls with speed over slow runs: the nominal's IDIM viscous comes out negative and is
+    set to 0 (spent held-out dataset 51000004: -444 N s/m against the truth's +165). Given such a nominal, the
+    Stribeck's plain start carries its own parameters alone (on the nominal's friction), and its alternative
+    start (``own_start``) the candidate's own inverse-dynamics friction, within 10 % of the axis's; the reference's
+    alternative carries the reference's own values of the refitted friction."""
+    runs = _runs(dict(BASE, stribeck_extra=1.5 * BASE["coulomb"], stribeck_velocity=0.01))
+    off = dict(BASE, viscous=0.0, coulomb=1.3 * BASE["coulomb"])
+    sc = screen_effect(DRAKE_EFFECTS["stribeck"], runs[:3], runs[3:], off)
+    assert sc.passes
+    assert set(sc.start) == {"stribeck_extra", "stribeck_velocity"}
+    alt = sc.alternative_start
+    for name in ("viscous", "coulomb"):
+        assert alt[name] == pytest.approx(BASE[name], rel=0.1), name
+    assert {k: alt[k] for k in sc.start} == sc.start
+    assert alt["stribeck_velocity"] == pytest.approx(0.01, rel=0.2)
+    assert set(sc.reference_alternative) == {"viscous", "coulomb", "offset"}
+    assert sc.reference_values == {}
+
+
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
     """A 3 N force ripple of period 3.7 mm (none of the candidate's own starts): the Lomb-Scargle scan of the
     residual against position starts the fit at the period, which it refines to within 0.2 %, with the amplitude

@@ -97,7 +97,8 @@ def test_the_ranking_json_says_when_a_lead_error_passed_by_the_held_out_runs_pie
 def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
     """A drive saturation whose screen offered two closed-loop starts: ``ranking.json`` carries the second one
     beside the first, and ``started_from`` says which one its fit came from (``inverse_dynamics`` or
-    ``shifted_nominal``); a candidate with one start has neither."""
+    ``shifted_nominal``; ``nominal`` for a Stribeck, whose first start does not shift the nominal's friction); a
+    candidate with one start has neither."""
     from types import SimpleNamespace
 
     from drakecreep.gap.drake_diagnosis import RankedEffect
@@ -110,6 +111,9 @@ def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
     rows = _ranking(("drive_saturation", {"screen": offered}), ("stribeck", {}))
     assert rows["drive_saturation"]["started_from"] == "shifted_nominal"  # the stub fit has no start_index: the first
     assert rows["stribeck"]["started_from"] is None
+    own = ScreenResult("stribeck", {"stribeck_extra": 20.0}, 1.0, 1.0, 2.0, 1.0, 0.1, True,
+                       alternative_start={"stribeck_extra": 20.0, "viscous": 296.0})
+    assert _ranking(("stribeck", {"screen": own}))["stribeck"]["started_from"] == "nominal"
     fit = SimpleNamespace(name="drive_saturation", test_force_error=8.0, train_force_error=7.0, start_index=1,
                           parameters={"inverse_drive_limit": 0.016}, delay=0.0, seconds=1.0)
     ranked = RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, screen=offered)
