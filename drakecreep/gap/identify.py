@@ -433,8 +433,8 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
             base.update({n: start.parameters[n] for n in iv})
     for name, floor in floors.items():
         if name in uncertain and not base[name] > _AT_ZERO * floor:
-            warnings.append(f"{name} starts at {floor:.3g} {AXIS_UNITS[name]} instead of {base[name]:.3g}: a log-scaled "
-                            f"value cannot start at 0 ({100 * START_FLOOR_SHARE:g} % of the training runs' RMS force)")
+            warnings.append(f"{name} starts at {floor:.3g} {AXIS_UNITS[name]} instead of {base[name]:.3g}: on its log "
+                            f"scale 0 cannot move ({100 * START_FLOOR_SHARE:g} % of the training runs' RMS force)")
             base[name] = floor
     if "bristle_stiffness" in uncertain and "bristle_stiffness" not in (fixed or {}):
         # LuGre bristles from a presliding displacement of PRESLIDING_START at the Coulomb level

@@ -96,8 +96,9 @@ class ScreenResult:
         nominal parameters as the reference's inverse-dynamics fit found them (the closed-loop reference of the
         candidate starts there; ``start`` has the candidate's own values).
     alternative_start, reference_alternative : dict
-        For a candidate with ``screen_refits`` or ``own_start``: ``start`` with the refitted nominal friction at the candidate's
-        own inverse-dynamics values instead of shifted, and the reference's inverse-dynamics values of every
+        For a candidate with ``screen_refits`` or ``own_start``: ``start`` with the refitted nominal friction at
+        the candidate's own inverse-dynamics values (instead of the nominal's, shifted for a candidate with
+        ``shifts_nominal``), and the reference's inverse-dynamics values of every
         refitted parameter. The closed-loop fit starts from whichever of the two has the lower training error,
         and its reference the same way (:func:`drakecreep.gap.drake_effects.fit_effect` ``choose``): a drive that
         saturates biases the nominal itself (on spent dataset 45010001 an IDIM mass of 317 kg against the truth's
