@@ -396,12 +396,16 @@ def _refit(train, model, names, max_nfev):
     its gain would include what the extra iterations of the friction alone give: the nominal of ``max_nfev``
     evaluations is not converged, and on effect-free data every refitting candidate "gained" 0.3-0.5 points of %
     on the held-out runs, consistently enough to pass (docs/gap_benchmark.md, "Since then: equal effort").
-    The result keeps ``model``'s IDIM start (the IDIM-IV start its mass comes from; the refit fixes the mass).
+    The result keeps ``model``'s IDIM start (the IDIM-IV start its mass comes from; the refit fixes the mass) and
+    its warnings (a negative IDIM value set to 0, a start lifted from 0: :func:`~drakecreep.gap.identify.identify`),
+    which the refit from its values would not raise again.
     """
     idf = identify(train, tuple(names), flexible=model.flexible, delay=model.delay, fixed=dict(model.parameters),
                    max_nfev=max_nfev)
     start = getattr(model, "start", None)  # an EffectFit has none (its refit is only replayed, never reported)
-    return dataclasses.replace(idf, start=start) if start is not None else idf
+    if start is None:
+        return idf
+    return dataclasses.replace(idf, start=start, warnings=tuple(dict.fromkeys(model.warnings + idf.warnings)))
 
 
 def _greedy_fit(name, train, test, current, fitted, start, max_nfev):

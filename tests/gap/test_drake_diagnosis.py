@@ -289,6 +289,18 @@ def test_a_stribeck_fit_may_start_from_its_own_friction_against_a_reference_that
     assert rows["thermal_drift"].reference_errors is None
 
 
+def test_the_equal_effort_refit_keeps_the_warnings_of_the_fit_it_starts_from(runs):
+    """The nominal a user reads is the first fit refitted (``_refit``); the first fit's warnings (here a viscous
+    friction lifted from a start of 0) are not raised again from its values, so the refit carries them."""
+    from drakecreep.gap.identify import identify
+
+    first = identify(runs[:2], ("viscous", "coulomb", "offset"), max_nfev=2, fixed={"viscous": 0.0})
+    assert any(w.startswith("viscous starts at") for w in first.warnings)
+    nominal = D._refit(runs[:2], first, first.fitted, 1)
+    assert set(first.warnings) <= set(nominal.warnings)
+    assert len(set(nominal.warnings)) == len(nominal.warnings)
+
+
 def test_skewed_gains_in_every_run_pass_by_the_sign_flip_null_and_one_run_worse_by_t():
     """Development seed 11002's drive saturation: errors x0.55, 0.91, 0.91, 0.98, 0.98 (every run better, one much
     more) miss the t bar and pass the sign-flip null; development seed 4003's lead error (one run a hair worse,
