@@ -259,8 +259,12 @@ class RankedEffect:
         candidate with ``shifts_nominal``) or ``nominal``; empty otherwise."""
         if self.fit is None or not getattr(self.screen, "alternative_start", None):
             return ""
-        if getattr(self.fit, "start_index", 0) == 1:
-            return "inverse_dynamics"
+        return "inverse_dynamics" if getattr(self.fit, "start_index", 0) == 1 else self._first_start
+
+    @property
+    def _first_start(self):
+        """The screen's first closed-loop start: ``shifted_nominal`` for a candidate with ``shifts_nominal``,
+        else ``nominal``."""
         effect = DRAKE_EFFECTS.get(self.name)
         return "shifted_nominal" if effect is None or effect.shifts_nominal else "nominal"
 
@@ -328,7 +332,7 @@ class DrakeDiagnosis:
                     if r.name == "axial_mode" else "")
             if r.closed_loop_start == "inverse_dynamics":
                 note += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
-                        + ("the nominal's shifted)" if DRAKE_EFFECTS[r.name].shifts_nominal else "the nominal's)")
+                        + ("the nominal's shifted)" if r._first_start == "shifted_nominal" else "the nominal's)")
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{note}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(

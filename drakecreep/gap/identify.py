@@ -408,7 +408,6 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         warnings.append("'coulomb' and 'offset' both marked uncertain on one-way data: 'offset' left at 0")
         uncertain = tuple(n for n in uncertain if n != "offset")
     iv = tuple(n for n in _IDIM_NAMES if n not in (fixed or {})) if instruments else ()
-    floors = start_floors(runs)
     if replays is None:
         # the mass stays symbolic when the IV start moves it: one build serves the instruments' replay and the fit
         free = uncertain + (("mass",) if "mass" in iv and "mass" not in uncertain else ())
@@ -431,7 +430,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
                                                                   if w not in start.warnings))
             warnings += list(start.warnings)
             base.update({n: start.parameters[n] for n in iv})
-    for name, floor in floors.items():
+    for name, floor in start_floors(runs).items():
         if name in uncertain and not base[name] > _AT_ZERO * floor:
             warnings.append(f"{name} starts at {floor:.3g} {AXIS_UNITS[name]} instead of {base[name]:.3g}: on its log "
                             f"scale 0 cannot move ({100 * START_FLOOR_SHARE:g} % of the training runs' RMS force)")
