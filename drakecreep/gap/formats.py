@@ -10,6 +10,7 @@ See ``docs/measured_format.md``.
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +65,19 @@ def _frame(path, fmt, key):
 
     if fmt == "csv":
         try:
-            return pd.read_csv(path, comment="#", skipinitialspace=True, skip_blank_lines=True)
+            # index_col=False: a trailing comma on every line is an empty field, not a shift of every column under
+            # the header (pandas would take the first column as the index); rows with more values than the header
+            # has names would lose data, so that warning is an error here
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", pd.errors.ParserWarning)
+                frame = pd.read_csv(path, comment="#", skipinitialspace=True, skip_blank_lines=True,
+                                    index_col=False)
+            # a trailing comma on the header line too: an unnamed column with no values
+            empty = [c for c in frame.columns if re.fullmatch(r"Unnamed: \d+", str(c)) and frame[c].isna().all()]
+            return frame.drop(columns=empty)
+        except pd.errors.ParserWarning:
+            raise InputError(str(path), "data rows with more values than the header has column names",
+                             "one value per header column (a trailing comma on every line is allowed)") from None
         except UnicodeDecodeError as err:
             raise InputError(str(path), f"byte 0x{err.object[err.start]:02x} at offset {err.start} is not UTF-8",
                              "a UTF-8 text CSV (not binary, not UTF-16)") from None
@@ -155,6 +168,9 @@ def read_signals(path, u_units, columns=None, units=None, key=None):
     else:
         for name, column in by_file.items():
             signal, unit = parse_column(name)
+            first = re.match(r"^(.*)\.\d+$", name)
+            if fmt == "csv" and first and first.group(1) in by_file:  # pandas renames a repeated name 'x' to 'x.1'
+                signal = parse_column(first.group(1))[0]
             if signal in out:
                 raise InputError(f"{path}: header", signal, "each column once")
             out[signal] = (column, units.get(signal, unit))

@@ -249,6 +249,33 @@ def test_row_length_mismatch(tmp_path):
         load_measured(path)
 
 
+@pytest.mark.parametrize("on_header", [True, False])
+def test_a_trailing_comma_on_every_line_is_an_empty_field_not_a_shift_of_the_columns(tmp_path, on_header):
+    cols = _rows()
+    path = _write(tmp_path, cols)
+    lines = path.read_text().splitlines()
+    header = lines[0] + ("," if on_header else "")
+    path.write_text("\n".join([header] + [line + "," for line in lines[1:]]) + "\n")
+    run = load_measured(path).run()
+    np.testing.assert_array_equal(run.t, cols["t"])
+    np.testing.assert_array_equal(run.u, cols["u"])
+
+
+def test_every_row_longer_than_the_header_is_refused_not_shifted(tmp_path):
+    path = _write(tmp_path)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(lines[:1] + [line + ",5.0" for line in lines[1:]]) + "\n")
+    with pytest.raises(InputError, match="more values than the header has column names"):
+        load_measured(path)
+
+
+def test_a_repeated_column_is_named(tmp_path):
+    cols = _rows()
+    path = _write(tmp_path, cols, header=["t[s]", "x_ref[m]", "x_ref[m]", "u[V]", "f_ext[N]"])
+    with pytest.raises(InputError, match="header: got 'x_ref'; allowed: each column once"):
+        load_measured(path)
+
+
 def test_array_length_mismatch_in_constructor():
     r = _rows()
     meta = MeasuredMeta(u_units="N", u_gain=1.0)
