@@ -35,9 +35,11 @@ def add_parser(subparsers):
                    "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")
     p.add_argument("--train", metavar="RUNS", help="training runs: labels or indices, comma separated "
-                   "(default: even indices; parts of one split run: 0, 1, 4, 5, ...; three runs or parts: 0)")
-    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: odd indices; parts of one "
-                   "split run: 2, 3, 6, 7, ...; three runs or parts: 1, 2)")
+                   "(default: the runs --test does not name; without --test: even indices; parts of one split run: "
+                   "0, 1, 4, 5, ...; three runs or parts: 0)")
+    p.add_argument("--test", metavar="RUNS", help="held-out runs, at least two (default: the runs --train does not "
+                   "name; without --train: odd indices; parts of one split run: 2, 3, 6, 7, ...; three runs or "
+                   "parts: 1, 2)")
     p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous)")
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "

@@ -96,11 +96,18 @@ def train_test(runs, train_spec=None, test_spec=None, pairs=False):
     """Training and held-out runs from the ``--train`` / ``--test`` selections (:func:`pick`).
 
     Without either selection: even / odd indices (or pairs of them, ``pairs``); three runs (or parts) are split
-    1 / 2 instead (the first trains, the other two are held out), since a diagnosis needs two held-out runs.
+    1 / 2 instead (the first trains, the other two are held out), since a diagnosis needs two held-out runs. With
+    one selection only, the other is every run it does not name.
     """
     if not train_spec and not test_spec and len(runs) == 3:
         return [runs[0]], list(runs[1:])
-    return pick(runs, train_spec, 0, "--train", pairs=pairs), pick(runs, test_spec, 1, "--test", pairs=pairs)
+    train = pick(runs, train_spec, 0, "--train", pairs=pairs) if train_spec or not test_spec else None
+    test = pick(runs, test_spec, 1, "--test", pairs=pairs) if test_spec or not train_spec else None
+    if train is None:
+        train = [r for r in runs if all(r is not t for t in test)]
+    if test is None:
+        test = [r for r in runs if all(r is not t for t in train)]
+    return train, test
 
 
 def pick(runs, spec, default_parity, option="--train", pairs=False):

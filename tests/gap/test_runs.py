@@ -46,3 +46,15 @@ def test_default_train_test_split_keeps_two_held_out_runs():
     assert [[r.label for r in part] for part in train_test(runs[:3], "r2", "0,1")] == [["r2"], ["r0", "r1"]]
     assert [[r.label for r in part] for part in train_test(runs[:3], pairs=True)] == [["r0"], ["r1", "r2"]]
     assert [[r.label for r in part] for part in train_test(runs[:4], pairs=True)] == [["r0", "r1"], ["r2", "r3"]]
+
+
+def test_one_selection_leaves_the_other_runs_to_the_other_set():
+    from types import SimpleNamespace
+
+    from drakecreep.gap.runs import train_test
+
+    runs = [SimpleNamespace(label=f"r{i}") for i in range(5)]
+    labels = lambda parts: [[r.label for r in part] for part in parts]  # noqa: E731
+    assert labels(train_test(runs[:3], test_spec="1")) == [["r0", "r2"], ["r1"]]
+    assert labels(train_test(runs, train_spec="0,1")) == [["r0", "r1"], ["r2", "r3", "r4"]]
+    assert labels(train_test(runs, test_spec="r4,r0", pairs=True)) == [["r1", "r2", "r3"], ["r4", "r0"]]
