@@ -1,0 +1,81 @@
+"""Which held-out runs carry a withheld effect: one spent dataset, the effect's own candidate only.
+
+Spent held-out datasets only (runs already scored and looked into). For a missed effect whose true fit shrinks the
+audit, the question is whether the candidate's fit is wrong or the held-out runs do not show it. This script
+diagnoses the dataset with the product path (``benchmark.diagnose_dataset``, the withheld effect as the only
+candidate), then prints
+
+* the truth's values beside the nominal's and the candidate's fitted ones (mass, viscous, Coulomb, offset and the
+  effect's own parameters);
+* every run's reference speed and commanded force (training, held out, audit);
+* every held-out run's closed-loop force error [%] with the nominal and with the candidate, and their log ratio
+  (the claim's per-run statistic), plain and with each run's own friction level.
+
+Usage: ``PYTHONPATH=. python analysis/held_out_run_study.py SEED:WITHHELD:AXIS`` (e.g.
+``55010002:drive_saturation:flexible``; docs/gap_benchmark.md, 3am).
+"""
+
+import math
+import sys
+
+import numpy as np
+
+from drakecreep.errors import InputError
+from drakecreep.gap import benchmark
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+_BASE = ("mass", "viscous", "coulomb", "offset")
+
+
+def _refuse(line):
+    print(line, file=sys.stderr)
+    sys.exit(2)
+
+
+def _run_line(kind, r):
+    v = np.gradient(r.x_ref, r.dt)
+    return (f"  {kind:8s} {r.label:6s} top speed {1e3 * np.abs(v).max():5.0f} mm/s, commanded force RMS "
+            f"{np.sqrt(np.mean(r.force ** 2)):6.1f} N, peak {np.abs(r.force).max():5.0f} N")
+
+
+def main(argv):
+    if len(argv) != 1:
+        _refuse("usage: analysis/held_out_run_study.py SEED:WITHHELD:AXIS")
+    try:
+        seed, withheld, axis = benchmark.dataset_spec(argv[0])
+    except InputError as e:
+        _refuse(str(e))
+    name = benchmark.EXPECTED.get(withheld[0]) if len(withheld) == 1 else None
+    if name not in DRAKE_EFFECTS:
+        allowed = [w for w, c in benchmark.EXPECTED.items() if c in DRAKE_EFFECTS]
+        _refuse(f"WITHHELD: got {'+'.join(withheld) or 'null'!r}; allowed: a withheld effect with a fitted candidate, "
+                "one of " + ", ".join(allowed))
+    ds = benchmark.generate_dataset(seed, withheld=withheld, kind="p_p_cascade", axis=axis)
+    res = benchmark.diagnose_dataset(ds, effects=[name])
+    ranked = next(r for r in res.ranking if r.name == name)
+    tr = ds.truth
+    print(f"{seed} {withheld[0]} (candidate {name}) {axis}: SNR {ds.snr:.1f}, nominal friction {res.friction}")
+    print(f"  truth: mass {tr.M:.1f} kg, viscous {tr.Fv:.1f} N s/m, Coulomb {tr.Fc:.2f} N, offset {tr.offset:.2f} N, "
+          f"effect {tr.effects.get(withheld[0])}")
+    keys = _BASE + DRAKE_EFFECTS[name].parameters
+    print("  nominal:   " + ", ".join(f"{k} {res.nominal.parameters[k]:.4g}" for k in keys))
+    if ranked.fit is None:
+        print("  the candidate was screened out: no closed-loop fit")
+        return
+    print("  candidate: " + ", ".join(f"{k} {ranked.fit.parameters[k]:.4g}" for k in keys)
+          + (f" (closed-loop start: {ranked.closed_loop_start})" if ranked.closed_loop_start else ""))
+    for kind, runs in (("training", ds.train), ("held out", ds.test), ("audit", ds.audit)):
+        for r in runs:
+            print(_run_line(kind, r))
+    ref = ranked.reference_errors or res.nominal_test_errors
+    print("  held-out force error [%], reference -> candidate, log ratio (with the run's friction level):")
+    for label, cand in ranked.fit.test_errors.items():
+        a, b = ref[label], cand
+        print(f"    {label:6s} {a['force']:7.2f} -> {b['force']:7.2f}  {math.log(a['force'] / b['force']):+.3f} "
+              f"({math.log(a['force_level'] / b['force_level']):+.3f})")
+    print(f"  mean log ratio {ranked.log_ratio:+.3f} vs bar {ranked.threshold:.3f}; with each run's level "
+          f"{ranked.level_log_ratio:+.3f} vs bar {ranked.level_threshold:.3f}; passes: {ranked.passes}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
