@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 
 import numpy as np
 
@@ -51,7 +52,10 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "piece_sign_flip_p": r.piece_p_sign_flip, "by_pieces": r.pieces,
                                   "started_from": r.closed_loop_start or None,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
-                                  "delay_samples": r.fit.delay, "seconds": r.fit.seconds}
+                                  "delay_samples": r.fit.delay, "seconds": r.fit.seconds,
+                                  # which held-out runs carry it: each run's force error against the reference
+                                  # it is measured against (an effect one fast run carries shows here)
+                                  "held_out_force_error_percent_by_run": _by_run(r, nominal_test_errors)}
             if r.regime:  # the regime it must show in too, or may pass by (DrakeEffect.regime, fallback_regime)
                 row["closed_loop"]["regime"] = {"name": r.regime, "log_error_ratio": r.regime_log_ratio,
                                                 "log_error_ratio_standard_error": r.regime_log_ratio_se,
@@ -66,6 +70,21 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                     "held_out_force_error_percent": rms_force_error(nominal_test_errors),
                                     "held_out_errors": nominal_test_errors},
                         "ranking": rows})
+
+
+def _by_run(ranked, nominal_test_errors):
+    """``{label: {"reference", "candidate", "log_error_ratio"}}``: each held-out run's closed-loop force error [%]
+    with the reference a fitted candidate is measured against (its equal-effort refit, else the nominal) and with
+    the candidate, and their log ratio (the claim's per-run statistic)."""
+    ref = ranked.reference_errors or nominal_test_errors
+    out = {}
+    for label, errors in ranked.fit.test_errors.items():
+        if label not in ref:
+            continue
+        a, b = float(ref[label]["force"]), float(errors["force"])
+        ratio = math.log(a / b) if a > 0 and b > 0 and math.isfinite(a) and math.isfinite(b) else float("nan")
+        out[label] = {"reference": a, "candidate": b, "log_error_ratio": ratio}
+    return out
 
 
 def drake_to_json_dict(diagnosis, **extra):
@@ -274,6 +293,18 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                         "closed-loop held-out force error [%]", "closed-loop gain [points of %]",
                         "error ratio (log ratio vs bar; with each run's own friction level)", "passes alone",
                         "fitted parameters"], rows))
+    fitted = [r for r in diagnosis.ranking if not r.screened_out]
+    if fitted:
+        labels = list(diagnosis.nominal_test_errors)
+        by_run = {r.name: _by_run(r, diagnosis.nominal_test_errors) for r in fitted}
+        parts.append("<p>Which held-out runs carry each fitted candidate: force error [%] of the run, reference → "
+                     "candidate (log ratio; positive: the candidate replays the run better). An effect that only "
+                     "some runs excite (a saturating drive: the runs that command the most force) shows in those "
+                     "runs alone; the claim needs the mean over the runs.</p>")
+        parts.append(table(["effect"] + labels,
+                           [[name] + [f"{v[lab]['reference']:.3g} → {v[lab]['candidate']:.3g} "
+                                      f"({v[lab]['log_error_ratio']:+.2f})" if lab in v else "-" for lab in labels]
+                            for name, v in by_run.items()]))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = ("position", "velocity", "acceleration", "force")
     rows = [[lab] + [f"{diagnosis.nominal_test_errors[lab][s]:.4g} → {diagnosis.test_errors[lab][s]:.4g}"

@@ -59,6 +59,11 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
     assert "Unexplained: where" in html and "Residual-input independence" in html
     assert "a friction along the travel, which is a level over a short run, needs one of the two" in html
+    # which held-out runs carry each fitted candidate: a row per fitted candidate, a column per held-out run
+    by_run = data["ranking"][0]["closed_loop"]["held_out_force_error_percent_by_run"]
+    assert set(by_run) == {"w3", "w4", "w5"} and all(v["log_error_ratio"] > 0 for v in by_run.values())
+    assert "Which held-out runs carry each fitted candidate" in html
+    assert f"{by_run['w3']['reference']:.3g} → {by_run['w3']['candidate']:.3g}" in html
     # the training runs: the nominal's values with each left out, their spread in the table and the JSON
     assert "leave one training run out" in html
     # the mass, which output error does not refine, is in the nominal's table with its source

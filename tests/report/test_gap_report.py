@@ -26,6 +26,7 @@ def test_the_ranking_json_carries_a_candidate_s_regime_test():
 
     def fit(name):
         return SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
+                               test_errors={"r0": {"force": 8.0}},
                                seconds=1.0)
 
     ripple = RankedEffect(fit=fit("time_ripple"), gain=0.4, standard_error=0.1, passes=False, effect="time_ripple", log_ratio=0.06,
@@ -53,6 +54,7 @@ def _ranking(*candidates):
 
     def ranked(name, **kw):
         fit = SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, parameters=values, delay=0.0,
+                               test_errors={"r0": {"force": 8.0}},
                               seconds=1.0)
         return RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, effect=name, **kw)
 
@@ -115,6 +117,7 @@ def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
                        alternative_start={"stribeck_extra": 20.0, "viscous": 296.0})
     assert _ranking(("stribeck", {"screen": own}))["stribeck"]["started_from"] == "nominal"
     fit = SimpleNamespace(name="drive_saturation", test_force_error=8.0, train_force_error=7.0, start_index=1,
+                          test_errors={"r0": {"force": 8.0}},
                           parameters={"inverse_drive_limit": 0.016}, delay=0.0, seconds=1.0)
     ranked = RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=True, screen=offered)
     assert ranked.closed_loop_start == "inverse_dynamics"
@@ -122,3 +125,35 @@ def test_the_ranking_json_says_where_a_closed_loop_fit_with_two_starts_began():
     row = ranking_json(nominal, {"r0": {"force": 9.0}}, (ranked,))["ranking"][0]
     assert row["inverse_dynamics"]["alternative_start"]["viscous"] == 122.0
     assert row["closed_loop"]["started_from"] == "inverse_dynamics"
+
+
+def test_the_ranking_json_shows_which_held_out_runs_carry_a_candidate():
+    """Each fitted candidate's force error per held-out run, against the reference it is measured against (its
+    equal-effort refit when it has one, else the nominal), with the per-run log ratio, in ``ranking.json`` (the
+    page's table: tests/cli/test_diagnose.py). A run the candidate replays better has a positive log ratio."""
+    import math
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import RankedEffect
+    from drakecreep.report.gap_report import ranking_json
+
+    def ranked(name, errors, reference=None):
+        fit = SimpleNamespace(name=name, test_force_error=8.0, train_force_error=7.0, delay=0.0, seconds=1.0,
+                              parameters={"inverse_drive_limit": 0.01, "stribeck_extra": 1.0,
+                                          "stribeck_velocity": 0.001},
+                              test_errors={k: {"force": v} for k, v in errors.items()})
+        return RankedEffect(fit=fit, gain=0.4, standard_error=0.1, passes=False, effect=name,
+                            reference_errors=reference)
+
+    nominal_errors = {"run4": {"force": 8.55}, "run7": {"force": 71.1}}
+    drive = ranked("drive_saturation", {"run4": 9.35, "run7": 51.8},
+                   reference={"run4": {"force": 8.6}, "run7": {"force": 70.0}})
+    stribeck = ranked("stribeck", {"run4": 8.0, "run7": 71.1})
+    nominal = SimpleNamespace(parameters={"mass": 95.0}, fitted=("mass",), ci95={}, jackknife_std={}, warnings=())
+    rows = {r["effect"]: r["closed_loop"]["held_out_force_error_percent_by_run"]
+            for r in ranking_json(nominal, nominal_errors, (drive, stribeck))["ranking"]}
+    assert rows["drive_saturation"]["run7"] == {"reference": 70.0, "candidate": 51.8,
+                                                "log_error_ratio": math.log(70.0 / 51.8)}
+    assert rows["drive_saturation"]["run4"]["log_error_ratio"] < 0
+    assert rows["stribeck"]["run4"]["reference"] == 8.55  # no refit of its own: the nominal's
+    assert rows["stribeck"]["run7"]["log_error_ratio"] == 0.0
