@@ -125,6 +125,7 @@ def build_parser():
     for name in COMMANDS:
         module = importlib.import_module(f"drakecreep.cli.{name}")
         _add_common(module.add_parser(sub), suppress=True)
+    parser.commands = sub.choices  # name -> subcommand parser: its own errors name it (main)
     return parser
 
 
@@ -132,7 +133,10 @@ def main(argv=None):
     """Entry point of the ``drakecreep`` console script."""
     os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # the command's own parser says it, with its name and where its options are listed
+        parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)} "
+                                            f"(drakecreep {args.command} --help lists the options)")
     if args.verbose:
         import logging
 

@@ -36,6 +36,9 @@ def test_simulate_text(tmp_path, capsys):
     (["simulate", "--params", "/no/such/file.yaml"], "No such file"),
     (["diagram", "--out", "x.jpg"], "--out"),
     (["nonsense"], "invalid choice"),
+    # an option of no command: the command's own parser names itself and where its options are listed
+    (["margins", "--speed", "abc"], "drakecreep margins: error: unrecognized arguments: --speed abc "
+                                    "(drakecreep margins --help lists the options)"),
 ])
 def test_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
     try:
