@@ -17,7 +17,7 @@ import numpy as np
 
 from drakecreep.errors import InputError
 
-__all__ = ["FORMATS", "UNITS", "read_signals", "unit_factor", "parse_column"]
+__all__ = ["DECIMALS", "FORMATS", "SEPARATORS", "UNITS", "read_signals", "unit_factor", "parse_column"]
 
 #: file suffix -> format name
 FORMATS = {".csv": "csv", ".txt": "csv", ".parquet": "parquet", ".pq": "parquet", ".h5": "hdf5",
@@ -60,10 +60,43 @@ def unit_factor(signal, unit, u_units, where):
     return table[unit]
 
 
-def _frame(path, fmt, key):
+#: CSV field separators a file may use (``file.separator``; without it, the header line decides)
+SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t"}
+#: decimal marks (``file.decimal``; without it, ``,`` when the separator is not a comma and the first data row
+#: writes numbers with a comma, as spreadsheets in many locales export)
+DECIMALS = (".", ",")
+
+
+def _sniff_csv(path, separator, decimal):
+    """``(separator, decimal)`` of a CSV: the given ones, else the one of ``,``, ``;`` and tab the header line
+    (its first line that is neither blank nor a ``#`` comment) uses most, and ``,`` as the decimal mark when the
+    separator is not a comma and the first data row has a digit, a comma and a digit."""
+    if separator is not None and decimal is not None:
+        return separator, decimal
+    lines = []
+    try:
+        with open(path, encoding="utf-8", errors="strict") as fh:
+            for line in fh:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    lines.append(line)
+                    if len(lines) == 2:
+                        break
+    except (UnicodeDecodeError, OSError):
+        return separator or ",", decimal or "."  # pandas names the problem
+    if separator is None:
+        header = lines[0] if lines else ""
+        counts = {sep: header.count(sep) for sep in (",", ";", "\t")}
+        separator = max(counts, key=counts.get) if max(counts.values()) > 0 else ","
+    if decimal is None:
+        decimal = "," if separator != "," and len(lines) > 1 and re.search(r"\d,\d", lines[1]) else "."
+    return separator, decimal
+
+
+def _frame(path, fmt, key, separator=None, decimal=None):
     import pandas as pd
 
     if fmt == "csv":
+        separator, decimal = _sniff_csv(path, separator, decimal)
         try:
             # index_col=False: a trailing comma on every line is an empty field, not a shift of every column under
             # the header (pandas would take the first column as the index); rows with more values than the header
@@ -71,7 +104,7 @@ def _frame(path, fmt, key):
             with warnings.catch_warnings():
                 warnings.simplefilter("error", pd.errors.ParserWarning)
                 frame = pd.read_csv(path, comment="#", skipinitialspace=True, skip_blank_lines=True,
-                                    index_col=False)
+                                    index_col=False, sep=separator, decimal=decimal)
             # a trailing comma on the header line too: an unnamed column with no values
             empty = [c for c in frame.columns if re.fullmatch(r"Unnamed: \d+", str(c)) and frame[c].isna().all()]
             return frame.drop(columns=empty)
@@ -122,7 +155,7 @@ def _frame(path, fmt, key):
     return pd.DataFrame(columns)
 
 
-def read_signals(path, u_units, columns=None, units=None, key=None):
+def read_signals(path, u_units, columns=None, units=None, key=None, separator=None, decimal=None):
     """Read a measured file into SI arrays of the project's signal names.
 
     Parameters
@@ -137,6 +170,9 @@ def read_signals(path, u_units, columns=None, units=None, key=None):
         Project signal name -> unit, for columns whose name carries none.
     key : str, optional
         The HDF5 key of the table.
+    separator, decimal : str, optional
+        A CSV's field separator (``,``, ``;`` or a tab) and decimal mark (``.`` or ``,``); default: from the
+        header line and the first data row (:func:`_sniff_csv`).
 
     Returns
     -------
@@ -147,7 +183,7 @@ def read_signals(path, u_units, columns=None, units=None, key=None):
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise InputError(str(path), path.suffix or "(no suffix)", "a file ending in " + ", ".join(FORMATS))
-    frame = _frame(path, fmt, key)
+    frame = _frame(path, fmt, key, separator, decimal)
     if frame.shape[1] == 0 or frame.shape[0] == 0:
         raise InputError(str(path), "no data", "a header line and data rows")
     mapping = dict(columns or {})

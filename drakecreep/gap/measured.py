@@ -474,12 +474,23 @@ def _meta_to_dict(meta):
 # --------------------------------------------------------------------------- CSV
 
 def _file_options(opts, meta_path):
-    """The metadata's ``file:`` mapping (``columns``, ``units``, ``key``) as keyword arguments of read_signals."""
+    """The metadata's ``file:`` mapping (``columns``, ``units``, ``key``, ``separator``, ``decimal``) as keyword
+    arguments of read_signals."""
+    from drakecreep.gap.formats import DECIMALS, SEPARATORS
+
     if opts is None:
         return {}
     where = f"{meta_path}: file"
-    if not isinstance(opts, dict) or set(opts) - {"columns", "units", "key"}:
-        raise InputError(where, opts, "a mapping with columns (signal: file column), units (signal: unit), key (HDF5)")
+    if not isinstance(opts, dict) or set(opts) - {"columns", "units", "key", "separator", "decimal"}:
+        raise InputError(where, opts, "a mapping with columns (signal: file column), units (signal: unit), key (HDF5), "
+                                      "separator and decimal (CSV)")
+    separator, decimal = opts.get("separator"), opts.get("decimal")
+    if separator is not None and separator not in SEPARATORS:
+        raise InputError(f"{where}.separator", separator, "one of ',', ';', 'tab'")
+    if decimal is not None and decimal not in DECIMALS:
+        raise InputError(f"{where}.decimal", decimal, "'.' or ','")
+    if separator is not None and SEPARATORS[separator] == decimal:
+        raise InputError(f"{where}.decimal", decimal, "a mark other than the separator")
     for name in ("columns", "units"):
         value = opts.get(name)
         if value is not None and not (isinstance(value, dict) and all(isinstance(v, str) for v in value.values())):
@@ -487,7 +498,8 @@ def _file_options(opts, meta_path):
     key = opts.get("key")
     if key is not None and not isinstance(key, str):
         raise InputError(f"{where}.key", key, "a string (the HDF5 table's key)")
-    return dict(columns=opts.get("columns"), units=opts.get("units"), key=key)
+    return dict(columns=opts.get("columns"), units=opts.get("units"), key=key,
+                separator=None if separator is None else SEPARATORS[separator], decimal=decimal)
 
 
 def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):

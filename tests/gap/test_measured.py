@@ -276,6 +276,36 @@ def test_a_repeated_column_is_named(tmp_path):
         load_measured(path)
 
 
+@pytest.mark.parametrize("separator, decimal", [(";", ","), (";", "."), ("\t", "."), ("\t", ",")])
+def test_semicolon_and_tab_separated_files_with_either_decimal_mark(tmp_path, separator, decimal):
+    """Spreadsheet and scope exports in many locales: ``;`` or tab between fields, often a decimal comma. The
+    header line gives the separator, the first data row the decimal mark."""
+    cols = _rows()
+    path = _write(tmp_path, cols)
+    lines = path.read_text().splitlines()
+    path.write_text("# exported by a scope\n" + "\n".join(
+        line.replace(",", separator).replace(".", decimal) for line in lines) + "\n")
+    run = load_measured(path).run()
+    np.testing.assert_allclose(run.t, cols["t"], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(run.u, cols["u"], rtol=1e-15)
+
+
+def test_the_metadata_may_name_the_separator_and_the_decimal_mark(tmp_path):
+    cols = _rows()
+    meta = dict(META, file={"separator": ";", "decimal": ","})
+    path = _write(tmp_path, cols, meta=meta)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(line.replace(",", ";").replace(".", ",") for line in lines) + "\n")
+    np.testing.assert_allclose(load_measured(path).run().u, cols["u"], rtol=1e-15)
+
+
+@pytest.mark.parametrize("file, field", [({"separator": "|"}, "file.separator"), ({"decimal": ";"}, "file.decimal"),
+                                         ({"separator": ",", "decimal": ","}, "file.decimal")])
+def test_a_bad_separator_or_decimal_mark_is_named(tmp_path, file, field):
+    with pytest.raises(InputError, match=field):
+        load_measured(_write(tmp_path, meta=dict(META, file=file)))
+
+
 def test_array_length_mismatch_in_constructor():
     r = _rows()
     meta = MeasuredMeta(u_units="N", u_gain=1.0)
