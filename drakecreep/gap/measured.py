@@ -571,6 +571,11 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
         labels = np.array(cols["run"], dtype=object)
         order = list(dict.fromkeys(labels.tolist()))
         groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
+        for lab, idx in groups:  # a run's rows in two blocks would read as one run with a jump in time
+            if idx[-1] - idx[0] + 1 != idx.size:
+                gap = int(np.flatnonzero(np.diff(idx) > 1)[0])
+                raise InputError(f"{csv_path}: column run", f"{lab}: data rows {idx[0] + 1}-{idx[gap] + 1} and "
+                                 f"again from {idx[gap + 1] + 1}", "each run's rows together, one block per label")
     else:
         groups = [(csv_path.stem, np.arange(n_rows))]
     runs = []

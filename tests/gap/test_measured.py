@@ -306,6 +306,13 @@ def test_a_bad_separator_or_decimal_mark_is_named(tmp_path, file, field):
         load_measured(_write(tmp_path, meta=dict(META, file=file)))
 
 
+def test_a_run_whose_rows_are_in_two_blocks_is_refused_with_where(tmp_path):
+    cols = _rows(30)
+    cols["run"] = ["A"] * 10 + ["B"] * 10 + ["A"] * 10
+    with pytest.raises(InputError, match="A: data rows 1-10 and again from 21.*each run's rows together"):
+        load_measured(_write(tmp_path, cols))
+
+
 def test_array_length_mismatch_in_constructor():
     r = _rows()
     meta = MeasuredMeta(u_units="N", u_gain=1.0)
