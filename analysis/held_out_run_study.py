@@ -7,7 +7,8 @@ candidate), then prints
 
 * the truth's values beside the nominal's and the candidate's fitted ones (mass, viscous, Coulomb, offset and the
   effect's own parameters);
-* every run's reference speed and commanded force (training, held out, audit);
+* every run's reference speed, commanded force and travel (training, held out, audit);
+* the candidate's inverse-dynamics screen (its held-out log ratio and start values);
 * every held-out run's closed-loop force error [%] with the nominal and with the candidate, and their log ratio
   (the claim's per-run statistic), plain and with each run's own friction level.
 
@@ -35,7 +36,8 @@ def _refuse(line):
 def _run_line(kind, r):
     v = np.gradient(r.x_ref, r.dt)
     return (f"  {kind:8s} {r.label:6s} top speed {1e3 * np.abs(v).max():5.0f} mm/s, commanded force RMS "
-            f"{np.sqrt(np.mean(r.force ** 2)):6.1f} N, peak {np.abs(r.force).max():5.0f} N")
+            f"{np.sqrt(np.mean(r.force ** 2)):6.1f} N, peak {np.abs(r.force).max():5.0f} N, travel "
+            f"{1e3 * r.x_ref.min():6.1f} .. {1e3 * r.x_ref.max():6.1f} mm")
 
 
 def main(argv):
@@ -59,14 +61,18 @@ def main(argv):
           f"effect {tr.effects.get(withheld[0])}")
     keys = _BASE + DRAKE_EFFECTS[name].parameters
     print("  nominal:   " + ", ".join(f"{k} {res.nominal.parameters[k]:.4g}" for k in keys))
+    for kind, runs in (("training", ds.train), ("held out", ds.test), ("audit", ds.audit)):
+        for r in runs:
+            print(_run_line(kind, r))
+    sc = ranked.screen
+    if sc is not None:
+        print(f"  screen (inverse dynamics): held-out log ratio {sc.log_ratio:+.3f} (standard error "
+              f"{sc.log_ratio_se:.3f}), passes: {sc.passes}; start " + ", ".join(f"{k} {v:.4g}" for k, v in sc.start.items()))
     if ranked.fit is None:
         print("  the candidate was screened out: no closed-loop fit")
         return
     print("  candidate: " + ", ".join(f"{k} {ranked.fit.parameters[k]:.4g}" for k in keys)
           + (f" (closed-loop start: {ranked.closed_loop_start})" if ranked.closed_loop_start else ""))
-    for kind, runs in (("training", ds.train), ("held out", ds.test), ("audit", ds.audit)):
-        for r in runs:
-            print(_run_line(kind, r))
     ref = ranked.reference_errors or res.nominal_test_errors
     print("  held-out force error [%], reference -> candidate, log ratio (with the run's friction level):")
     for label, cand in ranked.fit.test_errors.items():
