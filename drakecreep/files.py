@@ -38,6 +38,8 @@ __all__ = [
     "write_json",
     "write_text",
     "read_input_text",
+    "csv_dialect",
+    "first_non_number",
     "check_input_file",
     "resolve_reference",
     "check_output_dir",
@@ -145,6 +147,53 @@ def check_input_file(path, field, max_bytes=MAX_INPUT_BYTES):
     if info.st_size > max_bytes:
         raise InputError(field, f"{path} ({info.st_size} bytes)", f"a file of at most {max_bytes} bytes")
     return path
+
+
+def csv_dialect(lines, separator=None, decimal=None):
+    """``(separator, decimal)`` of a CSV from its first lines (``#`` comments and blank lines are skipped).
+
+    Spreadsheet, scope and hammer-test exports in many locales separate fields by ``;`` or a tab and write a
+    decimal comma. Without ``separator``: the one of ``,``, ``;`` and tab the header line (the first line
+    read) uses most (``,`` when it has none). Without ``decimal``: ``,`` when the separator is not a comma and
+    the first data row has a digit, a comma and a digit, else ``.``.
+
+    Parameters
+    ----------
+    lines : iterable of str
+        The file's lines from its start (only the first two that are not comments or blank are read).
+    separator, decimal : str, optional
+        Given values are kept.
+
+    Returns
+    -------
+    tuple of str
+    """
+    import re
+
+    found = []
+    for line in lines:
+        if line.strip() and not line.lstrip().startswith("#"):
+            found.append(line)
+            if len(found) == 2:
+                break
+    if separator is None:
+        header = found[0] if found else ""
+        counts = {sep: header.count(sep) for sep in (",", ";", "\t")}
+        separator = max(counts, key=counts.get) if max(counts.values()) > 0 else ","
+    if decimal is None:
+        decimal = "," if separator != "," and len(found) > 1 and re.search(r"\d,\d", found[1]) else "."
+    return separator, decimal
+
+
+def first_non_number(values):
+    """The first of ``values`` (cells of a table read as text) that ``float`` cannot read, for a message naming
+    it; None when all can."""
+    for value in values:
+        try:
+            float(value)
+        except (TypeError, ValueError):
+            return value
+    return None
 
 
 def read_input_text(path, field=None, max_bytes=MAX_INPUT_BYTES):

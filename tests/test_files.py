@@ -154,3 +154,14 @@ def test_output_file_checks(tmp_path):
             check_output_file(bad, "--write")
     assert check_output_file(tmp_path / "new" / "p.yaml", "--write") == tmp_path / "new" / "p.yaml"
     assert sorted(p.name for p in (tmp_path / "new").iterdir()) == []  # the probe file is gone, nothing written
+
+
+def test_csv_dialect_reads_the_separator_from_the_header_and_the_decimal_mark_from_the_first_row():
+    from drakecreep.files import csv_dialect
+
+    assert csv_dialect(["# a comment; with, marks", "", "t;x;u", "0,5;1,25;2"]) == (";", ",")
+    assert csv_dialect(["t;x;u", "0.5;1.25;2"]) == (";", ".")
+    assert csv_dialect(["t\tx", "1,5\t2"]) == ("\t", ",")
+    assert csv_dialect(["t,x", "1.5,2"]) == (",", ".")
+    assert csv_dialect(["t"]) == (",", ".")  # one column: nothing to tell, the default
+    assert csv_dialect(["t;x", "1,5;2"], separator=";", decimal=".") == (";", ".")  # given values are kept

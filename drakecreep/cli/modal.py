@@ -1,8 +1,8 @@
 """``drakecreep modal FILE.csv``: identify one joint mode (fn, damping, k, c) from a hammer test.
 
 The CSV holds either an FRF (columns ``f_Hz,re,im``; choose its kind with ``--frf-type``) or time
-records (columns ``t,force,response``; the response kind with ``--response``). Lines starting with
-``#`` are ignored. Results by the half-power bandwidth method (the paper's) and by a least-squares
+records (columns ``t,force,response``; the response kind with ``--response``), separated by ``,``, ``;`` or a
+tab. Lines starting with ``#`` are ignored. Results by the half-power bandwidth method (the paper's) and by a least-squares
 SDOF fit of the complex FRF.
 """
 
@@ -12,12 +12,10 @@ import math
 import numpy as np
 
 from drakecreep.errors import InputError
-from drakecreep.paper.modal import HammerTest, identify_frf, identify_hammer_test
+from drakecreep.paper.modal import FRF_COLUMNS, HammerTest, identify_frf, identify_hammer_test, read_hammer_csv
 
 __all__ = ["add_parser", "run"]
 
-_FRF_COLUMNS = ("f_Hz", "re", "im")
-_TIME_COLUMNS = ("t", "force", "response")
 
 
 def add_parser(subparsers):
@@ -40,28 +38,6 @@ def add_parser(subparsers):
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
     p.set_defaults(func=run)
     return p
-
-
-def _read_csv(path):
-    from drakecreep.files import MAX_DATA_BYTES, read_input_text
-
-    text = read_input_text(path, str(path), MAX_DATA_BYTES)  # regular UTF-8 file, bounded
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
-        raise InputError(str(path), "empty", "a CSV with header f_Hz,re,im or t,force,response")
-    header = tuple(h.strip() for h in lines[0].split(","))
-    if header not in (_FRF_COLUMNS, _TIME_COLUMNS):
-        raise InputError(f"{path}: header", ",".join(header), "f_Hz,re,im  or  t,force,response")
-    try:
-        data = np.array([[float(x) for x in ln.split(",")] for ln in lines[1:]], dtype=float)
-    except ValueError as err:
-        raise InputError(f"{path}: data", str(err).split(": ")[-1], "numbers") from None
-    if data.ndim != 2 or data.shape[0] < 8 or data.shape[1] != 3:
-        raise InputError(f"{path}: rows", data.shape[0] if data.ndim else 0,
-                         "at least 8 rows of 3 numbers")
-    if not np.all(np.isfinite(data)):
-        raise InputError(f"{path}: data", "nan/inf", "finite numbers")
-    return header, data
 
 
 def _uniform_step(x, name):
@@ -89,13 +65,13 @@ def run(args):
     for option, value in (("--fmin", args.fmin), ("--fmax", args.fmax)):
         if value is not None and not math.isfinite(value):
             raise InputError(option, value, "a finite frequency in Hz")
-    header, data = _read_csv(args.file)
-    if header == _FRF_COLUMNS and args.pulse_width is not None:
+    header, data = read_hammer_csv(args.file)
+    if header == FRF_COLUMNS and args.pulse_width is not None:
         raise InputError("--pulse-width", args.pulse_width, "only with a t,force,response file (this one is an FRF)")
     band = None
     if args.fmin is not None or args.fmax is not None:
         band = (args.fmin, args.fmax)
-    if header == _FRF_COLUMNS:
+    if header == FRF_COLUMNS:
         f = data[:, 0]
         _uniform_step(f, "f_Hz")
         ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], args.frf_type, args.mass, band,

@@ -68,28 +68,16 @@ DECIMALS = (".", ",")
 
 
 def _sniff_csv(path, separator, decimal):
-    """``(separator, decimal)`` of a CSV: the given ones, else the one of ``,``, ``;`` and tab the header line
-    (its first line that is neither blank nor a ``#`` comment) uses most, and ``,`` as the decimal mark when the
-    separator is not a comma and the first data row has a digit, a comma and a digit."""
+    """``(separator, decimal)`` of a CSV file (:func:`drakecreep.files.csv_dialect` of its first lines)."""
+    from drakecreep.files import csv_dialect
+
     if separator is not None and decimal is not None:
         return separator, decimal
-    lines = []
     try:
         with open(path, encoding="utf-8", errors="strict") as fh:
-            for line in fh:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    lines.append(line)
-                    if len(lines) == 2:
-                        break
+            return csv_dialect(fh, separator, decimal)
     except (UnicodeDecodeError, OSError):
         return separator or ",", decimal or "."  # pandas names the problem
-    if separator is None:
-        header = lines[0] if lines else ""
-        counts = {sep: header.count(sep) for sep in (",", ";", "\t")}
-        separator = max(counts, key=counts.get) if max(counts.values()) > 0 else ","
-    if decimal is None:
-        decimal = "," if separator != "," and len(lines) > 1 and re.search(r"\d,\d", lines[1]) else "."
-    return separator, decimal
 
 
 def _frame(path, fmt, key, separator=None, decimal=None):
@@ -172,7 +160,7 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
         The HDF5 key of the table.
     separator, decimal : str, optional
         A CSV's field separator (``,``, ``;`` or a tab) and decimal mark (``.`` or ``,``); default: from the
-        header line and the first data row (:func:`_sniff_csv`).
+        header line and the first data row (:func:`drakecreep.files.csv_dialect`).
 
     Returns
     -------
@@ -222,15 +210,11 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
         try:
             data = values.to_numpy(dtype=float)
         except (TypeError, ValueError):
-            bad = next((v for v in values if not _is_number(v)), values.iloc[0])
+            from drakecreep.files import first_non_number
+
+            bad = first_non_number(values)
+            bad = values.iloc[0] if bad is None else bad
             raise InputError(f"{path}: column {signal}", str(bad)[:40], "numbers") from None
         signals[signal] = data * unit_factor(signal, unit, u_units, str(path))
     return signals
 
-
-def _is_number(value):
-    try:
-        float(value)
-    except (TypeError, ValueError):
-        return False
-    return True

@@ -51,7 +51,14 @@ __all__ = [
     "identify_frf",
     "identify_hammer_test",
     "half_power_error_study",
+    "FRF_COLUMNS",
+    "TIME_COLUMNS",
+    "read_hammer_csv",
 ]
+
+#: the columns of a measured FRF file and of a file of time records (``drakecreep modal``)
+FRF_COLUMNS = ("f_Hz", "re", "im")
+TIME_COLUMNS = ("t", "force", "response")
 
 _FRF_POWERS = {"receptance": 0, "displacement": 0, "mobility": 1, "velocity": 1,
                "accelerance": 2, "acceleration": 2}
@@ -740,3 +747,59 @@ def half_power_error_study(mass, stiffness, damping, noise_levels, durations, fs
                 row["k_err_fit"] = ident.fit.k / stiffness - 1.0
             rows.append(row)
     return rows
+
+
+def read_hammer_csv(path):
+    """Read a hammer test: an FRF (columns ``f_Hz,re,im``) or time records (``t,force,response``).
+
+    Fields may be separated by ``,``, ``;`` or a tab, with a decimal point or comma
+    (:func:`drakecreep.files.csv_dialect`); ``#`` lines are comments.
+
+    Parameters
+    ----------
+    path : path-like
+
+    Returns
+    -------
+    header : tuple of str
+        :data:`FRF_COLUMNS` or :data:`TIME_COLUMNS`.
+    data : numpy.ndarray
+        ``(n, 3)`` finite values, ``n >= 8``.
+
+    Raises
+    ------
+    InputError
+        Not a bounded UTF-8 text file, another header, a cell that is not a number, NaN or inf, too few rows.
+    """
+    import io
+
+    import pandas as pd
+
+    from drakecreep.files import MAX_DATA_BYTES, csv_dialect, first_non_number, read_input_text
+
+    text = read_input_text(path, str(path), MAX_DATA_BYTES)  # regular UTF-8 file, bounded
+    separator, decimal = csv_dialect(text.splitlines())
+    allowed = "f_Hz,re,im  or  t,force,response (separated by ',', ';' or a tab)"
+    try:
+        frame = pd.read_csv(io.StringIO(text), comment="#", sep=separator, decimal=decimal, skipinitialspace=True,
+                            index_col=False, skip_blank_lines=True)
+    except pd.errors.EmptyDataError:
+        raise InputError(str(path), "empty", "a CSV with header " + allowed) from None
+    except pd.errors.ParserError as err:
+        raise InputError(str(path), f"unreadable CSV ({str(err).splitlines()[0][:80]})", "a CSV with header "
+                         + allowed) from None
+    header = tuple(str(c).strip() for c in frame.columns)
+    if header not in (FRF_COLUMNS, TIME_COLUMNS):
+        raise InputError(f"{path}: header", separator.join(header), allowed)
+    try:
+        data = frame.to_numpy(dtype=float)
+    except (TypeError, ValueError):
+        bad = str(first_non_number(frame.to_numpy().ravel()))
+        raise InputError(f"{path}: data", bad[:40], "numbers") from None
+    if data.shape[0] < 8:
+        raise InputError(f"{path}: rows", data.shape[0], "at least 8 rows of 3 numbers")
+    if not np.all(np.isfinite(data)):
+        row = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
+        raise InputError(f"{path}: data", f"NaN, inf or an empty cell at data row {row + 1}", "finite numbers")
+    return header, data
+

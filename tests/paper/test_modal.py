@@ -109,3 +109,31 @@ def test_bad_inputs_raise_input_error():
         frf_h1(np.ones(10), np.ones(12), 1e3)
     with pytest.raises(InputError):
         synthetic_hammer_test(1.0, 1.0, 1e4, 1e3, 1.0, 1e-3)  # pulse shorter than 4 samples
+
+
+@pytest.mark.parametrize("separator, decimal", [(",", "."), (";", ","), ("\t", "."), ("\t", ",")])
+def test_a_hammer_test_file_is_read_with_any_common_separator_and_decimal_mark(tmp_path, separator, decimal):
+    """FRF exports of analysers in many locales use ';' or a tab and a decimal comma: all read the same values."""
+    from drakecreep.paper.modal import FRF_COLUMNS, read_hammer_csv
+
+    f = np.linspace(10.0, 500.0, 40)
+    re_, im = np.cos(f / 50.0) * 1e-6, -np.sin(f / 70.0) * 1e-6
+    rows = [separator.join(repr(float(v)).replace(".", decimal) for v in row) for row in zip(f, re_, im)]
+    path = tmp_path / "frf.csv"
+    path.write_text("# exported by an analyser\n" + separator.join(FRF_COLUMNS) + "\n" + "\n".join(rows) + "\n")
+    header, data = read_hammer_csv(path)
+    assert header == FRF_COLUMNS
+    np.testing.assert_allclose(data, np.column_stack([f, re_, im]), rtol=1e-15)
+
+
+@pytest.mark.parametrize("body, message", [("f_Hz,re,im\n" + "1,2,3\n" * 7 + "1,2,x\n", "data: got 'x'"),
+                                           ("f_Hz,re,im\n" + "1,2,3\n" * 7 + "1,2,\n", "empty cell at data row 8"),
+                                           ("f,re,im\n" + "1,2,3\n" * 8, "header: got 'f,re,im'"),
+                                           ("f_Hz,re,im\n" + "1,2,3\n" * 3, "rows: got 3")])
+def test_a_bad_hammer_test_file_is_named(tmp_path, body, message):
+    from drakecreep.paper.modal import read_hammer_csv
+
+    path = tmp_path / "frf.csv"
+    path.write_text(body)
+    with pytest.raises(InputError, match=message):
+        read_hammer_csv(path)
