@@ -215,3 +215,44 @@ def test_a_non_positive_instrumental_mass_keeps_the_least_squares_start(runs, mo
     assert idf.parameters["mass"] == pytest.approx(real(runs).parameters["mass"])
     assert any("instrumental-variable mass is -3 kg, not positive" in w for w in idf.warnings)
     assert not any("did not stay finite" in w for w in idf.warnings)
+
+
+def test_a_parameter_the_error_does_not_depend_on_alone_has_no_finite_interval():
+    """Two parameters the replay error only sees as a sum get an infinite half-width and the warning (the
+    pseudo-inverse gave them a finite, minimum-norm one); a third, identifiable one keeps its finite interval.
+    With three independent columns every interval is finite and there is no warning."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.identify import _confidence
+
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=200), rng.normal(size=200)
+    values = {"viscous": 200.0, "coulomb": 20.0, "bristle_stiffness": 1e7}
+    prob = SimpleNamespace(names=tuple(values), log=np.array([False, False, True]), scale=np.array([100.0, 10.0, 1.0]))
+    sol = SimpleNamespace(jac=np.column_stack([a, a, b]), fun=0.1 * rng.normal(size=200), cost=1.0)
+    std, ci, _, warnings = _confidence(sol, prob, values)
+    assert std["viscous"] == np.inf and std["coulomb"] == np.inf and np.isfinite(std["bristle_stiffness"])
+    assert any("does not depend on 1 combination" in w for w in warnings)
+    sol = SimpleNamespace(jac=np.column_stack([a, rng.normal(size=200), b]), fun=sol.fun, cost=1.0)
+    std, _, _, warnings = _confidence(sol, prob, values)
+    assert all(np.isfinite(s) for s in std.values()) and not any("does not depend" in w for w in warnings)
+
+
+def test_a_stiff_parameter_beside_a_viscous_one_keeps_its_interval():
+    """The covariance is taken in the fit's scaled variables: in SI the normal matrix of a stiffness of 1e12 N/m
+    (fitted on a log scale) beside a viscous coefficient is beyond a pseudo-inverse's tolerance, which cut the
+    stiffness's direction and gave it a half-width of ~0 (a LuGre nominal showed 7e-6 N/m beside a
+    leave-one-run-out spread of 1.6e6 N/m)."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.identify import _confidence
+
+    rng = np.random.default_rng(1)
+    values = {"viscous": 200.0, "bristle_stiffness": 1e12}
+    prob = SimpleNamespace(names=tuple(values), log=np.array([False, True]), scale=np.array([100.0, 1.0]))
+    sol = SimpleNamespace(jac=rng.normal(size=(300, 2)), fun=0.1 * rng.normal(size=300), cost=1.5)
+    std, _, _, warnings = _confidence(sol, prob, values)
+    # one scaled unit is the value itself on the log scale and the scale (100) on the linear one: two independent
+    # columns of the same size give the two the same std in scaled units
+    assert 0.5 < (std["bristle_stiffness"] / 1e12) / (std["viscous"] / 100.0) < 2.0
+    assert not warnings
