@@ -2,8 +2,8 @@
 
 The CSV holds either an FRF (columns ``f_Hz,re,im``; choose its kind with ``--frf-type``) or time
 records (columns ``t,force,response``; the response kind with ``--response``), separated by ``,``, ``;`` or a
-tab. Lines starting with ``#`` are ignored. Results by the half-power bandwidth method (the paper's) and by a least-squares
-SDOF fit of the complex FRF.
+tab. Lines starting with ``#`` are ignored. Results by the half-power bandwidth method (the paper's) and by a
+least-squares SDOF fit of the complex FRF.
 """
 
 import json
@@ -15,7 +15,6 @@ from drakecreep.errors import InputError
 from drakecreep.paper.modal import FRF_COLUMNS, HammerTest, identify_frf, identify_hammer_test, read_hammer_csv
 
 __all__ = ["add_parser", "run"]
-
 
 
 def add_parser(subparsers):

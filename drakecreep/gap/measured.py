@@ -485,9 +485,9 @@ def _file_options(opts, meta_path):
         raise InputError(where, opts, "a mapping with columns (signal: file column), units (signal: unit), key (HDF5), "
                                       "separator and decimal (CSV)")
     separator, decimal = opts.get("separator"), opts.get("decimal")
-    if separator is not None and separator not in SEPARATORS:
+    if separator is not None and not (isinstance(separator, str) and separator in SEPARATORS):
         raise InputError(f"{where}.separator", separator, "one of ',', ';', 'tab'")
-    if decimal is not None and decimal not in DECIMALS:
+    if decimal is not None and not (isinstance(decimal, str) and decimal in DECIMALS):
         raise InputError(f"{where}.decimal", decimal, "'.' or ','")
     if separator is not None and SEPARATORS[separator] == decimal:
         raise InputError(f"{where}.decimal", decimal, "a mark other than the separator")

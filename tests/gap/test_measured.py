@@ -300,6 +300,7 @@ def test_the_metadata_may_name_the_separator_and_the_decimal_mark(tmp_path):
 
 
 @pytest.mark.parametrize("file, field", [({"separator": "|"}, "file.separator"), ({"decimal": ";"}, "file.decimal"),
+                                         ({"separator": [";"]}, "file.separator"),
                                          ({"separator": ",", "decimal": ","}, "file.decimal")])
 def test_a_bad_separator_or_decimal_mark_is_named(tmp_path, file, field):
     with pytest.raises(InputError, match=field):
