@@ -802,4 +802,3 @@ def read_hammer_csv(path):
         row = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
         raise InputError(f"{path}: data", f"NaN, inf or an empty cell at data row {row + 1}", "finite numbers")
     return header, data
-
