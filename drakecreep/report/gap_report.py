@@ -276,7 +276,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
         names = DRAKE_EFFECTS[r.name].parameters if r.name in DRAKE_EFFECTS else ()
-        params = "; ".join("{} = {:.4g} {}".format(n, *_edge(n, r.fit.parameters[n])) for n in names)
+        params = "; ".join(f"{n} = {value:.4g}" + ("" if unit == "-" else f" {unit}")  # a share: no unit
+                           for n in names for value, unit in [_edge(n, r.fit.parameters[n])])
         if r.name == "control_delay":
             params = f"delay = {r.fit.delay:.3g} samples"
         rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f}",
