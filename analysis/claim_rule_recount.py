@@ -9,6 +9,8 @@ error dicts whose log ratios are the stored values) under
 * ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), its
   fallback regime (the asymmetric friction's constant speed, from session 38) and its piece test (the lead error,
   from session 40; rows stored before have no pieces, so it never passes there), the product today;
+* ``before_3ap``: ``current`` without the outranking of session 42 (a passing candidate below a fitted one that
+  fails is not claimed; docs/gap_benchmark.md, 3ap);
 * ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
 * ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive);
 * ``pieces_bound``: ``current``, with a piece test that passes whenever its two means pass (both above their
@@ -33,7 +35,7 @@ from drakecreep.gap.drake_diagnosis import _fallback, _passes, _piece_test, _rul
 from drakecreep.gap.drake_replay import piece_keys
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
-RULES = ("current", "both", "either", "pieces_bound")
+RULES = ("current", "before_3ap", "both", "either", "pieces_bound")
 _KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ratios",
          "force_constant_speed": "run_constant_speed_log_error_ratios"}
 
@@ -79,8 +81,10 @@ def _errors(entry):
 
 
 def first_claim(row, rule):
-    """The first candidate of ``row``'s ranking that passes under ``rule`` (None if none)."""
+    """The first candidate of ``row``'s ranking that passes under ``rule`` (None if none); under ``current`` and
+    ``pieces_bound`` not one whose log ratio is below a fitted candidate's that does not pass (``_outranked``)."""
     null = tuple(row.get("training_run_null") or (0.0, 0.0))
+    decided = []
     for entry in row["ranking"]:
         if entry.get("screened_out") or not entry.get("run_log_error_ratios"):
             continue
@@ -88,16 +92,16 @@ def first_claim(row, rule):
         bar = float(stats.t.ppf(1.0 - ALPHA, len(entry["run_log_error_ratios"]) - 1))
         name = entry["effect"]
         own = _rule(name)
-        current = rule in ("current", "pieces_bound")
+        current = rule in ("current", "pieces_bound", "before_3ap")
         chosen = own if current else {"both": "both" if own == "drift_robust" else own}.get(rule, rule)
         t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry),
                     fallback_regime=_fallback(name) if current else "", pieces=_piece_test(name) if current else False)
-        if t.passes:
-            return name
-        if rule == "pieces_bound" and _piece_test(name) and null[0] > 0 and t.log_ratio > null[0] \
-                and not t.level_log_ratio <= null[1]:
-            return name
-    return None
+        passes = t.passes or (rule == "pieces_bound" and _piece_test(name) and null[0] > 0 and t.log_ratio > null[0]
+                              and not t.level_log_ratio <= null[1])
+        decided.append((name, passes, t.log_ratio))
+    failing = [lr for _, passes, lr in decided if not passes and math.isfinite(lr)]
+    best = max(failing) if failing and rule in ("current", "pieces_bound") else -math.inf
+    return next((name for name, passes, lr in decided if passes and not lr < best), None)
 
 
 def recount(rows):

@@ -51,6 +51,8 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "piece_log_error_ratio": r.piece_log_ratio,
                                   "piece_sign_flip_p": r.piece_p_sign_flip, "by_pieces": r.pieces,
                                   "started_from": r.closed_loop_start or None,
+                                  # passes, but a fitted candidate that does not explains more: not claimed
+                                  "outranked_by": r.outranked_by or None,
                                   "parameters": {n: r.fit.parameters[n] for n in names},
                                   "delay_samples": r.fit.delay, "seconds": r.fit.seconds,
                                   # which held-out runs carry it: each run's force error against the reference
@@ -247,7 +249,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                  "is significant), "
                  "and its "
                  "inverse-dynamics fit of the held-out runs' sliding samples beats the nominal's by more than one "
-                 "standard error (the screen, on the same log ratio). The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
+                 "standard error (the screen, on the same log ratio). A candidate that passes is still not claimed "
+                 "when a fitted candidate that does not pass has a higher log ratio: the data do not single it out. "
+                 "The augmented model is <code>augmented_model.yaml</code> beside this page.</p>")
     parts.append("<h2>Nominal model (training runs: IDIM start, closed-loop output error)</h2>")
     jack = nom.jackknife_std
     parts.append(table(["parameter", "value", "95 % half-width", "std, leave one training run out", "unit"],
@@ -287,7 +291,9 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                      ("yes" if r.passes else "no")
                      + (f" (by the {r.regime.replace('_', ' ')} fallback)" if r.fallback else "")
                      + (" (by the held-out runs' pieces)" if r.pieces else "")
-                     + ("" if r.name in diagnosis.claimed or not r.passes else " (not kept by the greedy step)"),
+                     + ("" if r.name in diagnosis.claimed or not r.passes else
+                        f" (not claimed: {r.outranked_by}, which does not pass, explains more)" if r.outranked_by
+                        else " (not kept by the greedy step)"),
                      params])
     parts.append("<h2>Which effect: ranking on the held-out runs</h2>")
     parts.append(table(["effect", "inverse-dynamics gain [points of %]; error ratio (log ratio ± 1 SE)",

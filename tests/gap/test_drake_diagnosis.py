@@ -508,3 +508,22 @@ def test_a_lead_error_carried_by_two_fast_runs_passes_by_the_held_out_runs_piece
     assert t.passes and not t.pieces
     assert D._piece_test("lead_error") and not D._piece_test("control_delay")
     assert not any(e.piece_test for n, e in D.DRAKE_EFFECTS.items() if n != "lead_error")
+
+
+def test_a_passing_candidate_below_a_fitted_one_that_fails_is_not_claimed():
+    """``_outranked``: a passing candidate whose held-out log ratio is below that of a fitted candidate that does
+    not pass is marked (and the greedy step skips it); one above every failing candidate, a screened-out
+    candidate and a ranking without failing fitted candidates are left alone."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import RankedEffect, _outranked
+
+    def ranked(name, passes, log_ratio, fitted=True):
+        fit = SimpleNamespace(name=name, test_force_error=1.0) if fitted else None
+        return RankedEffect(fit=fit, gain=1.0, standard_error=0.1, passes=passes, effect=name, log_ratio=log_ratio)
+
+    ranking = [ranked("axial_mode", False, 0.161), ranked("position_friction", True, 0.082),
+               ranked("stribeck", True, 0.30), ranked("lead_error", False, float("nan"), fitted=False)]
+    out = {r.name: r.outranked_by for r in _outranked(ranking)}
+    assert out == {"axial_mode": "", "position_friction": "axial_mode", "stribeck": "", "lead_error": ""}
+    assert [r.outranked_by for r in _outranked(ranking[1:3])] == ["", ""]

@@ -157,3 +157,8 @@ def test_the_ranking_json_shows_which_held_out_runs_carry_a_candidate():
     assert rows["drive_saturation"]["run4"]["log_error_ratio"] < 0
     assert rows["stribeck"]["run4"]["reference"] == 8.55  # no refit of its own: the nominal's
     assert rows["stribeck"]["run7"]["log_error_ratio"] == 0.0
+
+
+def test_the_ranking_json_says_which_failing_candidate_outranked_a_passing_one():
+    rows = _ranking(("position_friction", {"outranked_by": "axial_mode"}), ("stribeck", {}))
+    assert rows["position_friction"]["outranked_by"] == "axial_mode" and rows["stribeck"]["outranked_by"] is None
