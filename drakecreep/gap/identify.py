@@ -554,7 +554,9 @@ def _confidence(sol, prob, values):
     # rank, null space and covariance in the fit's own scaled variables (J), whose columns are of comparable
     # size; in SI a bristle stiffness (1e7 N/m) has a derivative ~1e-9 times a viscous coefficient's, and the
     # normal matrix's condition (~1e30) is beyond any pseudo-inverse tolerance
-    _, sv, vt = np.linalg.svd(J, full_matrices=True)
+    # (the thin SVD: the full one builds an m x m factor, 5 GB for a 25 000-sample file; with fewer samples than
+    # parameters the full one is small and gives the whole null space)
+    _, sv, vt = np.linalg.svd(J, full_matrices=m < p)
     sv = np.concatenate([sv, np.zeros(p - sv.size)])
     null = vt[sv <= sv.max(initial=0.0) * max(m, p) * np.finfo(float).eps]
     rank = p - len(null)
