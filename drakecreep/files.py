@@ -39,6 +39,7 @@ __all__ = [
     "write_text",
     "read_input_text",
     "csv_dialect",
+    "read_csv_frame",
     "first_non_number",
     "check_input_file",
     "resolve_reference",
@@ -183,6 +184,61 @@ def csv_dialect(lines, separator=None, decimal=None):
     if decimal is None:
         decimal = "," if separator != "," and len(found) > 1 and re.search(r"\d,\d", found[1]) else "."
     return separator, decimal
+
+
+def read_csv_frame(source, field, allowed, separator=None, decimal=None):
+    """A CSV as a pandas DataFrame, the one CSV reader of measured runs and hammer tests.
+
+    ``#`` lines are comments. The separator and the decimal mark come from :func:`csv_dialect` unless given.
+    ``index_col=False``: a trailing comma on every line is an empty field, not a shift of every column under the
+    header (pandas would take the first column as the index); an unnamed column left with no values (a trailing
+    comma on the header line too) is dropped. Rows with more values than the header has names would lose data,
+    so pandas' warning of that is an error here.
+
+    Parameters
+    ----------
+    source : path-like or io.StringIO
+    field : str
+        What the file is, for messages.
+    allowed : str
+        What a readable file is, for the message of an unreadable one.
+    separator, decimal : str, optional
+
+    Raises
+    ------
+    InputError
+        Not UTF-8, rows longer than the header, or a file pandas cannot parse.
+    """
+    import io
+    import re
+    import warnings
+
+    import pandas as pd
+
+    if separator is None or decimal is None:
+        if isinstance(source, io.StringIO):
+            separator, decimal = csv_dialect(source.getvalue().splitlines(), separator, decimal)
+        else:
+            try:
+                with open(source, encoding="utf-8", errors="strict") as fh:
+                    separator, decimal = csv_dialect(fh, separator, decimal)
+            except (UnicodeDecodeError, OSError):
+                separator, decimal = separator or ",", decimal or "."  # pandas names the problem
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            frame = pd.read_csv(source, comment="#", skipinitialspace=True, skip_blank_lines=True, index_col=False,
+                                sep=separator, decimal=decimal)
+    except pd.errors.ParserWarning:
+        raise InputError(field, "data rows with more values than the header has column names",
+                         "one value per header column (a trailing comma on every line is allowed)") from None
+    except UnicodeDecodeError as err:
+        raise InputError(field, f"byte 0x{err.object[err.start]:02x} at offset {err.start} is not UTF-8",
+                         "a UTF-8 text CSV (not binary, not UTF-16)") from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
+        raise InputError(field, f"unreadable CSV ({str(err).splitlines()[0][:80]})", allowed) from None
+    empty = [c for c in frame.columns if re.fullmatch(r"Unnamed: \d+", str(c)) and frame[c].isna().all()]
+    return frame.drop(columns=empty)
 
 
 def first_non_number(values):

@@ -10,7 +10,6 @@ See ``docs/measured_format.md``.
 from __future__ import annotations
 
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -67,44 +66,13 @@ SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t"}
 DECIMALS = (".", ",")
 
 
-def _sniff_csv(path, separator, decimal):
-    """``(separator, decimal)`` of a CSV file (:func:`drakecreep.files.csv_dialect` of its first lines)."""
-    from drakecreep.files import csv_dialect
-
-    if separator is not None and decimal is not None:
-        return separator, decimal
-    try:
-        with open(path, encoding="utf-8", errors="strict") as fh:
-            return csv_dialect(fh, separator, decimal)
-    except (UnicodeDecodeError, OSError):
-        return separator or ",", decimal or "."  # pandas names the problem
-
-
 def _frame(path, fmt, key, separator=None, decimal=None):
     import pandas as pd
 
     if fmt == "csv":
-        separator, decimal = _sniff_csv(path, separator, decimal)
-        try:
-            # index_col=False: a trailing comma on every line is an empty field, not a shift of every column under
-            # the header (pandas would take the first column as the index); rows with more values than the header
-            # has names would lose data, so that warning is an error here
-            with warnings.catch_warnings():
-                warnings.simplefilter("error", pd.errors.ParserWarning)
-                frame = pd.read_csv(path, comment="#", skipinitialspace=True, skip_blank_lines=True,
-                                    index_col=False, sep=separator, decimal=decimal)
-            # a trailing comma on the header line too: an unnamed column with no values
-            empty = [c for c in frame.columns if re.fullmatch(r"Unnamed: \d+", str(c)) and frame[c].isna().all()]
-            return frame.drop(columns=empty)
-        except pd.errors.ParserWarning:
-            raise InputError(str(path), "data rows with more values than the header has column names",
-                             "one value per header column (a trailing comma on every line is allowed)") from None
-        except UnicodeDecodeError as err:
-            raise InputError(str(path), f"byte 0x{err.object[err.start]:02x} at offset {err.start} is not UTF-8",
-                             "a UTF-8 text CSV (not binary, not UTF-16)") from None
-        except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
-            raise InputError(str(path), f"unreadable CSV ({str(err).splitlines()[0][:80]})",
-                             "a CSV with a header line and data rows") from None
+        from drakecreep.files import read_csv_frame
+
+        return read_csv_frame(path, str(path), "a CSV with a header line and data rows", separator, decimal)
     if fmt == "parquet":
         try:
             return pd.read_parquet(path)

@@ -773,21 +773,14 @@ def read_hammer_csv(path):
     """
     import io
 
-    import pandas as pd
-
-    from drakecreep.files import MAX_DATA_BYTES, csv_dialect, first_non_number, read_input_text
+    from drakecreep.files import MAX_DATA_BYTES, csv_dialect, first_non_number, read_csv_frame, read_input_text
 
     text = read_input_text(path, str(path), MAX_DATA_BYTES)  # regular UTF-8 file, bounded
-    separator, decimal = csv_dialect(text.splitlines())
     allowed = "f_Hz,re,im  or  t,force,response (separated by ',', ';' or a tab)"
-    try:
-        frame = pd.read_csv(io.StringIO(text), comment="#", sep=separator, decimal=decimal, skipinitialspace=True,
-                            index_col=False, skip_blank_lines=True)
-    except pd.errors.EmptyDataError:
-        raise InputError(str(path), "empty", "a CSV with header " + allowed) from None
-    except pd.errors.ParserError as err:
-        raise InputError(str(path), f"unreadable CSV ({str(err).splitlines()[0][:80]})", "a CSV with header "
-                         + allowed) from None
+    if not any(ln.strip() and not ln.lstrip().startswith("#") for ln in text.splitlines()):
+        raise InputError(str(path), "empty", "a CSV with header " + allowed)
+    separator, decimal = csv_dialect(text.splitlines())
+    frame = read_csv_frame(io.StringIO(text), str(path), "a CSV with header " + allowed, separator, decimal)
     header = tuple(str(c).strip() for c in frame.columns)
     if header not in (FRF_COLUMNS, TIME_COLUMNS):
         raise InputError(f"{path}: header", separator.join(header), allowed)
