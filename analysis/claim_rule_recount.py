@@ -31,7 +31,7 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _fallback, _passes, _piece_test, _rule
+from drakecreep.gap.drake_diagnosis import _fallback, _passes, _piece_test, _rule, outranking
 from drakecreep.gap.drake_replay import piece_keys
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
@@ -82,7 +82,7 @@ def _errors(entry):
 
 def first_claim(row, rule):
     """The first candidate of ``row``'s ranking that passes under ``rule`` (None if none); under ``current`` and
-    ``pieces_bound`` not one whose log ratio is below a fitted candidate's that does not pass (``_outranked``)."""
+    ``pieces_bound`` not one whose log ratio is below a fitted candidate's that does not pass (``outranking``)."""
     null = tuple(row.get("training_run_null") or (0.0, 0.0))
     decided = []
     for entry in row["ranking"]:
@@ -99,9 +99,8 @@ def first_claim(row, rule):
         passes = t.passes or (rule == "pieces_bound" and _piece_test(name) and null[0] > 0 and t.log_ratio > null[0]
                               and not t.level_log_ratio <= null[1])
         decided.append((name, passes, t.log_ratio))
-    failing = [lr for _, passes, lr in decided if not passes and math.isfinite(lr)]
-    best = max(failing) if failing and rule in ("current", "pieces_bound") else -math.inf
-    return next((name for name, passes, lr in decided if passes and not lr < best), None)
+    outranked = outranking(decided) if rule in ("current", "pieces_bound") else {}
+    return next((name for name, passes, _ in decided if passes and name not in outranked), None)
 
 
 def recount(rows):

@@ -144,7 +144,7 @@ from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 from drakecreep.params import MEASURED_AXIS_KIND
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
-           "paired_log_ratio", "run_log_ratios", "training_run_null", "load_model",
+           "paired_log_ratio", "run_log_ratios", "training_run_null", "load_model", "outranking",
            "NOMINAL_PARAMETERS", "NOMINAL_FRICTION", "CLAIM_RULE"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
@@ -643,21 +643,27 @@ def _verdict(t):
             f"{t.threshold:.3f}, sign-flip p {t.p_sign_flip:.2g}{level})" + ("  passes" if t.passes else ""))
 
 
-def _outranked(ranking):
-    """The ranking with ``outranked_by`` set on each passing candidate whose plain held-out log ratio is below
-    that of a fitted candidate that did not pass: the data then do not single out the passing one, and neither
-    is claimed (the answer is "unexplained", with both in the ranking).
+def outranking(candidates):
+    """``{name: outranked_by}`` of ``candidates``, ``(name, passes, log_ratio)`` of each fitted candidate: every
+    passing one whose plain held-out log ratio is below that of a candidate that does not pass, mapped to the best
+    such one. The data then do not single out the passing one, and neither is claimed (the answer is
+    "unexplained", with both in the ranking).
 
     On the spent held-out rows of runs 14-31 this fired on 7 of 289 claims, all wrong first claims: six where
     the withheld effect's own candidate had the higher log ratio but failed a test (a drive saturation claimed as
     an asymmetry, a lead error as a load friction, ...) and a position friction on a null below an axial mode
     that failed its band test; no right claim (docs/gap_benchmark.md, 3ap)."""
-    best = max(((r.log_ratio, r.name) for r in ranking
-                if not r.screened_out and not r.passes and math.isfinite(r.log_ratio)), default=None)
+    candidates = list(candidates)
+    best = max(((lr, name) for name, passes, lr in candidates if not passes and math.isfinite(lr)), default=None)
     if best is None:
-        return list(ranking)
-    return [dataclasses.replace(r, outranked_by=best[1]) if r.passes and r.log_ratio < best[0] else r
-            for r in ranking]
+        return {}
+    return {name: best[1] for name, passes, lr in candidates if passes and lr < best[0]}
+
+
+def _outranked(ranking):
+    """The ranking with ``outranked_by`` set (:func:`outranking` of its fitted candidates)."""
+    by = outranking((r.name, r.passes, r.log_ratio) for r in ranking if not r.screened_out)
+    return [dataclasses.replace(r, outranked_by=by[r.name]) if r.name in by else r for r in ranking]
 
 
 def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress=None, screen=True,
