@@ -68,7 +68,12 @@ def run(args):
     """Check everything, diagnose, print the answer, write the report."""
     from drakecreep.files import check_output_dir
     from drakecreep.gap.drake_replay import check_replayable
+    from drakecreep.gap.measured import EMPS_FILES
 
+    for option, path in (("DATA", args.data), ("--score", args.score)):
+        if path and path not in EMPS_FILES and not Path(path).exists():
+            raise InputError(option, path, "an existing file: a measured run (CSV, Parquet, HDF5, .mat with its "
+                             "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
     runs = load_runs(args.data, args.meta, split=False)
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so

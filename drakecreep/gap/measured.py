@@ -61,6 +61,7 @@ __all__ = [
     "MeasuredRun",
     "MeasuredData",
     "load_measured",
+    "check_recorded",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -93,6 +94,9 @@ MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
 MAX_SPEED = 10.0
 #: Share of a run's samples whose speed may exceed :data:`MAX_SPEED` (a reference step, an encoder glitch)
 _FAST_SHARE = 0.01
+#: Share of a position column's non-zero steps that may be shorter than half a declared count: a counting
+#: sensor moves by whole counts, so more means the resolution is in the wrong unit or not the one recorded
+_SUBCOUNT_SHARE = 0.02
 #: Controller kinds of the metadata schema.
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
@@ -526,7 +530,8 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     ------
     InputError
         Missing or unknown column, unknown unit, unknown ``u_units``, a non-number, NaN, non-monotonic or
-        non-uniform time, missing metadata.
+        non-uniform time, missing metadata, a sensor resolution the positions contradict or a ``u`` that is
+        zero throughout (:func:`check_recorded`).
     FileNotFoundError
         If the CSV does not exist.
     """
@@ -583,9 +588,40 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
         kw = {name: (arrays[name][idx] if name in arrays else None) for name in _ARRAYS}
         try:
             runs.append(MeasuredRun(meta=meta, label=str(label), dt_rtol=dt_rtol, **kw))
+            check_recorded(runs[-1])
         except InputError as err:
             raise InputError(f"{csv_path}: {err.field}", err.value, err.allowed) from None
     return MeasuredData(runs=tuple(runs), meta=meta)
+
+
+def check_recorded(run):
+    """Raise :class:`InputError` where a measured run contradicts its metadata or cannot be diagnosed.
+
+    * A position that a counting sensor recorded moves by whole counts: when more than 2 % of the non-zero
+      steps of ``x_motor`` (``x_table``) are shorter than half the declared ``sensors.encoder_resolution``
+      (``scale_resolution``), the resolution is in the wrong unit (a micrometre count given in millimetres),
+      or not the one the positions were recorded at; the replay would count with it.
+    * A drive command ``u`` that is zero throughout gives the fit nothing to match.
+
+    Only measured files are checked: simulated positions (replays, instruments) are not counted.
+    """
+    sensors = run.meta.sensors
+    for column, field_name in (("x_motor", "encoder_resolution"), ("x_table", "scale_resolution")):
+        a, res = getattr(run, column), getattr(sensors, field_name)
+        if a is None or res <= 0.0:
+            continue
+        steps = np.abs(np.diff(a))
+        steps = steps[steps > max(1e-6 * res, 64 * np.finfo(float).eps * float(np.max(np.abs(a))))]  # not rounding
+        if steps.size < 20:
+            continue
+        share = float(np.mean(steps < 0.5 * res))
+        if share > _SUBCOUNT_SHARE:
+            raise InputError(f"sensors.{field_name} (run {run.label})", res,
+                             f"a count no longer than the steps {column} makes ({share:.0%} of its non-zero steps "
+                             f"are below half of {res:g} m, the shortest {steps.min():.3g} m): the resolution in m "
+                             "at the load that the positions were recorded at, or 0 for none")
+    if not np.any(run.u):
+        raise InputError(f"u (run {run.label})", "zero throughout", "the drive command the controller gave")
 
 
 def save_measured(data, csv_path, meta_path=None):

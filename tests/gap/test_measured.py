@@ -128,6 +128,33 @@ def test_positions_in_the_wrong_unit_are_refused_by_their_speed(tmp_path):
         load_measured(_write(tmp_path, {**cols, "x_motor": fast}, name="fast.csv"))
 
 
+def test_a_resolution_the_recorded_positions_contradict_is_refused(tmp_path):
+    """A counting sensor moves by whole counts: a count given in the wrong unit shows as shorter steps."""
+    n, dt, count = 2000, 1e-3, 5e-8
+    t = np.arange(n) * dt
+    x = 0.01 * (1 - np.cos(np.pi * t))  # 0 .. 31 mm/s, slow at both ends
+    counted = np.round(x / count) * count
+    cols = {"t": t, "x_ref": x, "x_motor": counted, "x_table": counted, "u": np.sin(t)}
+    meta = {**META, "sensors": {"encoder_resolution": count, "scale_resolution": count}}
+    assert load_measured(_write(tmp_path, cols, meta=meta)).run().n == n
+    for field in ("encoder_resolution", "scale_resolution"):  # 50 um: the count in mm written as m
+        wrong = {**META, "sensors": {**meta["sensors"], field: 1e3 * count}}
+        with pytest.raises(InputError) as err:
+            load_measured(_write(tmp_path, cols, meta=wrong, name=f"{field}.csv"))
+        assert err.value.field.endswith(f"sensors.{field} (run {field})") and err.value.value == 1e3 * count
+        assert ("x_motor" if field == "encoder_resolution" else "x_table") in err.value.allowed
+    # an unquantized (simulated) position is not checked against a count of 0
+    ideal = {**META, "sensors": {"encoder_resolution": 0.0}}
+    assert load_measured(_write(tmp_path, {**cols, "x_motor": x}, meta=ideal, name="ideal.csv")).run().n == n
+
+
+def test_a_drive_command_that_is_zero_throughout_is_refused(tmp_path):
+    cols = _rows()
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, {**cols, "u": 0 * cols["t"]}))
+    assert err.value.field.endswith("u (run run)") and err.value.value == "zero throughout"
+
+
 def test_not_a_number(tmp_path):
     cols = {k: list(v) for k, v in _rows().items()}
     cols["u"][2] = "abc"
