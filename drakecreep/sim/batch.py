@@ -26,7 +26,7 @@ from drakecreep.model.nut_friction import nut_friction_levels
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
-from drakecreep.sim.simulation import make_simulator, target_accuracy
+from drakecreep.sim.simulation import check_log_period, make_simulator, target_accuracy
 
 __all__ = ["BatchedFeedDrive", "batch_key", "simulate_batch"]
 
@@ -258,6 +258,7 @@ def simulate_batch(cases):
     sim = params.simulation
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
+    check_log_period(sim.log_period, scenario.duration, sim.steady_start)
     models = [BaselineModel(p, s) for p, s in cases]
     builder = DiagramBuilder()
     plant = builder.AddSystem(BatchedFeedDrive(models))

@@ -49,7 +49,7 @@ from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "target_accuracy", "FIXED_STEP",
-           "ACCURACY_BY_LAW", "MAX_SAMPLES", "MODELS",
+           "ACCURACY_BY_LAW", "MAX_SAMPLES", "MIN_WINDOW_SAMPLES", "MODELS",
            "MAX_TABLE_SPEED", "MIN_STEP"]
 
 #: integrators without error control: they step at ``max_step``
@@ -57,6 +57,9 @@ FIXED_STEP = ("runge_kutta2",)
 #: most recorded samples of one run: 2e6 samples of the ~20 signals are ~0.3 GB in memory and a 0.5 GB CSV;
 #: a finer log (``log_period: 1e-8`` over seconds) would take minutes and gigabytes and show nothing more
 MAX_SAMPLES = 2_000_000
+#: Fewest recorded samples in the metrics window: the creep metrics difference the logged speed and count its
+#: stick-slip cycles; with fewer the result had no metrics at all, reported as a run that went well
+MIN_WINDOW_SAMPLES = 20
 #: divergence guard: largest table speed (m/s). Feed drives of this class traverse at 0.5-1 m/s
 #: (:data:`drakecreep.scenario.MAX_FEED`); a table ten times faster has left the physics of a feed drive
 #: (an unstable loop, a raised torque limit) and its results mean nothing
@@ -192,12 +195,18 @@ class SimulationResult:
         return paths
 
 
-def check_log_period(log_period, duration):
-    """Refuse a log period that records more than :data:`MAX_SAMPLES` samples over ``duration``."""
+def check_log_period(log_period, duration, steady_start=None):
+    """Refuse a log period that records more than :data:`MAX_SAMPLES` samples over ``duration``, or (with
+    ``steady_start``) fewer than :data:`MIN_WINDOW_SAMPLES` in the metrics window ``[steady_start, duration]``."""
     if duration / log_period > MAX_SAMPLES:
         raise InputError("simulation.log_period", log_period,
                          f">= {duration / MAX_SAMPLES:.3g} s for a {duration:g} s run (at most {MAX_SAMPLES} "
                          "recorded samples per run)")
+    if steady_start is not None and (duration - steady_start) / log_period < MIN_WINDOW_SAMPLES:
+        raise InputError("simulation.log_period", log_period,
+                         f"<= {(duration - steady_start) / MIN_WINDOW_SAMPLES:.3g} s: at least {MIN_WINDOW_SAMPLES} "
+                         f"recorded samples in the metrics window ({steady_start:g}-{duration:g} s; a longer "
+                         "duration or an earlier simulation.steady_start widens it)")
 
 
 def _unit_tag(unit):
@@ -312,7 +321,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
                          "a whole number of samples with simulation.backend: compiled (fractional: backend leaf)")
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
-    check_log_period(sim.log_period, scenario.duration)
+    check_log_period(sim.log_period, scenario.duration, sim.steady_start)
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))

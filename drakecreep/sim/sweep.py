@@ -235,6 +235,9 @@ def make_cases(base, points, scenario=None, metric=None):
         scen = scenario_with_drive(**fields)
         if params.simulation.steady_start >= scen.duration:
             raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
+        from drakecreep.sim.simulation import check_log_period  # pydrake, as simulate below: not at import
+
+        check_log_period(params.simulation.log_period, scen.duration, params.simulation.steady_start)
         params.load_case(scen.load_case)  # validates the load case number
         cases.append(Case(index=index, point=dict(point), params=params, scenario=scen,
                           key=case_key(params, scen, name)))

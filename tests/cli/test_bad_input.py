@@ -76,6 +76,8 @@ PARAM_TEXTS = {
     "tab_indent": ("table:\n\tmass: 3\n", "invalid YAML"),
     "deep_nesting": ("a: " + "[" * 5000 + "]" * 5000 + "\n", "nested"),
     "log_period_tiny": ("simulation: {log_period: 1.0e-8}\n", "simulation.log_period"),
+    # 19 samples in the 19 s metrics window: the run used to end "ok" with no metrics at all
+    "log_period_coarse": ("simulation: {log_period: 1.0}\n", "at least 20 recorded samples in the metrics window"),
     "seed_like_bool": ("controller: {anti_windup: 3}\n", "anti_windup"),
     "binary_nul": ("table:\x00\x01\x02 {mass: 3}\n", "UTF-8"),
 }
@@ -87,7 +89,7 @@ def test_bad_parameter_files(name, tmp_path, capsys):
     path = tmp_path / f"{name}.yaml"
     path.write_text(text)
     argv = ["simulate", "--params", str(path), "--duration", "20", "--out", str(tmp_path / "out")]
-    if name == "log_period_tiny":
+    if name.startswith("log_period"):
         argv += ["--load-case", "0"]
     code, _, err = _run(argv, capsys)
     _one_line_exit_2(code, err, fragment)
