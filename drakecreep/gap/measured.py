@@ -599,8 +599,8 @@ def check_recorded(run):
 
     * A position that a counting sensor recorded moves by whole counts: when more than 2 % of the non-zero
       steps of ``x_motor`` (``x_table``) are shorter than half the declared ``sensors.encoder_resolution``
-      (``scale_resolution``), the resolution is in the wrong unit (a micrometre count given in millimetres),
-      or not the one the positions were recorded at; the replay would count with it.
+      (``scale_resolution``), the resolution is in the wrong unit (5e-5 for a 50 nm count: millimetres written
+      as metres), or not the one the positions were recorded at; the replay would count with it.
     * A drive command ``u`` that is zero throughout gives the fit nothing to match.
 
     Only measured files are checked: simulated positions (replays, instruments) are not counted.
@@ -611,15 +611,15 @@ def check_recorded(run):
         if a is None or res <= 0.0:
             continue
         steps = np.abs(np.diff(a))
-        steps = steps[steps > max(1e-6 * res, 64 * np.finfo(float).eps * float(np.max(np.abs(a))))]  # not rounding
+        steps = steps[steps > max(1e-12, 64 * np.finfo(float).eps * float(np.max(np.abs(a))))]  # not rounding
         if steps.size < 20:
             continue
         share = float(np.mean(steps < 0.5 * res))
         if share > _SUBCOUNT_SHARE:
             raise InputError(f"sensors.{field_name} (run {run.label})", res,
-                             f"a count no longer than the steps {column} makes ({share:.0%} of its non-zero steps "
-                             f"are below half of {res:g} m, the shortest {steps.min():.3g} m): the resolution in m "
-                             "at the load that the positions were recorded at, or 0 for none")
+                             f"the count {column} was recorded with, in m at the load, or 0 for none: "
+                             f"{share:.0%} of its non-zero steps are shorter than half of {res:g} m (the shortest "
+                             f"{steps.min():.3g} m), so it moves by less than a count (a unit error?)")
     if not np.any(run.u):
         raise InputError(f"u (run {run.label})", "zero throughout", "the drive command the controller gave")
 
