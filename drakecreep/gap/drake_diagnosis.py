@@ -239,6 +239,12 @@ class RankedEffect:
     outranked_by: str = ""
 
     @property
+    def outranked_note(self):
+        """Why a passing candidate is not claimed (``outranked_by``), for the text and the progress lines."""
+        return (f"passes, not claimed: {self.outranked_by} explains more of the held-out error but is not confirmed"
+                if self.outranked_by else "")
+
+    @property
     def error_ratio(self):
         """Geometric mean over the held-out runs of the candidate's force error over the reference's."""
         return math.exp(-self.log_ratio)
@@ -336,8 +342,7 @@ class DrakeDiagnosis:
                 note += " (fitted from its own inverse-dynamics friction: it replays the training runs better than "\
                         + ("the nominal's shifted)" if r._first_start == "shifted_nominal" else "the nominal's)")
             if r.outranked_by:
-                note += f" (passes, not claimed: {r.outranked_by} explains more of the held-out error but is not " \
-                        "confirmed)"
+                note += f" ({r.outranked_note})"
             lines.append(f"  {r.name:20s} held-out {r.fit.test_force_error:.3f} %{note}, "
                          + _verdict(r)
                          + (" [against its own reference: the nominal with " + ", ".join(
@@ -815,8 +820,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             on_ranking(nominal, nom_test, tuple(ranking))
         for r in ranking:
             if r.outranked_by:
-                say(f"{r.name}: passes, not claimed: {r.outranked_by} explains more of the held-out error "
-                    "but is not confirmed")
+                say(f"{r.name}: {r.outranked_note}")
         claimed, current, current_test = [], nominal, nom_test
         fitted = list(nominal.fitted)
         model = {"parameters": dict(nominal.parameters), "flexible": False, "delay": nominal.delay}

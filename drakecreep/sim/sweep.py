@@ -216,6 +216,8 @@ def make_cases(base, points, scenario=None, metric=None):
     InputError
         Naming the path and value of the first invalid point.
     """
+    from drakecreep.sim.simulation import check_log_period  # pydrake, as simulate below: not at import
+
     metric = metric or feed_report
     defaults = dataclasses.asdict(scenario) if isinstance(scenario, Scenario) else dict(scenario or {})
     unknown = set(defaults) - set(SCENARIO_FIELDS)
@@ -235,8 +237,6 @@ def make_cases(base, points, scenario=None, metric=None):
         scen = scenario_with_drive(**fields)
         if params.simulation.steady_start >= scen.duration:
             raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
-        from drakecreep.sim.simulation import check_log_period  # pydrake, as simulate below: not at import
-
         check_log_period(params.simulation.log_period, scen.duration, params.simulation.steady_start)
         params.load_case(scen.load_case)  # validates the load case number
         cases.append(Case(index=index, point=dict(point), params=params, scenario=scen,
