@@ -66,10 +66,16 @@ class _Formatter(argparse.HelpFormatter):
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit code 2; help without reStructuredText markup."""
+    """ArgumentParser whose errors are one line and exit code 2; help without reStructuredText markup.
+
+    Options are spelled out: an abbreviation is an error, not a guess (``--n 0`` would otherwise be read as
+    ``--no-progress`` followed by a stray ``0``, and a new option could silently change what an old
+    abbreviation means).
+    """
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", _Formatter)
+        kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
 
     def error(self, message):

@@ -39,6 +39,9 @@ def test_simulate_text(tmp_path, capsys):
     # an option of no command: the command's own parser names itself and where its options are listed
     (["margins", "--speed", "abc"], "drakecreep margins: error: unrecognized arguments: --speed abc "
                                     "(drakecreep margins --help lists the options)"),
+    # an abbreviation is refused, not guessed (--dur would be --duration, --n would be --no-progress)
+    (["simulate", "--dur", "1"], "unrecognized arguments: --dur 1"),
+    (["uncertainty", "--n", "0"], "unrecognized arguments: --n 0"),
 ])
 def test_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
     try:
