@@ -139,6 +139,13 @@ def main(argv=None):
     """Entry point of the ``drakecreep`` console script."""
     os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
+    given = sys.argv[1:] if argv is None else list(argv)
+    if not any(token in parser.commands for token in given):  # no command: name an unknown option first
+        unknown = [token for token in given if token.startswith("-") and token.split("=")[0] not in
+                   parser._option_string_actions and not re.fullmatch(r"-[qv]+", token)]
+        if unknown:
+            parser.error(f"unrecognized arguments: {' '.join(unknown)} (drakecreep --help lists the commands "
+                         "and the options)")
     args, extra = parser.parse_known_args(argv)
     if extra:  # the command's own parser says it, with its name and where its options are listed
         parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)} "

@@ -42,6 +42,9 @@ def test_simulate_text(tmp_path, capsys):
     # an abbreviation is refused, not guessed (--dur would be --duration, --n would be --no-progress)
     (["simulate", "--dur", "1"], "unrecognized arguments: --dur 1"),
     (["uncertainty", "--n", "0"], "unrecognized arguments: --n 0"),
+    # no command: an unknown option is named before the missing command
+    (["--vers"], "drakecreep: error: unrecognized arguments: --vers"),
+    (["-vv"], "the following arguments are required: COMMAND"),
 ])
 def test_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
     try:
