@@ -254,7 +254,8 @@ class _Problem:
         typical = {"friction_drift": 1e-2, "friction_ripple_cos": 0.3, "friction_ripple_sin": 0.3,
                    **{n: 0.1 for n in FRICTION_MAP},
                    "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
-                   "position_ripple_sin": force, "time_ripple_cos": force, "time_ripple_sin": force,
+                   "position_ripple_sin": force, "position_ripple_2_cos": force, "position_ripple_2_sin": force,
+                   "time_ripple_cos": force, "time_ripple_sin": force,
                    "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2,
                    # parameters whose start may be ~0 (the screen's answer on data without the effect): a scale of
                    # the start's size makes every finite-difference step invisible (a 400 N drive limit; a load

@@ -48,8 +48,8 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
-from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, LEAD_ERROR, applied_force, axis_friction,
-                                   axis_parameters, axis_ripple, lead_error_force, nut_load)
+from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE, applied_force,
+                                   axis_friction, axis_parameters, axis_ripple, lead_error_force, nut_load)
 
 __all__ = ["ScreenResult", "Constancy", "constancy", "screen_effect", "screen_delay", "inverse_dynamics_force",
            "NOT_SCREENED", "LINEAR", "SHAPE", "SLOW_SHARE", "MIN_SLIDING"]
@@ -190,7 +190,7 @@ def _rms(a):
 #: linear least squares inside the fit: variable projection)
 LINEAR = ("viscous", "viscous_asym", "coulomb", "coulomb_asym", "offset", "load_friction_coefficient",
           "stribeck_extra",
-          "position_ripple_cos", "position_ripple_sin", "time_ripple_cos", "time_ripple_sin") + LEAD_ERROR
+          "time_ripple_cos", "time_ripple_sin") + POSITION_RIPPLE + LEAD_ERROR
 
 
 #: relative singular-value cut of the linear least squares of :func:`_project` (unit-norm columns)

@@ -70,7 +70,8 @@ from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
            "set_axis_parameters", "axis_friction", "applied_force", "nut_load", "friction_map", "FRICTION_MAP",
-           "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force"]
+           "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "POSITION_RIPPLE",
+           "axis_ripple"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -89,6 +90,8 @@ AXIS_PARAMETERS = {
     "damping": 0.0,
     "position_ripple_cos": 0.0,
     "position_ripple_sin": 0.0,
+    "position_ripple_2_cos": 0.0,
+    "position_ripple_2_sin": 0.0,
     "position_period": 2.5e-3,
     "friction_ripple_cos": 0.0,
     "friction_ripple_sin": 0.0,
@@ -118,7 +121,8 @@ AXIS_UNITS = {
     "load_friction_coefficient": "-",
     "stribeck_extra": "N", "stribeck_velocity": "m/s", "regularization_velocity": "m/s",
     "motor_mass_fraction": "-", "stiffness": "N/m", "damping": "N s/m",
-    "position_ripple_cos": "N", "position_ripple_sin": "N", "position_period": "m",
+    "position_ripple_cos": "N", "position_ripple_sin": "N", "position_ripple_2_cos": "N", "position_ripple_2_sin": "N",
+    "position_period": "m",
     "friction_ripple_cos": "-", "friction_ripple_sin": "-", "friction_period": "m",
     "friction_map_0": "-", "friction_map_1": "-", "friction_map_2": "-", "friction_map_3": "-",
     "friction_map_start": "m", "friction_map_end": "m",
@@ -331,14 +335,22 @@ def lead_error_force(x, v, p):
     return -(1.0 - P["motor_mass_fraction"]) * P["mass"] * e2 * v * v
 
 
+#: the position ripple's harmonic amplitudes [N]: ``(cos, sin)`` of its first and second harmonic (a cogging's
+#: force has harmonics of its fundamental; so has a bearing's)
+POSITION_RIPPLE = ("position_ripple_cos", "position_ripple_sin", "position_ripple_2_cos", "position_ripple_2_sin")
+
+
 def axis_ripple(x, t, p):
-    """Position-periodic (cogging, a bearing) plus time-periodic ripple force [N] along +x (a lead error's force
-    is :func:`lead_error_force`)."""
+    """Position-periodic (cogging, a bearing: first and second harmonic of ``position_period``) plus time-periodic
+    ripple force [N] along +x (a lead error's force is :func:`lead_error_force`)."""
     P = dict(zip(_NAMES, p))
     a = 2.0 * math.pi * x / P["position_period"]
     b = 2.0 * math.pi * P["ripple_frequency"] * t
-    return (P["position_ripple_cos"] * cos(a) + P["position_ripple_sin"] * sin(a)
-            + P["time_ripple_cos"] * cos(b) + P["time_ripple_sin"] * sin(b))
+    force = (P["position_ripple_cos"] * cos(a) + P["position_ripple_sin"] * sin(a)
+             + P["time_ripple_cos"] * cos(b) + P["time_ripple_sin"] * sin(b))
+    if not (_off(P["position_ripple_2_cos"]) and _off(P["position_ripple_2_sin"])):
+        force = force + P["position_ripple_2_cos"] * cos(2.0 * a) + P["position_ripple_2_sin"] * sin(2.0 * a)
+    return force
 
 
 def set_axis_parameters(axis, context, **values):

@@ -39,6 +39,31 @@ def test_asymmetry_ripple_and_drift_terms():
     assert _xdot(MeasuredAxis(False), [0.0, 0.0], 0.0, t=0.025, **ripple)[1] == pytest.approx(5.0)
 
 
+def test_the_position_ripple_has_a_first_and_a_second_harmonic():
+    """``c1 cos a + s1 sin a + c2 cos 2a + s2 sin 2a`` with ``a = 2 pi x / position_period``, the same in the
+    Drake axis (float and AutoDiffXd) and in :func:`axis_ripple` on arrays of positions (the screen)."""
+    from drakecreep.model.axis import axis_ripple
+
+    values = dict(mass=2.0, position_ripple_cos=1.0, position_ripple_sin=-2.0, position_ripple_2_cos=0.5,
+                  position_ripple_2_sin=0.25, position_period=4e-3)
+    xs = np.array([0.0, 1e-3, 1.7e-3, 3e-3])
+    a = 2 * np.pi * xs / 4e-3
+    want = np.cos(a) - 2 * np.sin(a) + 0.5 * np.cos(2 * a) + 0.25 * np.sin(2 * a)
+    np.testing.assert_allclose(axis_ripple(xs, 0.0, axis_parameters(**values)), want, rtol=1e-12, atol=1e-12)
+    for x, f in zip(xs, want):
+        assert _xdot(MeasuredAxis(False), [x, 0.0], 0.0, **values)[1] == pytest.approx(f / 2.0, rel=1e-12, abs=1e-12)
+    ad = MeasuredAxis(False).ToAutoDiffXd()
+    ctx = ad.CreateDefaultContext()
+    ctx.SetContinuousState([AutoDiffXd(1.7e-3, [1.0]), AutoDiffXd(0.0, [0.0])])
+    set_axis_parameters(ad, ctx, **values)
+    ad.GetInputPort("force").FixValue(ctx, [AutoDiffXd(0.0)])
+    acc = ad.EvalTimeDerivatives(ctx).CopyToVector()[1]
+    w = 2 * np.pi / 4e-3
+    slope = w * (-np.sin(a[2]) - 2 * np.cos(a[2]) - np.sin(2 * a[2]) + 0.5 * np.cos(2 * a[2])) / 2.0
+    assert acc.value() == pytest.approx(want[2] / 2.0, rel=1e-12)
+    assert acc.derivatives()[0] == pytest.approx(slope, rel=1e-9)
+
+
 def test_the_friction_map_is_smooth_steps_over_the_travel_and_flat_beyond():
     """Four tanh steps over [start, end]: nothing happens while all amplitudes are 0, equal amplitudes make a
     ramp odd about the middle, and beyond the span the level stays at its edge value (no extrapolated trend:
