@@ -660,12 +660,14 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
             row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
             rows[case.key] = row
         elif cache_dir is not None:
-            rows[case.key] = row  # kept even if Ctrl-C lands while the cache file is written
-            write_json(cache_dir / f"{case.key}.json",
-                       dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row))
+            unwritten[case.key] = dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row)
+            rows[case.key] = row  # kept even if Ctrl-C lands while the cache file is written (then written below)
+            write_json(cache_dir / f"{case.key}.json", unwritten[case.key])
+            del unwritten[case.key]
         rows[case.key] = row
         bar.update()
 
+    unwritten = {}  # finished cases whose cache file is being written (a Ctrl-C may cut the write short)
     retried = 0
     interrupted = False
     try:
@@ -678,6 +680,8 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
                 retried = _run_dask(units, metric, retries, done, scheduler)
     except KeyboardInterrupt:
         interrupted = True
+        for key, entry in unwritten.items():  # the finished case whose cache write the Ctrl-C cut short
+            write_json(cache_dir / f"{key}.json", entry)
     finally:
         bar.close()
 

@@ -101,6 +101,34 @@ def test_cache_resume_computes_only_the_missing_cases(base, tmp_path):
     assert not list(tmp_path.glob(".*.tmp"))
 
 
+def test_a_ctrl_c_during_a_cache_write_still_caches_the_finished_case(base, tmp_path, monkeypatch):
+    """The Ctrl-C lands while a finished case's cache file is written: the case is in the table as ok, and its
+    cache file is written before the sweep stops (a rerun does not compute it again)."""
+    from drakecreep.sim import sweep
+
+    real = sweep.write_json
+    calls = []
+
+    def interrupted_once(path, payload):
+        calls.append(path)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+        return real(path, payload)
+
+    monkeypatch.setattr(sweep, "write_json", interrupted_once)
+    points = grid({"feed": [0.3e-3, 1e-3]})
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(base, points, scenario=SHORT, executor="serial", out_dir=tmp_path, progress=False)
+    import pandas as pd
+
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert list(table.status) == ["ok", "not run (interrupted)"]
+    assert len(list((tmp_path / "cache").glob("*.json"))) == 1
+    monkeypatch.setattr(sweep, "write_json", real)
+    again = run_sweep(base, points, scenario=SHORT, executor="serial", out_dir=tmp_path, progress=False)
+    assert (again.computed, again.cached) == (1, 1)
+
+
 def test_serial_and_processes_give_the_same_table(base):
     points = grid({"nut.axial_stiffness": [10e6, 50e6], "feed": [0.2e-3, 1e-3]})
     serial = run_sweep(base, points, scenario=SHORT, executor="serial", progress=False)
