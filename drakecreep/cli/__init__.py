@@ -127,7 +127,7 @@ def build_parser():
     _add_common(parser, suppress=False)
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an unexpected error")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    sub.required = True
+    sub.required = False  # main names an unknown option before the missing command
     for name in COMMANDS:
         module = importlib.import_module(f"drakecreep.cli.{name}")
         _add_common(module.add_parser(sub), suppress=True)
@@ -139,14 +139,10 @@ def main(argv=None):
     """Entry point of the ``drakecreep`` console script."""
     os.environ.setdefault("MPLBACKEND", "Agg")  # the CLI writes plots to files, never to a screen
     parser = build_parser()
-    given = sys.argv[1:] if argv is None else list(argv)
-    if not any(token in parser.commands for token in given):  # no command: name an unknown option first
-        unknown = [token for token in given if token.startswith("-") and token.split("=")[0] not in
-                   parser._option_string_actions and not re.fullmatch(r"-[qv]+", token)]
-        if unknown:
-            parser.error(f"unrecognized arguments: {' '.join(unknown)} (drakecreep --help lists the commands "
-                         "and the options)")
     args, extra = parser.parse_known_args(argv)
+    if args.command is None:  # an unknown option before no command is named first
+        parser.error(f"unrecognized arguments: {' '.join(extra)} (drakecreep --help lists the commands and the "
+                     "options)" if extra else "the following arguments are required: COMMAND")
     if extra:  # the command's own parser says it, with its name and where its options are listed
         parser.commands[args.command].error(f"unrecognized arguments: {' '.join(extra)} "
                                             f"(drakecreep {args.command} --help lists the options)")
