@@ -653,18 +653,17 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
 
     def done_case(case, row, error):
         nonlocal failed, computed
-        if row is not None:
-            computed += 1
         if row is None:
             failed += 1
-            row = dict(status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
+            rows[case.key] = dict(
+                status=f"failed: {type(error).__name__}: {str(error).splitlines()[0] if str(error) else ''}")
+        else:
+            computed += 1
             rows[case.key] = row
-        elif cache_dir is not None:
-            unwritten[case.key] = dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row)
-            rows[case.key] = row  # kept even if Ctrl-C lands while the cache file is written (then written below)
-            write_json(cache_dir / f"{case.key}.json", unwritten[case.key])
-            del unwritten[case.key]
-        rows[case.key] = row
+            if cache_dir is not None:  # held until written: the Ctrl-C handler writes it if the write is cut short
+                unwritten[case.key] = dict(key=case.key, batch=batch_of.get(case.key), point=case.point, row=row)
+                write_json(cache_dir / f"{case.key}.json", unwritten[case.key])
+                del unwritten[case.key]
         bar.update()
 
     unwritten = {}  # finished cases whose cache file is being written (a Ctrl-C may cut the write short)
