@@ -42,7 +42,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
-from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR
+from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT",
            "PRESLIDING_START", "DEFAULT_BOUNDS", "START_FLOOR_SHARE", "start_floors"]
@@ -253,9 +253,8 @@ class _Problem:
         force = max(abs(base.get("coulomb", 0.0)), 1.0)
         typical = {"friction_drift": 1e-2, "friction_ripple_cos": 0.3, "friction_ripple_sin": 0.3,
                    **{n: 0.1 for n in FRICTION_MAP},
-                   "offset": force, "coulomb_asym": force, "position_ripple_cos": force,
-                   "position_ripple_sin": force, "position_ripple_2_cos": force, "position_ripple_2_sin": force,
-                   "time_ripple_cos": force, "time_ripple_sin": force,
+                   **{n: force for n in POSITION_RIPPLE},
+                   "offset": force, "coulomb_asym": force, "time_ripple_cos": force, "time_ripple_sin": force,
                    "viscous_asym": max(abs(base.get("viscous", 0.0)), 1.0), "motor_mass_fraction": 0.2,
                    # parameters whose start may be ~0 (the screen's answer on data without the effect): a scale of
                    # the start's size makes every finite-difference step invisible (a 400 N drive limit; a load
