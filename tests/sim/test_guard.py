@@ -57,7 +57,7 @@ def test_wall_clock_limit(short_paper):
     assert r.time[-1] < 60.0
 
 
-def test_ctrl_c_keeps_what_was_computed(short_paper, tmp_path, capsys, monkeypatch):
+def test_ctrl_c_keeps_what_was_computed(short_paper, tmp_path, capsys, monkeypatch, ctrl_c_as_at_a_terminal):
     # a real SIGINT, sent from inside the run once it is under way (as a user's Ctrl-C would arrive)
     real = simulation._guard
 

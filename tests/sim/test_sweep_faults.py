@@ -57,9 +57,16 @@ def _cached(cache):
     return [p for p in cache.glob("*.json") if not p.name.startswith(".")] if cache.is_dir() else []
 
 
+def _sigint_as_at_a_terminal():
+    # a shell starts a background job (``cmd &`` without job control, ``nohup``) with SIGINT ignored, and the
+    # child would inherit that: the sweep is started as from a terminal, where Ctrl-C is delivered
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", _SCRIPT, str(tmp_path / "out")], cwd=_ROOT,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_sigint_as_at_a_terminal)
     assert proc.stdout.readline().strip() == "START"
     cache = tmp_path / "out" / "cache"
     deadline = time.time() + 120
