@@ -121,6 +121,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import dataclasses
+import functools
 import math
 import multiprocessing
 import time as _time
@@ -136,7 +137,7 @@ from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, si
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency,
                                          best_start_index, effect_regime, fit_delay, fit_effect, score_parameters)
-from drakecreep.gap.drake_replay import piece_keys, rms_force_error
+from drakecreep.gap.drake_replay import piece_keys, rms_force_error, set_replay_threads
 from drakecreep.gap.identify import identify
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
 from drakecreep.gap.where import where_gap, where_lines
@@ -671,6 +672,22 @@ def _outranked(ranking):
     return [dataclasses.replace(r, outranked_by=by[r.name]) if r.name in by else r for r in ranking]
 
 
+def _replay_threads_from_workers(diagnose):
+    """``diagnose`` with :func:`~drakecreep.gap.drake_replay.simulate_each` running as many replays at once as it
+    has ``workers`` (threads of each of its processes), and the previous number restored after it."""
+    @functools.wraps(diagnose)
+    def wrapped(*args, workers=1, **kwargs):
+        if not isinstance(workers, int) or workers < 1:
+            raise InputError("workers", workers, "an integer >= 1")
+        previous = set_replay_threads(int(workers))
+        try:
+            return diagnose(*args, workers=workers, **kwargs)
+        finally:
+            set_replay_threads(previous)
+    return wrapped
+
+
+@_replay_threads_from_workers
 def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress=None, screen=True,
                    screen_k_se=1.0, on_nominal=None, on_ranking=None, workers=1, friction="regularized"):
     """Diagnose the gap of the Drake replay model (see the module docstring).
@@ -703,8 +720,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     workers : int
         Processes for the closed-loop fits of the candidates that pass the screen (they are independent),
         and, in the greedy step, for a candidate's refit beside its equal-effort reference (one pool for
-        both; ``spawn`` processes, each imports Drake once, a few seconds). 1 fits them one after another in
-        this process. The result does not depend on it.
+        both; ``spawn`` processes, each imports Drake once, a few seconds); in each process, the threads
+        that replay the runs of one evaluation side by side (:func:`~drakecreep.gap.drake_replay.simulate_each`).
+        1 fits them one after another in this process, one run at a time. The result does not depend on it.
     friction : {"auto", "lugre", "regularized"}
         Friction law of the nominal model (:data:`NOMINAL_FRICTION`); ``auto`` identifies both and keeps the
         one with the lower training cost. The default stays ``regularized``: the LuGre replay needs 2-5 sub-steps
@@ -769,7 +787,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start
         # on the first submissions); a single candidate is fitted here, without the processes' start-up
         pool = None if workers == 1 or len(names) < 2 else stack.enter_context(cf.ProcessPoolExecutor(
-            min(workers, len(names)), mp_context=multiprocessing.get_context("spawn")))
+            min(workers, len(names)), mp_context=multiprocessing.get_context("spawn"),
+            initializer=set_replay_threads, initargs=(workers,)))
         fits_, own = {}, {}
         # the training-run null (training_run_null), beside the candidates' fits when there is a pool
         null = _submit(pool, training_run_null, test, nominal, nom_test)

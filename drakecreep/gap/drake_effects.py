@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import drake_replay_errors, make_replay, mode_band, rms_force_error
+from drakecreep.gap.drake_replay import drake_replay_errors, make_replay, mode_band, rms_force_error, simulate_each
 from drakecreep.gap.identify import identify
 from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
@@ -266,9 +266,9 @@ def score_parameters(runs, parameters, *, flexible=False, delay=0.0, replays=Non
     """Replay ``runs`` with FIXED parameters: ``({label: errors}, rms force error [%])`` (no fitting)."""
     replays = replays or [make_replay(r, flexible=flexible, delay=delay, free=()) for r in runs]
     errors = {}
-    for i, rep in enumerate(replays):
+    for i, (rep, res) in enumerate(zip(replays, simulate_each(replays, parameters))):
         label = rep.run.label if rep.run.label not in errors else f"{rep.run.label}#{i}"
-        errors[label] = drake_replay_errors(rep.simulate(parameters))
+        errors[label] = drake_replay_errors(res)
     return errors, rms_force_error(errors)
 
 

@@ -40,7 +40,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from drakecreep.errors import InputError
-from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay
+from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay, simulate_each
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
@@ -295,7 +295,7 @@ class _Problem:
     def simulate(self, values):
         start = _time.perf_counter()
         if all(math.isfinite(v) for v in values.values()):
-            results = [rep.simulate(values) for rep in self.replays]
+            results = simulate_each(self.replays, values)
         else:  # a log-scaled step past exp's range (inf): a replay that cannot be run is a diverged one
             results = [diverged_result(rep.run, values) for rep in self.replays]
         self.evaluations += 1
@@ -413,7 +413,7 @@ def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False
         free = uncertain + (("mass",) if "mass" in iv and "mass" not in uncertain else ())
         replays = [make_replay(r, flexible=flexible, delay=delay, quantize=quantize, free=free) for r in runs]
     if iv:
-        sims = [rep.simulate(base) for rep in replays]
+        sims = simulate_each(replays, base)
         xs = [res.x_motor for res in sims]
         if all(np.all(np.isfinite(x)) for x in xs):
             iv_start = idim_start(runs, instruments=xs, **preprocess)

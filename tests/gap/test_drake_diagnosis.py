@@ -10,7 +10,7 @@ import pytest
 from drakecreep.errors import InputError
 import drakecreep.gap.drake_diagnosis as D
 from drakecreep.gap.drake_diagnosis import DrakeDiagnosis, diagnose_drake, load_model
-from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
+from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim, set_replay_threads
 from drakecreep.gap.idim import PUBLISHED_IDIM
 from drakecreep.gap.measured import load_emps
 
@@ -61,7 +61,12 @@ def test_candidates_fitted_in_worker_processes_give_the_same_diagnosis():
     # (the delay has no screen: it goes to the pool first)
     kwargs = dict(effects=("asymmetric_friction", "time_ripple", "control_delay"), max_nfev=3)
     serial = diagnose_drake(runs[:2], runs[2:], **kwargs)
-    pooled = diagnose_drake(runs[:2], runs[2:], workers=2, **kwargs)
+    previous = set_replay_threads(3)
+    try:
+        pooled = diagnose_drake(runs[:2], runs[2:], workers=2, **kwargs)  # two threads in each process
+        assert set_replay_threads(3) == 3  # restored after the run
+    finally:
+        set_replay_threads(previous)
     assert serial.claimed == ("time_ripple", "asymmetric_friction")  # the greedy step's refit ran
     assert [r.name for r in pooled.ranking] == [r.name for r in serial.ranking]
     assert [r.gain for r in pooled.ranking] == pytest.approx([r.gain for r in serial.ranking], rel=1e-9, abs=1e-12)

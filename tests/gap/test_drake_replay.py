@@ -301,6 +301,32 @@ def test_sampled_replay_rebuilds_for_new_fixed_values_and_finer_steps(run):
         SampledReplay(run, free=("no_such",))
 
 
+def test_replays_side_by_side_in_threads_are_the_serial_ones_in_order(run):
+    """simulate_each in two threads: each run's result is bit for bit its serial one, in the order given, for the
+    sampled replay and for the leaf path (whose Python controller takes the GIL back inside AdvanceTo). The threaded
+    call is each replay's second simulation: the error-controlled one starts from a fresh integrator every time
+    (one that kept its last step-size guess moved the motor by 1e-13 m)."""
+    from drakecreep.gap.drake_replay import SampledReplay, set_replay_threads, simulate_each
+
+    p = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3)
+    runs = [run.slice(0, 500), run.slice(500, 1100), run.slice(1100, 1500)]
+    for make in (lambda r: SampledReplay(r, free=("coulomb",)), lambda r: DrakeReplay(r, compiled=False)):
+        replays = [make(r) for r in runs]
+        previous = set_replay_threads(1)
+        try:
+            serial = simulate_each(replays, p)
+            set_replay_threads(2)
+            threaded = simulate_each(replays, p)
+        finally:
+            set_replay_threads(previous)
+        assert all(res.run is r for res, r in zip(threaded, runs)) and len(threaded) == len(runs)
+        for a, b in zip(serial, threaded):
+            assert np.array_equal(a.x_motor, b.x_motor) and np.array_equal(a.force, b.force)
+    for bad in (0, -1, 1.5, True, "2"):
+        with pytest.raises(InputError, match="replay threads"):
+            set_replay_threads(bad)
+
+
 def test_a_replay_that_needs_more_than_max_substeps_is_returned_diverged_at_once(run):
     """A least-squares step to an astronomically stiff bristle asks for more ticks
     per sample than any axis needs: the replay returns all-NaN samples at once instead of hanging (held-out run
