@@ -56,9 +56,9 @@ def add_parser(subparsers):
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
                    "report --params, diagnosis.json, summary.txt)")
     p.add_argument("--workers", type=workers, metavar="N", default=os.cpu_count() or 1,
-                   help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits; drakecreep: "
-                        f"the runs and Jacobian columns; default: all cores, {os.cpu_count()}; 1: all in this "
-                        "process)")
+                   help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits, and as many "
+                        f"threads in each for the runs of one evaluation; drakecreep: the runs and Jacobian columns; "
+                        f"default: all cores, {os.cpu_count()}; 1: all in this process, one at a time)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p
