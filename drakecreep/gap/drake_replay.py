@@ -659,7 +659,7 @@ def simulate_each(replays, parameters):
     """
     replays = list(replays)
     threads = min(_REPLAY_THREADS, len(replays))
-    if threads < 2:
+    if threads < 2 or len({id(rep) for rep in replays}) < len(replays):  # one replay twice: not at once
         return [rep.simulate(parameters) for rep in replays]
     with cf.ThreadPoolExecutor(threads) as pool:
         return list(pool.map(lambda rep: rep.simulate(parameters), replays))

@@ -322,6 +322,12 @@ def test_replays_side_by_side_in_threads_are_the_serial_ones_in_order(run):
         assert all(res.run is r for res, r in zip(threaded, runs)) and len(threaded) == len(runs)
         for a, b in zip(serial, threaded):
             assert np.array_equal(a.x_motor, b.x_motor) and np.array_equal(a.force, b.force)
+        previous = set_replay_threads(2)
+        try:  # the same replay twice runs one after the other (one context cannot simulate twice at once)
+            twice = simulate_each([replays[0], replays[0]], p)
+        finally:
+            set_replay_threads(previous)
+        assert all(np.array_equal(res.x_motor, serial[0].x_motor) for res in twice)
     for bad in (0, -1, 1.5, True, "2"):
         with pytest.raises(InputError, match="replay threads"):
             set_replay_threads(bad)
