@@ -741,8 +741,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         if n != "control_delay" and n not in DRAKE_EFFECTS:
             why = NOT_RANKED.get(n, "one of " + ", ".join(tuple(DRAKE_EFFECTS) + ("control_delay",)))
             raise InputError("effects", n, why)
-    if not isinstance(workers, int) or workers < 1:
-        raise InputError("workers", workers, "an integer >= 1")
+    # (``workers`` is checked by _replay_threads_from_workers, before this body runs)
     if friction != "auto" and friction not in NOMINAL_FRICTION:
         raise InputError("friction", friction, "one of auto, " + ", ".join(NOMINAL_FRICTION))
     say = progress or (lambda line: None)
