@@ -618,6 +618,9 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                     r, res, f"force_{r.regime}")}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction, training_run_null=[float(v) for v in res.null],
+               # the signed moves (plain, level) the null is the largest size of, one per left-out training run:
+               # another statistic of them can be counted on the rows
+               training_run_moves=[[float(v) for v in m] for m in res.null_moves],
                test_force_nominal=rms_force_error(res.nominal_test_errors),
                test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
                claimed_model={"parameters": {k: float(v) for k, v in res.model["parameters"].items()},

@@ -145,7 +145,8 @@ from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 from drakecreep.params import MEASURED_AXIS_KIND
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
-           "paired_log_ratio", "run_log_ratios", "training_run_null", "load_model", "outranking",
+           "paired_log_ratio", "run_log_ratios", "training_run_null", "training_run_moves", "null_of_moves",
+           "load_model", "outranking",
            "NOMINAL_PARAMETERS", "NOMINAL_FRICTION", "CLAIM_RULE"]
 
 NOMINAL_PARAMETERS = ("viscous", "coulomb", "offset")
@@ -303,6 +304,9 @@ class DrakeDiagnosis:
         (:func:`drakecreep.gap.where.where_gap`): regimes, frequency bands, residual-input independence, screw side.
     null : tuple of float
         The training-run null ``(plain, level)`` every claimed log error ratio exceeds (:func:`training_run_null`).
+    null_moves : tuple
+        The signed moves ``(plain, level)`` of the nominal's held-out log error with each training run left out,
+        in training-run order (:func:`training_run_moves`); the null is the largest of their sizes.
     """
 
     nominal: object
@@ -317,6 +321,7 @@ class DrakeDiagnosis:
     where: dict = field(default_factory=dict)
     friction: str = "regularized"
     null: tuple = (0.0, 0.0)
+    null_moves: tuple = ()
 
     def summary(self):
         """Lines of text."""
@@ -458,6 +463,16 @@ def _with_values(model, values):
     return dataclasses.replace(model, parameters=dict(model.parameters, **values))
 
 
+class _Derived:
+    """``fn`` of a future's result, on demand (the future's ``result()`` shape)."""
+
+    def __init__(self, future, fn):
+        self._future, self._fn = future, fn
+
+    def result(self):
+        return self._fn(self._future.result())
+
+
 def _submit(pool, fn, *args):
     """``fn(*args)`` on ``pool``, or here and now without one (a done future either way)."""
     if pool is not None:
@@ -579,21 +594,38 @@ def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime="", fa
                      alone and regime_ok, **piece)
 
 
+def training_run_moves(test, nominal, nominal_test_errors):
+    """How the nominal's held-out log error moves with each training run left out: one ``(plain, level)`` per run.
+
+    The nominal's values with training run ``k`` left out (:attr:`drakecreep.gap.identify.Identified.jackknife`,
+    one Gauss-Newton step each, no refit) replay the held-out runs; its move is the signed
+    ``mean over held-out runs of ln(e_k / e)`` on the plain force error and with each run's own friction level
+    (NaN where a held-out run lacks that error). Empty with one training run (no jackknife).
+    :func:`training_run_null` is the largest of their sizes; the moves themselves are kept
+    (:attr:`DrakeDiagnosis.null_moves`) so that another statistic of them can be counted on the benchmark rows.
+    Module level, for a process pool."""
+    moved = [score_parameters(test, dict(nominal.parameters, **values), flexible=nominal.flexible,
+                              delay=nominal.delay)[0] for values in nominal.jackknife]
+    has = {key: all(key in e for e in nominal_test_errors.values()) for key in ("force", "force_level")}
+    return tuple(tuple(float(paired_log_ratio(nominal_test_errors, e, key)[0]) if has[key] else float("nan")
+                       for key in ("force", "force_level")) for e in moved)
+
+
+def null_of_moves(moves):
+    """The training-run null ``(plain, level)`` of :func:`training_run_moves`: the largest ``|move|`` of each,
+    ``0.0`` without moves or without that error."""
+    return tuple(float(max((abs(m[i]) for m in moves if not math.isnan(m[i])), default=0.0)) for i in (0, 1))
+
+
 def training_run_null(test, nominal, nominal_test_errors):
     """How far the nominal's held-out log error moves with the training runs alone: ``(plain, level)``.
 
-    The nominal's values with each training run left out (:attr:`drakecreep.gap.identify.Identified.jackknife`,
-    one Gauss-Newton step each, no refit) replay the held-out runs; the null is the largest
-    ``|mean over held-out runs of ln(e_k / e)|`` over the left-out runs ``k``, on the plain force error and with
-    each run's own friction level. A candidate must shrink the held-out error by more than that (module
-    docstring, 3), as the ``drakecreep`` kind's diagnosis asks of its candidates
-    (:mod:`drakecreep.gap.drive_fit`). ``(0, 0)`` with one training run (no jackknife). Module level, for a
-    process pool."""
-    moved = [score_parameters(test, dict(nominal.parameters, **values), flexible=nominal.flexible,
-                              delay=nominal.delay)[0] for values in nominal.jackknife]
-    has = {key: bool(moved) and all(key in e for e in nominal_test_errors.values()) for key in ("force", "force_level")}
-    return tuple(float(max(abs(paired_log_ratio(nominal_test_errors, e, key)[0]) for e in moved)) if has[key] else 0.0
-                 for key in ("force", "force_level"))
+    The largest ``|mean over held-out runs of ln(e_k / e)|`` over the left-out training runs ``k``
+    (:func:`training_run_moves`), on the plain force error and with each run's own friction level. A candidate
+    must shrink the held-out error by more than that (module docstring, 3), as the ``drakecreep`` kind's
+    diagnosis asks of its candidates (:mod:`drakecreep.gap.drive_fit`). ``(0, 0)`` with one training run (no
+    jackknife). Module level, for a process pool."""
+    return null_of_moves(training_run_moves(test, nominal, nominal_test_errors))
 
 
 def _rule(name):
@@ -790,7 +822,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             initializer=set_replay_threads, initargs=(workers,)))
         fits_, own = {}, {}
         # the training-run null (training_run_null), beside the candidates' fits when there is a pool
-        null = _submit(pool, training_run_null, test, nominal, nom_test)
+        moves = _submit(pool, training_run_moves, test, nominal, nom_test)
+        null = _Derived(moves, null_of_moves)
 
         def launch(n, sc, start):
             # a candidate goes to the pool as soon as its screen passes: the closed-loop fits run while the
@@ -875,4 +908,4 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])
     return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
                           model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se,
-                          where=where, friction=friction, null=null.result())
+                          where=where, friction=friction, null=null.result(), null_moves=moves.result())

@@ -104,7 +104,9 @@ def drake_to_json_dict(diagnosis, **extra):
         "not_ranked": diagnosis.not_ranked,
         "unexplained": diagnosis.where,
         "k_se": diagnosis.k_se,
-        "training_run_null": {"log_error_ratio": diagnosis.null[0], "level_log_error_ratio": diagnosis.null[1]},
+        "training_run_null": {"log_error_ratio": diagnosis.null[0], "level_log_error_ratio": diagnosis.null[1],
+                              # each left-out training run's signed move (plain, level), the null their largest size
+                              "moves": [list(m) for m in diagnosis.null_moves]},
         "seconds": diagnosis.seconds,
         "summary": diagnosis.summary(),
     }))

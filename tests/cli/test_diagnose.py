@@ -42,6 +42,8 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     data = json.loads(captured.out)
     assert data["claimed"] == ["asymmetric_friction"]
     assert "volatile bar" not in " ".join(data["summary"])  # three training runs: no warning on the null
+    null = data["training_run_null"]  # with each left-out training run's signed move, the null their largest size
+    assert len(null["moves"]) == 3 and null["log_error_ratio"] == pytest.approx(max(abs(m[0]) for m in null["moves"]))
     assert data["train_runs"] == ["w0", "w1", "w2"] and data["test_runs"] == ["w3", "w4", "w5"]
     assert [r["effect"] for r in data["ranking"]][0] == "asymmetric_friction"
     assert data["held_out_force_error_percent"]["augmented"] < data["held_out_force_error_percent"]["nominal"]

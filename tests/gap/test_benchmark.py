@@ -220,6 +220,9 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     for key, runs in (("log_error_ratio", "run_log_error_ratios"), ("level_log_error_ratio", "run_level_log_error_ratios")):
         assert len(ranked[runs]) == len(ds.test) and np.mean(ranked[runs]) == pytest.approx(ranked[key])
         assert np.std(ranked[runs], ddof=1) / np.sqrt(len(ds.test)) == pytest.approx(ranked[key + "_standard_error"])
+    # and so are the training-run null's signed moves, one per training run, the null their largest size
+    assert len(row["training_run_moves"]) == len(ds.train)
+    assert row["training_run_null"] == pytest.approx([max(abs(m[i]) for m in row["training_run_moves"]) for i in (0, 1)])
     null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
     assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
     assert null["audit"]["claimed"] == null["audit"]["nominal"]

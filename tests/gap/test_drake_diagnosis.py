@@ -43,6 +43,8 @@ def test_the_withheld_asymmetry_is_claimed_and_the_drift_is_not(runs, tmp_path):
     assert diag.ranking[0].name == "asymmetric_friction" and diag.ranking[0].passes
     assert diag.ranking[0].log_ratio > diag.ranking[0].threshold >= diag.null[0] > 0
     assert f"training-run null {diag.null[0]:.3f}" in diag.summary()[0]
+    # the null is the largest size of the signed moves it keeps, one per training run
+    assert len(diag.null_moves) == 2 and diag.null == D.null_of_moves(diag.null_moves)
     # while moving, coulomb_asym * s(v)^2 is a constant like the offset: only their sum is well determined
     p = diag.model["parameters"]
     assert abs(p["coulomb_asym"] + p["offset"] - (4.0 + PUBLISHED_IDIM["offset"])) < 0.3
@@ -250,8 +252,14 @@ def test_the_training_run_null_is_the_largest_move_of_the_nominal_with_one_train
         moved, _ = score_parameters(test, dict(nominal.parameters, **values))
         moves.append(abs(np.mean([np.log(moved[k]["force"] / nom_test[k]["force"]) for k in nom_test])))
     assert null[0] == pytest.approx(max(moves))
+    # the signed moves, one per left-out training run in order, are what the null is the largest size of
+    signed = D.training_run_moves(test, nominal, nom_test)
+    assert len(signed) == 2 and [abs(m[0]) for m in signed] == pytest.approx(moves)
+    assert D.null_of_moves(signed) == pytest.approx(null)
+    assert D.null_of_moves([(0.1, float("nan")), (-0.3, float("nan"))]) == (0.3, 0.0)
     # one training run: no jackknife, no null (the significance test alone decides)
     one = identify(train[:1], D.NOMINAL_PARAMETERS, max_nfev=3)
+    assert D.training_run_moves(test, one, score_parameters(test, one.parameters)[0]) == ()
     assert D.training_run_null(test, one, score_parameters(test, one.parameters)[0]) == (0.0, 0.0)
 
 
