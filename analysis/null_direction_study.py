@@ -1,0 +1,86 @@
+"""Development-seed study: should the training-run null count the moves that make the held-out error worse?
+
+The training-run null (:func:`drakecreep.gap.drake_diagnosis.training_run_null`) is the largest
+``|mean over held-out runs of ln(e_k / e)|`` over the training runs ``k`` left out of the nominal's fit. A move
+``m_k > 0`` says the nominal fitted without run ``k`` replays the held-out runs *worse*: run ``k`` carried
+something the held-out runs need. A move ``m_k < 0`` says the nominal fitted without it replays them *better*:
+the choice of training runs alone gains that much, which is what the null guards against (a candidate that
+absorbs what one training run happens to have).
+
+When only some training runs excite an effect (a drive that saturates above a force only one run reaches, an
+asymmetry one run's direction carries), leaving that run out makes the nominal much worse on the held-out runs
+that excite it too: a large positive move, and a null of the effect's own size (held-out run 39 missed a drive
+saturation at SNR 58 whose plain bar was a null of 1.292, docs/gap_benchmark.md 3ay). The question here: does
+``improving`` = ``max(0, max_k -m_k)`` (the same for the level error) keep the nulls and the effects outside
+the library unclaimed while it rescues such misses?
+
+Rows come from ``analysis/bench_gap_benchmark.py --seeds dev`` at a code that stores each dataset's
+``training_run_moves`` (from 1ddd75b). The recount is the first claim only, by the product's own test
+(``analysis/claim_rule_recount.py``, ``current``), with the stored null replaced by each statistic of the stored
+moves; ``largest`` must give the stored first claims back.
+
+Development seeds only (nothing here is a held-out figure). Usage::
+
+    PYTHONPATH=. python analysis/null_direction_study.py ROWS.json [...]
+
+Session 47's rows (11 datasets): ``analysis/null_direction_dev.json``; what they say: docs/gap_benchmark.md, 3ba
+(no first claim changes, and the runs that excite an effect move the nominal the *improving* way).
+"""
+
+import json
+import math
+import sys
+
+from claim_rule_recount import first_claim
+
+#: statistic name -> the (plain, level) null of a list of signed moves
+STATISTICS = {
+    "largest": lambda moves: tuple(max((abs(m[i]) for m in moves if not math.isnan(m[i])), default=0.0)
+                                   for i in (0, 1)),
+    "improving": lambda moves: tuple(max([0.0] + [-m[i] for m in moves if not math.isnan(m[i])]) for i in (0, 1)),
+}
+
+
+def recount(rows):
+    """Per statistic: top-1 right / scored (SNR >= 3), claims on nulls, claims outside the library, and each
+    row's first claim."""
+    out = {}
+    for name, stat in STATISTICS.items():
+        counts = {"top1": [0, 0], "null": [0, 0], "ool": [0, 0]}
+        firsts = {}
+        for r in rows:
+            moves = r.get("training_run_moves")
+            if moves is None:
+                raise SystemExit(f"row {r['seed']}: no training_run_moves (rows from 1ddd75b on carry them)")
+            f = first_claim(dict(r, training_run_null=list(stat(moves))), "current")
+            firsts[r["seed"]] = f
+            if r["category"] == "library" and (r["snr"] or 0) >= 3:
+                key, hit = "top1", f == r["expected"]
+            elif r["category"] == "null":
+                key, hit = "null", f is not None
+            else:
+                key, hit = "ool", f is not None
+            counts[key][0] += hit
+            counts[key][1] += 1
+        out[name] = dict(counts, first=firsts)
+    return out
+
+
+def main(paths):
+    rows = sorted((r for p in paths for r in json.load(open(p))["datasets"]), key=lambda r: r["seed"])
+    res = recount(rows)
+    agree = sum(res["largest"]["first"][r["seed"]] == r["first_passing"] for r in rows)
+    print(f"{len(rows)} rows; the recount with the largest move gives the stored first claim on {agree}")
+    for name in STATISTICS:
+        x = res[name]
+        print(f"  {name:10s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null'][0]}/{x['null'][1]}  "
+              f"outside the library claimed {x['ool'][0]}/{x['ool'][1]}")
+    for r in rows:
+        moves = " ".join(f"{m[0]:+.3f}/{m[1]:+.3f}" for m in r["training_run_moves"])
+        firsts = " ".join(f"{name} {res[name]['first'][r['seed']] or '-':20s}" for name in STATISTICS)
+        print(f"    {r['seed']} {r['category']:15s} {r['expected'] or '-':20s} SNR {r['snr'] or 0:5.1f}  {firsts}"
+              f" moves (plain/level) {moves}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
