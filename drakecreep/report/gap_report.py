@@ -271,6 +271,18 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         parts.append(f"<p>The mass is {how}; output error does not refine it.</p>")
     if nom.warnings:
         parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in nom.warnings) + "</ul>")
+    if diagnosis.null_moves:
+        labels = list(extra.get("train_runs", ()))
+        if len(labels) != len(diagnosis.null_moves):
+            labels = [f"training run {i + 1}" for i in range(len(diagnosis.null_moves))]
+        parts.append("<h3>Training-run null: the nominal's held-out log error with one training run left out</h3>")
+        parts.append(table(["left-out training run", "move, mean ln(e_k / e)", "with each run's friction level"],
+                           [[lab] + [f"{m:+.3f}" if np.isfinite(m) else "-" for m in move]
+                            for lab, move in zip(labels, diagnosis.null_moves)]))
+        parts.append("<p class='note'>The null is the largest size of these moves. A negative move: the nominal "
+                     "fitted without that run replays the held-out runs better. A run that alone excites an effect "
+                     "(a drive driven into its knee) biases the nominal so, and the null can then be as large as that "
+                     "effect's own gain (docs/gap_benchmark.md, 3ba).</p>")
     rows = []
     for r in diagnosis.ranking:
         sc = r.screen

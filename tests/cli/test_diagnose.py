@@ -68,6 +68,10 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert f"{by_run['w3']['reference']:.3g} → {by_run['w3']['candidate']:.3g}" in html
     # the training runs: the nominal's values with each left out, their spread in the table and the JSON
     assert "leave one training run out" in html
+    # and the held-out move with each left out, a row per training run by its label, as the JSON has them
+    assert "Training-run null: the nominal's held-out log error with one training run left out" in html
+    for label, move in zip(("w0", "w1", "w2"), null["moves"]):
+        assert f"<td>{label}</td><td>{move[0]:+.3f}</td><td>{move[1]:+.3f}</td>" in html
     # the mass, which output error does not refine, is in the nominal's table with its source
     assert data["nominal"]["mass_source"] == "IDIM-IV start"
     assert f"<td>mass</td><td>{data['nominal']['parameters']['mass']:.5g}</td>" in html
