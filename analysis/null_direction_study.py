@@ -28,42 +28,29 @@ Session 47's rows (11 datasets): ``analysis/null_direction_dev.json``; what they
 """
 
 import json
-import math
 import sys
 
-from claim_rule_recount import first_claim
+import claim_rule_recount
+
+from drakecreep.gap.drake_diagnosis import null_of_moves
 
 #: statistic name -> the (plain, level) null of a list of signed moves
 STATISTICS = {
-    "largest": lambda moves: tuple(max((abs(m[i]) for m in moves if not math.isnan(m[i])), default=0.0)
-                                   for i in (0, 1)),
-    "improving": lambda moves: tuple(max([0.0] + [-m[i] for m in moves if not math.isnan(m[i])]) for i in (0, 1)),
+    "largest": null_of_moves,  # the product's
+    "improving": lambda moves: null_of_moves([[min(v, 0.0) for v in m] for m in moves]),
 }
 
 
 def recount(rows):
-    """Per statistic: top-1 right / scored (SNR >= 3), claims on nulls, claims outside the library, and each
-    row's first claim."""
-    out = {}
-    for name, stat in STATISTICS.items():
-        counts = {"top1": [0, 0], "null": [0, 0], "ool": [0, 0]}
-        firsts = {}
-        for r in rows:
-            moves = r.get("training_run_moves")
-            if moves is None:
-                raise SystemExit(f"row {r['seed']}: no training_run_moves (rows from 1ddd75b on carry them)")
-            f = first_claim(dict(r, training_run_null=list(stat(moves))), "current")
-            firsts[r["seed"]] = f
-            if r["category"] == "library" and (r["snr"] or 0) >= 3:
-                key, hit = "top1", f == r["expected"]
-            elif r["category"] == "null":
-                key, hit = "null", f is not None
-            else:
-                key, hit = "ool", f is not None
-            counts[key][0] += hit
-            counts[key][1] += 1
-        out[name] = dict(counts, first=firsts)
-    return out
+    """Per statistic: :func:`claim_rule_recount.recount`'s ``current`` rule on the rows with their null replaced
+    by the statistic of their moves (top-1 right / scored where SNR >= 3, claims on nulls, claims outside the
+    library, each row's first claim)."""
+    for r in rows:
+        if r.get("training_run_moves") is None:
+            raise SystemExit(f"row {r['seed']}: no training_run_moves (rows from 1ddd75b on carry them)")
+    return {name: claim_rule_recount.recount([dict(r, training_run_null=list(stat(r["training_run_moves"])))
+                                              for r in rows])["current"]
+            for name, stat in STATISTICS.items()}
 
 
 def main(paths):
@@ -73,8 +60,9 @@ def main(paths):
     print(f"{len(rows)} rows; the recount with the largest move gives the stored first claim on {agree}")
     for name in STATISTICS:
         x = res[name]
-        print(f"  {name:10s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null'][0]}/{x['null'][1]}  "
-              f"outside the library claimed {x['ool'][0]}/{x['ool'][1]}")
+        print(f"  {name:10s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null_claims'][0]}/"
+              f"{x['null_claims'][1]}  outside the library claimed {x['out_of_library_claims'][0]}/"
+              f"{x['out_of_library_claims'][1]}")
     for r in rows:
         moves = " ".join(f"{m[0]:+.3f}/{m[1]:+.3f}" for m in r["training_run_moves"])
         firsts = " ".join(f"{name} {res[name]['first'][r['seed']] or '-':20s}" for name in STATISTICS)

@@ -302,11 +302,9 @@ class DrakeDiagnosis:
     where : dict
         What the augmented model still does not explain on the held-out runs, and where
         (:func:`drakecreep.gap.where.where_gap`): regimes, frequency bands, residual-input independence, screw side.
-    null : tuple of float
-        The training-run null ``(plain, level)`` every claimed log error ratio exceeds (:func:`training_run_null`).
     null_moves : tuple
         The signed moves ``(plain, level)`` of the nominal's held-out log error with each training run left out,
-        in training-run order (:func:`training_run_moves`); the null is the largest of their sizes.
+        in training-run order (:func:`training_run_moves`); :attr:`null` is the largest of their sizes.
     """
 
     nominal: object
@@ -320,8 +318,13 @@ class DrakeDiagnosis:
     k_se: float = 2.0
     where: dict = field(default_factory=dict)
     friction: str = "regularized"
-    null: tuple = (0.0, 0.0)
     null_moves: tuple = ()
+
+    @property
+    def null(self):
+        """The training-run null ``(plain, level)`` every claimed log error ratio exceeds (:func:`null_of_moves`
+        of :attr:`null_moves`; ``(0, 0)`` without them)."""
+        return null_of_moves(self.null_moves)
 
     def summary(self):
         """Lines of text."""
@@ -461,16 +464,6 @@ def _with_values(model, values):
     reference from the screen's reference values, and both refit the friction by the same ``max_nfev``: against
     the nominal's IDIM mass, the mass change alone would count as the candidate's gain."""
     return dataclasses.replace(model, parameters=dict(model.parameters, **values))
-
-
-class _Derived:
-    """``fn`` of a future's result, on demand (the future's ``result()`` shape)."""
-
-    def __init__(self, future, fn):
-        self._future, self._fn = future, fn
-
-    def result(self):
-        return self._fn(self._future.result())
 
 
 def _submit(pool, fn, *args):
@@ -795,7 +788,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     ranking, jobs = [], []
 
     def ranked(n, sc, fit, own=None):
-        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null.result(),
+        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null(),
                     regime=effect_regime(n, fit.parameters), fallback_regime=_fallback(n), pieces=_piece_test(n))
         say(f"{n}: held-out {_verdict(t)}")
         return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
@@ -823,7 +816,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
         fits_, own = {}, {}
         # the training-run null (training_run_null), beside the candidates' fits when there is a pool
         moves = _submit(pool, training_run_moves, test, nominal, nom_test)
-        null = _Derived(moves, null_of_moves)
+
+        def null():  # the training-run null of the moves, once they are there
+            return null_of_moves(moves.result())
 
         def launch(n, sc, start):
             # a candidate goes to the pool as soon as its screen passes: the closed-loop fits run while the
@@ -864,8 +859,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
             ranking += [done[n] for n, _, _ in jobs]
         ranking.sort(key=lambda r: (r.screened_out, -r.gain if not r.screened_out else -r.screen.gain))
         ranking = _outranked(ranking)
-        say(f"training-run null: the nominal's held-out log error moves by up to {null.result()[0]:.3f} "
-            f"({null.result()[1]:.3f} with each run's friction level) with one training run left out"
+        say(f"training-run null: the nominal's held-out log error moves by up to {null()[0]:.3f} "
+            f"({null()[1]:.3f} with each run's friction level) with one training run left out"
             if nominal.jackknife else "training-run null: none (it needs two or more training runs)")
         if on_ranking is not None:
             on_ranking(nominal, nom_test, tuple(ranking))
@@ -895,7 +890,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 fit = f_fit.result()
                 if f_ref is not None:
                     reference = f_ref.result()
-            t = _passes(reference, fit.test_errors, k_se, rule=_rule(r.name), null=null.result(),
+            t = _passes(reference, fit.test_errors, k_se, rule=_rule(r.name), null=null(),
                         regime=effect_regime(r.name, fit.parameters), fallback_regime=_fallback(r.name),
                         pieces=_piece_test(r.name))
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(t)}")
@@ -908,4 +903,4 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     where = where_gap(test, model["parameters"], flexible=model["flexible"], delay=model["delay"])
     return DrakeDiagnosis(nominal=nominal, nominal_test_errors=nom_test, ranking=tuple(ranking), claimed=tuple(claimed),
                           model=model, test_errors=current_test, seconds=_time.perf_counter() - t0, k_se=k_se,
-                          where=where, friction=friction, null=null.result(), null_moves=moves.result())
+                          where=where, friction=friction, null_moves=moves.result())
