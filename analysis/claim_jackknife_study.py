@@ -25,13 +25,13 @@ Session 29's rows (9 of the 16 datasets): ``analysis/claim_jackknife_dev.json``;
 docs/gap_benchmark.md, 3o.
 """
 
-import argparse
 import json
 import math
 import sys
 
 import numpy as np
 from scipy import stats
+from study_cli import shard_main
 
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark as B
@@ -117,26 +117,7 @@ def score(paths):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--shard", default="0/1", help="K/N: this process's share of the datasets")
-    ap.add_argument("--json", help="rows file to write")
-    ap.add_argument("--score", nargs="+", metavar="JSON", help="score rows files instead of running")
-    a = ap.parse_args(argv)
-    if a.score:
-        score(a.score)
-        return 0
-    try:
-        k, n = (int(x) for x in a.shard.split("/"))
-        if not 0 <= k < n:
-            raise ValueError
-    except ValueError:
-        print(f"--shard: got {a.shard!r}; allowed: K/N with 0 <= K < N", file=sys.stderr)
-        return 2
-    if not a.json:
-        print("--json: missing; allowed: a path for the rows", file=sys.stderr)
-        return 2
-    study(k, n, a.json)
-    return 0
+    return shard_main(__doc__.splitlines()[0], study, score, argv)
 
 
 if __name__ == "__main__":

@@ -80,14 +80,15 @@ def _errors(entry):
     return ref, cand
 
 
-def first_claim(row, rule):
+def first_claim(row, rule, null_of=None):
     """The first candidate of ``row``'s ranking that passes under ``rule`` (None if none); under ``current`` and
-    ``pieces_bound`` not one whose log ratio is below a fitted candidate's that does not pass (``outranking``)."""
-    null = tuple(row.get("training_run_null") or (0.0, 0.0))
+    ``pieces_bound`` not one whose log ratio is below a fitted candidate's that does not pass (``outranking``).
+    ``null_of(row, entry)``: each candidate's training-run null ``(plain, level)`` (default: the row's)."""
     decided = []
     for entry in row["ranking"]:
         if entry.get("screened_out") or not entry.get("run_log_error_ratios"):
             continue
+        null = tuple(null_of(row, entry) if null_of else row.get("training_run_null") or (0.0, 0.0))
         ref, cand = _errors(entry)
         bar = float(stats.t.ppf(1.0 - ALPHA, len(entry["run_log_error_ratios"]) - 1))
         name = entry["effect"]
@@ -103,17 +104,17 @@ def first_claim(row, rule):
     return next((name for name, passes, _ in decided if passes and name not in outranked), None)
 
 
-def recount(rows):
+def recount(rows, rules=RULES, null_of=None):
     """Per rule: top-1 right / scored (SNR >= 3), claims on nulls, claims on out-of-library effects, and each
-    row's first claim (``first``: seed -> candidate or None)."""
+    row's first claim (``first``: seed -> candidate or None); ``null_of`` as :func:`first_claim`'s."""
     out = {}
-    for rule in RULES:
+    for rule in rules:
         top = [0, 0]
         null = [0, 0]
         ool = [0, 0]
         firsts = {}
         for r in rows:
-            f = first_claim(r, rule)
+            f = first_claim(r, rule, null_of)
             firsts[r["seed"]] = f
             if r["category"] == "library" and (r["snr"] or 0) >= 3:
                 top[1] += 1

@@ -575,6 +575,15 @@ def _piece_log_ratios(ranked, res):
     return None if any(v is None for v in per_key) else [list(v) for v in zip(*per_key)]
 
 
+def _own_moves(ds, ranked):
+    """:func:`~drakecreep.gap.drake_diagnosis.candidate_moves` of a ranked candidate's fit, as lists (None when
+    it was screened out or its fit has no jackknife)."""
+    from drakecreep.gap.drake_diagnosis import candidate_moves
+
+    moves = None if ranked.screened_out else candidate_moves(ds.test, ranked.fit)
+    return None if moves is None else [[float(v) for v in m] for m in moves]
+
+
 def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):
     """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
 
@@ -616,7 +625,10 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 "pieces": bool(r.pieces),
                 "piece_log_error_ratios": None if r.screened_out else _piece_log_ratios(r, res),
                 "run_regime_log_error_ratios": None if r.screened_out or not r.regime else _run_log_ratios(
-                    r, res, f"force_{r.regime}")}
+                    r, res, f"force_{r.regime}"),
+                # the candidate's own model's training-run moves (plain, level), as training_run_moves is the
+                # nominal's: a null of the candidate's own can be counted on the rows (no claim uses it)
+                "own_training_run_moves": _own_moves(ds, r)}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction, training_run_null=[float(v) for v in res.null],
                # the signed moves (plain, level) the null is the largest size of, one per left-out training run:

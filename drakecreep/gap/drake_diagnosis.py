@@ -145,7 +145,8 @@ from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 from drakecreep.params import MEASURED_AXIS_KIND
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
-           "paired_log_ratio", "run_log_ratios", "training_run_null", "training_run_moves", "null_of_moves",
+           "paired_log_ratio", "run_log_ratios", "training_run_null", "training_run_moves", "candidate_moves",
+           "null_of_moves",
            "load_model", "outranking",
            "NOMINAL_PARAMETERS", "NOMINAL_FRICTION", "CLAIM_RULE"]
 
@@ -597,10 +598,28 @@ def training_run_moves(test, nominal, nominal_test_errors):
     :func:`training_run_null` is the largest of their sizes; the moves themselves are kept
     (:attr:`DrakeDiagnosis.null_moves`) so that another statistic of them can be counted on the benchmark rows.
     Module level, for a process pool."""
-    moved = [score_parameters(test, dict(nominal.parameters, **values), flexible=nominal.flexible,
-                              delay=nominal.delay)[0] for values in nominal.jackknife]
-    has = {key: all(key in e for e in nominal_test_errors.values()) for key in ("force", "force_level")}
-    return tuple(tuple(float(paired_log_ratio(nominal_test_errors, e, key)[0]) if has[key] else float("nan")
+    return _moves(test, nominal.parameters, nominal.jackknife, nominal.flexible, nominal.delay, nominal_test_errors)
+
+
+def candidate_moves(test, fit):
+    """A fitted candidate's own training-run moves (:func:`training_run_moves` of its model): how its held-out
+    log error moves with each training run left out of its closed-loop fit (the fit's
+    :attr:`~drakecreep.gap.identify.Identified.jackknife`: one Gauss-Newton step each, no refit). ``None`` when
+    the fit has no jackknife (a control delay is searched, not fitted; one training run). Kept in benchmark rows
+    so that a null of the candidate's own model can be counted on them (docs/gap_benchmark.md, 3bc); no claim
+    uses it."""
+    identified = getattr(fit, "identified", None)
+    if fit is None or identified is None or not identified.jackknife:
+        return None
+    return _moves(test, fit.parameters, identified.jackknife, fit.flexible, fit.delay, fit.test_errors)
+
+
+def _moves(test, parameters, jackknife, flexible, delay, test_errors):
+    """Signed ``(plain, level)`` mean held-out log error moves of a model with each jackknife value set."""
+    moved = [score_parameters(test, dict(parameters, **values), flexible=flexible, delay=delay)[0]
+             for values in jackknife]
+    has = {key: all(key in e for e in test_errors.values()) for key in ("force", "force_level")}
+    return tuple(tuple(float(paired_log_ratio(test_errors, e, key)[0]) if has[key] else float("nan")
                        for key in ("force", "force_level")) for e in moved)
 
 

@@ -223,6 +223,9 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     # and so are the training-run null's signed moves, one per training run, the null their largest size
     assert len(row["training_run_moves"]) == len(ds.train)
     assert row["training_run_null"] == pytest.approx([max(abs(m[i]) for m in row["training_run_moves"]) for i in (0, 1)])
+    # and the candidate's own model's moves (its fit's jackknife), for a null of its own counted on the rows
+    assert len(ranked["own_training_run_moves"]) == len(ds.train)
+    assert all(len(m) == 2 and all(np.isfinite(m)) for m in ranked["own_training_run_moves"])
     null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
     assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
     assert null["audit"]["claimed"] == null["audit"]["nominal"]

@@ -257,6 +257,15 @@ def test_the_training_run_null_is_the_largest_move_of_the_nominal_with_one_train
     assert len(signed) == 2 and [abs(m[0]) for m in signed] == pytest.approx(moves)
     assert D.null_of_moves(signed) == pytest.approx(null)
     assert D.null_of_moves([(0.1, float("nan")), (-0.3, float("nan"))]) == (0.3, 0.0)
+    # a candidate's own moves are the same statistic of its own fit's jackknife; none without one
+    from drakecreep.gap.drake_effects import EffectFit
+
+    fit = EffectFit(name="x", parameters=dict(nominal.parameters), identified=nominal, delay=nominal.delay,
+                    flexible=nominal.flexible, train_force_error=0.0, test_force_error=0.0, test_errors=nom_test,
+                    seconds=0.0)
+    assert np.allclose(D.candidate_moves(test, fit), signed)
+    assert D.candidate_moves(test, dataclasses.replace(fit, identified=None)) is None
+    assert D.candidate_moves(test, None) is None
     # one training run: no jackknife, no null (the significance test alone decides)
     one = identify(train[:1], D.NOMINAL_PARAMETERS, max_nfev=3)
     assert D.training_run_moves(test, one, score_parameters(test, one.parameters)[0]) == ()
