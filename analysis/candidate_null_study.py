@@ -65,8 +65,7 @@ def _own(row, e):
 VARIANTS = {
     "nominal": lambda row, e: row["training_run_null"],
     "own": _own,
-    "smaller": lambda row, e: tuple(min(a, b) for a, b in zip(row["training_run_null"],
-                                                               VARIANTS["own"](row, e))),
+    "smaller": lambda row, e: tuple(min(a, b) for a, b in zip(row["training_run_null"], _own(row, e))),
 }
 
 
@@ -91,12 +90,10 @@ def score(paths):
     rows = sorted((r for p in paths for r in json.load(open(p))["datasets"]), key=lambda r: r["seed"])
     res = {name: claim_rule_recount.recount(rows, rules=("current",), null_of=f)["current"]
            for name, f in VARIANTS.items()}
-    agree = sum(res["nominal"]["first"][r["seed"]] == (r["claimed"] or [None])[0] for r in rows)
+    agree = sum(res["nominal"]["first"][r["seed"]] == claim_rule_recount.stored_first(r) for r in rows)
     print(f"{len(rows)} rows; the recount with the nominal's null gives the stored first claim on {agree}")
     for name, x in res.items():
-        print(f"  {name:8s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null_claims'][0]}/"
-              f"{x['null_claims'][1]}  outside the library claimed {x['out_of_library_claims'][0]}/"
-              f"{x['out_of_library_claims'][1]}")
+        print(f"  {name:8s} {claim_rule_recount.score_line(x)}")
     for r in rows:
         firsts = "  ".join(f"{name} {res[name]['first'][r['seed']] or '-':20s}" for name in VARIANTS)
         print(f"    {r['seed']} {r['category']:15s} {r['expected'] or '-':20s} {r['axis']:8s} "

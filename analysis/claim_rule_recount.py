@@ -129,6 +129,18 @@ def recount(rows, rules=RULES, null_of=None):
     return out
 
 
+def score_line(counts):
+    """One line of a :func:`recount` entry's counts: top-1, claims on nulls, claims outside the library."""
+    return (f"top-1 {counts['top1'][0]}/{counts['top1'][1]}  claims on nulls {counts['null_claims'][0]}/"
+            f"{counts['null_claims'][1]}  out of library claimed {counts['out_of_library_claims'][0]}/"
+            f"{counts['out_of_library_claims'][1]}")
+
+
+def stored_first(row):
+    """The row's stored first claim: the first of ``claimed`` (``first_passing`` ignores the outranking)."""
+    return (row["claimed"] or [None])[0]
+
+
 def main(paths):
     for path in paths:
         with open(path) as fh:
@@ -136,10 +148,7 @@ def main(paths):
         res = recount(rows)
         print(path)
         for rule in RULES:
-            x = res[rule]
-            print(f"  {rule:8s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null_claims'][0]}/"
-                  f"{x['null_claims'][1]}  out of library claimed {x['out_of_library_claims'][0]}/"
-                  f"{x['out_of_library_claims'][1]}")
+            print(f"  {rule:8s} {score_line(res[rule])}")
         for r in rows:
             firsts = [res[rule]["first"][r["seed"]] for rule in RULES]
             if len(set(firsts) | {r["first_passing"]}) > 1:

@@ -56,13 +56,10 @@ def recount(rows):
 def main(paths):
     rows = sorted((r for p in paths for r in json.load(open(p))["datasets"]), key=lambda r: r["seed"])
     res = recount(rows)
-    agree = sum(res["largest"]["first"][r["seed"]] == r["first_passing"] for r in rows)
+    agree = sum(res["largest"]["first"][r["seed"]] == claim_rule_recount.stored_first(r) for r in rows)
     print(f"{len(rows)} rows; the recount with the largest move gives the stored first claim on {agree}")
     for name in STATISTICS:
-        x = res[name]
-        print(f"  {name:10s} top-1 {x['top1'][0]}/{x['top1'][1]}  claims on nulls {x['null_claims'][0]}/"
-              f"{x['null_claims'][1]}  outside the library claimed {x['out_of_library_claims'][0]}/"
-              f"{x['out_of_library_claims'][1]}")
+        print(f"  {name:10s} {claim_rule_recount.score_line(res[name])}")
     for r in rows:
         moves = " ".join(f"{m[0]:+.3f}/{m[1]:+.3f}" for m in r["training_run_moves"])
         firsts = " ".join(f"{name} {res[name]['first'][r['seed']] or '-':20s}" for name in STATISTICS)

@@ -581,7 +581,7 @@ def _own_moves(ds, ranked):
     it was screened out or its fit has no jackknife)."""
     from drakecreep.gap.drake_diagnosis import candidate_moves
 
-    moves = None if ranked.screened_out else candidate_moves(ds.test, ranked.fit)
+    moves = candidate_moves(ds.test, ranked.fit)  # (a candidate the screen ruled out has no fit)
     return None if moves is None else [[float(v) for v in m] for m in moves]
 
 

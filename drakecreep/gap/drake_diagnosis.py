@@ -608,8 +608,8 @@ def candidate_moves(test, fit):
     the fit has no jackknife (a control delay is searched, not fitted; one training run). Kept in benchmark rows
     so that a null of the candidate's own model can be counted on them (docs/gap_benchmark.md, 3bc); no claim
     uses it."""
-    identified = getattr(fit, "identified", None)
-    if fit is None or identified is None or not identified.jackknife:
+    identified = getattr(fit, "identified", None)  # (None for no fit)
+    if identified is None or not identified.jackknife:
         return None
     return _moves(test, fit.parameters, identified.jackknife, fit.flexible, fit.delay, fit.test_errors)
 
