@@ -12,8 +12,8 @@ On effect-free data a candidate is a small perturbation of the nominal, so its o
 nominal's and the null's guard against a candidate that absorbs a systematic share of what the nominal lacks
 (docs/gap_benchmark.md, 3s) should stay. This study asks whether that holds: the rows carry each fitted
 candidate's own moves (``own_training_run_moves``, :func:`drakecreep.gap.drake_diagnosis.candidate_moves`), and the
-first claim is recounted (``analysis/claim_rule_recount.py``, the product's ``current`` rule) with each
-candidate's null taken as
+first claim is recounted (``analysis/claim_rule_recount.py``, the product's rule before this study,
+``before_3bc``) with each candidate's null taken as
 
 * ``nominal``: the nominal's (the product; must give the stored first claims back);
 * ``own``: the candidate's own model's, for a candidate whose fit refits the nominal friction with its own
@@ -88,8 +88,12 @@ def study(shard, n_shards, path):
 def score(paths):
     """Print the recount per variant and each row's first claim under each."""
     rows = sorted((r for p in paths for r in json.load(open(p))["datasets"]), key=lambda r: r["seed"])
-    res = {name: claim_rule_recount.recount(rows, rules=("current",), null_of=f)["current"]
+    res = {name: claim_rule_recount.recount(rows, rules=("before_3bc",), null_of=f)["before_3bc"]
            for name, f in VARIANTS.items()}
+    product = claim_rule_recount.recount(rows, rules=("current",))["current"]
+    same = sum(product["first"][r["seed"]] == res["smaller"]["first"][r["seed"]] for r in rows)
+    print(f"the product's rule (the smaller null where the nominal's fails it) gives the first claim of `smaller` "
+          f"on {same} of {len(rows)}")
     agree = sum(res["nominal"]["first"][r["seed"]] == claim_rule_recount.stored_first(r) for r in rows)
     print(f"{len(rows)} rows; the recount with the nominal's null gives the stored first claim on {agree}")
     for name, x in res.items():

@@ -9,7 +9,10 @@ error dicts whose log ratios are the stored values) under
 * ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), its
   fallback regime (the asymmetric friction's constant speed, from session 38) and its piece test (the lead error,
   from session 40; rows stored before have no pieces, so it never passes there), the product today;
-* ``before_3ap``: ``current`` without the outranking of session 42 (a passing candidate below a fitted one that
+* ``before_3bc``: ``current`` with every candidate held to the nominal's training-run null (before session 48,
+  a candidate that refits the friction is held to the smaller of that and its own, where the rows carry its own
+  moves: ``own_training_run_moves``, rows from session 48 on; docs/gap_benchmark.md, 3bc);
+* ``before_3ap``: ``before_3bc`` without the outranking of session 42 (a passing candidate below a fitted one that
   fails is not claimed; docs/gap_benchmark.md, 3ap);
 * ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
 * ``either``: every candidate with ``either`` (one test passing, the other's mean log ratio positive);
@@ -31,11 +34,11 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _fallback, _passes, _piece_test, _rule, outranking
+from drakecreep.gap.drake_diagnosis import _claim_test, _fallback, _passes, _piece_test, _rule, null_of_moves, outranking
 from drakecreep.gap.drake_replay import piece_keys
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
-RULES = ("current", "before_3ap", "both", "either", "pieces_bound")
+RULES = ("current", "before_3bc", "before_3ap", "both", "either", "pieces_bound")
 _KEYS = {"force": "run_log_error_ratios", "force_level": "run_level_log_error_ratios",
          "force_constant_speed": "run_constant_speed_log_error_ratios"}
 
@@ -93,14 +96,19 @@ def first_claim(row, rule, null_of=None):
         bar = float(stats.t.ppf(1.0 - ALPHA, len(entry["run_log_error_ratios"]) - 1))
         name = entry["effect"]
         own = _rule(name)
-        current = rule in ("current", "pieces_bound", "before_3ap")
+        current = rule in ("current", "before_3bc", "pieces_bound", "before_3ap")
         chosen = own if current else {"both": "both" if own == "drift_robust" else own}.get(rule, rule)
-        t = _passes(ref, cand, bar, rule=chosen, null=null, regime=_regime_of(entry),
-                    fallback_regime=_fallback(name) if current else "", pieces=_piece_test(name) if current else False)
+        kw = dict(rule=chosen, regime=_regime_of(entry), fallback_regime=_fallback(name) if current else "",
+                  pieces=_piece_test(name) if current else False)
+        moves = entry.get("own_training_run_moves")
+        if rule == "current":
+            t = _claim_test(ref, cand, name, bar, null, lambda: null_of_moves(moves) if moves else None, **kw)
+        else:
+            t = _passes(ref, cand, bar, null=null, **kw)
         passes = t.passes or (rule == "pieces_bound" and _piece_test(name) and null[0] > 0 and t.log_ratio > null[0]
                               and not t.level_log_ratio <= null[1])
         decided.append((name, passes, t.log_ratio))
-    outranked = outranking(decided) if rule in ("current", "pieces_bound") else {}
+    outranked = outranking(decided) if rule in ("current", "before_3bc", "pieces_bound") else {}
     return next((name for name, passes, _ in decided if passes and name not in outranked), None)
 
 

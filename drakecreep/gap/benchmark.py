@@ -628,7 +628,7 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                 "run_regime_log_error_ratios": None if r.screened_out or not r.regime else _run_log_ratios(
                     r, res, f"force_{r.regime}"),
                 # the candidate's own model's training-run moves (plain, level), as training_run_moves is the
-                # nominal's: a null of the candidate's own can be counted on the rows (no claim uses it)
+                # nominal's: its own null (drake_diagnosis._claim_test) can be recounted on the rows
                 "own_training_run_moves": _own_moves(ds, r)}
                for r in res.ranking]
     row = _row(ds, claimed, ranking, friction=res.friction, training_run_null=[float(v) for v in res.null],

@@ -76,7 +76,10 @@
    ``drakecreep`` kind's diagnosis asks the same of its candidates (:mod:`drakecreep.gap.drive_fit`). On the
    development benchmark rows of docs/gap_benchmark.md, 3s, every first claim that was right stood at least
    twice as high as this null, and the small second claims (a friction drift or a load friction of 2-4 %)
-   fell under it.
+   fell under it. A candidate whose fit refits the nominal friction is held to the smaller of this null and
+   its own (:func:`candidate_moves`, :func:`_claim_test`): an effect that only some training runs excite biases
+   the nominal, whose null is then the effect's own size, while the candidate that is the effect moves little
+   (docs/gap_benchmark.md, 3ba, 3bc).
    A candidate that names a regime where it must show too (:attr:`~drakecreep.gap.drake_effects.DrakeEffect.regime`:
    the time ripple, at constant speed) must also shrink the held-out force error over that regime's samples
    (``force_constant_speed``), positively and significantly by the same t or sign-flip test. Runs that share
@@ -211,7 +214,8 @@ class RankedEffect:
     ``regime_*``: the log ratio in the candidate's own regime, when it has one; ``rule``: the claim rule it was
     decided on; ``level_alone``: it passes by the level test alone (``drift_robust``: :class:`ClaimTest`);
     ``fallback``: it passes by its fallback regime; ``piece_*`` and ``pieces``: its test over the held-out runs'
-    pieces, when it has one (:class:`ClaimTest`); ``outranked_by``: a fitted candidate that did not pass but
+    pieces, when it has one (:class:`ClaimTest`); ``own_null``: its own training-run null when it was
+    decided on the smaller of that and the nominal's (:func:`_claim_test`); ``outranked_by``: a fitted candidate that did not pass but
     whose held-out log ratio is higher, so this one is not claimed either (:func:`_outranked`)."""
 
     fit: EffectFit | None
@@ -239,6 +243,7 @@ class RankedEffect:
     piece_log_ratio: float = float("nan")
     piece_p_sign_flip: float = float("nan")
     pieces: bool = False
+    own_null: tuple = ()
     outranked_by: str = ""
 
     @property
@@ -487,7 +492,9 @@ class ClaimTest:
     null (``drift_robust``); ``fallback``: it fails its rule and passes by its fallback regime (``regime`` and
     ``regime_*`` are then that regime's, :func:`_passes`); ``piece_log_ratio`` and ``piece_p_sign_flip``: the mean
     log ratio over the held-out runs' pieces and its sign-flip p value (a candidate with a piece test only);
-    ``pieces``: it fails its rule and passes by them."""
+    ``pieces``: it fails its rule and passes by them; ``own_null``: the candidate's own training-run null
+    ``(plain, level)`` when it was decided on the smaller of that and the nominal's (:func:`_claim_test`), else
+    empty."""
 
     gain: float
     standard_error: float
@@ -510,6 +517,7 @@ class ClaimTest:
     piece_log_ratio: float = float("nan")
     piece_p_sign_flip: float = float("nan")
     pieces: bool = False
+    own_null: tuple = ()
 
 
 def _passes(reference, candidate, bar, rule=None, null=(0.0, 0.0), regime="", fallback_regime="", pieces=False):
@@ -605,9 +613,9 @@ def candidate_moves(test, fit):
     """A fitted candidate's own training-run moves (:func:`training_run_moves` of its model): how its held-out
     log error moves with each training run left out of its closed-loop fit (the fit's
     :attr:`~drakecreep.gap.identify.Identified.jackknife`: one Gauss-Newton step each, no refit). ``None`` when
-    the fit has no jackknife (a control delay is searched, not fitted; one training run). Kept in benchmark rows
-    so that a null of the candidate's own model can be counted on them (docs/gap_benchmark.md, 3bc); no claim
-    uses it."""
+    the fit has no jackknife (a control delay is searched, not fitted; one training run). The candidate's own
+    null (:func:`null_of_moves` of these) bounds the nominal's in its claim test (:func:`_claim_test`); benchmark
+    rows keep them (docs/gap_benchmark.md, 3bc)."""
     identified = getattr(fit, "identified", None)  # (None for no fit)
     if identified is None or not identified.jackknife:
         return None
@@ -627,6 +635,46 @@ def null_of_moves(moves):
     """The training-run null ``(plain, level)`` of :func:`training_run_moves`: the largest ``|move|`` of each,
     ``0.0`` without moves or without that error."""
     return tuple(float(max((abs(m[i]) for m in moves if not math.isnan(m[i])), default=0.0)) for i in (0, 1))
+
+
+def _claim_test(reference, candidate, name, bar, null, own_null, **rule):
+    """:func:`_passes` of candidate ``name``'s held-out errors ``candidate`` against ``reference`` (``rule``: its
+    ``rule``, ``regime``, ``fallback_regime`` and ``pieces``, :func:`_rule_of`), with the training-run null the
+    candidate is held to: the smaller of the nominal's ``null`` and its own, plain and level each (module
+    docstring, 3; docs/gap_benchmark.md 3bc), for a candidate whose fit refits the nominal friction beside its own
+    parameters (its jackknife then moves what the nominal's does; :func:`_refits`). ``own_null``: a callable that
+    gives the candidate's own null (:func:`candidate_moves`, :func:`null_of_moves`), or None when it has none; it
+    costs a replay of the held-out runs per training run, so it is called only when the nominal's null fails a
+    candidate whose plain mean log ratio is positive."""
+    t = _passes(reference, candidate, bar, null=null, **rule)
+    if t.passes or not _refits(name) or not t.log_ratio > 0:
+        return t
+    own = own_null()
+    if own is None:
+        return t
+    smaller = tuple(min(a, b) for a, b in zip(null, own))
+    if smaller == tuple(null):
+        return t
+    return dataclasses.replace(_passes(reference, candidate, bar, null=smaller, **rule),
+                               own_null=tuple(float(v) for v in own))
+
+
+def _own_null(test, fit, known=()):
+    """The callable :func:`_claim_test` asks for ``fit``'s own null: ``known`` when it was computed already (the
+    greedy step's first claim is the ranking's fit), else from :func:`candidate_moves` (None without a
+    jackknife)."""
+    def own():
+        if known:
+            return known
+        moves = candidate_moves(test, fit)
+        return None if moves is None else null_of_moves(moves)
+    return own
+
+
+def _rule_of(name, fit):
+    """The claim rule's settings of candidate ``name`` with ``fit`` (:func:`_passes`' keywords)."""
+    return dict(rule=_rule(name), regime=effect_regime(name, fit.parameters), fallback_regime=_fallback(name),
+                pieces=_piece_test(name))
 
 
 def training_run_null(test, nominal, nominal_test_errors):
@@ -689,6 +737,9 @@ def _verdict(t):
         level += (f"; over the held-out runs' pieces {t.piece_log_ratio:+.3f}, sign-flip p {t.piece_p_sign_flip:.2g}"
                   + (" (passes by its pieces: both means above their training-run nulls, one or two fast runs "
                      "carrying it)" if t.pieces else ""))
+    if t.own_null:
+        level += (f"; held to its own training-run null {t.own_null[0]:.3f} ({t.own_null[1]:.3f} with each run's "
+                  "level) where it is below the nominal's")
     return (f"gain {t.gain:+.3f} points of %, error x{math.exp(-t.log_ratio):.3f} (log ratio {t.log_ratio:+.3f} vs bar "
             f"{t.threshold:.3f}, sign-flip p {t.p_sign_flip:.2g}{level})" + ("  passes" if t.passes else ""))
 
@@ -807,8 +858,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     ranking, jobs = [], []
 
     def ranked(n, sc, fit, own=None):
-        t = _passes(own or nom_test, fit.test_errors, k_se, rule=_rule(n), null=null(),
-                    regime=effect_regime(n, fit.parameters), fallback_regime=_fallback(n), pieces=_piece_test(n))
+        t = _claim_test(own or nom_test, fit.test_errors, n, k_se, null(), _own_null(test, fit), **_rule_of(n, fit))
         say(f"{n}: held-out {_verdict(t)}")
         return RankedEffect(fit=fit, screen=sc, effect=n, reference_errors=own, **dataclasses.asdict(t))
 
@@ -909,9 +959,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
                 fit = f_fit.result()
                 if f_ref is not None:
                     reference = f_ref.result()
-            t = _passes(reference, fit.test_errors, k_se, rule=_rule(r.name), null=null(),
-                        regime=effect_regime(r.name, fit.parameters), fallback_regime=_fallback(r.name),
-                        pieces=_piece_test(r.name))
+            t = _claim_test(reference, fit.test_errors, r.name, k_se, null(),
+                            _own_null(test, fit, r.own_null if fit is r.fit else ()), **_rule_of(r.name, fit))
             say(f"greedy: {r.name} on top of {' + '.join(claimed) or 'nominal'}: {_verdict(t)}")
             if t.passes:
                 claimed.append(r.name)

@@ -50,6 +50,9 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                   "by_fallback_regime": r.fallback,
                                   "piece_log_error_ratio": r.piece_log_ratio,
                                   "piece_sign_flip_p": r.piece_p_sign_flip, "by_pieces": r.pieces,
+                                  # its own training-run null (plain, level), when it was held to it (below the
+                                  # nominal's; drake_diagnosis._claim_test)
+                                  "own_training_run_null": list(r.own_null) or None,
                                   "started_from": r.closed_loop_start or None,
                                   # passes, but a fitted candidate that does not explains more: not claimed
                                   "outranked_by": r.outranked_by or None,
@@ -305,6 +308,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                      ("yes" if r.passes else "no")
                      + (f" (by the {r.regime.replace('_', ' ')} fallback)" if r.fallback else "")
                      + (" (by the held-out runs' pieces)" if r.pieces else "")
+                     + (f" (held to its own training-run null, {r.own_null[0]:.3f} / {r.own_null[1]:.3f})"
+                        if r.own_null else "")
                      + ("" if r.name in diagnosis.claimed or not r.passes else
                         f" (not claimed: {r.outranked_by}, which does not pass, explains more)" if r.outranked_by
                         else " (not kept by the greedy step)"),
