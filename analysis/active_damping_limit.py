@@ -14,12 +14,14 @@ log grid is stable is the linear critical feed.
 Run: python analysis/active_damping_limit.py [LOAD_CASE]   (about 1 minute)
 """
 
+import argparse
 import math
 import sys
 
 import control
 import numpy as np
 
+from drakecreep.errors import InputError
 from drakecreep.servo.linearize import linearize_controller, linearize_plant
 from drakecreep.params import preset
 from drakecreep.scenario import Scenario
@@ -66,5 +68,31 @@ def main(load_case=3):
             print(f"| {signal} | {gain:+.0e} | {v * 1e3:.3f} |", flush=True)
 
 
+def _load_case(text):
+    """A load case number: an integer >= 0 (0 = unloaded)."""
+    try:
+        number = int(text)
+    except ValueError:
+        number = -1
+    if number < 0:
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: an integer >= 0 (0 = unloaded)")
+    return number
+
+
+def cli(argv=None):
+    """Parse ``argv``, check the load case against the preset and run :func:`main`; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("load_case", nargs="?", default=3, type=_load_case, metavar="LOAD_CASE",
+                    help="load case of the paper preset, 0 = unloaded (default 3)")
+    a = ap.parse_args(argv)
+    try:  # the preset's own range, before the first linearization
+        preset("paper").load_case(a.load_case)
+    except InputError as e:
+        print(e, file=sys.stderr)
+        return 2
+    main(a.load_case)
+    return 0
+
+
 if __name__ == "__main__":
-    main(*sys.argv[1:])
+    sys.exit(cli())

@@ -19,6 +19,7 @@ Usage: ``PYTHONPATH=. python analysis/axial_mode_band_study.py OUT.json SEED:EFF
 withheld effect, e.g. ``60000:backlash:rigid 61000:structural_mode:flexible``).
 """
 
+import argparse
 import json
 import math
 import sys
@@ -30,6 +31,7 @@ from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from drakecreep.gap.drake_effects import axial_mode_frequency
 from drakecreep.gap.drake_replay import drake_replay
+from study_cli import case_type
 
 
 _DRAW = benchmark.T.draw_truth
@@ -95,10 +97,15 @@ def study(seed, effect, axis):
     return row
 
 
-def main(argv):
-    out, rows = argv[0], []
-    for item in argv[1:]:
-        seed, effect, axis = item.split(":")
+def main(argv=None):
+    """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
+    ap.add_argument("cases", nargs="+", type=case_type(("null", "strong_mode") + tuple(benchmark.T.WITHHELD), "required", "60000:backlash:rigid"), metavar="SEED:EFFECT:AXIS",
+                    help="a dataset: EFFECT null, strong_mode or a withheld effect; AXIS rigid or flexible")
+    a = ap.parse_args(argv)
+    out, rows = a.out, []
+    for seed, effect, axis in a.cases:
         rows.append(study(int(seed), effect, axis))
         r = rows[-1]
         if "test" in r:
@@ -113,7 +120,8 @@ def main(argv):
         else:
             print(f"{seed} {effect} {axis} screened out", flush=True)
         write_text(out, json.dumps({"rows": rows}, indent=1))
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

@@ -9,9 +9,10 @@ error dicts whose log ratios are the stored values) under
 * ``current``: each candidate's own rule (``drift_robust``; ``either`` for the position friction), its
   fallback regime (the asymmetric friction's constant speed, from session 38) and its piece test (the lead error,
   from session 40; rows stored before have no pieces, so it never passes there), the product today;
-* ``before_3bc``: ``current`` with every candidate held to the nominal's training-run null (before session 48,
-  a candidate that refits the friction is held to the smaller of that and its own, where the rows carry its own
-  moves: ``own_training_run_moves``, rows from session 48 on; docs/gap_benchmark.md, 3bc);
+* ``before_3bc``: ``current`` with every candidate held to the nominal's training-run null, the rule of held-out
+  runs 36-42 (since session 49 a candidate that refits the friction is held to the smaller of that and its own,
+  where the rows carry its own moves: ``own_training_run_moves``, rows from session 48 on; docs/gap_benchmark.md,
+  3bc, 3be);
 * ``before_3ap``: ``before_3bc`` without the outranking of session 42 (a passing candidate below a fitted one that
   fails is not claimed; docs/gap_benchmark.md, 3ap);
 * ``both``: the rule before session 35 (``both`` where the product has ``drift_robust``);
@@ -27,6 +28,7 @@ cannot be recounted from the rows), so its top-1 is the benchmark's ``first_pass
 Usage: ``PYTHONPATH=. python analysis/claim_rule_recount.py analysis/gap_benchmark_heldout16.json [...]``
 """
 
+import argparse
 import json
 import math
 import sys
@@ -149,10 +151,20 @@ def stored_first(row):
     return (row["claimed"] or [None])[0]
 
 
-def main(paths):
-    for path in paths:
-        with open(path) as fh:
-            rows = json.load(fh)["datasets"]
+def main(argv=None):
+    """Print each rows file's recount; the exit status (2, with one line, on a file that is not a rows file)."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("paths", nargs="+", metavar="JSON", help="benchmark rows files (analysis/gap_benchmark_heldout*.json)")
+    files = {}
+    for path in ap.parse_args(argv).paths:  # every file read before the first recount
+        try:
+            with open(path) as fh:
+                files[path] = json.load(fh)["datasets"]
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            print(f"JSON: got {path!r}; allowed: a readable benchmark rows file with 'datasets' ({type(e).__name__})",
+                  file=sys.stderr)
+            return 2
+    for path, rows in files.items():
         res = recount(rows)
         print(path)
         for rule in RULES:
@@ -163,7 +175,8 @@ def main(paths):
                 print(f"    {r['seed']} {r['category']:15s} expected {r['expected'] or '-':20s} SNR {r['snr'] or 0:5.1f} "
                       f"stored {r['first_passing'] or '-':20s} "
                       + " ".join(f"{rule} {f or '-':20s}" for rule, f in zip(RULES, firsts)).rstrip())
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

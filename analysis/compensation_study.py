@@ -12,10 +12,11 @@ Writes to OUT_DIR/<preset>/: compensation.csv, summary.md, rows.json, comparison
 Run: python analysis/compensation_study.py [OUT_DIR] [PRESET ...]   (about 2 minutes on 2 cores)
 """
 
+import argparse
 import sys
 
 from drakecreep.studies.compensation import creep_boundaries, evaluate, robustness, write_report
-from drakecreep.params import preset
+from drakecreep.params import PRESETS, preset
 
 
 #: feeds (mm/s) of the mismatch study per preset: inside each drive's creeping range
@@ -36,5 +37,24 @@ def main(out="out/compensation-study", *names):
         study(out, name)
 
 
+def _preset_name(text):
+    """A preset's name (:data:`drakecreep.params.PRESETS`)."""
+    if text not in PRESETS:
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: one of " + ", ".join(PRESETS))
+    return text
+
+
+def cli(argv=None):
+    """Parse ``argv`` (every preset named checked first) and run :func:`main`; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", nargs="?", default="out/compensation-study", metavar="OUT_DIR",
+                    help="output directory (default out/compensation-study)")
+    ap.add_argument("names", nargs="*", type=_preset_name, metavar="PRESET",
+                    help="presets to study (default paper rigid_axis)")
+    a = ap.parse_args(argv)
+    main(a.out, *a.names)
+    return 0
+
+
 if __name__ == "__main__":
-    main(*sys.argv[1:])
+    sys.exit(cli())

@@ -20,27 +20,14 @@ import json
 import sys
 import time
 
-from drakecreep.errors import InputError
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
+from study_cli import out_and_specs
 
 
-def _refuse(line):
-    print(line, file=sys.stderr)
-    sys.exit(2)
-
-
-def _spec(arg):
-    try:
-        return benchmark.dataset_spec(arg)
-    except InputError as e:
-        _refuse(str(e))
-
-
-def main(argv):
-    if len(argv) < 2:
-        _refuse("usage: analysis/drive_saturation_start_study.py OUT.json SEED:WITHHELD:AXIS [...]")
-    out, specs = argv[0], [_spec(a) for a in argv[1:]]
+def main(argv=None):
+    """Rerun each dataset of ``argv`` (every spec checked first) and write the rows; the exit status."""
+    out, specs = out_and_specs(__doc__, argv)
     rows = []
     for seed, withheld, axis in specs:
         t0 = time.perf_counter()
@@ -52,7 +39,8 @@ def main(argv):
               f"{time.perf_counter() - t0:.0f} s", flush=True)
         write_text(out, json.dumps({"note": "spent held-out datasets rerun as development (benchmark.evaluate)",
                                     "datasets": rows}, indent=1, default=str))
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

@@ -4,13 +4,18 @@ Run: ``PYTHONPATH=. python analysis/emps_drake_plot.py MODEL.yaml OUT.png`` with
 ``DrakeDiagnosis.save_model`` (``analysis/emps_drake.py`` writes ``emps_augmented.yaml``).
 """
 
+import argparse
 import sys
+from pathlib import Path
 
 import matplotlib
+import yaml
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.backend_bases import FigureCanvasBase  # noqa: E402
 
+from drakecreep.errors import InputError  # noqa: E402
 from drakecreep.gap.drake_diagnosis import load_model  # noqa: E402
 from drakecreep.gap.drake_replay import DrakeReplay, drake_replay_errors  # noqa: E402
 from drakecreep.gap.identify import idim_start  # noqa: E402
@@ -49,5 +54,36 @@ def main(model_path, out):
     print(f"wrote {out}: augmented {ea}, IDIM rigid {en}")
 
 
+def _check(model_path, out):
+    """The line refusing a model :func:`load_model` cannot read or an ``out`` matplotlib cannot write, or None."""
+    try:
+        load_model(model_path)
+    except InputError as e:
+        return str(e)
+    except (OSError, ValueError, yaml.YAMLError) as e:
+        return (f"MODEL.yaml: got {model_path!r}; allowed: a YAML written by DrakeDiagnosis.save_model "
+                f"({type(e).__name__})")
+    out = Path(out)
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if not out.parent.is_dir() or (out.suffix and out.suffix[1:].lower() not in formats):
+        return (f"OUT.png: got {str(out)!r}; allowed: a file in an existing directory, of a format matplotlib writes "
+                "(" + ", ".join(sorted(formats)) + ")")
+    return None
+
+
+def cli(argv=None):
+    """Parse ``argv``, check the model and the output path, and run :func:`main`; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("model_path", metavar="MODEL.yaml", help="a model written by DrakeDiagnosis.save_model")
+    ap.add_argument("out", metavar="OUT.png", help="figure to write")
+    a = ap.parse_args(argv)
+    problem = _check(a.model_path, a.out)
+    if problem:
+        print(problem, file=sys.stderr)
+        return 2
+    main(a.model_path, a.out)
+    return 0
+
+
 if __name__ == "__main__":
-    main(*sys.argv[1:3])
+    sys.exit(cli())

@@ -16,6 +16,7 @@ Usage: ``PYTHONPATH=. python analysis/held_out_run_study.py SEED:WITHHELD:AXIS``
 ``55010002:drive_saturation:flexible``; docs/gap_benchmark.md, 3am).
 """
 
+import argparse
 import math
 import sys
 
@@ -28,11 +29,6 @@ from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 _BASE = ("mass", "viscous", "coulomb", "offset")
 
 
-def _refuse(line):
-    print(line, file=sys.stderr)
-    sys.exit(2)
-
-
 def _run_line(kind, r):
     v = np.gradient(r.x_ref, r.dt)
     return (f"  {kind:8s} {r.label:6s} top speed {1e3 * np.abs(v).max():5.0f} mm/s, commanded force RMS "
@@ -40,18 +36,23 @@ def _run_line(kind, r):
             f"{1e3 * r.x_ref.min():6.1f} .. {1e3 * r.x_ref.max():6.1f} mm")
 
 
-def main(argv):
-    if len(argv) != 1:
-        _refuse("usage: analysis/held_out_run_study.py SEED:WITHHELD:AXIS")
+def main(argv=None):
+    """Diagnose the dataset of ``argv`` with its effect's candidate and print the rows; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dataset", metavar="SEED:WITHHELD:AXIS",
+                    help="a spent dataset: WITHHELD an effect with a fitted candidate, AXIS rigid or flexible")
+    args = ap.parse_args(argv)
     try:
-        seed, withheld, axis = benchmark.dataset_spec(argv[0])
-    except InputError as e:
-        _refuse(str(e))
+        seed, withheld, axis = benchmark.dataset_spec(args.dataset)
+    except InputError as e:  # one line, exit 2, before any work
+        print(e, file=sys.stderr)
+        return 2
     name = benchmark.EXPECTED.get(withheld[0]) if len(withheld) == 1 else None
     if name not in DRAKE_EFFECTS:
         allowed = [w for w, c in benchmark.EXPECTED.items() if c in DRAKE_EFFECTS]
-        _refuse(f"WITHHELD: got {'+'.join(withheld) or 'null'!r}; allowed: a withheld effect with a fitted candidate, "
-                "one of " + ", ".join(allowed))
+        print(f"WITHHELD: got {'+'.join(withheld) or 'null'!r}; allowed: a withheld effect with a fitted candidate, "
+              "one of " + ", ".join(allowed), file=sys.stderr)
+        return 2
     ds = benchmark.generate_dataset(seed, withheld=withheld, kind="p_p_cascade", axis=axis)
     res = benchmark.diagnose_dataset(ds, effects=[name])
     ranked = next(r for r in res.ranking if r.name == name)
@@ -70,7 +71,7 @@ def main(argv):
               f"{sc.log_ratio_se:.3f}), passes: {sc.passes}; start " + ", ".join(f"{k} {v:.4g}" for k, v in sc.start.items()))
     if ranked.fit is None:
         print("  the candidate was screened out: no closed-loop fit")
-        return
+        return 0
     print("  candidate: " + ", ".join(f"{k} {ranked.fit.parameters[k]:.4g}" for k in keys)
           + (f" (closed-loop start: {ranked.closed_loop_start})" if ranked.closed_loop_start else ""))
     ref = ranked.reference_errors or res.nominal_test_errors
@@ -81,7 +82,8 @@ def main(argv):
               f"({math.log(a['force_level'] / b['force_level']):+.3f})")
     print(f"  mean log ratio {ranked.log_ratio:+.3f} vs bar {ranked.threshold:.3f}; with each run's level "
           f"{ranked.level_log_ratio:+.3f} vs bar {ranked.level_threshold:.3f}; passes: {ranked.passes}")
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

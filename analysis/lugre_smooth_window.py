@@ -11,6 +11,8 @@ Test: the lowest creeping feed for sigma0 = 1e7, 1e8 (preset), 1e9 N/m; the hypo
 Run: ``python analysis/lugre_smooth_window.py``
 """
 
+import argparse
+
 from drakecreep.model.lumped import axial_mode_frequency, lumped
 from drakecreep.params import preset, with_value
 from drakecreep.scenario import Scenario
@@ -35,4 +37,6 @@ def main():
 
 
 if __name__ == "__main__":
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -7,6 +7,7 @@ external force in N; units in the header) and its metadata ``emps_segment.yaml``
     python analysis/make_example_dataset.py
 """
 
+import argparse
 
 import numpy as np
 import yaml
@@ -45,4 +46,6 @@ def main():
 
 
 if __name__ == "__main__":
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

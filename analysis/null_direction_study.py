@@ -27,6 +27,7 @@ Session 47's rows (11 datasets): ``analysis/null_direction_dev.json``; what they
 (no first claim changes, and the runs that excite an effect move the nominal the *improving* way).
 """
 
+import argparse
 import json
 import sys
 
@@ -53,8 +54,31 @@ def recount(rows):
             for name, stat in STATISTICS.items()}
 
 
-def main(paths):
-    rows = sorted((r for p in paths for r in json.load(open(p))["datasets"]), key=lambda r: r["seed"])
+def _read_rows(path):
+    """The rows of a rows file, or the line refusing it (not a rows file, or rows without ``training_run_moves``)."""
+    try:
+        with open(path) as fh:
+            rows = list(json.load(fh)["datasets"])
+        missing = [r["seed"] for r in rows if r.get("training_run_moves") is None]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as e:
+        return f"ROWS.json: got {path!r}; allowed: a readable benchmark rows file with 'datasets' ({type(e).__name__})"
+    if missing:
+        return (f"ROWS.json: got {path!r} (row {missing[0]}: no training_run_moves); allowed: rows with "
+                "training_run_moves (rows from 1ddd75b on carry them)")
+    return rows
+
+
+def main(argv=None):
+    """Print the recount of the rows files of ``argv`` (every file read first); the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("paths", nargs="+", metavar="ROWS.json",
+                    help="rows files of analysis/bench_gap_benchmark.py with training_run_moves")
+    files = [_read_rows(p) for p in ap.parse_args(argv).paths]
+    problems = [f for f in files if isinstance(f, str)]
+    if problems:  # one line, exit 2, before the recount
+        print(problems[0], file=sys.stderr)
+        return 2
+    rows = sorted((r for f in files for r in f), key=lambda r: r["seed"])
     res = recount(rows)
     agree = sum(res["largest"]["first"][r["seed"]] == claim_rule_recount.stored_first(r) for r in rows)
     print(f"{len(rows)} rows; the recount with the largest move gives the stored first claim on {agree}")
@@ -65,7 +89,8 @@ def main(paths):
         firsts = " ".join(f"{name} {res[name]['first'][r['seed']] or '-':20s}" for name in STATISTICS)
         print(f"    {r['seed']} {r['category']:15s} {r['expected'] or '-':20s} SNR {r['snr'] or 0:5.1f}  {firsts}"
               f" moves (plain/level) {moves}")
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

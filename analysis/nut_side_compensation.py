@@ -6,6 +6,8 @@ lugre / dob, for the old and the new nut; prints the fluctuation rate of each an
 Run: python analysis/nut_side_compensation.py   (a few minutes on 2 cores)
 """
 
+import argparse
+
 from drakecreep.params import preset, with_value
 from drakecreep.studies.compensation import evaluate
 
@@ -31,4 +33,6 @@ def main():
 
 
 if __name__ == "__main__":
+    argparse.ArgumentParser(description=__doc__,
+                            formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -5,6 +5,7 @@ Writes to out/paper-reproduction/: table8_9.md/.csv, rows.json, fig11/fig12, sen
 Run: python analysis/paper_reproduction.py [OUT_DIR]   (about 3-4 minutes on one core)
 """
 
+import argparse
 import sys
 from pathlib import Path
 
@@ -39,5 +40,14 @@ def main(out="out/paper-reproduction"):
     (out / "sensitivity.md").write_text("\n".join(lines) + "\n")
 
 
+def cli(argv=None):
+    """Parse ``argv`` and run :func:`main`; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", nargs="?", default="out/paper-reproduction", metavar="OUT_DIR",
+                    help="output directory (default out/paper-reproduction)")
+    main(ap.parse_args(argv).out)
+    return 0
+
+
 if __name__ == "__main__":
-    main(*sys.argv[1:])
+    sys.exit(cli())

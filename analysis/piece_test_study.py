@@ -28,13 +28,13 @@ import time
 
 import numpy as np
 
-from drakecreep.errors import InputError
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from drakecreep.gap.claims import sign_flip_p
 from drakecreep.gap.drake_diagnosis import run_log_ratios
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 from drakecreep.gap.drake_replay import RUN_PIECES, piece_keys
+from study_cli import out_and_specs
 
 
 def study(seed, withheld, axis):
@@ -60,14 +60,9 @@ def study(seed, withheld, axis):
             "screen_refits": [n for n in ranking_names if n in DRAKE_EFFECTS and DRAKE_EFFECTS[n].screen_refits]}
 
 
-def main(argv):
-    try:
-        if len(argv) < 2:
-            raise InputError("arguments", " ".join(argv), "OUT.json SEED:WITHHELD:AXIS [...]")
-        out, specs = argv[0], [benchmark.dataset_spec(a) for a in argv[1:]]
-    except InputError as e:  # one line, exit 2, before any work
-        print(e, file=sys.stderr)
-        sys.exit(2)
+def main(argv=None):
+    """Run the study on each dataset of ``argv`` (every spec checked first) and write the rows; the exit status."""
+    out, specs = out_and_specs(__doc__, argv)
     rows = []
     for seed, withheld, axis in specs:
         row = study(seed, withheld, axis)
@@ -80,7 +75,8 @@ def main(argv):
                   f"p {c['piece_p_sign_flip']:.3g}", flush=True)
         write_text(out, json.dumps({"note": "piece test study on spent held-out datasets (session 40)",
                                     "pieces": RUN_PIECES, "datasets": rows}, indent=1, default=str))
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

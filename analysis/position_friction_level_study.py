@@ -15,6 +15,7 @@ Usage: ``PYTHONPATH=. python analysis/position_friction_level_study.py OUT.json 
 (``EFFECT`` is ``null`` or a withheld effect, e.g. ``3000:position_friction:rigid 14000:null``).
 """
 
+import argparse
 import json
 import sys
 
@@ -22,6 +23,7 @@ import numpy as np
 
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
+from study_cli import case_type
 
 
 def _travel(run):
@@ -54,11 +56,16 @@ def study(seed, effect, axis=None):
     return row
 
 
-def main(argv):
-    out, rows = argv[0], []
-    for item in argv[1:]:
-        seed, effect, *axis = item.split(":")
-        rows.append(study(int(seed), effect, axis[0] if axis else None))
+def main(argv=None):
+    """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
+    ap.add_argument("cases", nargs="+", type=case_type(("null",) + tuple(benchmark.T.WITHHELD), "optional", "3000:position_friction:rigid or 14000:null"), metavar="SEED:EFFECT[:AXIS]",
+                    help="a dataset: EFFECT null or a withheld effect; AXIS rigid or flexible (default: the design's)")
+    a = ap.parse_args(argv)
+    out, rows = a.out, []
+    for seed, effect, axis in a.cases:
+        rows.append(study(int(seed), effect, axis))
         r = rows[-1]
         if r["screened_out"]:
             print(f"{seed} {effect} snr {r['snr']:.1f} screened out", flush=True)
@@ -69,7 +76,8 @@ def main(argv):
                   f"thr {r['threshold']:.2f}\n  level {np.round(r['run_level_log_error_ratios'], 2)} "
                   f"thr {r['level_threshold']:.2f}\n  travel {trav}", flush=True)
         write_text(out, json.dumps({"rows": rows}, indent=1))
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

@@ -1,8 +1,13 @@
-"""The command line the development-seed studies share: ``--shard K/N --json ROWS`` runs this process's share of
-the datasets, ``--score ROWS...`` only scores stored rows."""
+"""The command lines the development-seed studies share: ``--shard K/N --json ROWS`` runs this process's share of
+the datasets, ``--score ROWS...`` only scores stored rows (:func:`shard_main`); ``OUT.json SEED:WITHHELD:AXIS...``
+names spent datasets (:func:`out_and_specs`), or ``OUT.json SEED:EFFECT[:AXIS]...`` a study's own cases
+(:func:`case_type`)."""
 
 import argparse
 import sys
+
+from drakecreep.errors import InputError
+from drakecreep.gap import benchmark
 
 
 def shard_main(description, study, score, argv=None):
@@ -28,3 +33,38 @@ def shard_main(description, study, score, argv=None):
         return 2
     study(k, n, a.json)
     return 0
+
+
+def out_and_specs(description, argv=None):
+    """``(out, specs)`` of ``OUT.json SEED:WITHHELD:AXIS [...]``, each spec read by
+    :func:`drakecreep.gap.benchmark.dataset_spec` before any work; a bad one exits 2 with its line."""
+    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
+    ap.add_argument("datasets", nargs="+", metavar="SEED:WITHHELD:AXIS",
+                    help="a spent dataset: WITHHELD null or an effect, AXIS rigid or flexible")
+    a = ap.parse_args(argv)
+    try:
+        return a.out, [benchmark.dataset_spec(d) for d in a.datasets]
+    except InputError as e:
+        ap.exit(2, f"{e}\n")
+
+
+def case_type(effects, axis, example):
+    """An argparse ``type`` reading ``SEED:EFFECT`` (``axis`` "none"), ``SEED:EFFECT:AXIS`` ("required") or
+    ``SEED:EFFECT[:AXIS]`` ("optional") into a tuple of its texts (a left-out axis None), ``EFFECT`` one of
+    ``effects``, ``SEED`` an integer >= 0, ``AXIS`` one of the truth's axes; ``example`` shows the form."""
+    counts = {"none": (2,), "required": (3,), "optional": (2, 3)}[axis]
+
+    def case(text):
+        parts = text.split(":")
+        fields = (parts + [None])[:3] if len(parts) in counts else [None, None, None]
+        seed, effect, ax = fields
+        checks = ((len(parts) in counts, f"the form of {example}"),
+                  (seed is not None and seed.isdigit(), "SEED an integer >= 0"),
+                  (effect in effects, "EFFECT one of " + ", ".join(effects)),
+                  (ax is None or ax in benchmark.T.AXES, "AXIS one of " + ", ".join(benchmark.T.AXES)))
+        for ok, allowed in checks:
+            if not ok:
+                raise argparse.ArgumentTypeError(f"got {text!r}; allowed: {allowed}")
+        return (seed, effect) if axis == "none" else (seed, effect, ax)
+    return case

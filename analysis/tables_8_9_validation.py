@@ -11,16 +11,23 @@ Run: python analysis/tables_8_9_validation.py [OUT_DIR] [--no-sensitivity]   (ab
 the library caches every simulation within the run)
 """
 
+import argparse
 import sys
 import time
 
 from drakecreep.studies.table_fluctuation import write_validation
 
 
-def main(argv):
-    out = next((a for a in argv if not a.startswith("--")), "out/tables-8-9")
+def main(argv=None):
+    """Write and print the validation of ``argv``'s options; the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 allow_abbrev=False)  # "--no" is refused, not read as --no-sensitivity
+    ap.add_argument("out", nargs="?", default="out/tables-8-9", metavar="OUT_DIR",
+                    help="output directory (default out/tables-8-9)")
+    ap.add_argument("--no-sensitivity", action="store_true", help="skip the sensitivity to each fixed shape")
+    a = ap.parse_args(argv)
     start = time.perf_counter()
-    v = write_validation(out, with_sensitivity="--no-sensitivity" not in argv)
+    v = write_validation(a.out, with_sensitivity=not a.no_sensitivity)
     exps = v["experiments"]
     print(f"{'hypothesis':28s} {'k':>2s} {'in-sample RMS %':>15s} {'held-out mean|%|':>16s} {'max|%|':>7s}  "
           + "  ".join(f"LC{e['load_case']}@{e['feed_mm_s']:g}" for e in exps) + "   AICc    BIC   amplitudes")
@@ -48,7 +55,8 @@ def main(argv):
                   f"{r['hypothesis']:28s} {r['held_out_mean_abs_percent']:6.1f}")
     print(f"\nwrote {v['paths']['validation_markdown']} and {v['paths']['validation_json']} "
           f"in {time.perf_counter() - start:.0f} s")
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())

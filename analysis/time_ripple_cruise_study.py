@@ -15,6 +15,7 @@ Usage: ``PYTHONPATH=. python analysis/time_ripple_cruise_study.py OUT.json SEED:
 (``EFFECT`` is ``null`` or a withheld effect, e.g. ``14000:null 9000:time_ripple``).
 """
 
+import argparse
 import json
 import sys
 
@@ -23,6 +24,7 @@ import numpy as np
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from drakecreep.gap.drake_replay import drake_replay
+from study_cli import case_type
 
 
 def _split_log_ratios(runs, nominal, candidate):
@@ -62,10 +64,15 @@ def study(seed, effect):
     return row
 
 
-def main(argv):
-    out, rows = argv[0], []
-    for item in argv[1:]:
-        seed, effect = item.split(":")
+def main(argv=None):
+    """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
+    ap.add_argument("cases", nargs="+", type=case_type(("null",) + tuple(benchmark.T.WITHHELD), "none", "14000:null or 9000:time_ripple"), metavar="SEED:EFFECT",
+                    help="a dataset: EFFECT null or a withheld effect")
+    a = ap.parse_args(argv)
+    out, rows = a.out, []
+    for seed, effect in a.cases:
         rows.append(study(int(seed), effect))
         r = rows[-1]
         if "test" in r:
@@ -76,7 +83,8 @@ def main(argv):
         else:
             print(f"{seed} {effect} screened out", flush=True)
         write_text(out, json.dumps({"rows": rows}, indent=1))
+    return 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main())
