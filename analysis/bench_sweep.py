@@ -23,10 +23,16 @@ Run: ``python analysis/bench_sweep.py [--cases N] [--grid N] [--duration S] [--s
 import argparse
 import math
 import os
+import sys
 import time
 
 import numpy as np
-from numba import njit
+
+try:
+    from numba import njit
+except ImportError:  # one line, not a traceback: the comparison needs the bench extra
+    print('numba: not installed; allowed: install the bench extra, pip install -e ".[bench]"', file=sys.stderr)
+    sys.exit(2)
 
 from drakecreep.sim.simulation import target_accuracy
 from drakecreep.sim.baseline import BaselineModel
