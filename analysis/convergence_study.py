@@ -29,6 +29,7 @@ def _feeds(text):
 
 
 def main(argv=None):
+    """Simulate each feed at each accuracy (every input checked first) and print the metrics; the exit status."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("law", help="friction law (friction.law of the params)")
     ap.add_argument("feeds", type=_feeds, help="comma-separated feeds, mm/s")
