@@ -36,6 +36,9 @@ from study_cli import case_type
 
 _DRAW = benchmark.T.draw_truth
 
+#: the argparse type of one dataset on the command line
+CASE = case_type(("null", "strong_mode") + tuple(benchmark.T.WITHHELD), "required", "60000:backlash:rigid")
+
 
 def band_log_ratios(runs, nominal, candidate, f):
     out = []
@@ -101,7 +104,7 @@ def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=case_type(("null", "strong_mode") + tuple(benchmark.T.WITHHELD), "required", "60000:backlash:rigid"), metavar="SEED:EFFECT:AXIS",
+    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT:AXIS",
                     help="a dataset: EFFECT null, strong_mode or a withheld effect; AXIS rigid or flexible")
     a = ap.parse_args(argv)
     out, rows = a.out, []

@@ -25,6 +25,10 @@ from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from study_cli import case_type
 
+#: the argparse type of one dataset on the command line
+CASE = case_type(("null",) + tuple(benchmark.T.WITHHELD), "optional",
+                 "3000:position_friction:rigid or 14000:null")
+
 
 def _travel(run):
     x = np.asarray(run.x_ref, dtype=float)
@@ -60,7 +64,7 @@ def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=case_type(("null",) + tuple(benchmark.T.WITHHELD), "optional", "3000:position_friction:rigid or 14000:null"), metavar="SEED:EFFECT[:AXIS]",
+    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT[:AXIS]",
                     help="a dataset: EFFECT null or a withheld effect; AXIS rigid or flexible (default: the design's)")
     a = ap.parse_args(argv)
     out, rows = a.out, []

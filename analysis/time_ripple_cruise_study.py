@@ -26,6 +26,9 @@ from drakecreep.gap import benchmark
 from drakecreep.gap.drake_replay import drake_replay
 from study_cli import case_type
 
+#: the argparse type of one dataset on the command line
+CASE = case_type(("null",) + tuple(benchmark.T.WITHHELD), "none", "14000:null or 9000:time_ripple")
+
 
 def _split_log_ratios(runs, nominal, candidate):
     out = []
@@ -68,7 +71,7 @@ def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=case_type(("null",) + tuple(benchmark.T.WITHHELD), "none", "14000:null or 9000:time_ripple"), metavar="SEED:EFFECT",
+    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT",
                     help="a dataset: EFFECT null or a withheld effect")
     a = ap.parse_args(argv)
     out, rows = a.out, []
