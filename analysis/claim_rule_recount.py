@@ -36,7 +36,8 @@ import sys
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
-from drakecreep.gap.drake_diagnosis import _claim_test, _fallback, _passes, _piece_test, _rule, null_of_moves, outranking
+from drakecreep.gap.drake_diagnosis import (_claim_test, _fallback, _passes, _piece_test, _rule, null_of_moves,
+                                            outranking)
 from drakecreep.gap.drake_replay import piece_keys
 from drakecreep.gap.drake_effects import DRAKE_EFFECTS
 
@@ -154,7 +155,8 @@ def stored_first(row):
 def main(argv=None):
     """Print each rows file's recount; the exit status (2, with one line, on a file that is not a rows file)."""
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("paths", nargs="+", metavar="JSON", help="benchmark rows files (analysis/gap_benchmark_heldout*.json)")
+    ap.add_argument("paths", nargs="+", metavar="JSON",
+                    help="benchmark rows files (analysis/gap_benchmark_heldout*.json)")
     files = {}
     for path in ap.parse_args(argv).paths:  # every file read before the first recount
         try:

@@ -215,8 +215,9 @@ class RankedEffect:
     decided on; ``level_alone``: it passes by the level test alone (``drift_robust``: :class:`ClaimTest`);
     ``fallback``: it passes by its fallback regime; ``piece_*`` and ``pieces``: its test over the held-out runs'
     pieces, when it has one (:class:`ClaimTest`); ``own_null``: its own training-run null when it was
-    decided on the smaller of that and the nominal's (:func:`_claim_test`); ``outranked_by``: a fitted candidate that did not pass but
-    whose held-out log ratio is higher, so this one is not claimed either (:func:`_outranked`)."""
+    decided on the smaller of that and the nominal's (:func:`_claim_test`); ``outranked_by``: a fitted candidate
+    that did not pass but whose held-out log ratio is higher, so this one is not claimed either
+    (:func:`_outranked`)."""
 
     fit: EffectFit | None
     gain: float
