@@ -19,7 +19,6 @@ Usage: ``PYTHONPATH=. python analysis/axial_mode_band_study.py OUT.json SEED:EFF
 withheld effect, e.g. ``60000:backlash:rigid 61000:structural_mode:flexible``).
 """
 
-import argparse
 import json
 import math
 import sys
@@ -31,7 +30,7 @@ from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from drakecreep.gap.drake_effects import axial_mode_frequency
 from drakecreep.gap.drake_replay import drake_replay
-from study_cli import case_type
+from study_cli import case_type, out_and_cases
 
 
 _DRAW = benchmark.T.draw_truth
@@ -102,13 +101,10 @@ def study(seed, effect, axis):
 
 def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT:AXIS",
-                    help="a dataset: EFFECT null, strong_mode or a withheld effect; AXIS rigid or flexible")
-    a = ap.parse_args(argv)
-    out, rows = a.out, []
-    for seed, effect, axis in a.cases:
+    out, cases = out_and_cases(__doc__, CASE, "SEED:EFFECT:AXIS",
+                               "a dataset: EFFECT null, strong_mode or a withheld effect; AXIS rigid or flexible", argv)
+    rows = []
+    for seed, effect, axis in cases:
         rows.append(study(int(seed), effect, axis))
         r = rows[-1]
         if "test" in r:

@@ -15,7 +15,6 @@ Usage: ``PYTHONPATH=. python analysis/position_friction_level_study.py OUT.json 
 (``EFFECT`` is ``null`` or a withheld effect, e.g. ``3000:position_friction:rigid 14000:null``).
 """
 
-import argparse
 import json
 import sys
 
@@ -23,7 +22,7 @@ import numpy as np
 
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
-from study_cli import case_type
+from study_cli import case_type, out_and_cases
 
 #: the argparse type of one dataset on the command line
 CASE = case_type(("null",) + tuple(benchmark.T.WITHHELD), "optional",
@@ -62,13 +61,11 @@ def study(seed, effect, axis=None):
 
 def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT[:AXIS]",
-                    help="a dataset: EFFECT null or a withheld effect; AXIS rigid or flexible (default: the design's)")
-    a = ap.parse_args(argv)
-    out, rows = a.out, []
-    for seed, effect, axis in a.cases:
+    out, cases = out_and_cases(__doc__, CASE, "SEED:EFFECT[:AXIS]",
+                               "a dataset: EFFECT null or a withheld effect; AXIS rigid or flexible "
+                               "(default: the design's)", argv)
+    rows = []
+    for seed, effect, axis in cases:
         rows.append(study(int(seed), effect, axis))
         r = rows[-1]
         if r["screened_out"]:

@@ -1,7 +1,7 @@
 """The command lines the development-seed studies share: ``--shard K/N --json ROWS`` runs this process's share of
 the datasets, ``--score ROWS...`` only scores stored rows (:func:`shard_main`); ``OUT.json SEED:WITHHELD:AXIS...``
 names spent datasets (:func:`out_and_specs`), or ``OUT.json SEED:EFFECT[:AXIS]...`` a study's own cases
-(:func:`case_type`)."""
+(:func:`out_and_cases`, :func:`case_type`)."""
 
 import argparse
 import sys
@@ -35,18 +35,31 @@ def shard_main(description, study, score, argv=None):
     return 0
 
 
+def _out_parser(description, metavar, help, type=None):
+    """A parser of ``OUT.json`` and one or more datasets named ``metavar`` (read with ``type``)."""
+    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
+    ap.add_argument("datasets", nargs="+", type=type, metavar=metavar, help=help)
+    return ap
+
+
 def out_and_specs(description, argv=None):
     """``(out, specs)`` of ``OUT.json SEED:WITHHELD:AXIS [...]``, each spec read by
     :func:`drakecreep.gap.benchmark.dataset_spec` before any work; a bad one exits 2 with its line."""
-    ap = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("datasets", nargs="+", metavar="SEED:WITHHELD:AXIS",
-                    help="a spent dataset: WITHHELD null or an effect, AXIS rigid or flexible")
+    ap = _out_parser(description, "SEED:WITHHELD:AXIS", "a spent dataset: WITHHELD null or an effect, AXIS rigid or "
+                     "flexible")
     a = ap.parse_args(argv)
     try:
         return a.out, [benchmark.dataset_spec(d) for d in a.datasets]
     except InputError as e:
         ap.exit(2, f"{e}\n")
+
+
+def out_and_cases(description, case, metavar, help, argv=None):
+    """``(out, cases)`` of ``OUT.json CASE [...]``, each case read by ``case`` (:func:`case_type`) before any work;
+    a bad one exits 2 with its line (argparse's)."""
+    a = _out_parser(description, metavar, help, type=case).parse_args(argv)
+    return a.out, a.datasets
 
 
 def case_type(effects, axis, example):

@@ -15,7 +15,6 @@ Usage: ``PYTHONPATH=. python analysis/time_ripple_cruise_study.py OUT.json SEED:
 (``EFFECT`` is ``null`` or a withheld effect, e.g. ``14000:null 9000:time_ripple``).
 """
 
-import argparse
 import json
 import sys
 
@@ -24,7 +23,7 @@ import numpy as np
 from drakecreep.files import write_text
 from drakecreep.gap import benchmark
 from drakecreep.gap.drake_replay import drake_replay
-from study_cli import case_type
+from study_cli import case_type, out_and_cases
 
 #: the argparse type of one dataset on the command line
 CASE = case_type(("null",) + tuple(benchmark.T.WITHHELD), "none", "14000:null or 9000:time_ripple")
@@ -69,13 +68,10 @@ def study(seed, effect):
 
 def main(argv=None):
     """Run the study on each dataset of ``argv`` (every one checked first); the exit status."""
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
-    ap.add_argument("cases", nargs="+", type=CASE, metavar="SEED:EFFECT",
-                    help="a dataset: EFFECT null or a withheld effect")
-    a = ap.parse_args(argv)
-    out, rows = a.out, []
-    for seed, effect in a.cases:
+    out, cases = out_and_cases(__doc__, CASE, "SEED:EFFECT",
+                               "a dataset: EFFECT null or a withheld effect", argv)
+    rows = []
+    for seed, effect in cases:
         rows.append(study(int(seed), effect))
         r = rows[-1]
         if "test" in r:
