@@ -535,7 +535,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     row = _row(ds, claimed, ranking, friction=res.params.friction.law,
                test_force_nominal=rms_force_error(res.nominal_test_errors),
                test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
-               warnings=list(res.warnings),
+               warnings=list(res.warnings), oscillation=res.oscillation,
                claimed_model={"fitted": {f.path: f.value for f in res.fitted},
                               "effects": {c.name: dict(c.values) for c in res.candidates if c.name in claimed}})
     if audit:

@@ -72,6 +72,7 @@ from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
                                          rms_force_error)
 from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
+from drakecreep.gap.residuals import oscillates_at, sustained_oscillation
 
 __all__ = [
     "FITTABLE",
@@ -215,6 +216,13 @@ class DriveDiagnosis:
     simulations : int
         Closed-loop replays run.
     seconds : float
+    oscillation : dict or None
+        When the measured training runs carry a sustained oscillation that the fitted model's replay does not
+        (:func:`drakecreep.gap.residuals.sustained_oscillation`: an unstable real loop, a stable model): its
+        ``freq_Hz``, ``rms`` and ``model_rms`` [N], ``share``, ``runs`` of ``of``, and ``reproduced_by``, the
+        computation delays the delay search tried whose replay oscillates within +-15 % of that frequency
+        (``{"path", "value", "freq_Hz", "rms", "runs"}``). Reported as unexplained: a replay sample by sample
+        cannot follow an oscillation whose phase is free, so no claim rests on it.
     """
 
     prior: DriveParams
@@ -231,6 +239,26 @@ class DriveDiagnosis:
     simulations: int = 0
     seconds: float = 0.0
     nominal: DriveParams | None = None
+    oscillation: dict | None = None
+
+    def oscillation_lines(self):
+        """Lines of text on :attr:`oscillation` (none without one)."""
+        o = self.oscillation
+        if not o:
+            return []
+        lines = [f"unexplained: the measured runs oscillate at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} "
+                 f"training runs; {o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of the force's "
+                 f"variance), the fitted model's replay {o['model_rms']:.3g} N: the real loop is unstable (or nearly) "
+                 "where the model is stable. A replay sample by sample cannot follow an oscillation whose phase is "
+                 "free, so no claim rests on it."]
+        rep = o.get("reproduced_by") or []
+        if rep:
+            lines.append("  in the model, " + "; ".join(
+                f"{r['path']} = {r['value']:g} oscillates at {r['freq_Hz']:.0f} Hz ({r['rms']:.3g} N, "
+                f"{r['runs']} of {o['of']} runs)" for r in rep))
+        elif "reproduced_by" in o:
+            lines.append("  no computation delay the search tried makes the model oscillate there")
+        return lines
 
     def summary(self):
         """Lines of text (units labelled)."""
@@ -254,7 +282,7 @@ class DriveDiagnosis:
                          f"{rms_force_error(self.test_errors):.3f} %")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
-        return lines
+        return lines + self.oscillation_lines()
 
     def save_params(self, path):
         """Write the augmented :class:`DriveParams` as YAML (:func:`drakecreep.params.save_params`)."""
@@ -280,6 +308,7 @@ class DriveDiagnosis:
             "params": params_to_dict(self.params),
             "simulations": self.simulations,
             "seconds": self.seconds,
+            "oscillation": self.oscillation,
         })
 
 
@@ -597,13 +626,17 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     return out
 
 
-def _delay_effect(runs, base, replayer, base_sims, scale):
+def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
     """The computation delay that replays the training ``runs`` best: ``({path: delay}, sse)``.
 
     A delay is not a small change of a smooth model (each whole sample shifts the command by a step), so it is
     searched, not fitted: every delay of :data:`DELAY_GRID`, then, while the best delay's nearest tried
     neighbours (the params file's delay among them) are more than a sample away, the whole samples halfway to
-    them. The params file's own delay is never the answer (it is the nominal): the best other one is."""
+    them. The params file's own delay is never the answer (it is the nominal): the best other one is.
+
+    With ``oscillation`` (the measured runs' :func:`~drakecreep.gap.residuals.sustained_oscillation`), each
+    delay whose replay oscillates within +-15 % of its frequency on most runs is appended to its
+    ``reproduced_by`` (no extra replay: the search's own)."""
     path = "controller.computation_delay"
     declared = float(base.controller.computation_delay)
     r0 = _residual(runs, base_sims, scale)
@@ -614,6 +647,8 @@ def _delay_effect(runs, base, replayer, base_sims, scale):
         for d, sims in zip(delays, _replay_many(replayer, [(runs, _with(base, {path: d})) for d in delays])):
             r = _residual(runs, sims, scale)
             tried[d] = float(r @ r)
+            if oscillation is not None:
+                _reproduces(oscillation, path, d, runs, sims)
 
     replay(DELAY_GRID)
     while True:
@@ -626,6 +661,18 @@ def _delay_effect(runs, base, replayer, base_sims, scale):
         if not new:
             return {path: best}, tried[best]
         replay(new)
+
+
+def _reproduces(oscillation, path, value, runs, sims):
+    """Append ``{path: value}`` to ``oscillation["reproduced_by"]`` when its replays ``sims`` of ``runs``
+    oscillate at the measured frequency on more than half of the runs."""
+    hits = [o for ok, o in (oscillates_at(s.force, r.dt, oscillation["freq_Hz"]) for r, s in zip(runs, sims)) if ok]
+    if 2 * len(hits) > len(runs):
+        rep = oscillation.setdefault("reproduced_by", [])
+        rep.append({"path": path, "value": float(value), "runs": len(hits),
+                    "freq_Hz": float(np.median([o["freq_Hz"] for o in hits])),
+                    "rms": float(np.median([o["rms"] for o in hits]))})
+        rep.sort(key=lambda x: x["value"])
 
 
 def _ripple_frequencies(runs, sims, k=2, pad=8):
@@ -659,8 +706,9 @@ def _ripple_frequencies(runs, sims, k=2, pad=8):
     return out
 
 
-def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
-    """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain)``."""
+def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillation=None):
+    """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain)``
+    (``oscillation``: :func:`_delay_effect`'s)."""
     scale = _force_scale(runs)
     if name in _PERIODIC:  # the lead error over the lead's harmonics, the ripple at the residual's peaks
         if name == "lead_error":
@@ -689,7 +737,7 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev):
     elif name == "control_delay":
         if not base.controller.sampled:
             return None, 0.0  # a continuous controller has no computation delay
-        values, sse = _delay_effect(runs, base, replayer, base_sims, scale)
+        values, sse = _delay_effect(runs, base, replayer, base_sims, scale, oscillation)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
@@ -807,11 +855,17 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     if names:
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %"))
     base_sims = replay(train, params)
+    oscillation = sustained_oscillation([r.force for r in train], [s.force for s in base_sims], train[0].dt)
+    if oscillation is not None:
+        say(f"the measured runs oscillate at {oscillation['freq_Hz']:.0f} Hz ({oscillation['runs']} of "
+            f"{oscillation['of']}), the fitted model does not")
+        if "control_delay" in names and params.controller.sampled:
+            oscillation["reproduced_by"] = []
     candidates = []
     for name in names:
         if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):
             continue  # already fitted as uncertain
-        values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev)
+        values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation)
         if values is None:
             continue
         if not values:
@@ -845,4 +899,4 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
                           replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0,
-                          nominal=params)
+                          nominal=params, oscillation=oscillation)

@@ -10,7 +10,9 @@ decomposes what it still does not explain, measured force minus replayed force, 
 * ``independence``: the residual-input independence test of system identification (cross-correlation of the
   residual with the reference speed and the known external force, with a 99 % family-wise band): a residual
   correlated with an input is a model error, not noise;
-* ``split``: for runs with a linear scale (``x_table``), the position gap before or after the screw.
+* ``split``: for runs with a linear scale (``x_table``), the position gap before or after the screw;
+* ``oscillation``: a sustained oscillation of the measured force that the replay lacks (an unstable real loop,
+  :func:`~drakecreep.gap.residuals.sustained_oscillation`), or None.
 
 ``diagnose_drake`` stores it as :attr:`~drakecreep.gap.drake_diagnosis.DrakeDiagnosis.where` ("unexplained":
 what is left after the claimed effects, and where).
@@ -21,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from drakecreep.gap.drake_replay import make_replay
-from drakecreep.gap.residuals import classify_regimes, frequency_bands, independence, motor_table_split, regime_shares
+from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, regime_shares,
+                                      sustained_oscillation)
 
 __all__ = ["where_gap", "where_lines"]
 
@@ -48,10 +51,12 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         ``regimes`` (:func:`~drakecreep.gap.residuals.regime_shares` over all runs), ``bands``
         (:func:`~drakecreep.gap.residuals.frequency_bands`), ``independence`` (per input: ``max_abs``, ``band``,
         ``lag_of_max`` [samples], ``independent``, worst over the runs), ``split`` (per run with a scale), and
-        ``force_rms_N`` of the residual; ``diverged``: the labels of runs whose replay diverged (non-finite), left
-        out of the rest (all of them: no regimes, bands or independence, and ``force_rms_N`` NaN).
+        ``force_rms_N`` of the residual, ``oscillation``
+        (:func:`~drakecreep.gap.residuals.sustained_oscillation` of the measured and replayed force, or None);
+        ``diverged``: the labels of runs whose replay diverged (non-finite), left out of the rest (all of them: no
+        regimes, bands or independence, ``force_rms_N`` NaN and ``oscillation`` None).
     """
-    residuals, labels, tests, split, diverged = [], [], {}, {}, []
+    residuals, labels, tests, split, diverged, forces = [], [], {}, {}, [], ([], [])
     for run in runs:
         sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters)
         e = run.force - sim.force
@@ -59,6 +64,8 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
             diverged.append(run.label)
             continue
         residuals.append(e)
+        forces[0].append(run.force)
+        forces[1].append(sim.force)
         labels.append(classify_regimes(run.t, run.x_ref, np.gradient(run.x_motor, run.dt)))
         inputs = {"reference speed": np.gradient(run.x_ref, run.dt)}
         if run.f_ext is not None and np.any(run.f_ext):
@@ -76,11 +83,11 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
                        "independent": all(r["independent"] for r in results), "run": worst["run"]}
     if not residuals:
         return {"regimes": {}, "bands": None, "independence": {}, "split": {}, "force_rms_N": float("nan"),
-                "diverged": diverged}
+                "diverged": diverged, "oscillation": None}
     flat = np.concatenate(residuals)
     return {"regimes": regime_shares(flat, np.concatenate(labels)), "bands": frequency_bands(residuals, runs[0].dt),
             "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2))),
-            "diverged": diverged}
+            "diverged": diverged, "oscillation": sustained_oscillation(*forces, runs[0].dt)}
 
 
 def where_lines(where):
@@ -105,4 +112,10 @@ def where_lines(where):
     for label, s in where["split"].items():
         lines.append(f"  {label}: position gap {s['where']} (motor {1e6 * s['motor_rms_m']:.3g} um rms, "
                      f"transmission {1e6 * s['transmission_rms_m']:.3g} um rms)")
+    o = where.get("oscillation")
+    if o:
+        lines.append(f"  the measured force oscillates at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} runs, "
+                     f"{o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of its variance), the model's "
+                     f"replay {o['model_rms']:.3g} N: an unstable real loop where the model is stable; a replay "
+                     "sample by sample cannot follow its free phase")
     return lines

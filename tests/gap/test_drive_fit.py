@@ -107,6 +107,32 @@ def test_control_delay_is_found_between_the_grid_points(delay_case):
     assert result.params.controller.computation_delay == 5.0
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.test_errors) < 0.2 * rms(result.nominal_test_errors)
+    assert result.oscillation is None  # a stable loop with a larger delay: no sustained oscillation
+
+
+def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
+    """Truth: a computation delay of 24 samples, past the rig's stability limit (20-24): the measured force
+    oscillates at about 30 Hz, and the model (params file 1 sample; the delay grid ends at 16) does not. The
+    diagnosis says so and claims nothing on samples of an oscillation whose phase is free; a replay of the
+    model with the truth's delay is recognised as oscillating there."""
+    truth = with_value(RIG, "controller.computation_delay", 24.0)
+    runs = _runs(truth, seed=6)
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=("control_delay",))
+    o = result.oscillation
+    assert o is not None and o["runs"] == o["of"] == 2
+    assert 20.0 < o["freq_Hz"] < 40.0 and o["share"] > 0.5 and o["rms"] > 10 * o["model_rms"]
+    assert o["reproduced_by"] == [] and result.claimed == ()
+    text = "\n".join(result.summary())
+    assert f"oscillate at {o['freq_Hz']:.0f} Hz" in text and "no computation delay the search tried" in text
+    assert result.to_json()["oscillation"]["freq_Hz"] == o["freq_Hz"]
+    sims = [drive_fit.replay_drakecreep(r, truth) for r in runs[:2]]
+    seen = dict(o)
+    drive_fit._reproduces(seen, "controller.computation_delay", 24.0, runs[:2], sims)
+    (rep,) = seen["reproduced_by"]
+    assert rep["value"] == 24.0 and abs(rep["freq_Hz"] - o["freq_Hz"]) <= 0.15 * o["freq_Hz"]
+    drive_fit._reproduces(seen, "controller.computation_delay", 1.0, runs[:2],
+                          [drive_fit.replay_drakecreep(r, RIG) for r in runs[:2]])
+    assert len(seen["reproduced_by"]) == 1  # the params file's own (stable) delay does not oscillate
 
 
 def test_a_declared_lead_error_is_replaced_not_added_to():
@@ -169,6 +195,7 @@ def test_null_dataset_makes_no_claim():
     (seal,) = result.fitted
     assert seal.contains(RIG.table.seal_force)
     assert result.params.disturbance == RIG.disturbance
+    assert result.oscillation is None
 
 
 def test_switch_candidates_find_the_nut_drag_on_the_screw():

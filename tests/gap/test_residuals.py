@@ -6,9 +6,12 @@ from drakecreep.gap.benchmark import out_and_back
 from drakecreep.gap.residuals import (
     REGIMES,
     classify_regimes,
+    dominant_oscillation,
     operating_map,
+    oscillates_at,
     order_spectrum,
     regime_shares,
+    sustained_oscillation,
     time_spectrum,
     whiteness,
 )
@@ -118,3 +121,37 @@ def test_motor_table_split():
     before = motor_table_split(x + 2e-6 * np.sin(2 * np.pi * 3 * t), x + 2e-6 * np.sin(2 * np.pi * 3 * t), sim)
     assert after["where"] == "after the screw" and after["after_screw_share"] > 0.99
     assert before["where"] == "before the screw" and before["after_screw_share"] < 0.01
+
+
+def _oscillating(freq=160.0, amp=50.0, n=2000, dt=1e-3, seed=0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    slow = 20.0 * np.sin(2 * np.pi * 0.5 * t)  # the motion's own force, well below 20 Hz
+    return slow + amp * np.sin(2 * np.pi * freq * t + 0.3) + rng.normal(0.0, 1.0, n), slow + rng.normal(0.0, 1.0, n)
+
+
+def test_dominant_oscillation_finds_a_limit_cycle_and_its_share():
+    measured, quiet = _oscillating()
+    o = dominant_oscillation(measured, 1e-3)
+    assert abs(o["freq_Hz"] - 160.0) < 4.0
+    assert o["rms"] == pytest.approx(50.0 / np.sqrt(2), rel=0.1)
+    assert 0.75 < o["share"] < 0.9  # 1250 of 1250 + 200 + 1 N^2
+    with pytest.raises(InputError, match="dt"):
+        dominant_oscillation(measured, 0.0)
+    with pytest.raises(InputError, match="f_min"):
+        dominant_oscillation(measured, 1e-3, f_min=600.0)
+
+
+def test_sustained_oscillation_only_when_the_replay_lacks_it_and_it_dominates():
+    measured, quiet = _oscillating()
+    o = sustained_oscillation([measured, measured], [quiet, quiet], 1e-3)
+    assert o["runs"] == o["of"] == 2 and abs(o["freq_Hz"] - 160.0) < 4.0 and o["model_rms"] < 2.0
+    assert sustained_oscillation([measured], [measured[::-1]], 1e-3) is None  # the replay oscillates too
+    ripple, _ = _oscillating(freq=23.0, amp=5.0)  # a force ripple: 12.5 of 213 N^2, not a limit cycle
+    assert sustained_oscillation([ripple], [quiet], 1e-3) is None
+    assert sustained_oscillation([quiet], [quiet], 1e-3) is None
+    with pytest.raises(InputError, match="simulated"):
+        sustained_oscillation([measured], [], 1e-3)
+    ok, osc = oscillates_at(measured, 1e-3, 150.0)
+    assert ok and abs(osc["freq_Hz"] - 160.0) < 4.0
+    assert not oscillates_at(measured, 1e-3, 100.0)[0] and not oscillates_at(quiet, 1e-3, 160.0)[0]

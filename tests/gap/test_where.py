@@ -73,3 +73,13 @@ def test_runs_whose_replay_diverged_are_named_and_left_out(runs, monkeypatch):
     assert gone["bands"] is None and math.isnan(gone["force_rms_N"])
     assert where_lines(gone) == [f"unexplained: not located (the model's replay diverged on held-out run "
                                  f"{runs[1].label})"]
+
+
+def test_a_measured_oscillation_the_replay_lacks_is_named_with_its_frequency(runs):
+    """The same runs with a 150 N oscillation at 160 Hz on the measured force (as an unstable real loop would
+    show): located by its frequency; the true model on the plain runs shows none."""
+    assert where_gap(runs, TRUTH)["oscillation"] is None
+    shaken = [dataclasses.replace(r, u=r.u + 150.0 / r.u_gain * np.sin(2 * np.pi * 160.0 * r.t)) for r in runs]
+    o = where_gap(shaken, TRUTH)["oscillation"]
+    assert o["runs"] == o["of"] == len(runs) and abs(o["freq_Hz"] - 160.0) < 0.15 * 160.0
+    assert "the measured force oscillates at" in "\n".join(where_lines(where_gap(shaken, TRUTH)))
