@@ -73,6 +73,7 @@ from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, 
                                          rms_force_error)
 from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 from drakecreep.gap.residuals import oscillates_at, sustained_oscillation
+from drakecreep.gap.where import oscillation_line
 
 __all__ = [
     "FITTABLE",
@@ -246,11 +247,7 @@ class DriveDiagnosis:
         o = self.oscillation
         if not o:
             return []
-        lines = [f"unexplained: the measured runs oscillate at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} "
-                 f"training runs; {o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of the force's "
-                 f"variance), the fitted model's replay {o['model_rms']:.3g} N: the real loop is unstable (or nearly) "
-                 "where the model is stable. A replay sample by sample cannot follow an oscillation whose phase is "
-                 "free, so no claim rests on it."]
+        lines = ["unexplained: " + oscillation_line(o, "training runs")]
         rep = o.get("reproduced_by") or []
         if rep:
             lines.append("  in the model, " + "; ".join(

@@ -26,7 +26,7 @@ from drakecreep.gap.drake_replay import make_replay
 from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, regime_shares,
                                       sustained_oscillation)
 
-__all__ = ["where_gap", "where_lines"]
+__all__ = ["where_gap", "where_lines", "oscillation_line"]
 
 
 def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
@@ -112,10 +112,16 @@ def where_lines(where):
     for label, s in where["split"].items():
         lines.append(f"  {label}: position gap {s['where']} (motor {1e6 * s['motor_rms_m']:.3g} um rms, "
                      f"transmission {1e6 * s['transmission_rms_m']:.3g} um rms)")
-    o = where.get("oscillation")
-    if o:
-        lines.append(f"  the measured force oscillates at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} runs, "
-                     f"{o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of its variance), the model's "
-                     f"replay {o['model_rms']:.3g} N: an unstable real loop where the model is stable; a replay "
-                     "sample by sample cannot follow its free phase")
+    if where.get("oscillation"):
+        lines.append("  " + oscillation_line(where["oscillation"], "held-out runs"))
     return lines
+
+
+def oscillation_line(oscillation, runs="runs"):
+    """One sentence on a :func:`~drakecreep.gap.residuals.sustained_oscillation` (edge units: Hz, N, %), of the
+    ``runs`` it was found on (e.g. ``"held-out runs"``)."""
+    o = oscillation
+    return (f"the measured force oscillates at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} {runs}; "
+            f"{o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of the force's variance), the model's "
+            f"replay {o['model_rms']:.3g} N: the real loop is unstable (or nearly) where the model is stable. A "
+            "replay sample by sample cannot follow an oscillation whose phase is free, so no claim rests on it.")

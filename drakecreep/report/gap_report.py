@@ -11,6 +11,7 @@ import numpy as np
 from drakecreep.files import to_jsonable
 from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
+from drakecreep.gap.where import oscillation_line
 
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
 
@@ -362,6 +363,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
             parts.append("<p>Residual-input independence (cross-correlation over ±25 samples against a 99 % "
                          "family-wise band; a residual correlated with an input is a model error, not noise):</p>")
             parts.append(table(["input", "independent", "largest |r|", "band", "at lag [samples]", "worst run"], rows))
+        if where.get("oscillation"):
+            parts.append(f"<p><b>Unstable?</b> {escape(oscillation_line(where['oscillation'], 'held-out runs'))}</p>")
         if where["split"]:
             parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
                                [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]

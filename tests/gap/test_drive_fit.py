@@ -123,7 +123,7 @@ def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
     assert 20.0 < o["freq_Hz"] < 40.0 and o["share"] > 0.5 and o["rms"] > 10 * o["model_rms"]
     assert o["reproduced_by"] == [] and result.claimed == ()
     text = "\n".join(result.summary())
-    assert f"oscillate at {o['freq_Hz']:.0f} Hz" in text and "no computation delay the search tried" in text
+    assert f"oscillates at {o['freq_Hz']:.0f} Hz" in text and "no computation delay the search tried" in text
     assert result.to_json()["oscillation"]["freq_Hz"] == o["freq_Hz"]
     sims = [drive_fit.replay_drakecreep(r, truth) for r in runs[:2]]
     seen = dict(o)
