@@ -135,6 +135,22 @@ def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
     assert len(seen["reproduced_by"]) == 1  # the params file's own (stable) delay does not oscillate
 
 
+def test_a_stribeck_hump_is_found_from_a_params_file_whose_curve_is_flat(monkeypatch):
+    """Truth: Fs/Fc 1.8 with a Stribeck velocity of 8 mm/s; the params file says 1.03 at 1.2 mm/s, a hump the
+    runs (20-35 mm/s) hardly feel, so the fit from it has no gradient. From the best of the starts
+    (``STRIBECK_STARTS``) the fit lands on the truth; from the params file's curve alone it does not."""
+    flat = with_value(with_value(RIG, "friction.static_ratio", 1.03), "friction.stribeck_velocity", 1.2e-3)
+    truth = with_value(with_value(RIG, "friction.static_ratio", 1.8), "friction.stribeck_velocity", 8e-3)
+    runs = simulated_runs(truth, SPEEDS, declared=flat, n=N, noise=NOISE, seed=700)
+    (c,) = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=("stribeck",)).candidates
+    assert c.values["friction.static_ratio"] == pytest.approx(1.8, rel=0.05)
+    assert c.values["friction.stribeck_velocity"] == pytest.approx(8e-3, rel=0.1)
+    assert c.train_gain > 0.9 and c.gain > c.threshold
+    monkeypatch.setattr(drive_fit, "STRIBECK_STARTS", ())
+    (alone,) = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=("stribeck",)).candidates
+    assert alone.values["friction.static_ratio"] < 1.2 and alone.train_gain < 0.5
+
+
 def test_a_declared_lead_error_is_replaced_not_added_to():
     """The params file declares 0.5 um at phase 0, the rig has 2 um at -0.7 rad: the candidate fits the error
     about none (a linearisation about the declared one put 1.74 um at 0.54 rad for 2 um at 1.0 rad on a
