@@ -151,6 +151,25 @@ def test_a_stribeck_hump_is_found_from_a_params_file_whose_curve_is_flat(monkeyp
     assert alone.values["friction.static_ratio"] < 1.2 and alone.train_gain < 0.5
 
 
+def test_a_stribeck_hump_is_fitted_with_the_friction_level_the_nominal_raised_for_it():
+    """The same hump with the seal force uncertain: the nominal fit raises it (to about 23 N of the truth's 4 N) to
+    absorb the hump; the Stribeck candidate refits it with its curve, is claimed, and the final model has the
+    truth's curve and seal force."""
+    flat = with_value(with_value(RIG, "friction.static_ratio", 1.03), "friction.stribeck_velocity", 1.2e-3)
+    truth = with_value(with_value(RIG, "friction.static_ratio", 1.8), "friction.stribeck_velocity", 8e-3)
+    runs = simulated_runs(truth, SPEEDS + (0.028,), declared=flat, n=N, noise=NOISE, seed=710)
+    res = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=("stribeck",))
+    assert res.nominal.table.seal_force > 3 * RIG.table.seal_force
+    (c,) = res.candidates
+    assert c.values["table.seal_force"] < 1.5 * RIG.table.seal_force
+    assert res.claimed == ("stribeck",)
+    assert res.params.friction.static_ratio == pytest.approx(1.8, rel=0.05)
+    assert res.params.friction.stribeck_velocity == pytest.approx(8e-3, rel=0.1)
+    assert res.params.table.seal_force == pytest.approx(RIG.table.seal_force, rel=0.1)
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(res.test_errors) < 0.2 * rms(res.nominal_test_errors)
+
+
 def test_a_declared_lead_error_is_replaced_not_added_to():
     """The params file declares 0.5 um at phase 0, the rig has 2 um at -0.7 rad: the candidate fits the error
     about none (a linearisation about the declared one put 1.74 um at 0.54 rad for 2 um at 1.0 rad on a
