@@ -71,9 +71,9 @@ from drakecreep.gap.claims import ALPHA, replay_test
 from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
                                          rms_force_error)
-from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 from drakecreep.gap.residuals import oscillates_at, sustained_oscillation
 from drakecreep.gap.where import oscillation_line
+from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 
 __all__ = [
     "FITTABLE",
@@ -112,14 +112,15 @@ _STEP = 0.1
 _BOUND = 4.0
 #: Largest leave-one-out step of a fitted field in the fit's log coordinate (a factor e).
 _TRUST = 1.0
-#: Trials of the Stribeck candidate's start besides the params file's own curve (:func:`_stribeck_start` scales
-#: each hump by a line search): ``(static_ratio, stribeck_velocity [m/s])``, Fs/Fc 1.5 (FrictionParams' default) at
-#: a log grid of Stribeck velocities over the
-#: rolling elements' 0.01-1 mm/s of the presets' source (Armstrong-Helouvry et al., Automatica 1994) and a decade
-#: above it for sliding contacts (guide seals). A Stribeck hump far below the data's speeds has no gradient: from a
-#: params file whose curve is nearly flat (Fs/Fc 1.03 at 1.2 mm/s) four Gauss-Newton steps moved it to 1.04 at
-#: 1.6 mm/s on development seed 1100 (truth 1.83 at 8.7 mm/s).
+#: Trials of the Stribeck candidate's start besides the nominal's own curve (:func:`_stribeck_start` scales each
+#: hump by a line search): ``(static_ratio, stribeck_velocity [m/s])``, Fs/Fc 1.5 (FrictionParams' default) at a
+#: log grid of Stribeck velocities over the rolling elements' 0.01-1 mm/s of the presets' source
+#: (Armstrong-Helouvry et al., Automatica 1994) and a decade above it for sliding contacts (guide seals). A hump
+#: far below the data's speeds has no gradient: from a params file whose curve is nearly flat (Fs/Fc 1.03 at
+#: 1.2 mm/s) four Gauss-Newton steps moved it to 1.04 at 1.6 mm/s on development seed 1100 (truth 1.83 at 8.7 mm/s).
 STRIBECK_STARTS = ((1.5, 1e-4), (1.5, 1e-3), (1.5, 1e-2))
+#: Largest static ratio the line search of :func:`_stribeck_start` may give (Fs/Fc of 4: far above any lubricated
+#: contact; the fit may still move beyond it).
 _STRIBECK_MAX_RATIO = 4.0
 #: Lead-error periods tried: the lead divided by these harmonics.
 LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
@@ -714,8 +715,9 @@ def _ripple_frequencies(runs, sims, k=2, pad=8):
 
 
 def _stribeck_start(runs, base, start, replayer, base_sims, scale):
-    """Where the Stribeck fit starts: ``start`` (the params file's curve) or, at each Stribeck velocity of
-    :data:`STRIBECK_STARTS`, the static ratio that a line search along its hump gives (one replay each).
+    """Where the Stribeck fit starts: ``start`` (the nominal's curve, its ratio at least 1.2) or, at each Stribeck
+    velocity of :data:`STRIBECK_STARTS`, the static ratio that a line search along its hump gives (one replay
+    each).
 
     At a Stribeck velocity ``v_s`` the hump scales nearly linearly with ``Fs/Fc - 1``: with ``d`` the change of
     the training residual from ``base`` to the trial ratio, the best scale is ``a = -(d . r0) / (d . d)``, the
