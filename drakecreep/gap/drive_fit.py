@@ -647,6 +647,8 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
     ``reproduced_by`` (no extra replay: the search's own)."""
     path = "controller.computation_delay"
     declared = float(base.controller.computation_delay)
+    if oscillation is not None:  # searched: an empty list says that no delay tried oscillates there
+        oscillation.setdefault("reproduced_by", [])
     r0 = _residual(runs, base_sims, scale)
     tried = {declared: float(r0 @ r0)}
 
@@ -672,11 +674,11 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
 
 
 def _reproduces(oscillation, path, value, runs, sims):
-    """Append ``{path: value}`` to ``oscillation["reproduced_by"]`` when its replays ``sims`` of ``runs``
+    """Append ``{path: value}`` to ``oscillation["reproduced_by"]`` (a list) when its replays ``sims`` of ``runs``
     oscillate at the measured frequency on more than half of the runs."""
     hits = [o for ok, o in (oscillates_at(s.force, r.dt, oscillation["freq_Hz"]) for r, s in zip(runs, sims)) if ok]
     if 2 * len(hits) > len(runs):
-        rep = oscillation.setdefault("reproduced_by", [])
+        rep = oscillation["reproduced_by"]
         rep.append({"path": path, "value": float(value), "runs": len(hits),
                     "freq_Hz": float(np.median([o["freq_Hz"] for o in hits])),
                     "rms": float(np.median([o["rms"] for o in hits]))})
@@ -906,8 +908,6 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     if oscillation is not None:
         say(f"the measured runs oscillate at {oscillation['freq_Hz']:.0f} Hz ({oscillation['runs']} of "
             f"{oscillation['of']}), the fitted model does not")
-        if "control_delay" in names and params.controller.sampled:
-            oscillation["reproduced_by"] = []
     candidates = []
     for name in names:
         if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):

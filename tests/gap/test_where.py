@@ -80,6 +80,7 @@ def test_a_measured_oscillation_the_replay_lacks_is_named_with_its_frequency(run
     show): located by its frequency; the true model on the plain runs shows none."""
     assert where_gap(runs, TRUTH)["oscillation"] is None
     shaken = [dataclasses.replace(r, u=r.u + 150.0 / r.u_gain * np.sin(2 * np.pi * 160.0 * r.t)) for r in runs]
-    o = where_gap(shaken, TRUTH)["oscillation"]
+    w = where_gap(shaken, TRUTH)
+    o = w["oscillation"]
     assert o["runs"] == o["of"] == len(runs) and abs(o["freq_Hz"] - 160.0) < 0.15 * 160.0
-    assert "the measured force oscillates at" in "\n".join(where_lines(where_gap(shaken, TRUTH)))
+    assert "the measured force oscillates at" in "\n".join(where_lines(w))
