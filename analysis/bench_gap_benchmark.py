@@ -80,6 +80,21 @@ def report(res):
               f"claimed {f(e.get('claimed'))} true {f(e.get('true'))}  {r['seconds']:.0f} s")
 
 
+def _read_rows(ap, option, path):
+    """The parsed rows file ``path`` given to ``option``, or one line naming what is wrong with it (exit 2)."""
+    try:
+        with open(path) as fh:
+            data = json.load(fh)
+    except OSError as err:
+        ap.error(f"{option}: cannot read {path!r} ({err.strerror}); allowed: a rows file written by --json")
+    except ValueError as err:
+        ap.error(f"{option}: {path!r} is not JSON ({err}); allowed: a rows file written by --json")
+    if not isinstance(data, dict) or not isinstance(data.get("datasets"), list) \
+            or not all(isinstance(r, dict) and "seed" in r for r in data["datasets"]):
+        ap.error(f"{option}: {path!r} has no list of dataset rows with seeds; allowed: a rows file written by --json")
+    return data
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-per-effect", type=int, default=3, help="diagnosed datasets per library effect with SNR >= 3")
@@ -101,10 +116,11 @@ def main():
                                      "not diagnosed again")
     args = ap.parse_args()
     if args.score:
-        data = {"datasets": []}
+        by_seed = {}  # a resumed shard repeats the rows it resumed from: each dataset is scored once
         for path in args.score:
-            with open(path) as fh:
-                data["datasets"] += json.load(fh)["datasets"]
+            for row in _read_rows(ap, "--score", path)["datasets"]:
+                by_seed[row["seed"]] = row
+        data = {"datasets": list(by_seed.values())}
         data["scores"] = score_rows(data["datasets"])
         report(data)
         return
@@ -122,8 +138,7 @@ def main():
             ap.error(str(err))
     done = []
     if args.resume:
-        with open(args.resume) as fh:
-            earlier = json.load(fh)
+        earlier = _read_rows(ap, "--resume", args.resume)
         if earlier.get("seed") != seed:
             raise SystemExit(f"--resume: {args.resume} has seeds from {earlier.get('seed')}; this run's are from {seed}")
         done = earlier["datasets"]

@@ -35,3 +35,33 @@ def test_each_script_parses_its_arguments(path):
     tree = ast.parse(path.read_text())
     assert _parses_arguments(tree), f"{path.name}: --help would run the job (no argparse)"
     assert not _indexes_argv(tree), f"{path.name}: reads sys.argv[...] itself"
+
+
+def _bench(*args, cwd):
+    import os
+    import subprocess
+    import sys
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    return subprocess.run([sys.executable, str(ANALYSIS / "bench_gap_benchmark.py"), *args], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once(tmp_path):
+    import json
+    missing = _bench("--resume", str(tmp_path / "none.json"), cwd=tmp_path)
+    assert missing.returncode == 2 and "Traceback" not in missing.stderr
+    assert missing.stderr.strip().splitlines()[-1].endswith(
+        "error: --resume: cannot read '%s' (No such file or directory); allowed: a rows file written by --json"
+        % (tmp_path / "none.json"))
+    (tmp_path / "bad.json").write_text('{"datasets": [1]}')
+    bad = _bench("--score", str(tmp_path / "bad.json"), cwd=tmp_path)
+    assert bad.returncode == 2 and "--score" in bad.stderr and "Traceback" not in bad.stderr
+    rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
+    data = json.loads(rows.read_text())
+    (tmp_path / "a.json").write_text(json.dumps(dict(data, datasets=data["datasets"][:2])))
+    (tmp_path / "b.json").write_text(json.dumps(data))  # resumed from a.json: it repeats a.json's rows
+    once = _bench("--score", str(rows), cwd=tmp_path)
+    scored = _bench("--score", str(tmp_path / "a.json"), str(tmp_path / "b.json"), cwd=tmp_path)
+    assert once.returncode == 0 and scored.returncode == 0, scored.stderr
+    assert scored.stdout == once.stdout
+    assert f"(n={sum(r['category'] == 'null' for r in data['datasets'])})" in once.stdout
