@@ -444,9 +444,12 @@ class DisturbanceParams(_Params):
     """Periodic disturbances of a real rig that the base model leaves out; all amplitudes 0 = off.
 
     ``lead_error``: a kinematic error of the screw-nut pair, the nut advancing
-    ``x + a sin(2 pi x / period + phase)`` for a travel ``x = theta Ph / 2 pi`` (lead-error harmonic,
-    ball-passage waviness); the motor encoder cannot see it. The error is fixed to the screw: ``phase`` is its
-    phase at the screw position a measured run's ``x_motor`` counts from; a simulation starts there.
+    ``x + a sin(2 pi x / period + phase) + a2 sin(4 pi x / period + phase2)`` for a travel
+    ``x = theta Ph / 2 pi`` (a lead-error harmonic and its second harmonic, ball-passage waviness); the motor
+    encoder cannot see it. The error is fixed to the screw: ``phase`` and ``phase2`` are its phases at the screw
+    position a measured run's ``x_motor`` counts from; a simulation starts there. The drive force of a lead
+    error grows with the square of its order, so a second harmonic of a quarter of the fundamental's amplitude
+    pushes the table as hard as the fundamental.
     ``load_ripple``: the axial load of the load case (the paper's air cylinders) pulsates as
     ``Fx (1 + r sin(2 pi f t + ripple_phase))``; ``force_ripple`` adds ``-A sin(2 pi f t + ripple_phase)`` to the
     push on the table. See
@@ -459,11 +462,21 @@ class DisturbanceParams(_Params):
     )
     lead_error_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                                  doc="phase of the lead error at the screw's position 0")
+    lead_error_2_amplitude: float = _q(0.0, "m", 0.0, 1e-3,
+                                       doc="amplitude a2 of the lead error's second harmonic (travel period "
+                                           "lead_error_period / 2)")
+    lead_error_2_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
+                                   doc="phase of the lead error's second harmonic at the screw's position 0")
     force_ripple: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude A of a fixed-frequency force ripple on the table")
     load_ripple: float = _q(0.0, "-", 0.0, 1.0, doc="relative amplitude r of the axial load pulsation")
     ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")
     ripple_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                              doc="phase of both ripples at t = 0, a simulation's start (a replayed run's first sample)")
+
+    @property
+    def has_lead_error(self):
+        """Whether either harmonic of the lead error is switched on."""
+        return self.lead_error_amplitude > 0.0 or self.lead_error_2_amplitude > 0.0
 
 
 #: friction compensation methods (:mod:`drakecreep.studies.compensation`)

@@ -881,12 +881,15 @@ def _lead_error_at(params, x_origin):
     """``params`` with the lead error's phase moved from the screw's position 0 to ``x_origin`` [m] (the run's
     first motor position, where the replayed diagram starts): the error is fixed to the screw, not to the run."""
     d = params.disturbance
-    if not d.lead_error_amplitude > 0.0 or x_origin == 0.0:
+    if not d.has_lead_error or x_origin == 0.0:
         return params
     from drakecreep.params import with_value
 
-    phase = math.remainder(d.lead_error_phase + 2.0 * math.pi * x_origin / d.lead_error_period, 2.0 * math.pi)
-    return with_value(params, "disturbance.lead_error_phase", phase)
+    turn = 2.0 * math.pi * x_origin / d.lead_error_period
+    params = with_value(params, "disturbance.lead_error_phase", math.remainder(d.lead_error_phase + turn,
+                                                                                2.0 * math.pi))
+    return with_value(params, "disturbance.lead_error_2_phase", math.remainder(d.lead_error_2_phase + 2.0 * turn,
+                                                                                2.0 * math.pi))
 
 
 def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="compiled"):

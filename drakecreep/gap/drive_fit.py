@@ -129,11 +129,15 @@ LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
 _PERIODIC = {"lead_error": ("disturbance.lead_error_amplitude", "disturbance.lead_error_period",
                             "disturbance.lead_error_phase"),
              "force_ripple": ("disturbance.force_ripple", "disturbance.ripple_frequency", "disturbance.ripple_phase")}
+#: The lead error's second harmonic (period ``disturbance.lead_error_period / 2``): amplitude and phase.
+_LEAD_SECOND = ("disturbance.lead_error_2_amplitude", "disturbance.lead_error_2_phase")
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
-_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude",), "force_ripple": ("disturbance.force_ripple",)}
+_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _LEAD_SECOND[0]),
+               "force_ripple": ("disturbance.force_ripple",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
-    "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k)",
+    "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
+                  "with its second harmonic, lead_error_2_amplitude and _phase)",
     "force_ripple": "force ripple on the table at a fixed frequency (disturbance.force_ripple, ripple_frequency and "
                     "ripple_phase: its phase at each run's first sample)",
     "stribeck": "velocity weakening: the Stribeck law with fitted friction.static_ratio and stribeck_velocity",
@@ -575,7 +579,8 @@ def _replay_many(replayer, jobs):
 def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scale):
     """A periodic effect's period (or frequency), amplitude and phase: ``(values, sse)``.
 
-    ``paths``: the amplitude, grid (period or frequency) and phase fields. To first order the residual is linear
+    ``paths``: the amplitude, grid (period or frequency) and phase fields (the grid field ``None`` with
+    ``grid = [None]``: the period is ``base``'s). To first order the residual is linear
     in the quadratures ``(a cos phi, a sin phi)``: two replays per grid value at a trial amplitude (``phi`` = 0 and
     pi / 2) give its two slopes, linear least squares the optimum; about the best grid value's optimum one
     Gauss-Newton step in the quadratures refines it (three replays), kept if its measured SSE is lower; an answer
@@ -586,7 +591,10 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
         base = _with(base, {amp: 0.0})
         base_sims = replayer(runs, base)
     r0 = _residual(runs, base_sims, scale)
-    jobs = [(runs, _with(base, {grid_path: g, amp: trial, phase: ph})) for g in grid for ph in (0.0, 0.5 * math.pi)]
+    def at(g, values):  # the grid value with ``values``
+        return dict(values, **({} if grid_path is None else {grid_path: g}))
+
+    jobs = [(runs, _with(base, at(g, {amp: trial, phase: ph}))) for g in grid for ph in (0.0, 0.5 * math.pi)]
     sims = _replay_many(replayer, jobs)
     best = None
     for i, g in enumerate(grid):
@@ -604,7 +612,7 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     _, g, q1 = best
 
     def residual_at(q):  # q: the quadratures (a cos phi, a sin phi)
-        values = {grid_path: g, amp: float(math.hypot(*q)), phase: float(math.atan2(q[1], q[0]))}
+        values = at(g, {amp: float(math.hypot(*q)), phase: float(math.atan2(q[1], q[0]))})
         return values, _residual(runs, replayer(runs, _with(base, values)), scale)
 
     # one Gauss-Newton step about the linear optimum, its slopes from two replays a trial amplitude away in each
@@ -630,8 +638,44 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
             vk, rk = residual_at(k * q1)
             if float(rk @ rk) < min(out[1], sse0):
                 return vk, float(rk @ rk)
-        return {grid_path: g, amp: 0.0, phase: 0.0}, sse0  # no gain: the candidate is reported as such
+        return at(g, {amp: 0.0, phase: 0.0}), sse0  # no gain: the candidate is reported as such
     return out
+
+
+def _lead_second_harmonic(runs, base, values, sse, trial, replayer, scale):
+    """The lead error of one harmonic ``values`` (SSE ``sse``) with a second harmonic: ``(values, sse)``.
+
+    A lead error's drive force grows with the square of its order, so a second harmonic of a quarter of the
+    fundamental's amplitude pushes as hard as the fundamental, and the one-harmonic fit may have found either.
+    Two readings, each one more quadrature fit (:func:`_quadrature_effect`, about six replays): the harmonic found
+    is the fundamental and its second harmonic is added, or (when twice its period is still a whole fraction of
+    the lead) it is the second harmonic of a fundamental of twice its period, which is added. The better of the
+    two is kept if its two more fields lower the SSE by more than noise would: a chi-square test at ``ALPHA`` on
+    two degrees of freedom, the one-harmonic residual's variance inflated for its lag-1 autocorrelation as in
+    :func:`fit_drive`'s intervals."""
+    amp, period, phase = _PERIODIC["lead_error"]
+    amp2, phase2 = _LEAD_SECOND
+    if not values.get(amp, 0.0) > 0.0:
+        return values, sse
+    found = dict(values, **{amp2: 0.0, phase2: 0.0})
+    readings = [(_with(base, found), (amp2, None, phase2))]
+    k = base.screw.lead / values[period]
+    if abs(k / 2 - round(k / 2)) < 1e-6:  # twice the period is the lead over a whole number
+        as_second = {period: 2.0 * values[period], amp: 0.0, phase: 0.0, amp2: values[amp], phase2: values[phase]}
+        readings.append((_with(base, as_second), (amp, None, phase)))
+    best, r1 = (dict(values), sse), None
+    for start, paths in readings:
+        sims = replayer(runs, start)
+        if r1 is None:  # the first reading's start is the one-harmonic fit itself
+            r1 = _residual(runs, sims, scale)
+        added, sse_added = _quadrature_effect(runs, start, paths, [None], trial, replayer, sims, scale)
+        if added and sse_added < best[1]:
+            best = ({p: get_value(start, p) for p in (amp, period, phase, amp2, phase2)} | added, sse_added)
+    rho = min(max(_lag1(r1), 0.0), 0.99)
+    s2 = float(r1 @ r1) / max(r1.size - 3, 1) * (1 + rho) / (1 - rho)
+    if best[1] >= sse or (sse - best[1]) / s2 <= stats.chi2.ppf(1 - ALPHA, 2):
+        return values, sse  # one harmonic explains the runs as well as two, within their noise
+    return best
 
 
 def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
@@ -763,6 +807,8 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         values, sse = _quadrature_effect(runs, base, _PERIODIC[name], grid, trial, replayer, base_sims, scale)
         if not values:
             return {}, 0.0
+        if name == "lead_error":
+            values, sse = _lead_second_harmonic(runs, base, values, sse, trial, replayer, scale)
     elif name == "stribeck":
         start = base if base.friction.law != "coulomb" else with_value(base, "friction.law", "stribeck")
         paths = ("friction.static_ratio", "friction.stribeck_velocity")

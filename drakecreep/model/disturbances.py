@@ -6,9 +6,10 @@ working; :func:`add_disturbances` wires them into the diagram only when their am
 
 LeadError
     Kinematic error of the screw-nut pair: the nut advances ``u(theta) = r theta + e(theta)`` with
-    ``r = Ph / 2 pi`` and ``e = a [sin(2 pi r (theta - theta0) / P + phi) - sin(phi)]`` (a lead-error harmonic
-    of travel period ``P``, e.g. the waviness left by ball passage in the nut; ``phi`` its phase at the start
-    angle ``theta0``, where ``e`` is counted from so the screw starts relaxed). The screw's spring sees ``u``
+    ``r = Ph / 2 pi``, ``psi = 2 pi r (theta - theta0) / P`` and
+    ``e = a [sin(psi + phi) - sin(phi)] + a2 [sin(2 psi + phi2) - sin(phi2)]`` (a lead-error harmonic of travel
+    period ``P``, e.g. the waviness left by ball passage in the nut, and its second harmonic; ``phi``, ``phi2``
+    their phases at the start angle ``theta0``, where ``e`` is counted from so the screw starts relaxed). The screw's spring sees ``u``
     instead of ``r theta``, and by virtual work the motor carries ``F du/dtheta = F (r + e')``; the
     screw already returns ``F r``, this system adds ``F e'``. A semi-closed loop (motor encoder)
     cannot see the error, so the table speed carries a ripple ``2 pi a / P`` of the feed, whatever
@@ -59,13 +60,16 @@ def LeadError_(T):
         torque : 1, ``F e'(theta)`` (N m), the reaction torque the screw's ``F r`` leaves out
         """
 
-        def _construct(self, amplitude, period, lead, angle0=0.0, phase=0.0, converter=None):
+        def _construct(self, amplitude, period, lead, angle0=0.0, phase=0.0, amplitude2=0.0, phase2=0.0,
+                       converter=None):
             LeafSystem_[T].__init__(self, converter=converter)
             self.amplitude = float(amplitude)
             self.period = float(period)
             self.lead = float(lead)
             self.angle0 = float(angle0)
             self.phase = float(phase)
+            self.amplitude2 = float(amplitude2)
+            self.phase2 = float(phase2)
             self.ratio = self.lead / (2.0 * math.pi)
             self._u_motor_state = self.DeclareVectorInputPort("motor_state", 2)
             self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
@@ -74,18 +78,32 @@ def LeadError_(T):
 
         def _construct_copy(self, other, converter=None):
             Impl._construct(self, other.amplitude, other.period, other.lead, other.angle0, other.phase,
-                            converter=converter)
+                            other.amplitude2, other.phase2, converter=converter)
 
-        def _phase(self, theta):
-            return 2.0 * math.pi * self.ratio * (theta - self.angle0) / self.period + self.phase
+        def _angle(self, theta):
+            """``psi``: the fundamental's angle of travel since the start angle."""
+            return 2.0 * math.pi * self.ratio * (theta - self.angle0) / self.period
+
+        def error(self, theta):
+            """``e(theta)`` (m), 0 at the start angle."""
+            psi = self._angle(theta)
+            e = self.amplitude * (sin(psi + self.phase) - math.sin(self.phase))
+            if self.amplitude2 > 0.0:
+                e = e + self.amplitude2 * (sin(2.0 * psi + self.phase2) - math.sin(self.phase2))
+            return e
 
         def slope(self, theta):
             """``de/dtheta`` (m/rad)."""
-            return self.amplitude * 2.0 * math.pi * self.ratio / self.period * cos(self._phase(theta))
+            psi = self._angle(theta)
+            k = 2.0 * math.pi * self.ratio / self.period
+            s = self.amplitude * k * cos(psi + self.phase)
+            if self.amplitude2 > 0.0:
+                s = s + self.amplitude2 * 2.0 * k * cos(2.0 * psi + self.phase2)
+            return s
 
         def _calc_motion(self, context, output):
             theta, omega = self._u_motor_state.Eval(context)
-            error = self.amplitude * (sin(self._phase(theta)) - math.sin(self.phase))
+            error = self.error(theta)
             output.SetFromVector(vector([theta + error / self.ratio, omega * (1.0 + self.slope(theta) / self.ratio)]))
 
         def _calc_torque(self, context, output):
@@ -146,9 +164,9 @@ def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
     """
     d = params.disturbance
     ports = dict(ports)
-    if d.lead_error_amplitude > 0.0:
+    if d.has_lead_error:
         lead = builder.AddSystem(LeadError(d.lead_error_amplitude, d.lead_error_period, params.screw.lead, angle0,
-                                           d.lead_error_phase))
+                                           d.lead_error_phase, d.lead_error_2_amplitude, d.lead_error_2_phase))
         lead.set_name("lead_error")
         torque_sum = builder.AddSystem(Adder(2, 1))
         torque_sum.set_name("load_torque_sum")

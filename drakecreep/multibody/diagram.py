@@ -434,8 +434,10 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
     (system, port): output port}`` of the recorded signals, or with ``open_loop`` the key
     ``"torque_command_in"`` (the torque limit's input) instead of the signals.
     """
-    if params.disturbance.lead_error_amplitude > 0.0:
-        raise InputError("disturbance.lead_error_amplitude", params.disturbance.lead_error_amplitude,
+    if params.disturbance.has_lead_error:
+        d = params.disturbance
+        field = "lead_error_amplitude" if d.lead_error_amplitude > 0.0 else "lead_error_2_amplitude"
+        raise InputError(f"disturbance.{field}", getattr(d, field),
                          "0 with the multibody model (its ScrewJoint has an exact lead; the lead error is a "
                          "two-mass model effect)")
     s = {}

@@ -36,7 +36,7 @@ def unsupported(params):
     if p.friction.law not in ("coulomb", "stribeck", "lugre"):
         return ("friction.law", p.friction.law, "coulomb, stribeck or lugre (the plain-Python equations)")
     d = p.disturbance
-    if d.lead_error_amplitude > 0 or d.force_ripple > 0 or d.load_ripple > 0:
+    if d.has_lead_error or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
     if p.sensors.scale_interpolation_error > 0 and p.controller.position_feedback == "table":
         return ("sensors.scale_interpolation_error", p.sensors.scale_interpolation_error,

@@ -102,6 +102,24 @@ def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
         with_value(rig, "disturbance.lead_error_phase", 7.0)
 
 
+def test_the_lead_errors_second_harmonic_is_fixed_to_the_screw_too():
+    """The second harmonic turns twice per period: a run from ``x0`` meets it at ``phi2 + 4 pi x0 / P``."""
+    rig = with_value(with_value(with_value(_rig(), "disturbance.lead_error_phase", 0.4),
+                                "disturbance.lead_error_2_amplitude", 0.7e-6), "disturbance.lead_error_2_phase", -1.3)
+    period = rig.disturbance.lead_error_period
+    x0 = 0.123 * period + 3 * period
+    at0 = _run(rig)
+    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
+    shifted = with_value(with_value(rig, "disturbance.lead_error_phase",
+                                    math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi)),
+                         "disturbance.lead_error_2_phase", math.remainder(-1.3 + 4 * math.pi * x0 / period, 2 * math.pi))
+    a = replay_drakecreep(moved, rig)
+    b = replay_drakecreep(at0, shifted)
+    assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
+    one = replay_drakecreep(at0, with_value(shifted, "disturbance.lead_error_2_amplitude", 0.0))
+    assert np.max(np.abs(one.x_table - b.x_table)) > 0.5e-6  # the harmonic moves the table
+
+
 def test_a_fractional_computation_delay_is_replayed_on_the_leaf_systems():
     """The compiled path takes one sampling offset; a params file with 1.5 samples of delay is replayed anyway,
     on the leaf systems (same result as asking for them), and differs from 1 and 2 samples."""

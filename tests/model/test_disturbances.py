@@ -75,6 +75,37 @@ def test_lead_error_phase_counts_from_the_start_angle_and_survives_scalar_conver
     assert np.isclose(sys_.GetOutputPort("nut_motion").Eval(ctx)[0], theta0, rtol=0, atol=1e-15)
 
 
+def test_lead_error_second_harmonic_error_slope_and_scalar_copies():
+    """``e = a [sin(psi + phi) - sin(phi)] + a2 [sin(2 psi + phi2) - sin(phi2)]``: zero at the start angle, its
+    slope the derivative of ``e`` (the torque ``F e'`` and the nut's speed), kept by the scalar copies."""
+    from drakecreep.model.disturbances import LeadError
+
+    a, period, lead, theta0, phi, a2, phi2 = 2e-6, 5e-3 / 6, 5e-3, 0.7, 1.1, 0.9e-6, -2.0
+    r = lead / (2 * math.pi)
+    sys_ = LeadError(a, period, lead, theta0, phi, a2, phi2)
+    for copy in (sys_, sys_.ToAutoDiffXd(), sys_.ToSymbolic()):
+        assert (copy.amplitude2, copy.phase2) == (a2, phi2)
+    assert sys_.error(theta0) == 0.0
+    for theta in (theta0 + 0.3, theta0 - 2.0, theta0 + 11.0):
+        psi = 2 * math.pi * r * (theta - theta0) / period
+        e = a * (math.sin(psi + phi) - math.sin(phi)) + a2 * (math.sin(2 * psi + phi2) - math.sin(phi2))
+        assert sys_.error(theta) == pytest.approx(e, rel=1e-12)
+        h = 1e-6
+        assert sys_.slope(theta) == pytest.approx((sys_.error(theta + h) - sys_.error(theta - h)) / (2 * h), rel=1e-6)
+        ctx = sys_.CreateDefaultContext()
+        sys_.GetInputPort("motor_state").FixValue(ctx, [theta, 10.0])
+        sys_.GetInputPort("axial_force").FixValue(ctx, [50.0])
+        assert sys_.GetOutputPort("nut_motion").Eval(ctx)[0] == pytest.approx(theta + e / r, abs=1e-12)
+        assert sys_.GetOutputPort("torque").Eval(ctx)[0] == pytest.approx(50.0 * sys_.slope(theta), rel=1e-12)
+    # the second harmonic alone switches the system into the diagram
+    from drakecreep.params import preset
+
+    p = with_value(preset("paper"), "disturbance.lead_error_2_amplitude", 1e-6)
+    assert p.disturbance.has_lead_error and not preset("paper").disturbance.has_lead_error
+    names = {s.get_name() for s in build_diagram(p, Scenario(feed=1e-3, duration=0.1)).diagram.GetSystems()}
+    assert "lead_error" in names
+
+
 def test_load_ripple_phase_and_scalar_copies():
     """``force = -A sin(2 pi f t + phi)``; the AutoDiffXd and symbolic copies keep the phase."""
     from drakecreep.model.disturbances import LoadRipple
