@@ -585,8 +585,9 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     ``paths``: the amplitude, grid (period or frequency) and phase fields (the grid field ``None`` with
     ``grid = [None]``: the period is ``base``'s). To first order the residual is linear
     in the quadratures ``(a cos phi, a sin phi)``: two replays per grid value at a trial amplitude (``phi`` = 0 and
-    pi / 2) give its two slopes, linear least squares the optimum; about the best grid value's optimum one
-    Gauss-Newton step in the quadratures refines it (three replays), kept if its measured SSE is lower; an answer
+    pi / 2) give its two slopes, linear least squares the optimum; about the best grid value's optimum up to
+    :data:`QUADRATURE_STEPS` Gauss-Newton steps in the quadratures refine it (three replays each, slopes half the
+    current amplitude away), each kept while its measured SSE is lower; an answer
     worse than no effect falls back along the line to none (amplitude 0 when nothing on it is better). An
     amplitude the params file declares is replaced, not added to: the fit linearises about none."""
     amp, grid_path, phase = paths
@@ -594,6 +595,7 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
         base = _with(base, {amp: 0.0})
         base_sims = replayer(runs, base)
     r0 = _residual(runs, base_sims, scale)
+
     def at(g, values):  # the grid value with ``values``
         return dict(values, **({} if grid_path is None else {grid_path: g}))
 
