@@ -2,6 +2,10 @@
 its usage instead of starting the long job, and a wrong argument is refused with exit status 2."""
 
 import ast
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -38,16 +42,12 @@ def test_each_script_parses_its_arguments(path):
 
 
 def _bench(*args, cwd):
-    import os
-    import subprocess
-    import sys
     env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
     return subprocess.run([sys.executable, str(ANALYSIS / "bench_gap_benchmark.py"), *args], cwd=cwd, env=env,
                           capture_output=True, text=True, timeout=300)
 
 
 def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once(tmp_path):
-    import json
     missing = _bench("--resume", str(tmp_path / "none.json"), cwd=tmp_path)
     assert missing.returncode == 2 and "Traceback" not in missing.stderr
     assert missing.stderr.strip().splitlines()[-1].endswith(
