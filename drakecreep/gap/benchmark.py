@@ -524,6 +524,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     (no true-effect fit for this kind: module docstring)."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.gap.residuals import oscillation_log_errors
 
     t0 = time.perf_counter()
     kw = {} if effects is None else {"effects": tuple(effects)}
@@ -543,15 +544,23 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
 
         def replayed(params):
             try:
-                errors = {r.label: drake_replay_errors(replay_drakecreep(r, params)) for r in ds.audit}
+                sims = [replay_drakecreep(r, params) for r in ds.audit]
             except InputError:
                 return None
+            errors = {r.label: drake_replay_errors(x) for r, x in zip(ds.audit, sims)}
             rms = rms_force_error(errors)
-            return {"energy": rms * rms, "force_rms": rms, "per_run": [float(e["force"]) for e in errors.values()]}
+            out = {"energy": rms * rms, "force_rms": rms, "per_run": [float(e["force"]) for e in errors.values()]}
+            if res.oscillation:  # the spectral error too: a free phase makes the sample-by-sample one blind
+                out["oscillation_nepers"] = oscillation_log_errors([r.force for r in ds.audit],
+                                                                   [x.force for x in sims], ds.audit[0].dt).tolist()
+            return out
 
         a = {"nominal": replayed(res.nominal)}
         a["claimed"] = replayed(res.params) if claimed else a["nominal"]
         row.update(_audit_fields(a, claimed))
+        if res.oscillation and a["nominal"] is not None and a["claimed"] is not None:
+            row["audit_oscillation_nepers"] = {k: float(np.mean(a[k]["oscillation_nepers"]))
+                                               for k in ("nominal", "claimed")}
         row["audit_seconds"] = time.perf_counter() - t1
     row["seconds"] = time.perf_counter() - t0
     return row

@@ -47,6 +47,7 @@ __all__ = [
     "dominant_oscillation",
     "sustained_oscillation",
     "oscillates_at",
+    "oscillation_log_errors",
 ]
 
 #: Frequency bands [Hz] of :func:`frequency_bands` (the last one ends at the Nyquist frequency).
@@ -458,6 +459,16 @@ def dominant_oscillation(record, dt, f_min=OSCILLATION_MIN_HZ):
     return {"freq_Hz": float(f[k]), "rms": rms, "share": rms * rms / var if var > 0 else 0.0}
 
 
+def _paired_bands(measured, simulated, dt, f_min):
+    """Per run: the measured record's :func:`dominant_oscillation` and the replay's RMS in its band."""
+    if len(measured) != len(simulated):
+        raise InputError("simulated", f"{len(simulated)} records", f"one per measured record ({len(measured)})")
+    for m, s in zip(measured, simulated):
+        o = dominant_oscillation(m, dt, f_min)
+        f, p, df = _welch(s, dt)
+        yield o, _band_rms(f, p, df, o["freq_Hz"])
+
+
 def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
     """Do the measured records carry a sustained oscillation that the replayed ones do not?
 
@@ -479,13 +490,8 @@ def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
         ``model_rms`` (their median RMS in the band, measured and replayed), ``share`` (median), ``runs`` (how
         many oscillate) and ``of`` (how many were checked).
     """
-    if len(measured) != len(simulated):
-        raise InputError("simulated", f"{len(simulated)} records", f"one per measured record ({len(measured)})")
     hits = []
-    for m, s in zip(measured, simulated):
-        o = dominant_oscillation(m, dt, f_min)
-        f, p, df = _welch(s, dt)
-        model = _band_rms(f, p, df, o["freq_Hz"])
+    for o, model in _paired_bands(measured, simulated, dt, f_min):
         if o["share"] >= OSCILLATION_SHARE and o["rms"] >= OSCILLATION_RATIO * model:
             hits.append((o["freq_Hz"], o["rms"], model, o["share"]))
     if not hits:
@@ -500,3 +506,28 @@ def oscillates_at(record, dt, freq, f_min=OSCILLATION_MIN_HZ):
     ``(bool, its dominant_oscillation)``."""
     o = dominant_oscillation(record, dt, f_min)
     return bool(o["share"] >= OSCILLATION_SHARE and abs(o["freq_Hz"] - freq) <= _OSC_WIDTH * freq), o
+
+
+def oscillation_log_errors(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
+    """How far each replay's oscillation is from the measured one's, in the measured one's band.
+
+    A spectral error for records whose phase is free (a limit cycle): ``|ln(model / measured)|`` of the RMS in
+    the band of +-15 % around each measured record's dominant oscillation (:func:`dominant_oscillation`). A replay
+    that oscillates there as strongly scores about 0; a stable replay of an oscillating record at least
+    ``ln(OSCILLATION_RATIO)`` = 2.3.
+
+    Parameters
+    ----------
+    measured, simulated, dt, f_min
+        As :func:`sustained_oscillation`.
+
+    Returns
+    -------
+    numpy.ndarray
+        One error per run [nepers].
+    """
+    out = []
+    for o, model in _paired_bands(measured, simulated, dt, f_min):
+        tiny = 1e-12 * max(o["rms"], 1.0)  # a replay with nothing in the band: finite, large
+        out.append(abs(math.log(max(model, tiny) / max(o["rms"], tiny))))
+    return np.array(out)

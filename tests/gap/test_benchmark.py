@@ -133,6 +133,7 @@ def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     assert [r["effect"] for r in row["ranking"]] == ["force_ripple"]
     assert set(row["claimed_model"]["fitted"]) == {"table.seal_force", "nut.preload_torque", "friction.viscous"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
+    assert row["oscillation"] is None and "audit_oscillation_nepers" not in row  # a stable null: no spectral audit
     assert row["worse"] is (bool(row["claimed"]) and row["audit"]["claimed"]["energy"] > row["audit"]["nominal"]["energy"])
 
 

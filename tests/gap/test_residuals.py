@@ -9,6 +9,7 @@ from drakecreep.gap.residuals import (
     dominant_oscillation,
     operating_map,
     oscillates_at,
+    oscillation_log_errors,
     order_spectrum,
     regime_shares,
     sustained_oscillation,
@@ -155,3 +156,17 @@ def test_sustained_oscillation_only_when_the_replay_lacks_it_and_it_dominates():
     ok, osc = oscillates_at(measured, 1e-3, 150.0)
     assert ok and abs(osc["freq_Hz"] - 160.0) < 4.0
     assert not oscillates_at(measured, 1e-3, 100.0)[0] and not oscillates_at(quiet, 1e-3, 160.0)[0]
+
+
+def test_oscillation_log_errors_compare_the_band_rms_whatever_the_phase():
+    """A replay of the same limit cycle with another phase scores about 0 nepers, one at half the amplitude
+    ln 2, a stable one more than ln 10, one oscillating at another frequency as if stable."""
+    measured, quiet = _oscillating()
+    t = np.arange(measured.size) * 1e-3
+    shifted = quiet + (measured - quiet)[::-1]  # the same oscillation, phase reversed in time
+    half = quiet + 0.5 * (measured - quiet)
+    elsewhere = quiet + 40.0 * np.sin(2 * np.pi * 90.0 * t)
+    e = oscillation_log_errors([measured] * 4, [shifted, half, quiet, elsewhere], 1e-3)
+    assert e[0] < 0.1 and abs(e[1] - np.log(2.0)) < 0.05 and e[2] > np.log(10.0) and e[3] > np.log(10.0)
+    with pytest.raises(InputError, match="simulated"):
+        oscillation_log_errors([measured], [], 1e-3)
