@@ -304,6 +304,9 @@ class DriveDiagnosis:
                          f"params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
+            if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
+                lines.append(f"  {c.name:18s} {c.reason}")
+                continue
             lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f})"
                          f"{'  passes' if c.passes else ''}: {c.reason}")
             if c.passes:

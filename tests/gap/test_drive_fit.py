@@ -137,6 +137,8 @@ def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
     text = "\n".join(result.summary())
     assert f"oscillates at {o['freq_Hz']:.0f} Hz" in text and "no computation delay the search tried" in text
     assert "withheld: the measured runs oscillate" in text
+    (line,) = [x for x in result.summary() if x.strip().startswith("force_ripple")]
+    assert "not fitted" in line and "held-out gain" not in line  # no gain is printed for what was not replayed
     assert result.to_json()["oscillation"]["freq_Hz"] == o["freq_Hz"]
     sims = [drive_fit.replay_drakecreep(r, truth) for r in runs[:2]]
     seen = dict(o)
