@@ -1084,6 +1084,10 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     withheld = claims_withheld(oscillation)
     if withheld:
         say("claims withheld: the held-out force error is the oscillation's; only the delay search runs")
+        if uncertain:
+            warnings = tuple(warnings) + (
+                f"{', '.join(uncertain)} fitted on runs that oscillate where the model does not: the values fit the "
+                "oscillation's samples as well as they can, not the friction; fit them on runs of a stable loop",)
     candidates = []
     for name in names:
         if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):

@@ -165,6 +165,7 @@ def test_a_delay_that_reproduces_the_oscillation_is_claimed_on_the_held_out_spec
     assert drive_fit.claims_withheld(o) and any(r["value"] == 24.0 for r in o["reproduced_by"])
     sp = o["spectral"]
     assert sp["passes"] and sp["gain"] > sp["threshold"] and sp["same_frequency"] == sp["of"] == 2
+    assert any("fitted on runs that oscillate" in w for w in result.warnings)
     assert min(sp["nominal_nepers"]) > math.log(10.0) > 10 * max(sp["delay_nepers"])
     assert result.claimed == ("control_delay",)
     assert abs(result.params.controller.computation_delay - 24.0) <= 1.0
