@@ -280,7 +280,9 @@ class DriveDiagnosis:
         o = self.oscillation
         if not o:
             return []
-        lines = ["unexplained: " + oscillation_line(o, "training runs")]
+        spectral = o.get("spectral") or {}
+        head = f"explained by {_OSCILLATION_EFFECT} on the spectrum: " if spectral.get("passes") else "unexplained: "
+        lines = [head + oscillation_line(o, "training runs")]
         rep = o.get("reproduced_by") or []
         if rep:
             lines.append("  in the model, " + "; ".join(
@@ -288,9 +290,9 @@ class DriveDiagnosis:
                 f"{r['runs']} of {o['of']} runs)" for r in rep))
         elif "reproduced_by" in o:
             lines.append("  no computation delay the search tried makes the model oscillate there")
-        if o.get("spectral"):
-            lines.append(f"  held-out spectrum ({'passes' if o['spectral']['passes'] else 'not claimed'}): "
-                         + o["spectral"]["reason"])
+        if spectral:
+            lines.append(f"  held-out spectrum ({'passes' if spectral['passes'] else 'not claimed'}): "
+                         + spectral["reason"])
         return lines
 
     def summary(self):

@@ -124,4 +124,5 @@ def oscillation_line(oscillation, runs="runs"):
     return (f"the measured force oscillates at {o['freq_Hz']:.0f} Hz ({o['runs']} of {o['of']} {runs}; "
             f"{o['rms']:.3g} N RMS in its band, {100 * o['share']:.0f} % of the force's variance), the model's "
             f"replay {o['model_rms']:.3g} N: the real loop is unstable (or nearly) where the model is stable. A "
-            "replay sample by sample cannot follow an oscillation whose phase is free, so no claim rests on its samples.")
+            "replay sample by sample cannot follow an oscillation whose phase is free, so no claim rests on its "
+            "samples.")

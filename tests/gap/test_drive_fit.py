@@ -172,6 +172,7 @@ def test_a_delay_that_reproduces_the_oscillation_is_claimed_on_the_held_out_spec
     assert next(c for c in result.candidates if c.name == "force_ripple").reason.startswith("not fitted")
     text = "\n".join(result.summary())
     assert "claimed: control_delay on the held-out spectrum" in text and "held-out spectrum (passes)" in text
+    assert "explained by control_delay on the spectrum: the measured force oscillates" in text
 
 
 def test_claims_are_withheld_only_when_most_runs_oscillate():
