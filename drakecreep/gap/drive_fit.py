@@ -120,6 +120,9 @@ MIN_DURATION = 0.1
 #: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
 _STEP = 0.1
 _BOUND = 4.0
+#: Decades beyond which a fitted field's 95 % interval is reported as not bounded (the fitted range itself spans
+#: e^8, 3.5 decades).
+_UNBOUNDED = 6.0
 #: Largest leave-one-out step of a fitted field in the fit's log coordinate (a factor e).
 _TRUST = 1.0
 #: Trials of the Stribeck candidate's start besides the nominal's own curve (:func:`_stribeck_start` scales each
@@ -302,7 +305,7 @@ class DriveDiagnosis:
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
-            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {f.lower:.4g} .. {f.upper:.4g}; "
+            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {_interval(f.lower, f.upper, '.4g')}; "
                          f"params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
@@ -354,6 +357,14 @@ class DriveDiagnosis:
             "seconds": self.seconds,
             "oscillation": self.oscillation,
         })
+
+
+def _interval(lower, upper, fmt=".3g"):
+    """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades (the Jacobian says the runs do
+    not determine the field at all; its exponent is clipped) as such, not as 1e-302 .. 1e+306."""
+    if not (lower > 0 and math.isfinite(upper)) or math.log10(upper) - math.log10(lower) > _UNBOUNDED:
+        return "not bounded by these runs"
+    return f"{lower:{fmt}} .. {upper:{fmt}}"
 
 
 def claims_withheld(oscillation):
@@ -567,7 +578,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         val = lo[i] + (v0[i] - lo[i]) * math.exp(sol.x[i])
         fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
         if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
-            warnings.append(f"{p} is poorly determined by these runs (95 % interval {lo_i:.3g} .. {hi_i:.3g})")
+            warnings.append(f"{p} is poorly determined by these runs (95 % interval {_interval(lo_i, hi_i)})")
     if sol.status == 0:  # least_squares stopped by max_nfev: the values are where it stopped, not a minimum
         warnings.append(f"the output-error fit of {', '.join(paths)} stopped after {sol.nfev} evaluations "
                         f"(max_nfev) before converging: its values and intervals are those of the last iterate")
