@@ -463,8 +463,12 @@ class _Replayer:
 
     def many_errors(self, jobs):
         """``{label: replay errors}`` of each ``(runs, params)`` of ``jobs``, replayed at once (:meth:`many`)."""
-        return [{r.label: drake_replay_errors(s, bands=False) for r, s in zip(runs, sims)}
-                for (runs, _), sims in zip(jobs, self.many(jobs))]
+        return [_errors_of(runs, sims) for (runs, _), sims in zip(jobs, self.many(jobs))]
+
+
+def _errors_of(runs, sims):
+    """``{label: replay errors}`` of the replays ``sims`` of ``runs``."""
+    return {r.label: drake_replay_errors(s, bands=False) for r, s in zip(runs, sims)}
 
 
 def _residual(runs, sims, scale):
@@ -791,11 +795,11 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
         replay(new)
 
 
-def _claim_on_spectrum(oscillation, candidates, test, params, nominal_errors, replay, null, say):
+def _claim_on_spectrum(oscillation, candidates, test, params, nominal_sims, nominal_errors, replay, null, say):
     """The claims of a diagnosis whose training runs oscillate (:func:`claims_withheld`): at most the delay of
     :func:`_spectral_delay`. Returns ``(candidates, claimed, params, held-out errors)``; the uncertain fields are
     not refitted on samples of a free-phase oscillation."""
-    spectral = _spectral_delay(oscillation, test, params, replay, null)
+    spectral, delay_errors = _spectral_delay(oscillation, test, params, nominal_sims, replay, null)
     if spectral is None:
         return candidates, [], params, nominal_errors
     say(f"{_OSCILLATION_EFFECT} on the spectrum: {spectral['reason']}")
@@ -806,10 +810,10 @@ def _claim_on_spectrum(oscillation, candidates, test, params, nominal_errors, re
                   if c.name == _OSCILLATION_EFFECT else c for c in candidates]
     current = _with(params, spectral["values"])
     say(f"claimed {_OSCILLATION_EFFECT} on the spectrum")
-    return candidates, [_OSCILLATION_EFFECT], current, replay.errors(test, current)
+    return candidates, [_OSCILLATION_EFFECT], current, delay_errors
 
 
-def _spectral_delay(oscillation, test, params, replay, null):
+def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
     """The claim a computation delay can make on runs that oscillate where the model does not: on the spectrum.
 
     Of the delays that make the model oscillate at the measured frequency on the training runs
@@ -821,21 +825,24 @@ def _spectral_delay(oscillation, test, params, replay, null):
     half of the runs improve, and the delayed model oscillates within +-15 % of each run's measured frequency on
     more than half of them. Needs the run-to-run null as every claim does (None: not claimed).
 
+    ``nominal_sims`` are the fitted model's replays of ``test`` (those of the diagnosis, not replayed again).
+
     Returns
     -------
-    dict or None
-        None without a reproducing delay; else ``values``, ``passes``, ``reason``, the per-run errors
-        (``nominal_nepers``, ``delay_nepers``), ``gain``, ``standard_error``, ``threshold`` [nepers] and
-        ``same_frequency`` (held-out runs), also stored as ``oscillation["spectral"]``.
+    tuple
+        ``(None, None)`` without a reproducing delay; else a dict of ``values``, ``passes``, ``reason``, the per-run
+        errors (``nominal_nepers``, ``delay_nepers``), ``gain``, ``standard_error``, ``threshold`` [nepers] and
+        ``same_frequency`` (held-out runs), also stored as ``oscillation["spectral"]``, and the delayed model's
+        sample-by-sample held-out errors (``{label: errors}``).
     """
     rep = oscillation.get("reproduced_by") or []
     if not rep:
-        return None
+        return None, None
     pick = min(rep, key=lambda r: abs(math.log(r["rms"] / oscillation["rms"])))
     values = {pick["path"]: pick["value"]}
     measured = [r.force for r in test]
     dt = test[0].dt
-    nominal_sims, delay_sims = replay.many([(test, params), (test, _with(params, values))])
+    delay_sims = replay(test, _with(params, values))
     e0 = oscillation_log_errors(measured, [x.force for x in nominal_sims], dt)
     e1 = oscillation_log_errors(measured, [x.force for x in delay_sims], dt)
     gain, se = mean_and_standard_error(e0 - e1)
@@ -854,7 +861,7 @@ def _spectral_delay(oscillation, test, params, replay, null):
            "delay_nepers": e1.tolist(), "gain": float(gain), "standard_error": float(se), "threshold": bar,
            "same_frequency": int(same), "of": n}
     oscillation["spectral"] = out
-    return out
+    return out, _errors_of(test, delay_sims)
 
 
 def _reproduces(oscillation, path, value, runs, sims):
@@ -1084,7 +1091,8 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
 def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0):
     prior_errors = replay.errors(test, prior)
     params, fitted, warnings, sse0, fit = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev, details=True)
-    nominal_errors = replay.errors(test, params)
+    nominal_sims = replay(test, params)
+    nominal_errors = _errors_of(test, nominal_sims)
     say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
     null = _replay_null(train, test, fit, replay, nominal_errors) if names else None
     if names:
@@ -1126,7 +1134,8 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     claimed, current, current_errors = [], params, nominal_errors
     if withheld:
         candidates, claimed, current, current_errors = _claim_on_spectrum(oscillation, candidates, test, params,
-                                                                          nominal_errors, replay, null, say)
+                                                                          nominal_sims, nominal_errors, replay,
+                                                                          null, say)
     else:
         for c in candidates:
             if not c.passes:

@@ -172,6 +172,9 @@ def test_a_delay_that_reproduces_the_oscillation_is_claimed_on_the_held_out_spec
     assert min(sp["nominal_nepers"]) > math.log(10.0) > 10 * max(sp["delay_nepers"])
     assert result.claimed == ("control_delay",)
     assert abs(result.params.controller.computation_delay - 24.0) <= 1.0
+    for r in runs[2:]:  # the claim's held-out errors are those of its own params (its spectral replays, kept)
+        again = drive_fit.drake_replay_errors(drive_fit.replay_drakecreep(r, result.params), bands=False)
+        assert result.test_errors[r.label] == pytest.approx(again, rel=1e-9)
     assert next(c for c in result.candidates if c.name == "force_ripple").reason.startswith("not fitted")
     text = "\n".join(result.summary())
     assert "claimed: control_delay on the held-out spectrum" in text and "held-out spectrum (passes)" in text
