@@ -14,7 +14,9 @@ diagram with a 2 um lead error and a 20 % higher seal force the params file lack
 :func:`drakecreep.gap.drive_fit.diagnose_drive` (what ``drakecreep diagnose`` runs on such data) with the
 default uncertain fields and every candidate. Every time is printed as wall and as CPU time of this
 process (``time.process_time``; the diagnosis runs in one process, so on an idle machine the two agree, and
-on a shared one the CPU time is the fairer figure).
+on a shared one the CPU time is the fairer figure), and, against a baseline timed in the same run (one
+closed-loop replay of a run on the params file, the mean over the six), as a multiple of it with the number
+of replays the diagnosis made: the figure to compare between machines and loads.
 
 With ``--validate`` it then refits the augmented model on the whole estimation file and replays the
 validation file once, parameters fixed (``analysis/emps_drake.py``'s last step): force error target < 6 %.
@@ -58,7 +60,7 @@ def main():
 
 def paper_rig(workers=1):
     from drakecreep.gap.drake_replay import simulated_runs
-    from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.gap.drive_fit import diagnose_drive, replay_drakecreep
     from drakecreep.params import preset, with_value
 
     declared = preset("paper")
@@ -69,6 +71,11 @@ def paper_rig(workers=1):
     runs = simulated_runs(truth, speeds, declared=declared, n=1500, noise=2.0, seed=42, leg=0.6, starts=(0.05, 0.8))
     print(f"paper rig: 6 runs of 1.5 s simulated in {time.perf_counter() - start:.1f} s wall, "
           f"{time.process_time() - cpu:.1f} s CPU")
+    replay_drakecreep(runs[0], declared)  # the baseline: one closed-loop replay of each run (the first builds)
+    base_wall, base_cpu = time.perf_counter(), time.process_time()
+    for run in runs:
+        replay_drakecreep(run, declared)
+    base_wall, base_cpu = (time.perf_counter() - base_wall) / len(runs), (time.process_time() - base_cpu) / len(runs)
     start, cpu = time.perf_counter(), time.process_time()
     diag = diagnose_drive(runs[0::2], runs[1::2], workers=workers, progress=lambda line: print(
         f"  [{time.perf_counter() - start:5.0f} s] {line}", flush=True))
@@ -76,6 +83,9 @@ def paper_rig(workers=1):
     print("\n".join(diag.summary()))
     print(f"paper-rig diagnosis (6 runs, kind drakecreep, {workers} worker(s)): {wall:.1f} s wall, {cpu:.1f} s CPU "
           "of this process (target 120 s on 2 cores)")
+    print(f"baseline, one closed-loop replay of a paper-rig run (the params file, mean of the 6): {base_wall:.2f} s "
+          f"wall, {base_cpu:.2f} s CPU -> diagnosis = {wall / base_wall:.0f} x baseline (wall); "
+          f"{diag.simulations} replays")
 
 
 def emps(validate, workers=1):
