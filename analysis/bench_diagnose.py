@@ -52,6 +52,10 @@ def main():
     ap.add_argument("--workers", type=int, default=1, help="processes for the candidates' closed-loop fits "
                     "(default 1; the CPU time printed is this process's only, so compare wall times then)")
     args = ap.parse_args()
+    if args.workers < 1:
+        ap.error(f"--workers: got {args.workers}; allowed: an integer >= 1")
+    if args.skip_emps and not args.paper_rig:
+        ap.error("--skip-emps: got it without --paper-rig; allowed: --skip-emps with --paper-rig (else nothing runs)")
     if not args.skip_emps:
         emps(args.validate, args.workers)
     if args.paper_rig:

@@ -65,3 +65,13 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     assert once.returncode == 0 and scored.returncode == 0, scored.stderr
     assert scored.stdout == once.stdout
     assert f"(n={sum(r['category'] == 'null' for r in data['datasets'])})" in once.stdout
+
+
+@pytest.mark.parametrize("args, field", [(("--workers", "0", "--paper-rig"), "--workers: got 0"),
+                                         (("--skip-emps",), "--skip-emps: got it without --paper-rig")])
+def test_diagnosis_bench_refuses_bad_options_before_any_work(tmp_path, args, field):
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    out = subprocess.run([sys.executable, str(ANALYSIS / "bench_diagnose.py"), *args], cwd=tmp_path, env=env,
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 2 and "Traceback" not in out.stderr and out.stdout == ""
+    assert field in out.stderr.strip().splitlines()[-1]
