@@ -9,7 +9,11 @@ from hypothesis import strategies as st
 from drakecreep.errors import InputError
 from drakecreep.params import DriveParams, load_params, preset, with_value
 
-SETTINGS = settings(max_examples=60, deadline=2000, suppress_health_check=[HealthCheck.function_scoped_fixture], database=None)
+# too_slow is a timing check of the input generation, not of the loader: on a loaded machine one draw took 13.9 s
+# (session 53, a fresh-clone CI beside three diagnoses) and failed the test; the deadline still catches a loader
+# that hangs
+SETTINGS = settings(max_examples=60, deadline=2000, database=None,
+                    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
 _GROUPS = {f.name: [g.name for g in dataclasses.fields(f.type if isinstance(f.type, type) else DriveParams)]
            for f in dataclasses.fields(DriveParams)}
