@@ -1117,6 +1117,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
             candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False,
                                            "not fitted: the measured runs oscillate, the model does not"))
             continue
+        before = replay.count
         values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
                                          uncertain)
         if values is None:
@@ -1129,7 +1130,8 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
             c = dataclasses.replace(c, passes=False, reason="withheld: the measured runs oscillate, the model "
                                                             "does not; " + c.reason)
         candidates.append(c)
-        say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f})")
+        say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f}; "
+            f"{replay.count - before} replays)")
     candidates.sort(key=lambda c: -c.gain)
     claimed, current, current_errors = [], params, nominal_errors
     if withheld:
@@ -1152,10 +1154,12 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         # jointly with the claimed effects' amplitudes (fixed, they would carry the bias of the first fit)
         amplitudes = tuple(p for name in claimed for p in _AMPLITUDES.get(name, ())
                            if get_value(current, p) > 0)
+        before = replay.count
         current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
         fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
         current_errors = replay.errors(test, current)
-        say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)}")
+        say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)} ({replay.count - before} replays; "
+            f"{replay.count} in all)")
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,

@@ -8,6 +8,7 @@ loop, so that a 0.5 s run replays in well under a second.
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -318,10 +319,17 @@ def test_switch_candidates_find_the_nut_drag_on_the_screw():
     """The friction-law and nut-side candidates set a word, not a number (they once failed on it)."""
     truth = with_value(RIG, "friction.nut_friction_on", "screw")
     runs = simulated_runs(truth, SPEEDS + (0.022, 0.032), declared=RIG, n=N, noise=NOISE, seed=900)
+    lines = []
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
-                            effects=("nut_friction_side", "law_coulomb"))
+                            effects=("nut_friction_side", "law_coulomb"), progress=lines.append)
     assert result.claimed == ("nut_friction_side",)
     assert result.params.friction.nut_friction_on == "screw" and result.params.friction.law == RIG.friction.law
+    # the progress says where the replays go: each switch's (one replay of every training and held-out run)
+    # and the refit's, whose line ends with the diagnosis's total
+    per_candidate = [int(re.search(r"; (\d+) replays\)$", line).group(1)) for line in lines if "training gain" in line]
+    assert per_candidate == [len(runs)] * 2, lines
+    refit = re.search(r"\((\d+) replays; (\d+) in all\)$", lines[-1])
+    assert refit and int(refit.group(1)) > 0 and int(refit.group(2)) == result.simulations, lines
 
 
 def test_replays_in_worker_processes_give_the_same_diagnosis():
