@@ -67,11 +67,14 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     assert f"(n={sum(r['category'] == 'null' for r in data['datasets'])})" in once.stdout
 
 
-@pytest.mark.parametrize("args, field", [(("--workers", "0", "--paper-rig"), "--workers: got 0"),
-                                         (("--skip-emps",), "--skip-emps: got it without --paper-rig")])
-def test_diagnosis_bench_refuses_bad_options_before_any_work(tmp_path, args, field):
+@pytest.mark.parametrize("script, args, field", [
+    ("bench_diagnose.py", ("--workers", "0", "--paper-rig"), "--workers: got 0"),
+    ("bench_diagnose.py", ("--skip-emps",), "--skip-emps: got it without --paper-rig"),
+    ("bench_replay_drakecreep.py", ("--repeat", "0"), "--repeat: got 0"),
+])
+def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, args, field):
     env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
-    out = subprocess.run([sys.executable, str(ANALYSIS / "bench_diagnose.py"), *args], cwd=tmp_path, env=env,
+    out = subprocess.run([sys.executable, str(ANALYSIS / script), *args], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stdout == ""
     assert field in out.stderr.strip().splitlines()[-1]
