@@ -9,6 +9,7 @@ loop, so that a 0.5 s run replays in well under a second.
 import json
 import math
 import re
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -413,7 +414,6 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
 def test_leave_one_out_step_is_close_to_the_refit():
     """The run-to-run null's refits are one Gauss-Newton step from the nominal fit (``_Fit.without``): on a
     residual linear in the values (as friction levels nearly are), that step lands on the refit."""
-    from types import SimpleNamespace
 
     rng = np.random.default_rng(3)
     paths = ("table.seal_force", "friction.viscous")
@@ -482,3 +482,36 @@ def test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null():
     assert result.replay_null is not None and result.replay_null < 0.05
     assert result.claimed == ("lead_error",)
     assert result.params.disturbance.lead_error_amplitude == pytest.approx(3e-6, rel=0.1)
+
+
+def _residual_runs(lines_per_run, n=3000, dt=1e-3, noise=1.0, seed=0):
+    """Runs whose force residual (measured minus replayed) is white noise plus sinusoids ``(amplitude, Hz)``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * dt
+    runs, sims = [], []
+    for lines in lines_per_run:
+        force = noise * rng.standard_normal(n) + sum(a * np.sin(2 * np.pi * f * t + 1.0) for a, f in lines)
+        runs.append(SimpleNamespace(n=n, dt=dt, force=force))
+        sims.append(SimpleNamespace(force=np.zeros(n)))
+    return runs, sims
+
+
+def test_ripple_frequencies_are_lines_of_most_runs():
+    """A ripple at a fixed frequency is a line in every run; a force periodic in position is a line at
+    speed / period, another frequency in each run of another speed, and the largest pooled peak is then the
+    fastest run's line alone (development dataset 1215: a lead error's 52 Hz line of a 130 mm/s run)."""
+    fixed, _ = _residual_runs([[(1.5, 12.3)]] * 4)
+    assert drive_fit._ripple_frequencies(fixed, _) and abs(drive_fit._ripple_frequencies(fixed, _)[0] - 12.3) < 0.05
+    speeds = (0.022, 0.008, 0.0425, 0.130)  # m/s, the runs of dataset 1215; a 2.5 mm period
+    position, sims = _residual_runs([[(3.0, v / 0.0025)] for v in speeds], seed=1)
+    assert drive_fit._ripple_frequencies(position, sims) == []
+    # a ripple shared by three of four runs is found beside the one run's far larger position line
+    mixed, sims = _residual_runs([[(1.5, 12.3), (20.0, 52.0)], [(1.5, 12.3)], [(1.5, 12.3)], [(0.0, 12.3)]], seed=2)
+    found = drive_fit._ripple_frequencies(mixed, sims)
+    assert len(found) >= 1 and abs(found[0] - 12.3) < 0.05 and all(abs(f - 52.0) > 1.0 for f in found)
+    # a line in two of four runs is no one frequency of the axis
+    half, sims = _residual_runs([[(1.5, 12.3)], [(1.5, 12.3)], [], []], seed=3)
+    assert all(abs(f - 12.3) > 1.0 for f in drive_fit._ripple_frequencies(half, sims))
+    # and noise alone gives few lines: at most the chance 5 % a bin's test allows, in most runs at once
+    noise, sims = _residual_runs([[]] * 4, seed=4)
+    assert drive_fit._ripple_frequencies(noise, sims) == []
