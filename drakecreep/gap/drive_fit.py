@@ -889,8 +889,8 @@ def _ripple_frequencies(runs, sims, k=2, pad=8, examined=20):
     speed, and the largest pooled peak is then the fastest run's line (development dataset 1215, a lead error on
     runs at 8-130 mm/s: its 52 Hz line of the 130 mm/s run, which a fixed-frequency ripple then fitted). A ripple at
     a fixed frequency is a line in every run. So a pooled peak is kept only when it is a line of more than half of
-    the runs (:func:`_line_in`: a line that noise gives a run with probability ``ALPHA``), the largest ``examined``
-    pooled peaks examined in turn.
+    the runs (:func:`_line_in`, :func:`_line_bar`: a line that noise gives a run with probability ``ALPHA``), the
+    largest ``examined`` pooled peaks examined in turn.
     """
     n = min(r.n for r in runs)
     dt = runs[0].dt
@@ -906,6 +906,7 @@ def _ripple_frequencies(runs, sims, k=2, pad=8, examined=20):
     ok = ok[(ok > 0) & (ok < f.size - 1)]
     peaks = [i for i in ok if power[i] >= power[i - 1] and power[i] >= power[i + 1] and power[i] > 0]
     peaks.sort(key=lambda i: -power[i])
+    bar = _line_bar(ok.size / pad)
     out, seen = [], []
     for i in peaks:
         a, b, c = np.log(np.maximum(power[i - 1: i + 2], 1e-300))
@@ -914,31 +915,36 @@ def _ripple_frequencies(runs, sims, k=2, pad=8, examined=20):
         if any(abs(fi - g) < 2.0 / (n * dt) for g in seen):
             continue
         seen.append(fi)
-        if 2 * sum(_line_in(p, i, pad, ok.size / pad) for p in each) > len(runs):
+        if 2 * sum(_line_in(p, i, pad, bar) for p in each) > len(runs):
             out.append(fi)
         if len(out) == k or len(seen) == examined:
             break
     return out
 
 
-def _line_in(power, i, pad, bins, half_band=16):
-    """Whether the padded periodogram ``power`` of one run has a line at padded bin ``i``.
+def _line_bar(bins):
+    """How many times a run's local floor (the median power near a bin) a line's power must exceed when ``bins``
+    unpadded bins are searched: ``ln(3 bins / ALPHA) / ln 2`` (15.7 for a 3 s run at 1 kHz searched from 1 to
+    300 Hz).
 
-    The largest power within one unpadded bin of ``i`` (about three independent bins) against the run's local
-    floor, the median power of the unpadded bins from 3 to ``half_band`` away on either side. A bin of noise has an
-    exponentially distributed power, whose median is ``ln 2`` times its mean, and the largest power of the ``bins``
-    unpadded bins searched, each taken with its two neighbours (``3 bins`` draws), exceeds ``c`` times the mean
-    with probability about ``3 bins exp(-c)``: a line is a power above ``ln(3 bins / ALPHA) / ln 2`` times the floor (15.7 for a 3 s run at
-    1 kHz searched from 1 to 300 Hz), a false line in a run of noise about as likely as ``ALPHA``, wherever the
-    pooled peak that points here came from.
+    A bin of noise has an exponentially distributed power, whose median is ``ln 2`` times its mean, and the largest
+    power of the ``bins`` bins searched, each taken with its two neighbours (``3 bins`` draws), exceeds ``c`` times
+    the mean with probability about ``3 bins exp(-c)``: a false line in a run of noise is about as likely as
+    ``ALPHA``, wherever the pooled peak that points to it came from.
     """
+    return math.log(3.0 * max(bins, 1.0) / ALPHA) / math.log(2.0)
+
+
+def _line_in(power, i, pad, bar, half_band=16):
+    """Whether the padded periodogram ``power`` of one run has a line at padded bin ``i``: the largest power within
+    one unpadded bin of ``i`` above ``bar`` (:func:`_line_bar`) times the run's local floor, the median power of the
+    unpadded bins from 3 to ``half_band`` away on either side."""
     near = power[max(i - pad, 0): i + pad + 1]
     offsets = np.arange(3, half_band + 1) * pad
     around = np.concatenate([power[i - offsets[i - offsets >= 0]], power[(i + offsets)[i + offsets < power.size]]])
     if around.size == 0:
         return False
-    floor = float(np.median(around))
-    return bool(float(np.max(near)) > math.log(3.0 * max(bins, 1.0) / ALPHA) / math.log(2.0) * floor)
+    return bool(float(np.max(near)) > bar * float(np.median(around)))
 
 
 def _stribeck_start(runs, base, start, replayer, base_sims, scale):

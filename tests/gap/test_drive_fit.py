@@ -414,7 +414,6 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
 def test_leave_one_out_step_is_close_to_the_refit():
     """The run-to-run null's refits are one Gauss-Newton step from the nominal fit (``_Fit.without``): on a
     residual linear in the values (as friction levels nearly are), that step lands on the refit."""
-
     rng = np.random.default_rng(3)
     paths = ("table.seal_force", "friction.viscous")
     basis = [rng.normal(size=(2, 300)) for _ in range(3)]
@@ -500,8 +499,9 @@ def test_ripple_frequencies_are_lines_of_most_runs():
     """A ripple at a fixed frequency is a line in every run; a force periodic in position is a line at
     speed / period, another frequency in each run of another speed, and the largest pooled peak is then the
     fastest run's line alone (development dataset 1215: a lead error's 52 Hz line of a 130 mm/s run)."""
-    fixed, _ = _residual_runs([[(1.5, 12.3)]] * 4)
-    assert drive_fit._ripple_frequencies(fixed, _) and abs(drive_fit._ripple_frequencies(fixed, _)[0] - 12.3) < 0.05
+    fixed, sims = _residual_runs([[(1.5, 12.3)]] * 4)
+    found = drive_fit._ripple_frequencies(fixed, sims)
+    assert found and abs(found[0] - 12.3) < 0.05
     speeds = (0.022, 0.008, 0.0425, 0.130)  # m/s, the runs of dataset 1215; a 2.5 mm period
     position, sims = _residual_runs([[(3.0, v / 0.0025)] for v in speeds], seed=1)
     assert drive_fit._ripple_frequencies(position, sims) == []
@@ -512,6 +512,6 @@ def test_ripple_frequencies_are_lines_of_most_runs():
     # a line in two of four runs is no one frequency of the axis
     half, sims = _residual_runs([[(1.5, 12.3)], [(1.5, 12.3)], [], []], seed=3)
     assert all(abs(f - 12.3) > 1.0 for f in drive_fit._ripple_frequencies(half, sims))
-    # and noise alone gives few lines: at most the chance 5 % a bin's test allows, in most runs at once
+    # and noise alone gives no line in most runs at once (a false line in one run is about as likely as ALPHA)
     noise, sims = _residual_runs([[]] * 4, seed=4)
     assert drive_fit._ripple_frequencies(noise, sims) == []
