@@ -486,6 +486,13 @@ def _lag1(r):
     return float(r[1:] @ r[:-1]) / d if d > 0 else 0.0
 
 
+def _effective_variance(r, n):
+    """The residual variance of a fit of ``n`` values, inflated by ``(1 + rho) / (1 - rho)`` for its lag-1
+    autocorrelation ``rho`` (clipped to [0, 0.99]): the ``s^2`` of the fit's covariance ``s^2 (J^T J)^-1``."""
+    rho = min(max(_lag1(r), 0.0), 0.99)
+    return float(r @ r) / max(r.size - n, 1) * (1 + rho) / (1 - rho)
+
+
 # --------------------------------------------------------------------------- output-error fit
 
 def _with(params, values):
@@ -566,11 +573,9 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
     sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, _BOUND), max_nfev=max_nfev,
                         x_scale=1.0, xtol=1e-3, ftol=1e-4)
     J, r = sol.jac, sol.fun
-    m, n = r.size, len(paths)
-    s2 = float(r @ r) / max(m - n, 1)
-    rho = min(max(_lag1(r), 0.0), 0.99)
+    n = len(paths)
     try:
-        cov = np.linalg.inv(J.T @ J) * s2 * (1 + rho) / (1 - rho)
+        cov = np.linalg.inv(J.T @ J) * _effective_variance(r, n)
     except np.linalg.LinAlgError:
         cov = np.full((n, n), np.inf)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
@@ -749,8 +754,7 @@ def _lead_second_harmonic(runs, base, values, sse, trial, replayer, scale):
         added, sse_added = _quadrature_effect(runs, start, paths, [None], trial, replayer, sims, scale)
         if added and sse_added < best[1]:
             best = ({p: get_value(start, p) for p in (amp, period, phase, amp2, phase2)} | added, sse_added)
-    rho = min(max(_lag1(r1), 0.0), 0.99)
-    s2 = float(r1 @ r1) / max(r1.size - 3, 1) * (1 + rho) / (1 - rho)
+    s2 = _effective_variance(r1, 3)
     if best[1] >= sse or (sse - best[1]) / s2 <= stats.chi2.ppf(1 - ALPHA, 2):
         return values, sse  # one harmonic explains the runs as well as two, within their noise
     return best
