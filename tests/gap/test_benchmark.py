@@ -124,13 +124,21 @@ def test_declared_params_carry_the_truths_effect_free_physics():
 
 
 def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
-    """One short null of the drakecreep kind (one candidate, to stay fast): the runs carry the declared params
-    file, the row has the drive diagnosis's ranking and the audit replays of the fitted params file."""
+    """One short null of the drakecreep kind (two cheap candidates, to stay fast): the runs carry the declared
+    params file, the row has the drive diagnosis's ranking and the audit replays of the fitted params file."""
     ds = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="drakecreep", axis="rigid", n_samples=600)
     assert all(r.meta.params is not None and r.meta.params.table.mass > 0 for r in ds.train + ds.test + ds.audit)
-    row = evaluate(ds, effects=("force_ripple",))
+    row = evaluate(ds, effects=("force_ripple", "nut_friction_side"))
     assert row["kind"] == "drakecreep" and row["category"] == "null" and row["expected"] is None
-    assert [r["effect"] for r in row["ranking"]] == ["force_ripple"]
+    ranked = {r["effect"]: r for r in row["ranking"]}
+    assert set(ranked) == {"force_ripple", "nut_friction_side"}
+    # the held-out runs' force errors, nominal and candidate, from which the ranking's gain is recounted (the
+    # switch is always replayed; the ripple of a null has no line to fit)
+    nominal, switched = row["test_force_nominal_runs"], ranked["nut_friction_side"]["test_force_runs"]
+    assert len(switched) == len(nominal) == len(ds.test)
+    assert np.mean(np.subtract(nominal, switched)) == pytest.approx(ranked["nut_friction_side"]["gain"], abs=1e-9)
+    ripple = ranked["force_ripple"]["test_force_runs"]
+    assert ripple is None or len(ripple) == len(ds.test)
     assert set(row["claimed_model"]["fitted"]) == {"table.seal_force", "nut.preload_torque", "friction.viscous"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
     assert row["oscillation"] is None and "audit_oscillation_nepers" not in row  # a stable null: no spectral audit
