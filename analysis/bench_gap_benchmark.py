@@ -2,7 +2,8 @@
 
 Datasets from :mod:`drakecreep.gap.truth` (see :mod:`drakecreep.gap.benchmark`), controller kind ``p_p_cascade``
 (``diagnose_drake``) or, with ``--kinds drakecreep``, the project's own controller (``diagnose_drive`` on the params
-file the truth's user would write; about 6 min per dataset on a free core). The reported
+file the truth's user would write; one to three hours per dataset: 3519-9727 s on a shared machine in run 3bm
+of docs/gap_benchmark.md). The reported
 figures use the held-out seeds (``--seeds heldout``, the default); ``--seeds dev`` is for debugging.
 
 Rows are written to ``--json`` after every dataset (a run cut short still gives figures: ``--score FILE``

@@ -2,12 +2,14 @@
 its usage instead of starting the long job, and a wrong argument is refused with exit status 2."""
 
 import ast
+import importlib.util
 import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ANALYSIS = Path(__file__).resolve().parents[1] / "analysis"
@@ -78,3 +80,48 @@ def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, 
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stdout == ""
     assert field in out.stderr.strip().splitlines()[-1]
+
+
+def _drive_row(seed, category, expected, snr, nominal, ranking, claimed, oscillation=None):
+    return {"seed": seed, "kind": "drakecreep", "category": category, "expected": expected, "snr": snr,
+            "withheld": [] if category == "null" else [expected], "claimed": claimed, "oscillation": oscillation,
+            "test_force_nominal_runs": nominal, "ranking": ranking}
+
+
+def _ranked(effect, nominal, runs, train_gain=0.5, null=0.01):
+    e_nom, e = np.square(nominal), np.square(runs)
+    return {"effect": effect, "train_gain": train_gain, "test_force_runs": runs,
+            "replay": {"shrink": float(1 - e.sum() / e_nom.sum()), "threshold": null,
+                       "runs_better": int(np.sum(e < e_nom))}}
+
+
+def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
+    """The recount of drakecreep-kind rows: a lead error whose five held-out runs all shrink by very different
+    amounts fails the Student bars on points and on log ratios but passes the sign-flip test; a null's candidate that helps two runs
+    of five is claimed by none; a row without per-run errors (written before session 55) is skipped."""
+    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
+    dcs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dcs)
+    nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
+    lead = _ranked("lead_error", nominal, [9.9, 11.5, 12.0, 10.8, 14.0])  # gains 0.1-26 points, all positive
+    noise = _ranked("force_ripple", nominal, [9.0, 11.0, 30.5, 11.5, 40.2])
+    rows = [_drive_row(1, "library", "lead_error", 9.0, nominal, [lead, noise], []),
+            _drive_row(2, "null", None, 0.0, nominal, [noise], []),
+            dict(_drive_row(3, "null", None, 0.0, None, [], []), test_force_nominal_runs=None)]
+    claims = dcs.first_claims(rows[0])
+    # (the log ratios, 0.01-1.05, differ as much as the points: a log-ratio bar does not pass it either)
+    assert claims == {"points_t": None, "sign_flip": "lead_error", "t_or_sign_flip": "lead_error",
+                      "log_ratio_t": None}
+    assert set(dcs.first_claims(rows[1]).values()) == {None}
+    table, scores = dcs.recount(rows)
+    assert [r["seed"] for r, _ in table] == [1, 2]
+    assert scores["t_or_sign_flip"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
+    assert scores["points_t"]["right"] == 0
+    (tmp_path / "rows.json").write_text(json.dumps({"datasets": rows}))
+    out = subprocess.run([sys.executable, str(ANALYSIS / "drive_claim_statistics.py"), str(tmp_path / "rows.json")],
+                         capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
+    assert out.returncode == 0 and "t_or_sign_flip   top-1 at SNR >= 3: 1 / 1" in out.stdout, out.stdout + out.stderr
+    (tmp_path / "bad.json").write_text("[1, 2]")
+    bad = subprocess.run([sys.executable, str(ANALYSIS / "drive_claim_statistics.py"), str(tmp_path / "bad.json")],
+                         capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
+    assert bad.returncode == 2 and "rows: got" in bad.stderr and "Traceback" not in bad.stderr
