@@ -97,8 +97,9 @@ def _ranked(effect, nominal, runs, train_gain=0.5, null=0.01):
 
 def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     """The recount of drakecreep-kind rows: a lead error whose five held-out runs all shrink by very different
-    amounts fails the Student bars on points and on log ratios but passes the sign-flip test; a null's candidate that helps two runs
-    of five is claimed by none; a row without per-run errors (written before session 55) is skipped."""
+    amounts fails the Student bars on points and on log ratios but passes the sign-flip test; a null's candidate
+    that helps two runs of five is claimed by none; a row without per-run errors (written before session 55) is
+    skipped."""
     spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
     dcs = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dcs)
