@@ -105,10 +105,13 @@ def main(argv=None):
         try:
             with open(path, encoding="utf-8") as f:
                 data = json.load(f)
-            rows += list(data["datasets"])
+            part = list(data["datasets"])
+            if not all(isinstance(r, dict) and "seed" in r and "ranking" in r for r in part):
+                raise ValueError("a dataset without seed or ranking")
+            rows += part
         except (OSError, ValueError, KeyError, TypeError) as e:
-            ap.error(f"rows: got {path!r} ({type(e).__name__}); allowed: a JSON file of gap-benchmark rows "
-                     "(a 'datasets' list)")
+            why = e.strerror if isinstance(e, OSError) else f"no {e}" if isinstance(e, KeyError) else str(e)
+            ap.error(f"rows: got {path!r} ({why}); allowed: a JSON file of gap-benchmark rows (a 'datasets' list)")
     seen, unique = set(), []
     for r in rows:  # a resumed shard's datasets appear in both of its files
         if r["seed"] not in seen:
