@@ -69,6 +69,8 @@ def first_claims(row):
             runs, replay = c.get("test_force_runs"), c.get("replay")
             if nominal is None or runs is None or not replay or c.get("train_gain", 0.0) <= 0:
                 continue
+            if row.get("replay_null") is None:
+                break  # no run-to-run null (one training run, nothing fitted): the product claims nothing
             pooled = replay["shrink"] > replay["threshold"] and 2 * replay["runs_better"] > len(runs)
             if pooled and held_out_passes(rule, nominal, runs):
                 out[rule] = c["effect"]

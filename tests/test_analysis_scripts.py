@@ -85,7 +85,7 @@ def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, 
 def _drive_row(seed, category, expected, snr, nominal, ranking, claimed, oscillation=None):
     return {"seed": seed, "kind": "drakecreep", "category": category, "expected": expected, "snr": snr,
             "withheld": [] if category == "null" else [expected], "claimed": claimed, "oscillation": oscillation,
-            "test_force_nominal_runs": nominal, "ranking": ranking}
+            "test_force_nominal_runs": nominal, "ranking": ranking, "replay_null": 0.01}
 
 
 def _ranked(effect, nominal, runs, train_gain=0.5, null=0.01):
@@ -114,6 +114,7 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     assert claims == {"points_t": None, "sign_flip": "lead_error", "t_or_sign_flip": "lead_error",
                       "log_ratio_t": None}
     assert set(dcs.first_claims(rows[1]).values()) == {None}
+    assert set(dcs.first_claims(dict(rows[0], replay_null=None)).values()) == {None}  # as the product: no null
     table, scores = dcs.recount(rows)
     assert [r["seed"] for r, _ in table] == [1, 2]
     assert scores["t_or_sign_flip"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
