@@ -30,7 +30,7 @@ import sys
 import numpy as np
 from scipy import stats
 
-from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
+from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, replay_test, sign_flip_p
 
 RULES = ("points_t", "sign_flip", "t_or_sign_flip", "log_ratio_t")
 
@@ -56,25 +56,21 @@ def held_out_passes(rule, nominal, candidate):
 
 def first_claims(row):
     """``{rule: first claimed effect or None}`` of one drakecreep-kind row (``None`` for every rule when the row
-    lacks the per-run errors; the row's own claim for every rule when its runs oscillate where the model does not,
-    as the claims are then made on the spectrum)."""
-    nominal = row.get("test_force_nominal_runs")
+    lacks the per-run errors or the run-to-run null, as the product then claims nothing; the row's own claim for
+    every rule when its runs oscillate where the model does not, as the claims are then made on the spectrum).
+    The pooled test is the product's own (:func:`drakecreep.gap.claims.replay_test` on the per-run force-error
+    energies, against the row's run-to-run null)."""
     if row.get("oscillation"):  # claims withheld, only the delay claimed on the spectrum: no held-out statistic
         own = row["claimed"][0] if row["claimed"] else None
         return {rule: own for rule in RULES}
-    out = {}
+    nominal, null = row.get("test_force_nominal_runs"), row.get("replay_null")
+    out = dict.fromkeys(RULES)
+    if nominal is None or null is None:
+        return out
+    passing = [c for c in row["ranking"] if c.get("test_force_runs") is not None and c.get("train_gain", 0.0) > 0
+               and replay_test(np.square(nominal), np.square(c["test_force_runs"]), null)["passes"]]
     for rule in RULES:
-        out[rule] = None
-        for c in row["ranking"]:
-            runs, replay = c.get("test_force_runs"), c.get("replay")
-            if nominal is None or runs is None or not replay or c.get("train_gain", 0.0) <= 0:
-                continue
-            if row.get("replay_null") is None:
-                break  # no run-to-run null (one training run, nothing fitted): the product claims nothing
-            pooled = replay["shrink"] > replay["threshold"] and 2 * replay["runs_better"] > len(runs)
-            if pooled and held_out_passes(rule, nominal, runs):
-                out[rule] = c["effect"]
-                break
+        out[rule] = next((c["effect"] for c in passing if held_out_passes(rule, nominal, c["test_force_runs"])), None)
     return out
 
 

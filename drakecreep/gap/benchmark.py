@@ -532,15 +532,14 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
     res = diagnose_drive(ds.train, ds.test, progress=progress or False, **kw)
     claimed = list(res.claimed)
     labels = list(res.nominal_test_errors)
-    # each held-out run's force error [%] beside the nominal's (the same run order), so that other claim
-    # statistics can be recounted on the rows (as the p_p_cascade kind's run log ratios allow)
+    # each held-out run's force error [%] beside the nominal's (the same run order) and the run-to-run null, so
+    # that the pooled replay test and other claim statistics can be recounted on the rows (as the p_p_cascade
+    # kind's run log ratios allow)
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
                 "test_force_runs": ([float(c.test_errors[k]["force"]) for k in labels]
-                                    if all(k in c.test_errors for k in labels) else None),
-                "replay": ({k: c.replay[k] for k in ("shrink", "threshold", "runs_better") if k in c.replay}
-                           if c.replay else None)}
+                                    if all(k in c.test_errors for k in labels) else None)}
                for c in res.candidates]
     row = _row(ds, claimed, ranking, friction=res.params.friction.law,
                test_force_nominal_runs=[float(res.nominal_test_errors[k]["force"]) for k in labels],
