@@ -160,6 +160,11 @@ class ControllerMeta:
             raise InputError("controller.feedback", self.feedback, "one of motor, table")
         for name in ("kp", "kv"):
             object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), 0.0))
+            if self.kind == "p_p_cascade" and getattr(self, name) == 0.0:
+                # Left out, a gain reads as 0: a P-P cascade without its position or velocity gain cannot
+                # have produced a tracking run, and its replay would diagnose an open loop.
+                raise InputError(f"controller.{name}", getattr(self, name),
+                                 "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
         sat = self.saturation
         if not (isinstance(sat, (int, float)) and not isinstance(sat, bool) and sat > 0 and not math.isnan(sat)):
             raise InputError("controller.saturation", sat, "a number > 0 (inf for none)")
@@ -205,6 +210,11 @@ class ControllerMeta:
         data = dict(data)
         if data.get("saturation") in (".inf", "inf", "none", None) and "saturation" in data:
             data["saturation"] = math.inf
+        if data.get("kind", cls.kind) == "p_p_cascade":
+            for name in ("kp", "kv"):
+                if name not in data:
+                    raise InputError(f"controller.{name}", "nothing (the key is missing)",
+                                     "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
         return cls(**data)
 
 

@@ -379,7 +379,8 @@ def no_replay(monkeypatch):
 
 
 def _blank(label="b", n=N, params=RIG, kind="drakecreep"):
-    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=params, controller=ControllerMeta(kind=kind))
+    gains = {"kp": 160.0, "kv": 240.0} if kind == "p_p_cascade" else {}
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=params, controller=ControllerMeta(kind=kind, **gains))
     t = np.arange(n) * 1e-3
     x = out_and_back(0.02, 0.0, n=n, dt=1e-3, leg=0.2, starts=(0.03, 0.26)) if n == N else np.zeros(n)
     return MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.zeros(n), meta=meta, label=label)

@@ -361,6 +361,15 @@ def test_bad_controller_metadata(tmp_path):
     bad = {**META, "controller": {**META["controller"], "kind": "pid"}}
     with pytest.raises(InputError, match="p_p_cascade, drakecreep"):
         load_measured(_write(tmp_path, meta=bad))
+    for gain in ("kp", "kv"):
+        # A P-P cascade whose gain is left out would be replayed as an open loop: refused, naming the gain.
+        bad = {**META, "controller": {k: v for k, v in META["controller"].items() if k != gain}}
+        with pytest.raises(InputError, match=f"controller.{gain}: got 'nothing .the key is missing.'; allowed: a "
+                                             "number > 0"):
+            load_measured(_write(tmp_path, meta=bad))
+        bad = {**META, "controller": {**META["controller"], gain: 0}}
+        with pytest.raises(InputError, match=f"controller.{gain}: got 0.0; allowed: a number > 0"):
+            load_measured(_write(tmp_path, meta=bad))
 
 
 def test_several_runs_and_round_trip(tmp_path):
