@@ -436,10 +436,16 @@ def _replay_one(run, params, load_case):
 
 
 class _Replayer:
-    """Closed-loop replays of a fixed set of runs, counting them; over a process pool when given one."""
+    """Closed-loop replays of a fixed set of runs, counting them; over a process pool when given one.
+
+    Over a pool the replays are handed out longest first, by each run's last replay time (unknown runs by their
+    length): one evaluation of a fit is often three runs on two workers, and a fast run (3 mm/s on the paper rig:
+    1.2 s against 0.4 s for 0.5 mm/s) handed out last sets the wall time. The results keep the order asked for.
+    """
 
     def __init__(self, load_case, pool=None):
         self.load_case, self.count, self.pool = load_case, 0, pool
+        self._seconds = {}  # id of a run -> its last replay's wall time [s]
 
     def __call__(self, runs, params):
         return self.many([(runs, params)])[0]
@@ -451,7 +457,13 @@ class _Replayer:
         if self.pool is None or len(tasks) < 2:
             flat = [replay_drakecreep(r, params, load_case=self.load_case) for r, params in tasks]
         else:
-            flat = list(self.pool.map(_replay_one, *zip(*tasks), [self.load_case] * len(tasks)))
+            order = sorted(range(len(tasks)), key=lambda i: -self._seconds.get(id(tasks[i][0]), 1e-6 * tasks[i][0].n))
+            done = self.pool.map(_replay_one, *zip(*(tasks[i] for i in order)), [self.load_case] * len(tasks))
+            flat = [None] * len(tasks)
+            for i, sim in zip(order, done):
+                flat[i] = sim
+        for (r, _), sim in zip(tasks, flat):
+            self._seconds[id(r)] = sim.wall_time
         out, k = [], 0
         for runs, _ in jobs:
             out.append(flat[k: k + len(runs)])

@@ -345,6 +345,29 @@ def test_replays_in_worker_processes_give_the_same_diagnosis():
         diagnose_drive(runs[:2], runs[2:], workers=0, **kwargs)
 
 
+def test_pooled_replays_are_handed_out_longest_first_and_returned_in_order(monkeypatch):
+    """The pool gets the slowest run first (by its last replay, else by its length); the caller its order."""
+    seconds = {"slow": 3.0, "mid": 2.0, "fast": 1.0}
+    handed = []
+
+    def fake_replay(run, params, load_case=0):
+        handed.append(run.label)
+        return SimpleNamespace(label=run.label, wall_time=seconds[run.label])
+
+    class Pool:
+        def map(self, fn, *columns):
+            return [fn(*args) for args in zip(*columns)]  # in the order handed out, as one worker would
+
+    monkeypatch.setattr(drive_fit, "replay_drakecreep", fake_replay)
+    runs = [SimpleNamespace(label=label, n=n) for label, n in (("fast", 300), ("slow", 100), ("mid", 200))]
+    replayer = drive_fit._Replayer(0, Pool())
+    assert [s.label for s in replayer(runs, None)] == ["fast", "slow", "mid"]
+    assert handed == ["fast", "mid", "slow"]  # nothing timed yet: the longest run first
+    handed.clear()
+    assert [s.label for s in replayer(runs, None)] == ["fast", "slow", "mid"]
+    assert handed == ["slow", "mid", "fast"] and replayer.count == 6
+
+
 def test_levels_acting_at_the_same_place_are_reported_not_separable():
     """Seal drag and nut preload drag both add to the one Coulomb level on the table in this rig."""
     runs = _runs(RIG, seed=4)
