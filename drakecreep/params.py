@@ -341,6 +341,15 @@ class FrictionParams(_Params):
     stribeck_velocity: float = _q(1.0e-4, "m/s", 0.0, 1.0, lo_open=True, doc="vs")
     stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
     viscous: float = _q(200.0, "N s/m", 0.0, doc="viscous coefficient Fv")
+    coulomb_asymmetry: float = _q(
+        0.0, "-", -0.9, 0.9,
+        doc="dry-friction levels (1 + a) times their mean moving +x, (1 - a) moving -x (seals, gravity on an "
+            "inclined axis); assumption: 0, the paper gives none; the friction compensators model it symmetric",
+    )
+    viscous_asymmetry: float = _q(
+        0.0, "-", -0.9, 0.9,
+        doc="viscous coefficient (1 + a) Fv moving +x, (1 - a) Fv moving -x; assumption: 0, the paper gives none",
+    )
     bristle_stiffness: float = _q(2.0e7, "N/m", 0.0, lo_open=True, doc="LuGre sigma0")
     bristle_damping: float = _q(2.0e3, "N s/m", 0.0, doc="LuGre sigma1")
     regularization_velocity: float = _q(

@@ -68,17 +68,49 @@ class FrictionLaw:
     stribeck_exponent : float
         ``delta`` of the Stribeck curve (see :func:`stribeck_curve`).
     regularization_velocity : float
-        ``v_reg`` (m/s) of the ``tanh`` that replaces ``sign`` in the stateless laws.
+        ``v_reg`` (m/s) of the ``tanh`` that replaces ``sign`` in the stateless laws (and gives the direction
+        of the asymmetries).
+    coulomb_asymmetry : float
+        ``a_c`` (-): the dry-friction curve ``g(v)`` (Coulomb and breakaway levels) is ``(1 + a_c)`` times its
+        mean moving in +x and ``(1 - a_c)`` times it moving in -x, blended by ``tanh(v / v_reg)``; 0 symmetric.
+    viscous_asymmetry : float
+        ``a_v`` (-): the viscous term is ``Fv (1 + a_v tanh(v / v_reg)) v``; 0 symmetric.
+
+    A law's internal states stay normalized by the mean level ``Fc``, so a stuck contact's force does not jump
+    when its tiny presliding speed changes sign; only the sliding level ``g(v)`` that the states approach
+    depends on the direction.
     """
 
     viscous: float
     stribeck_velocity: float
     regularization_velocity: float
     stribeck_exponent: float = 2.0
+    coulomb_asymmetry: float = 0.0
+    viscous_asymmetry: float = 0.0
 
     #: number of internal states
     num_states = 0
     name = "base"
+
+    def _direction_factor(self, v, asymmetry):
+        """``1 + asymmetry tanh(v / v_reg)`` (1 exactly, and no ``tanh`` in the expression, when symmetric)."""
+        if asymmetry == 0.0:
+            return 1.0
+        return 1.0 + asymmetry * tanh(v / self.regularization_velocity)
+
+    def viscous_force(self, v):
+        """Viscous friction ``Fv (1 + a_v tanh(v / v_reg)) v`` (N)."""
+        if self.viscous_asymmetry == 0.0:
+            return self.viscous * v
+        return self.viscous * self._direction_factor(v, self.viscous_asymmetry) * v
+
+    def sliding_level(self, v, Fc, Fs):
+        """The dry-friction level in steady sliding at ``v``: the Stribeck curve :func:`stribeck_curve` times
+        ``1 + a_c tanh(v / v_reg)`` (N, >= 0)."""
+        g = stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
+        if self.coulomb_asymmetry == 0.0:
+            return g
+        return g * self._direction_factor(v, self.coulomb_asymmetry)
 
     def initial_state(self):
         """Internal state of a contact at rest with no presliding displacement."""
@@ -118,7 +150,8 @@ class CoulombFriction(FrictionLaw):
     name = "coulomb"
 
     def force(self, v, z, Fc, Fs):
-        return Fc * tanh(v / self.regularization_velocity) + self.viscous * v
+        level = Fc * self._direction_factor(v, self.coulomb_asymmetry)
+        return level * tanh(v / self.regularization_velocity) + self.viscous_force(v)
 
     def breakaway(self, Fc, Fs):
         """``Fc``: the law has no static level above the sliding one (no friction drop, no creep)."""
@@ -132,8 +165,7 @@ class StribeckFriction(FrictionLaw):
     name = "stribeck"
 
     def force(self, v, z, Fc, Fs):
-        g = stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
-        return g * tanh(v / self.regularization_velocity) + self.viscous * v
+        return self.sliding_level(v, Fc, Fs) * tanh(v / self.regularization_velocity) + self.viscous_force(v)
 
 
 @dataclass(frozen=True)
@@ -161,7 +193,7 @@ class LuGreFriction(FrictionLaw):
     name = "lugre"
 
     def _g(self, v, Fc, Fs):
-        return stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
+        return self.sliding_level(v, Fc, Fs)
 
     def deflection_rate(self, v, w, Fc, Fs):
         """``dz/dt`` (m/s) of the bristles for the normalized state ``w``.
@@ -179,11 +211,11 @@ class LuGreFriction(FrictionLaw):
         return [self.bristle_stiffness / Fc * self.deflection_rate(v, w, Fc, Fs)]
 
     def force(self, v, w, Fc, Fs):
-        return Fc * w[0] + self.bristle_damping * self.deflection_rate(v, w, Fc, Fs) + self.viscous * v
+        return Fc * w[0] + self.bristle_damping * self.deflection_rate(v, w, Fc, Fs) + self.viscous_force(v)
 
     def steady_state_force(self, v, Fc, Fs):
         v = np.asarray(v, dtype=float)
-        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous * v
+        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
 
     def deflection(self, w, Fc):
         """Bristle deflection ``z`` (m) for the normalized state ``w``."""
@@ -264,7 +296,7 @@ class GMSFriction(FrictionLaw):
         return self.bristle_stiffness / (i * np.sum(1.0 / i))
 
     def _g(self, v, Fc, Fs):
-        return stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
+        return self.sliding_level(v, Fc, Fs)
 
     def force_rates(self, v, w, Fc, Fs):
         """``dF_i/dt`` (N/s) of the elements for the normalized states ``w``."""
@@ -293,11 +325,11 @@ class GMSFriction(FrictionLaw):
         for wi, r in zip(w, rates):
             total = total + Fc * wi
             rate = rate + r
-        return total + self.bristle_damping * rate / self.bristle_stiffness + self.viscous * v
+        return total + self.bristle_damping * rate / self.bristle_stiffness + self.viscous_force(v)
 
     def steady_state_force(self, v, Fc, Fs):
         v = np.asarray(v, dtype=float)
-        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous * v
+        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
 
     def presliding_stiffness(self, Fc, Fs):
         return self.bristle_stiffness
@@ -314,6 +346,8 @@ def make_friction_law(params):
         stribeck_velocity=params.stribeck_velocity,
         regularization_velocity=params.regularization_velocity,
         stribeck_exponent=params.stribeck_exponent,
+        coulomb_asymmetry=params.coulomb_asymmetry,
+        viscous_asymmetry=params.viscous_asymmetry,
     )
     if params.law == "lugre":
         return LuGreFriction(

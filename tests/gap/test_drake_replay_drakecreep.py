@@ -131,3 +131,22 @@ def test_a_fractional_computation_delay_is_replayed_on_the_leaf_systems():
     for whole in (1.0, 2.0):
         other = replay_drakecreep(run, with_value(rig, "controller.computation_delay", whole))
         assert np.max(np.abs(other.u - auto.u)) > 1.0
+
+
+def test_an_asymmetric_friction_is_an_offset_on_both_legs_compiled_and_leaf():
+    """Levels (1 + a) moving +x and (1 - a) moving -x: the force command rises by ``a_c Fc + a_v Fv |v|`` on
+    the out leg and on the back leg alike (what an identification reads as an offset); the compiled diagram
+    carries it as the leaf systems do."""
+    from drakecreep.model.nut_table import friction_levels
+
+    rig = _rig()
+    asym = with_value(with_value(rig, "friction.coulomb_asymmetry", 0.3), "friction.viscous_asymmetry", 0.5)
+    sym_run, run = _run(rig), _run(asym)
+    fast, slow, base = replay_drakecreep(run), replay_drakecreep(run, backend="leaf"), replay_drakecreep(sym_run)
+    count = rig.screw.lead / rig.sensors.encoder_counts_per_rev
+    assert np.max(np.abs(fast.u - slow.u)) <= 2 * rig.controller.velocity_gain * count / rig.controller.velocity_period
+    fc = friction_levels(asym, asym.load_case(0))[0]  # the replay is unloaded (load case 0)
+    expected = 0.3 * fc + 0.5 * asym.friction.viscous * 0.02
+    for lo, hi in ((0.06, 0.11), (0.19, 0.24)):  # cruise at 20 mm/s out, then back
+        window = (run.t >= lo) & (run.t <= hi)
+        assert np.mean(fast.u[window] - base.u[window]) == pytest.approx(expected, rel=0.05)

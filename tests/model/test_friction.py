@@ -45,7 +45,11 @@ def test_stribeck_slope_is_negative_just_above_zero_speed():
 @pytest.mark.parametrize("law", [CoulombFriction(**COMMON), StribeckFriction(**COMMON),
                                  LuGreFriction(**COMMON, bristle_stiffness=1e7, bristle_damping=1e3)])
 def test_one_source_for_float_autodiff_and_symbolic(law):
-    v, z = 2e-4, [1e-6] * law.num_states
+    _check_one_source(law, 2e-4, [1e-6] * law.num_states)
+
+
+def _check_one_source(law, v, z):
+    """The law's force at ``(v, z)`` in float, AutoDiffXd and a symbolic Expression evaluated there agree."""
     expected = law.force(v, z, FC, FS)
     ad = law.force(AutoDiffXd(v, np.array([1.0])), [AutoDiffXd(zi) for zi in z], FC, FS)
     assert ad.value() == pytest.approx(expected)
@@ -179,3 +183,48 @@ def test_gms_selectable_from_params(paper):
     law = make_friction_law(p.friction)
     assert isinstance(law, GMSFriction) and law.num_states == 5
     assert law.bristle_stiffness == p.friction.bristle_stiffness
+
+
+ASYM = dict(coulomb_asymmetry=0.2, viscous_asymmetry=-0.4)
+
+
+@pytest.mark.parametrize("name", ["coulomb", "stribeck", "lugre", "gms"])
+def test_asymmetric_levels_scale_each_direction_and_keep_the_mean(name, paper):
+    """Moving +x the dry level is (1 + a_c) and the viscous (1 + a_v) times the symmetric law's, -x (1 - a)."""
+    from drakecreep.params import with_value
+
+    sym = make_friction_law(with_value(paper, "friction.law", name).friction)
+    law = make_friction_law(with_value(with_value(with_value(paper, "friction.law", name), "friction.coulomb_asymmetry",
+                                                  0.2), "friction.viscous_asymmetry", -0.4).friction)
+    for v in (3e-4, 2e-3):  # well above v_reg (1 um/s)
+        dry = sym.steady_state_force(v, FC, FS) - sym.viscous * v
+        for s in (1.0, -1.0):
+            expected = s * dry * (1 + 0.2 * s) + sym.viscous * (1 - 0.4 * s) * s * v
+            assert float(law.steady_state_force(s * v, FC, FS)) == pytest.approx(expected, rel=1e-9)
+    # the mean of the two directions is the symmetric law's, so a fitted asymmetry leaves the level alone
+    v = 1e-3
+    mean = (law.steady_state_force(v, FC, FS) - law.steady_state_force(-v, FC, FS)) / 2
+    assert float(mean) == pytest.approx(float(sym.steady_state_force(v, FC, FS)), rel=1e-12)
+
+
+def test_symmetric_law_has_no_direction_term():
+    """a = 0 (every preset) builds the same expression as before the asymmetry existed: no tanh of v added."""
+    law = StribeckFriction(**COMMON)
+    sv = Variable("v")
+    assert law.viscous_force(Expression(sv)).EqualTo(COMMON["viscous"] * Expression(sv))
+    assert law.sliding_level(Expression(sv), FC, FS).EqualTo(stribeck_curve(Expression(sv), FC, FS, 1e-4))
+
+
+@pytest.mark.parametrize("law", [CoulombFriction(**COMMON, **ASYM), StribeckFriction(**COMMON, **ASYM),
+                                 LuGreFriction(**COMMON, **ASYM, bristle_stiffness=1e7, bristle_damping=1e3)])
+def test_asymmetric_law_one_source_for_float_autodiff_and_symbolic(law):
+    for v in (2e-4, -3e-4):
+        _check_one_source(law, v, [0.4] * law.num_states)
+
+
+def test_asymmetric_lugre_settles_on_its_own_level_in_each_direction():
+    law = LuGreFriction(**COMMON, **ASYM, bristle_stiffness=1e7, bristle_damping=1e3)
+    for v in (4e-4, -4e-4):
+        sol = solve_ivp(lambda t, z: law.state_rates(v, z, FC, FS), (0, 3.0), [0.0], method="LSODA", rtol=1e-10,
+                        atol=1e-14)
+        assert law.force(v, sol.y[:, -1], FC, FS) == pytest.approx(float(law.steady_state_force(v, FC, FS)), rel=1e-6)
