@@ -89,6 +89,7 @@ __all__ = [
     "DEFAULT_UNCERTAIN",
     "EFFECTS",
     "NOT_IN_MODEL",
+    "ON_REQUEST",
     "SEPARABILITY",
     "STRIBECK_STARTS",
     "MIN_SAMPLES",
@@ -106,12 +107,17 @@ FITTABLE = (
     "table.seal_force", "table.guide_friction_coefficient", "nut.preload_torque", "nut.load_friction_coefficient",
     "friction.viscous", "friction.static_ratio", "friction.stribeck_velocity", "friction.bristle_stiffness",
     "friction.bristle_damping", "nut.axial_stiffness", "nut.axial_damping", "screw.bearing_stiffness",
-    "screw.bearing_damping",
+    "screw.bearing_damping", "friction.coulomb_asymmetry", "friction.viscous_asymmetry",
 )
 #: Default uncertain fields: the friction level of the guides, the nut's preload drag, the viscous friction.
 DEFAULT_UNCERTAIN = ("table.seal_force", "nut.preload_torque", "friction.viscous")
-#: Lower bound of each fitted field (the field's own range: ``static_ratio >= 1``, the rest >= 0).
-_LOWER = {"friction.static_ratio": 1.0}
+#: The asymmetric friction candidate's fields (signed fractions, FrictionParams' range [-0.9, 0.9]).
+_ASYMMETRY = ("friction.coulomb_asymmetry", "friction.viscous_asymmetry")
+#: Lower bound of each fitted field (the field's own range: ``static_ratio >= 1``, the asymmetries >= -0.9, the
+#: rest >= 0), and the upper bound of the fields that have one. A field is fitted as ``lower + (start - lower)
+#: exp(theta)``; an asymmetry of 0 sits 0.9 above its lower bound, so it moves about linearly near 0.
+_LOWER = {"friction.static_ratio": 1.0, **{p: -0.9 for p in _ASYMMETRY}}
+_UPPER = {p: 0.9 for p in _ASYMMETRY}
 #: Estimates whose correlation exceeds this are reported as not separable.
 SEPARABILITY = 0.95
 #: Shortest run accepted (samples and seconds): the position loop needs a few periods to show anything.
@@ -152,7 +158,7 @@ _PERIODIC = {"lead_error": ("disturbance.lead_error_amplitude", "disturbance.lea
 _LEAD_SECOND = ("disturbance.lead_error_2_amplitude", "disturbance.lead_error_2_phase")
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _LEAD_SECOND[0]),
-               "force_ripple": ("disturbance.force_ripple",)}
+               "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -167,14 +173,20 @@ EFFECTS = {
     "nut_friction_side": "the nut's friction moved between the table and the screw (friction.nut_friction_on)",
     "control_delay": "computation delay of the sampled controller (controller.computation_delay, whole velocity "
                      "samples) fitted by a search over the delay",
+    "asymmetric_friction": "direction-dependent friction (friction.coulomb_asymmetry and viscous_asymmetry); in "
+                           "steady sliding a Coulomb asymmetry pushes as a constant force offset would",
 }
+#: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
+#: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
+#: otherwise and which a drive's current offset or an inclined axis gives; how often it would be claimed on data
+#: with an offset and no asymmetry has not been measured on development datasets (docs/gap_drakecreep_kind.md).
+ON_REQUEST = ("asymmetric_friction",)
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
 #: replay takes no fractional delay: a fraction adds a second sampling offset), up to 4 ms at a 4 kHz speed loop;
 #: the best is refined by halving the gaps to its neighbours down to one sample.
 DELAY_GRID = (0, 1, 2, 4, 8, 12, 16)
 #: Effects of issue 16 that DriveParams cannot express: never ranked, with the reason.
 NOT_IN_MODEL = {
-    "asymmetric_friction": "DriveParams has one friction level for both directions",
     "position_friction": "no position-dependent friction field in DriveParams",
     "load_friction": "load dependence is fixed by the load case (nut.load_friction_coefficient is fittable as uncertain)",
     "cogging": "no motor cogging field in DriveParams",
@@ -305,7 +317,7 @@ class DriveDiagnosis:
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
-            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {_interval(f.lower, f.upper, '.4g')}; "
+            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {_interval(f.lower, f.upper, '.4g', _LOWER.get(f.path, 0.0))}; "
                          f"params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
@@ -359,10 +371,11 @@ class DriveDiagnosis:
         })
 
 
-def _interval(lower, upper, fmt=".3g"):
-    """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades (the Jacobian says the runs do
-    not determine the field at all; its exponent is clipped) as such, not as 1e-302 .. 1e+306."""
-    if not (lower > 0 and math.isfinite(upper)) or math.log10(upper) - math.log10(lower) > _UNBOUNDED:
+def _interval(lower, upper, fmt=".3g", floor=0.0):
+    """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
+    ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
+    as 1e-302 .. 1e+306."""
+    if not (lower > floor and math.isfinite(upper)) or math.log10(upper - floor) - math.log10(lower - floor) > _UNBOUNDED:
         return "not bounded by these runs"
     return f"{lower:{fmt}} .. {upper:{fmt}}"
 
@@ -419,9 +432,11 @@ def _check_inputs(train, test, uncertain, effects, load_case):
             raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
         if get_value(prior, path) <= _LOWER.get(path, 0.0):
             raise InputError("uncertain", path, f"a field whose params value is above {_LOWER.get(path, 0.0):g}")
+        if path in _UPPER and get_value(prior, path) >= _UPPER[path]:
+            raise InputError("uncertain", path, f"a field whose params value is below {_UPPER[path]:g}")
     if len(set(uncertain)) != len(uncertain):
         raise InputError("uncertain", uncertain, "distinct fields")
-    names = tuple(EFFECTS) if effects is None else tuple(effects)
+    names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else tuple(effects)
     for n in names:
         if n not in EFFECTS:
             raise InputError("effects", n, NOT_IN_MODEL.get(n, "one of " + ", ".join(EFFECTS)))
@@ -547,6 +562,9 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         return (prior, (), (), float(r @ r)) + ((None,) if details else ())
     v0 = np.array([get_value(prior, p) for p in paths])
     lo = np.array([_LOWER.get(p, 0.0) for p in paths])
+    # theta's upper bound: the fitted range, or less where the field's range ends first
+    top = np.array([min(_BOUND, math.log((_UPPER[p] - lo[i]) / (v0[i] - lo[i]))) if p in _UPPER else _BOUND
+                    for i, p in enumerate(paths)])
 
     def values(theta):
         return dict(zip(paths, lo + (v0 - lo) * np.exp(theta)))
@@ -568,7 +586,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         for i in range(theta.size):
             step = np.zeros(theta.size)
             step[i] = _STEP
-            points.append((np.minimum(theta + step, _BOUND), np.maximum(theta - step, -_BOUND)))
+            points.append((np.minimum(theta + step, top), np.maximum(theta - step, -_BOUND)))
         many = getattr(replayer, "many", None)
         if many is not None:  # every column's replays at once (in parallel when the replayer has a pool)
             todo = {}
@@ -582,7 +600,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
                 cache[key] = _residual(runs, sims, scale)
         return np.column_stack([(residual(hi) - residual(lo_)) / (hi[i] - lo_[i]) for i, (hi, lo_) in enumerate(points)])
 
-    sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, _BOUND), max_nfev=max_nfev,
+    sol = least_squares(residual, np.zeros(len(paths)), jac=jacobian, bounds=(-_BOUND, top), max_nfev=max_nfev,
                         x_scale=1.0, xtol=1e-3, ftol=1e-4)
     J, r = sol.jac, sol.fun
     n = len(paths)
@@ -599,7 +617,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         val = lo[i] + (v0[i] - lo[i]) * math.exp(sol.x[i])
         fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
         if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
-            warnings.append(f"{p} is poorly determined by these runs (95 % interval {_interval(lo_i, hi_i)})")
+            warnings.append(f"{p} is poorly determined by these runs (95 % interval {_interval(lo_i, hi_i, floor=lo[i])})")
     if sol.status == 0:  # least_squares stopped by max_nfev: the values are where it stopped, not a minimum
         warnings.append(f"the output-error fit of {', '.join(paths)} stopped after {sol.nfev} evaluations "
                         f"(max_nfev) before converging: its values and intervals are those of the last iterate")
@@ -613,13 +631,14 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
     out = _with(prior, values(sol.x)), tuple(fitted), tuple(warnings), float(r @ r)
     if details:
         out = out + (_Fit(prior=prior, paths=tuple(paths), lower=lo, start=v0, theta=sol.x, jac=J, residual=r,
-                          sizes=tuple(run.n for run in runs)),)
+                          sizes=tuple(run.n for run in runs), top=top),)
     return out
 
 
 @dataclass(frozen=True)
 class _Fit:
-    """What :func:`fit_drive` leaves for the leave-one-out refits: values are ``lower + (start - lower) exp(theta)``."""
+    """What :func:`fit_drive` leaves for the leave-one-out refits: values are ``lower + (start - lower) exp(theta)``,
+    ``theta`` within ``[-_BOUND, top]``."""
 
     prior: object
     paths: tuple
@@ -629,6 +648,7 @@ class _Fit:
     jac: np.ndarray
     residual: np.ndarray
     sizes: tuple
+    top: np.ndarray = None
 
     def without(self, i):
         """The fit with run ``i`` left out, by one Gauss-Newton step from this optimum (a DriveParams).
@@ -649,7 +669,7 @@ class _Fit:
         size = float(np.max(np.abs(step))) if step.size else 0.0
         if size > _TRUST:
             step = step * (_TRUST / size)
-        theta = np.clip(self.theta + step, -_BOUND, _BOUND)
+        theta = np.clip(self.theta + step, -_BOUND, _BOUND if self.top is None else self.top)
         return _with(self.prior, dict(zip(self.paths, self.lower + (self.start - self.lower) * np.exp(theta))))
 
 
@@ -1036,6 +1056,14 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         if not base.controller.sampled:
             return None, 0.0  # a continuous controller has no computation delay
         values, sse = _delay_effect(runs, base, replayer, base_sims, scale, oscillation)
+    elif name == "asymmetric_friction":
+        # both fractions from the symmetric model by the output-error fit (four Jacobian replays of each run per
+        # iteration); the levels stay the nominal's: their mean is the symmetric model's in either direction
+        paths = tuple(p for p in _ASYMMETRY if p not in uncertain)
+        if not paths:
+            return None, 0.0  # already fitted as uncertain
+        fitted_params, _, _, sse = fit_drive(runs, base, paths, replayer, max_nfev=min(max_nfev, 4))
+        values = {p: get_value(fitted_params, p) for p in paths}
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
@@ -1209,7 +1237,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         # intervals (its residual is autocorrelated), so the values kept are the ones fitted with it in place
         # jointly with the claimed effects' amplitudes (fixed, they would carry the bias of the first fit)
         amplitudes = tuple(p for name in claimed for p in _AMPLITUDES.get(name, ())
-                           if get_value(current, p) > 0)
+                           if get_value(current, p) != 0 and p not in uncertain)
         before = replay.count
         current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
         fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)

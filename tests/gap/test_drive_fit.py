@@ -109,6 +109,41 @@ def test_lead_error_phase_is_fitted_on_runs_that_start_at_other_positions(lead_p
     assert rms(result.test_errors) < 0.3 * rms(result.nominal_test_errors)
 
 
+@pytest.fixture(scope="module")
+def asymmetry_case():
+    """Truth: the viscous friction 40 % higher moving +x than its mean, the dry levels 10 % lower (the truth
+    simulator's asymmetries are of this kind: viscous 25-50 %, Coulomb up to 5 %)."""
+    truth = with_value(with_value(RIG, "friction.viscous_asymmetry", 0.4), "friction.coulomb_asymmetry", -0.1)
+    runs = simulated_runs(truth, SPEEDS + (0.015, 0.04), declared=RIG, n=N, noise=NOISE, seed=500)
+    return truth, runs, diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
+                                       effects=("asymmetric_friction",))
+
+
+def test_asymmetric_friction_is_fitted_claimed_and_kept_only_when_named(asymmetry_case):
+    """Both fractions recovered, claimed, the held-out force error cut to a fraction; not a default candidate.
+
+    Four held-out runs: with two (``_runs``, seed 5) the fit was as good (-0.1005 and 0.379, held-out force error
+    3.53 -> 0.66 %, both runs better) but its gain of +2.82 points stayed under the Student bar of one degree of
+    freedom, 3.25: the held-out statistic of docs/gap_benchmark.md 3bo."""
+    truth, runs, result = asymmetry_case
+    assert result.claimed == ("asymmetric_friction",)
+    f = result.params.friction
+    assert f.viscous_asymmetry == pytest.approx(0.4, abs=0.05)
+    assert f.coulomb_asymmetry == pytest.approx(-0.1, abs=0.01)
+    # refitted with the seal force after the claim: each 95 % interval holds the truth and says so in the summary
+    intervals = {p.path: p for p in result.fitted}
+    assert intervals["friction.coulomb_asymmetry"].contains(-0.1)
+    assert intervals["friction.viscous_asymmetry"].contains(0.4)
+    assert not any("not bounded" in line for line in result.summary())
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(result.test_errors) < 0.3 * rms(result.nominal_test_errors)
+    assert "asymmetric_friction" in drive_fit.ON_REQUEST and "asymmetric_friction" not in drive_fit.NOT_IN_MODEL
+    # the same runs without the asymmetry: fitted, nothing claimed
+    plain = simulated_runs(RIG, SPEEDS + (0.015, 0.04), declared=RIG, n=N, noise=NOISE, seed=500)
+    none = diagnose_drive(plain[:2], plain[2:], uncertain=("table.seal_force",), effects=("asymmetric_friction",))
+    assert none.claimed == () and [c.name for c in none.candidates] == ["asymmetric_friction"]
+
+
 def test_control_delay_is_found_between_the_grid_points(delay_case):
     """5 samples is not on the delay grid (4, 8): the search halves the gaps down to one sample and finds it; the
     claimed params file replays the held-out runs at the noise level."""
