@@ -317,8 +317,8 @@ class DriveDiagnosis:
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
-            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {_interval(f.lower, f.upper, '.4g', _LOWER.get(f.path, 0.0))}; "
-                         f"params file {f.prior:.4g})")
+            ci = _interval(f.lower, f.upper, ".4g", _LOWER.get(f.path, 0.0))
+            lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {ci}; params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
             if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
@@ -375,7 +375,7 @@ def _interval(lower, upper, fmt=".3g", floor=0.0):
     """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
     ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
     as 1e-302 .. 1e+306."""
-    if not (lower > floor and math.isfinite(upper)) or math.log10(upper - floor) - math.log10(lower - floor) > _UNBOUNDED:
+    if not (lower > floor and math.isfinite(upper)) or math.log10((upper - floor) / (lower - floor)) > _UNBOUNDED:
         return "not bounded by these runs"
     return f"{lower:{fmt}} .. {upper:{fmt}}"
 
@@ -617,7 +617,8 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         val = lo[i] + (v0[i] - lo[i]) * math.exp(sol.x[i])
         fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
         if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
-            warnings.append(f"{p} is poorly determined by these runs (95 % interval {_interval(lo_i, hi_i, floor=lo[i])})")
+            ci = _interval(lo_i, hi_i, floor=lo[i])
+            warnings.append(f"{p} is poorly determined by these runs (95 % interval {ci})")
     if sol.status == 0:  # least_squares stopped by max_nfev: the values are where it stopped, not a minimum
         warnings.append(f"the output-error fit of {', '.join(paths)} stopped after {sol.nfev} evaluations "
                         f"(max_nfev) before converging: its values and intervals are those of the last iterate")
