@@ -36,7 +36,7 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
 
 @pytest.mark.parametrize("argv, needle", [(["--effects", "gremlins"], "--effects"),
                                           (["--effects", "backlash"], "--effects"),
-                                          (["--kinds", "drakecreep", "--effects", "asymmetric_friction"], "--effects"),
+                                          (["--kinds", "drakecreep", "--effects", "position_friction"], "--effects"),
                                           (["--kinds", "drakecreep", "p_p_cascade", "--effects", "stribeck"],
                                            "one --kinds")])
 def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv, needle):
