@@ -375,7 +375,9 @@ def _interval(lower, upper, fmt=".3g", floor=0.0):
     """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
     ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
     as 1e-302 .. 1e+306."""
-    if not (lower > floor and math.isfinite(upper)) or math.log10((upper - floor) / (lower - floor)) > _UNBOUNDED:
+    if not (lower > floor and math.isfinite(upper)):
+        return "not bounded by these runs"
+    if math.log10(upper - floor) - math.log10(lower - floor) > _UNBOUNDED:  # as logs: the ratio can overflow
         return "not bounded by these runs"
     return f"{lower:{fmt}} .. {upper:{fmt}}"
 
