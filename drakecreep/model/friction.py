@@ -93,23 +93,20 @@ class FrictionLaw:
     name = "base"
 
     def _direction_factor(self, v, asymmetry):
-        """``1 + asymmetry tanh(v / v_reg)`` (1 exactly, and no ``tanh`` in the expression, when symmetric)."""
+        """``1 + asymmetry tanh(v / v_reg)``; exactly 1 when symmetric, so no ``tanh`` enters the expression (a
+        product with 1.0 leaves floats, AutoDiffXd and Drake's Expression unchanged)."""
         if asymmetry == 0.0:
             return 1.0
         return 1.0 + asymmetry * tanh(v / self.regularization_velocity)
 
     def viscous_force(self, v):
         """Viscous friction ``Fv (1 + a_v tanh(v / v_reg)) v`` (N)."""
-        if self.viscous_asymmetry == 0.0:
-            return self.viscous * v
         return self.viscous * self._direction_factor(v, self.viscous_asymmetry) * v
 
     def sliding_level(self, v, Fc, Fs):
         """The dry-friction level in steady sliding at ``v``: the Stribeck curve :func:`stribeck_curve` times
         ``1 + a_c tanh(v / v_reg)`` (N, >= 0)."""
         g = stribeck_curve(v, Fc, Fs, self.stribeck_velocity, self.stribeck_exponent)
-        if self.coulomb_asymmetry == 0.0:
-            return g
         return g * self._direction_factor(v, self.coulomb_asymmetry)
 
     def initial_state(self):
@@ -192,9 +189,6 @@ class LuGreFriction(FrictionLaw):
     num_states = 1
     name = "lugre"
 
-    def _g(self, v, Fc, Fs):
-        return self.sliding_level(v, Fc, Fs)
-
     def deflection_rate(self, v, w, Fc, Fs):
         """``dz/dt`` (m/s) of the bristles for the normalized state ``w``.
 
@@ -203,7 +197,7 @@ class LuGreFriction(FrictionLaw):
         """
         if Fc <= 0.0:  # Fs = static_ratio * Fc is then 0 too
             return 0.0 * v
-        return v - fabs(v) * w[0] * Fc / self._g(v, Fc, Fs)
+        return v - fabs(v) * w[0] * Fc / self.sliding_level(v, Fc, Fs)
 
     def state_rates(self, v, w, Fc, Fs):
         if Fc <= 0.0:
@@ -215,7 +209,7 @@ class LuGreFriction(FrictionLaw):
 
     def steady_state_force(self, v, Fc, Fs):
         v = np.asarray(v, dtype=float)
-        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
+        return self.sliding_level(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
 
     def deflection(self, w, Fc):
         """Bristle deflection ``z`` (m) for the normalized state ``w``."""
@@ -295,14 +289,11 @@ class GMSFriction(FrictionLaw):
         i = np.arange(1, self.elements + 1)
         return self.bristle_stiffness / (i * np.sum(1.0 / i))
 
-    def _g(self, v, Fc, Fs):
-        return self.sliding_level(v, Fc, Fs)
-
     def force_rates(self, v, w, Fc, Fs):
         """``dF_i/dt`` (N/s) of the elements for the normalized states ``w``."""
         if Fc <= 0.0:
             return [0.0 * v for _ in range(self.elements)]
-        g = self._g(v, Fc, Fs)
+        g = self.sliding_level(v, Fc, Fs)
         rates = []
         for alpha, k, wi in zip(self.shares, self.stiffnesses, w):
             F = Fc * wi
@@ -329,7 +320,7 @@ class GMSFriction(FrictionLaw):
 
     def steady_state_force(self, v, Fc, Fs):
         v = np.asarray(v, dtype=float)
-        return self._g(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
+        return self.sliding_level(v, Fc, Fs) * np.sign(v) + self.viscous_force(v)
 
     def presliding_stiffness(self, Fc, Fs):
         return self.bristle_stiffness

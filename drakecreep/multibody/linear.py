@@ -93,7 +93,7 @@ def linearize_multibody_plant(params, scenario, options=None):
     for name, level in (("guide_friction", fc), ("nut_friction", fc_n)):
         if name in fd.systems and law.num_states:
             system = fd.systems[name]
-            z = float(law._g(v, level, params.friction.static_ratio * level)) * math.copysign(1.0, v) / level
+            z = float(law.sliding_level(v, level, params.friction.static_ratio * level)) * math.copysign(1.0, v) / level
             system.GetMyMutableContextFromRoot(context).SetContinuousState([z])
     if "current_loop" in fd.systems:
         lag = fd.systems["current_loop"]

@@ -194,7 +194,7 @@ def operating_point(params, scenario):
     c = float(axial_damping(params.screw, params.nut, x))
     theta = measured / ratio if g.position_feedback == "motor" else (x + spring / k) / ratio
     motor = (theta, omega) + ((torque,) if params.motor.current_loop_time_constant > 0 else ())
-    table = (x, v) + ((float(law._g(v, fc, fs)) * math.copysign(1.0, v) / fc,) if law.num_states else ())
+    table = (x, v) + ((float(law.sliding_level(v, fc, fs)) * math.copysign(1.0, v) / fc,) if law.num_states else ())
     # central difference with a small relative step: truncation ~1e-10, round-off ~1e-10 of C1 here
     c1 = float(friction_slope(lambda s: law.steady_state_force(s, fc, fs), v, step=1e-5 * abs(v)))
     return OperatingPoint(

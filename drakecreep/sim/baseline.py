@@ -35,6 +35,9 @@ def unsupported(params):
     p = params
     if p.friction.law not in ("coulomb", "stribeck", "lugre"):
         return ("friction.law", p.friction.law, "coulomb, stribeck or lugre (the plain-Python equations)")
+    for name in ("coulomb_asymmetry", "viscous_asymmetry"):
+        if getattr(p.friction, name) != 0.0:
+            return (f"friction.{name}", getattr(p.friction, name), "0 (the plain-Python equations are symmetric)")
     d = p.disturbance
     if d.has_lead_error or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")

@@ -27,3 +27,12 @@ def test_independent_scipy_model_agrees_with_drake(short_paper, sampled):
     swing = np.ptp(v_drake)
     assert len(base["t"]) == len(drake.time)
     np.testing.assert_allclose(base["table_speed"], v_drake, atol=1e-3 * swing)
+
+
+def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
+    """They are symmetric: an asymmetric case is refused by name, so a sweep runs it on the Drake systems."""
+    from drakecreep.sim.baseline import unsupported
+
+    assert unsupported(short_paper) is None
+    asym = with_value(short_paper, "friction.viscous_asymmetry", 0.2)
+    assert unsupported(asym) == ("friction.viscous_asymmetry", 0.2, "0 (the plain-Python equations are symmetric)")
