@@ -217,7 +217,8 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     (motor order 1) is claimed as position_ripple and shrinks the audit replay (runs the diagnosis never saw) as
     much as the true effect's fit (it is that fit); a null claims nothing. The rates over all candidates are
     the benchmark's business (docs/gap_benchmark.md); this checks the mechanism. Measured: SNR 4.0, audit force
-    error 20.4 -> 12.1 %; 10.5 s for both (22 s + 7 s under a load of 5 on 2 cores)."""
+    error 20.4 -> 12.1 %; 86 s for both on an idle core (session 57; the suite's slowest test, most of it the
+    nominal identification's least-squares replays)."""
     from drakecreep.gap.benchmark import evaluate
 
     ds = _dataset(DEV_SEEDS + 2200, ("cogging",), {"cogging": {"amplitude_N": 10.0, "order": 1, "phase": 0.5, "h2": 0.0}})
