@@ -330,6 +330,12 @@ class LoadParams(_Params):
 
     cases: typing.Tuple[LoadCase, ...] = field(default_factory=tuple, metadata=dict(unit="-"))
     gravity: float = _q(9.81, "m/s^2", 0.0, 100.0, doc="gravity (table weight on the guides)")
+    constant_force: float = _q(
+        0.0, "N", -1e6, 1e6,
+        doc="an axial force on the table in every load case, the unloaded one included, added to its fx (> 0 "
+            "opposes a feed in +x): a drive's current offset, the weight on an inclined axis, a cable carrier's "
+            "pull; assumption: 0, the paper gives none",
+    )
 
 
 @dataclass(frozen=True)
@@ -551,12 +557,17 @@ class DriveParams(_Params):
     compensation: CompensationParams = field(default_factory=CompensationParams)
 
     def load_case(self, number):
-        """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load."""
+        """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load. Its ``fx`` includes
+        ``loads.constant_force``, so every model of the drive sees that force through this one method."""
         if number == 0:
-            return LoadCase()
-        if not isinstance(number, int) or not 1 <= number <= len(self.loads.cases):
+            case = LoadCase()
+        elif not isinstance(number, int) or not 1 <= number <= len(self.loads.cases):
             raise InputError("load_case", number, f"an integer in 0..{len(self.loads.cases)} (0 = unloaded)")
-        return self.loads.cases[number - 1]
+        else:
+            case = self.loads.cases[number - 1]
+        if self.loads.constant_force == 0.0:
+            return case
+        return dataclasses.replace(case, fx=case.fx + self.loads.constant_force)
 
 
 # --------------------------------------------------------------------------- YAML I/O

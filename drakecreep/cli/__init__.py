@@ -163,7 +163,9 @@ def main(argv=None):
         return int(args.func(args) or 0)
     except DrakecreepError as err:
         _debug_traceback(debug)
-        print(f"{prefix}: error: {_one_line(err)}", file=sys.stderr)
+        # the whole line: an InputError bounds its own parts (value 120, allowed 600 characters), and a list of
+        # what is allowed cut short hides the right answer (the fitted fields' list is 450 characters)
+        print(f"{prefix}: error: {_one_line(err, limit=1000)}", file=sys.stderr)
         return 2
     except (FileNotFoundError, IsADirectoryError, NotADirectoryError, PermissionError) as err:
         _debug_traceback(debug)

@@ -901,7 +901,8 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     elastic screw and table with their friction law and disturbances; the ramp reference is replaced by the
     measured one (``TrajectorySource`` of a first-order hold, the speed its slope) and ``f_ext`` (a
     zero-order hold) is added to the push on the table. Positions are relative to the first sample (the
-    diagram starts at rest at 0, in equilibrium under ``load_case``); the lead error, fixed to the screw, keeps
+    diagram starts at rest, in equilibrium under ``load_case``, its position feedback reading the first sample:
+    under an axial load the screw is wound up, ``initial_conditions``' ``x_ref0``); the lead error, fixed to the screw, keeps
     its phase at the run's absolute start position ``x_motor[0]`` (``disturbance.lead_error_phase`` is its
     phase at the screw's position 0).
 
@@ -928,7 +929,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     """
     from pydrake.systems.primitives import ConstantVectorSource, Multiplexer
 
-    from drakecreep.model.diagram import build_diagram
+    from drakecreep.model.diagram import build_diagram, initial_conditions
     from drakecreep.scenario import Scenario
     from drakecreep.sim.compiled import compile_diagram
     from drakecreep.sim.simulation import make_simulator, target_accuracy
@@ -941,7 +942,9 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         backend = "leaf"  # a fractional delay is a second sampling offset, which the compiled path refuses
     start = _time.perf_counter()
     t = run.t - run.t[0]
-    x_origin = float(run.x_motor[0])
+    # the diagram starts at rest with the screw wound up by the axial load (the load case's fx, with
+    # loads.constant_force), its position feedback reading x_ref0; the run's first motor reading is that state
+    x_origin = float(run.x_motor[0]) - initial_conditions(params, Scenario(load_case=int(load_case)))["x_ref0"]
     params = _lead_error_at(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)

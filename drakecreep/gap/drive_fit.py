@@ -20,10 +20,12 @@ Steps:
 
 1. **Output-error fit** of the ``DriveParams`` fields named in ``uncertain`` (:data:`FITTABLE`: friction
    levels, Stribeck velocity and ratio, viscous, LuGre sigma0/sigma1, axial stiffness and damping of the
-   nut and bearing, nut friction) on the training runs with :func:`scipy.optimize.least_squares`: the
+   nut and bearing, nut friction, a constant axial force) on the training runs with :func:`scipy.optimize.least_squares`: the
    residual is the drive force ``u_gain u`` of each training run minus its closed-loop replay, divided by
    the spread of the measured force. Each field is fitted as ``lo + (v0 - lo) exp(theta)`` (``lo`` its
-   lower bound, ``v0`` the params file's value), so it stays in range. 95 % confidence intervals from the
+   lower bound, ``v0`` the params file's value), so it stays in range; a signed field without a range
+   (``loads.constant_force``, a constant axial force such as a drive's offset) as ``v0 + s theta`` with ``s`` the
+   params file's Coulomb level. 95 % confidence intervals from the
    Jacobian at the optimum, ``s^2 (J^T J)^-1`` with ``s^2`` the residual variance, inflated by
    ``(1 + rho) / (1 - rho)`` for the residual's lag-1 autocorrelation ``rho`` (closed-loop residuals are
    not white); a warning names every pair whose estimates correlate above :data:`SEPARABILITY` (not
@@ -107,7 +109,7 @@ FITTABLE = (
     "table.seal_force", "table.guide_friction_coefficient", "nut.preload_torque", "nut.load_friction_coefficient",
     "friction.viscous", "friction.static_ratio", "friction.stribeck_velocity", "friction.bristle_stiffness",
     "friction.bristle_damping", "nut.axial_stiffness", "nut.axial_damping", "screw.bearing_stiffness",
-    "screw.bearing_damping", "friction.coulomb_asymmetry", "friction.viscous_asymmetry",
+    "screw.bearing_damping", "friction.coulomb_asymmetry", "friction.viscous_asymmetry", "loads.constant_force",
 )
 #: Default uncertain fields: the friction level of the guides, the nut's preload drag, the viscous friction.
 DEFAULT_UNCERTAIN = ("table.seal_force", "nut.preload_torque", "friction.viscous")
@@ -118,6 +120,12 @@ _ASYMMETRY = ("friction.coulomb_asymmetry", "friction.viscous_asymmetry")
 #: exp(theta)``; an asymmetry of 0 sits 0.9 above its lower bound, so it moves about linearly near 0.
 _LOWER = {"friction.static_ratio": 1.0, **{p: -0.9 for p in _ASYMMETRY}}
 _UPPER = {p: 0.9 for p in _ASYMMETRY}
+#: Signed fields without a range of their own, fitted in a linear coordinate: ``start + scale theta``, the scale
+#: the params file's Coulomb level on the unloaded axis (at least 1 N; :func:`_linear_scale`), so the fit's step
+#: is a tenth of it and its range four times it either way. A constant force beside the dry friction is told apart
+#: from it by runs in both directions or with stops; from runs that slide one way throughout the fit says they are
+#: not separable.
+_LINEAR = ("loads.constant_force",)
 #: Estimates whose correlation exceeds this are reported as not separable.
 SEPARABILITY = 0.95
 #: Shortest run accepted (samples and seconds): the position loop needs a few periods to show anything.
@@ -317,7 +325,7 @@ class DriveDiagnosis:
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
-            ci = _interval(f.lower, f.upper, ".4g", _LOWER.get(f.path, 0.0))
+            ci = _interval(f.lower, f.upper, ".4g", None if f.path in _LINEAR else _LOWER.get(f.path, 0.0))
             lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {ci}; params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
@@ -374,7 +382,10 @@ class DriveDiagnosis:
 def _interval(lower, upper, fmt=".3g", floor=0.0):
     """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
     ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
-    as 1e-302 .. 1e+306."""
+    as 1e-302 .. 1e+306. ``floor=None``: a field of :data:`_LINEAR` (no lower bound), bounded when finite."""
+    if floor is None:
+        return f"{lower:{fmt}} .. {upper:{fmt}}" if math.isfinite(lower) and math.isfinite(upper) else \
+            "not bounded by these runs"
     if not (lower > floor and math.isfinite(upper)):
         return "not bounded by these runs"
     if math.log10(upper - floor) - math.log10(lower - floor) > _UNBOUNDED:  # as logs: the ratio can overflow
@@ -432,7 +443,7 @@ def _check_inputs(train, test, uncertain, effects, load_case):
     for path in uncertain:
         if path not in FITTABLE:
             raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
-        if get_value(prior, path) <= _LOWER.get(path, 0.0):
+        if path not in _LINEAR and get_value(prior, path) <= _LOWER.get(path, 0.0):
             raise InputError("uncertain", path, f"a field whose params value is above {_LOWER.get(path, 0.0):g}")
         if path in _UPPER and get_value(prior, path) >= _UPPER[path]:
             raise InputError("uncertain", path, f"a field whose params value is below {_UPPER[path]:g}")
@@ -531,6 +542,38 @@ def _with(params, values):
     return params
 
 
+def _linear_scale(prior):
+    """The scale of a :data:`_LINEAR` field's coordinate [N]: the params file's Coulomb level on the unloaded axis
+    (guides and nut, :func:`~drakecreep.model.nut_table.friction_levels`), at least 1 N."""
+    from drakecreep.model.nut_table import friction_levels
+    from drakecreep.params import LoadCase
+
+    return max(float(friction_levels(prior, LoadCase())[0]), 1.0)
+
+
+def _coordinates(prior, paths):
+    """Per fitted field: lower bound, start, theta's upper bound and the linear scale (NaN for the fields fitted
+    as ``lower + (start - lower) exp(theta)``)."""
+    v0 = np.array([get_value(prior, p) for p in paths], dtype=float)
+    lo = np.array([-np.inf if p in _LINEAR else _LOWER.get(p, 0.0) for p in paths])
+    # theta's upper bound: the fitted range, or less where the field's range ends first
+    top = np.array([min(_BOUND, math.log((_UPPER[p] - lo[i]) / (v0[i] - lo[i]))) if p in _UPPER else _BOUND
+                    for i, p in enumerate(paths)])
+    scale = np.array([_linear_scale(prior) if p in _LINEAR else np.nan for p in paths])
+    return lo, v0, top, scale
+
+
+def _field_values(lower, start, scale, theta):
+    """The fields' values at the fitted coordinates ``theta`` (see :func:`_coordinates`)."""
+    theta = np.asarray(theta, dtype=float)
+    linear = np.isfinite(scale)
+    out = np.empty(theta.shape)
+    out[linear] = start[linear] + scale[linear] * theta[linear]
+    log = ~linear
+    out[log] = lower[log] + (start[log] - lower[log]) * np.exp(np.clip(theta[log], -700.0, 700.0))
+    return out
+
+
 def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=False):
     """Output-error least squares of the DriveParams fields ``paths`` on ``runs``.
 
@@ -562,14 +605,10 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
     if not paths:
         r = _residual(runs, replayer(runs, prior), scale)
         return (prior, (), (), float(r @ r)) + ((None,) if details else ())
-    v0 = np.array([get_value(prior, p) for p in paths])
-    lo = np.array([_LOWER.get(p, 0.0) for p in paths])
-    # theta's upper bound: the fitted range, or less where the field's range ends first
-    top = np.array([min(_BOUND, math.log((_UPPER[p] - lo[i]) / (v0[i] - lo[i]))) if p in _UPPER else _BOUND
-                    for i, p in enumerate(paths)])
+    lo, v0, top, unit = _coordinates(prior, paths)  # unit: the linear fields' scale
 
     def values(theta):
-        return dict(zip(paths, lo + (v0 - lo) * np.exp(theta)))
+        return dict(zip(paths, _field_values(lo, v0, unit, theta)))
 
     cache = {}
 
@@ -613,13 +652,14 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     z = stats.norm.ppf(0.975)
     fitted, warnings = [], []
+    at = _field_values(lo, v0, unit, sol.x)
+    below, above = (_field_values(lo, v0, unit, sol.x + sign * z * sd) for sign in (-1.0, 1.0))
     for i, p in enumerate(paths):
-        lo_i = lo[i] + (v0[i] - lo[i]) * math.exp(max(sol.x[i] - z * sd[i], -700))
-        hi_i = lo[i] + (v0[i] - lo[i]) * math.exp(min(sol.x[i] + z * sd[i], 700))
-        val = lo[i] + (v0[i] - lo[i]) * math.exp(sol.x[i])
+        lo_i, hi_i, val = below[i], above[i], at[i]
         fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
+        # a decade of a bounded field; 2.3 Coulomb levels of a linear one (the same width in theta)
         if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
-            ci = _interval(lo_i, hi_i, floor=lo[i])
+            ci = _interval(lo_i, hi_i, floor=None if p in _LINEAR else lo[i])
             warnings.append(f"{p} is poorly determined by these runs (95 % interval {ci})")
     if sol.status == 0:  # least_squares stopped by max_nfev: the values are where it stopped, not a minimum
         warnings.append(f"the output-error fit of {', '.join(paths)} stopped after {sol.nfev} evaluations "
@@ -634,14 +674,15 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
     out = _with(prior, values(sol.x)), tuple(fitted), tuple(warnings), float(r @ r)
     if details:
         out = out + (_Fit(prior=prior, paths=tuple(paths), lower=lo, start=v0, theta=sol.x, jac=J, residual=r,
-                          sizes=tuple(run.n for run in runs), top=top),)
+                          sizes=tuple(run.n for run in runs), top=top, scale=unit),)
     return out
 
 
 @dataclass(frozen=True)
 class _Fit:
     """What :func:`fit_drive` leaves for the leave-one-out refits: values are ``lower + (start - lower) exp(theta)``,
-    ``theta`` within ``[-_BOUND, top]``."""
+    or ``start + scale theta`` where ``scale`` is finite (:func:`_field_values`), ``theta`` within
+    ``[-_BOUND, top]``."""
 
     prior: object
     paths: tuple
@@ -652,6 +693,7 @@ class _Fit:
     residual: np.ndarray
     sizes: tuple
     top: np.ndarray = None
+    scale: np.ndarray = None
 
     def without(self, i):
         """The fit with run ``i`` left out, by one Gauss-Newton step from this optimum (a DriveParams).
@@ -673,7 +715,8 @@ class _Fit:
         if size > _TRUST:
             step = step * (_TRUST / size)
         theta = np.clip(self.theta + step, -_BOUND, _BOUND if self.top is None else self.top)
-        return _with(self.prior, dict(zip(self.paths, self.lower + (self.start - self.lower) * np.exp(theta))))
+        scale = np.full(theta.size, np.nan) if self.scale is None else self.scale
+        return _with(self.prior, dict(zip(self.paths, _field_values(self.lower, self.start, scale, theta))))
 
 
 # --------------------------------------------------------------------------- candidate effects

@@ -71,6 +71,10 @@ def test_unknown_uncertain_field_is_one_line_exit_2(own_csv, capsys):
                      "--uncertain", "table.colour"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "table.colour" in err[0]
+    # the line lists every field that can be fitted, the last one too (it was cut at 400 characters)
+    from drakecreep.gap.drive_fit import FITTABLE
+
+    assert all(f in err[0] for f in FITTABLE) and not err[0].endswith("...")
 
 
 def test_diagnose_without_params_for_kind_drakecreep_is_one_line_exit_2(blank_csv, tmp_path, capsys):

@@ -403,6 +403,36 @@ def test_pooled_replays_are_handed_out_longest_first_and_returned_in_order(monke
     assert handed == ["slow", "mid", "fast"] and replayer.count == 6
 
 
+def test_a_constant_force_is_fitted_from_runs_both_ways_and_not_separable_from_runs_one_way(tmp_path):
+    """Truth: a constant 8 N axial force (a drive's offset, an incline) that the params file lacks. Out-and-back
+    runs tell it from the dry friction, which changes sign with the motion: fitted beside the seal force, each
+    95 % interval holds its truth and the held-out error drops to the noise's. Runs that slide +x from their first
+    sample to their last cannot tell the two apart, and the fit says so (with a stop they can: the dry friction
+    then holds the table, the constant force does not go away)."""
+    truth = with_value(RIG, "loads.constant_force", 8.0)
+    runs = _runs(truth, seed=6)
+    paths = ("table.seal_force", "loads.constant_force")
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=paths, effects=())
+    fitted = {p.path: p for p in result.fitted}
+    assert fitted["loads.constant_force"].contains(8.0), fitted
+    assert fitted["table.seal_force"].contains(RIG.table.seal_force), fitted
+    assert fitted["loads.constant_force"].unit == "N" and fitted["loads.constant_force"].upper - \
+        fitted["loads.constant_force"].lower < 2.0
+    assert not any("not separable" in w for w in result.warnings), result.warnings
+    assert any("loads.constant_force = 8" in line for line in result.summary())
+    alone = diagnose_drive(runs[:2], runs[2:], uncertain=paths[:1], effects=())
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(result.nominal_test_errors) < 0.5 * rms(alone.nominal_test_errors)
+    # the params file the user keeps carries it
+    result.save_params(tmp_path / "fitted.yaml")
+    assert load_params(tmp_path / "fitted.yaml").loads.constant_force == pytest.approx(fitted["loads.constant_force"].value)
+    one_way = simulated_runs(truth, SPEEDS, declared=RIG, n=N, noise=NOISE, seed=600, starts=(0.0,), leg=N * 1e-3)
+    blind = diagnose_drive(one_way[:2], one_way[2:], uncertain=paths, effects=())
+    assert any("not separable" in w and all(p in w for p in paths) for w in blind.warnings), blind.warnings
+    # and the replay starts where the run does: the screw wound up by the force at rest, not a start transient
+    assert all(p.contains(v) for p, v in zip(blind.fitted, (RIG.table.seal_force, 8.0))), blind.fitted
+
+
 def test_levels_acting_at_the_same_place_are_reported_not_separable():
     """Seal drag and nut preload drag both add to the one Coulomb level on the table in this rig."""
     runs = _runs(RIG, seed=4)

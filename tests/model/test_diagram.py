@@ -16,6 +16,21 @@ def test_starts_in_equilibrium_under_load(paper, continuous):
     assert ic["force0"] == 434.0
 
 
+@pytest.mark.parametrize("case, fx", [(0, 0.0), (3, 434.0)])
+def test_a_constant_force_adds_to_every_load_case_the_unloaded_one_too(paper, case, fx):
+    """``loads.constant_force`` (a drive's offset, an incline) reaches the diagram through ``load_case``: the
+    screw carries it at rest, beside the case's own fx, and the nut's load friction sees the sum."""
+    from drakecreep.params import with_value
+
+    pushed = with_value(paper, "loads.constant_force", -25.0)
+    assert pushed.load_case(case).fx == pytest.approx(fx - 25.0)
+    assert paper.load_case(case).fx == fx and pushed.loads.cases == paper.loads.cases  # the cases stay as written
+    drive = build_diagram(pushed, Scenario(feed=1e-3, load_case=case))
+    c = drive.diagram.CreateDefaultContext()
+    np.testing.assert_allclose(drive.diagram.EvalTimeDerivatives(c).CopyToVector(), 0.0, atol=1e-9)
+    assert drive.diagram.GetOutputPort("screw.axial_force").Eval(c)[0] == pytest.approx(fx - 25.0)
+
+
 def test_named_ports_and_signals(paper):
     drive = build_diagram(paper, Scenario())
     names = {drive.diagram.get_output_port(i).get_name() for i in range(drive.diagram.num_output_ports())}
