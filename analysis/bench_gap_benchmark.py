@@ -28,7 +28,7 @@ import time
 from drakecreep.files import write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
-                                      run_benchmark, score_rows)
+                                      check_effects, check_uncertain, run_benchmark, score_rows)
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
            "median_relative_shrink_snr3": ">= 70 %", "claims_making_audit_worse": "0"}
@@ -113,6 +113,14 @@ def main():
     ap.add_argument("--library", nargs="+", metavar="EFFECT",
                     help="withheld library effects to draw (default all; nulls and effects outside the library as "
                          "--n-null and --n-ool set)")
+    ap.add_argument("--effects", metavar="NAMES",
+                    help="candidates of the diagnosis of the one kind given, comma separated (default: its default "
+                         "candidates; e.g. the drakecreep kind's defaults with asymmetric_friction, which it fits "
+                         "only when named)")
+    ap.add_argument("--uncertain", metavar="PATHS",
+                    help="kinds drakecreep alone: the fields its nominal fit takes as uncertain, comma separated "
+                         "(default diagnose_drive's: table.seal_force,nut.preload_torque,friction.viscous); a "
+                         "development study of another nominal, e.g. with loads.constant_force")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
     args = ap.parse_args()
@@ -137,6 +145,15 @@ def main():
             benchmark_specs(seed, args.kinds, library=args.library)
         except InputError as err:
             ap.error(str(err))
+    def items(text):
+        return None if text is None else tuple(p.strip() for p in text.split(",") if p.strip())
+
+    uncertain, effects = items(args.uncertain), items(args.effects)
+    try:  # run_benchmark's checks, before any dataset is generated
+        check_uncertain(args.kinds, uncertain)
+        check_effects(args.kinds, effects)
+    except InputError as err:
+        ap.error(str(err))
     done = []
     if args.resume:
         earlier = _read_rows(ap, "--resume", args.resume)
@@ -151,7 +168,8 @@ def main():
                                               "datasets": rows}, indent=1, default=str))
 
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
-                        progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library)
+                        progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library,
+                        uncertain=uncertain, effects=effects)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, {', '.join(args.kinds)}, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "

@@ -41,7 +41,7 @@ MAX_SAMPLES = 1_000_000
 def run(args):
     """Run and print the scores (each dataset takes minutes: its kind's diagnosis fits every candidate)."""
     from drakecreep.errors import InputError
-    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, run_benchmark
+    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, check_effects, run_benchmark
 
     if not 600 <= args.samples <= MAX_SAMPLES:
         raise InputError("--samples", args.samples, f"an integer in [600, {MAX_SAMPLES}] samples per run (1 kHz)")
@@ -51,19 +51,7 @@ def run(args):
             raise InputError(option, n, f"an integer in [0, {MAX_DATASETS}]")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
-    effects = None
-    if args.effects is not None:
-        from drakecreep.gap.drake_effects import DRAKE_EFFECTS
-        from drakecreep.gap.drive_fit import EFFECTS as DRIVE_EFFECTS
-
-        kinds = sorted(set(args.kinds))
-        if len(kinds) != 1:
-            raise InputError("--effects", args.effects, "with one --kinds only (each kind has its own candidates)")
-        effects = names(args.effects)
-        allowed = tuple(DRIVE_EFFECTS) if kinds[0] == "drakecreep" else tuple(DRAKE_EFFECTS) + ("control_delay",)
-        for e in effects or ("",):
-            if e not in allowed:
-                raise InputError("--effects", e, "comma-separated names of " + ", ".join(allowed))
+    effects = None if args.effects is None else check_effects(args.kinds, names(args.effects), "--effects")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
                         n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects)

@@ -87,6 +87,8 @@ __all__ = [
     "true_effect_fit",
     "audit_replay",
     "evaluate",
+    "check_effects",
+    "check_uncertain",
     "run_benchmark",
     "score_rows",
 ]
@@ -520,16 +522,18 @@ def _audit_fields(a, claimed):
                           and a["claimed"]["energy"] > a["nominal"]["energy"])}
 
 
-def _evaluate_drive(ds, effects=None, progress=None, audit=True):
+def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None):
     """One benchmark row of a ``drakecreep`` dataset: ``diagnose_drive`` on the declared params file, its default
-    uncertain fields, then the audit runs replayed with the fitted params file (nominal) and the augmented one
-    (no true-effect fit for this kind: module docstring)."""
+    uncertain fields (or ``uncertain``), then the audit runs replayed with the fitted params file (nominal) and the
+    augmented one (no true-effect fit for this kind: module docstring)."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-    from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, diagnose_drive
     from drakecreep.gap.residuals import oscillation_log_errors
 
     t0 = time.perf_counter()
     kw = {} if effects is None else {"effects": tuple(effects)}
+    if uncertain is not None:
+        kw["uncertain"] = tuple(uncertain)
     res = diagnose_drive(ds.train, ds.test, progress=progress or False, **kw)
     claimed = list(res.claimed)
     labels = list(res.nominal_test_errors)
@@ -542,7 +546,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True):
                 "test_force_runs": ([float(c.test_errors[k]["force"]) for k in labels]
                                     if all(k in c.test_errors for k in labels) else None)}
                for c in res.candidates]
-    row = _row(ds, claimed, ranking, friction=res.params.friction.law,
+    row = _row(ds, claimed, ranking, friction=res.params.friction.law, uncertain=list(kw.get("uncertain", DEFAULT_UNCERTAIN)),
                test_force_nominal_runs=[float(res.nominal_test_errors[k]["force"]) for k in labels],
                replay_null=res.replay_null,
                test_force_nominal=rms_force_error(res.nominal_test_errors),
@@ -605,15 +609,17 @@ def _own_moves(ds, ranked):
     return None if moves is None else [[float(v) for v in m] for m in moves]
 
 
-def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto"):
+def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto", uncertain=None):
     """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
 
     ``p_p_cascade``: ``diagnose_drake`` (``max_nfev``, ``friction`` are its settings); ``drakecreep``:
-    ``diagnose_drive`` with its defaults (:func:`_evaluate_drive`).
+    ``diagnose_drive`` with its defaults, or the fields ``uncertain`` (:func:`_evaluate_drive`).
     """
     _check_kind(ds.kind)
     if ds.kind == "drakecreep":
-        return _evaluate_drive(ds, effects=effects, progress=progress, audit=audit)
+        return _evaluate_drive(ds, effects=effects, progress=progress, audit=audit, uncertain=uncertain)
+    if uncertain is not None:
+        raise InputError("uncertain", uncertain, "only for drakecreep-kind datasets (p_p_cascade fits its own axis)")
     t0 = time.perf_counter()
     res = diagnose_dataset(ds, effects=effects, progress=progress, max_nfev=max_nfev, friction=friction)
     claimed = list(res.claimed)
@@ -713,9 +719,59 @@ def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_nul
     return specs
 
 
+def check_effects(kinds, effects, field="effects"):
+    """``effects`` (the diagnosis's candidates) as a tuple, checked for :func:`run_benchmark`; None stays None
+    (every candidate of each kind).
+
+    Raises
+    ------
+    InputError
+        Naming ``field``: with more than one kind (each kind has its own candidates), or a name that is not a
+        candidate of the kind's diagnosis.
+    """
+    if effects is None:
+        return None
+    from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+    from drakecreep.gap.drive_fit import EFFECTS as DRIVE_EFFECTS
+
+    effects = tuple(effects)
+    kinds = sorted(set(kinds))
+    if len(kinds) != 1:
+        raise InputError(field, ",".join(effects), "with one --kinds only (each kind has its own candidates)")
+    allowed = tuple(DRIVE_EFFECTS) if kinds[0] == "drakecreep" else tuple(DRAKE_EFFECTS) + ("control_delay",)
+    for e in effects or ("",):
+        if e not in allowed:
+            raise InputError(field, e, "comma-separated names of " + ", ".join(allowed))
+    return effects
+
+
+def check_uncertain(kinds, uncertain):
+    """``uncertain`` as a tuple, checked for :func:`run_benchmark` (None stays None: ``diagnose_drive``'s default).
+
+    Raises
+    ------
+    InputError
+        With a kind other than ``drakecreep`` (the ``p_p_cascade`` diagnosis fits its own axis), or a field
+        ``diagnose_drive`` cannot fit.
+    """
+    if uncertain is None:
+        return None
+    from drakecreep.gap.drive_fit import FITTABLE
+
+    uncertain = tuple(uncertain)
+    if any(k != "drakecreep" for k in kinds):
+        raise InputError("uncertain", ",".join(uncertain), "only with kinds drakecreep alone")
+    for path in uncertain:
+        if path not in FITTABLE:
+            raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
+    if not uncertain or len(set(uncertain)) != len(uncertain):
+        raise InputError("uncertain", ",".join(uncertain), "distinct fields, at least one")
+    return uncertain
+
+
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
-                  done=(), shard=(0, 1), library=None):
+                  done=(), shard=(0, 1), library=None, uncertain=None):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -737,6 +793,9 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         concatenation). Default ``(0, 1)``: all.
     library : sequence of str, optional
         Withheld library effects to draw (:func:`benchmark_specs`); default all.
+    uncertain : sequence of str, optional
+        The fields the ``drakecreep`` kind's nominal fit takes as uncertain (``diagnose_drive``'s ``uncertain``;
+        default its ``DEFAULT_UNCERTAIN``); refused with a ``p_p_cascade`` kind, whose diagnosis fits its own axis.
 
     Returns
     -------
@@ -748,6 +807,8 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     kinds = tuple(kinds)
     for k in kinds:
         _check_kind(k)
+    uncertain = check_uncertain(kinds, uncertain)
+    effects = check_effects(kinds, effects)
     if (not isinstance(shard, tuple) or len(shard) != 2 or not all(isinstance(x, int) for x in shard)
             or not 0 <= shard[0] < shard[1]):
         raise InputError("shard", shard, "(i, n) with integers 0 <= i < n")
@@ -789,7 +850,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         t_ds = time.perf_counter()
         inner = (lambda line, t=t_ds: say(f"    {time.perf_counter() - t:5.0f} s  {line}")) if progress else None
         try:
-            row = evaluate(ds, effects=effects, audit=audit, progress=inner)
+            row = evaluate(ds, effects=effects, audit=audit, progress=inner, uncertain=uncertain)
         except Exception as err:  # noqa: BLE001 - one failing dataset is reported, the benchmark goes on
             failed.append({"seed": ds.seed, "withheld": list(ds.withheld), "error": f"{type(err).__name__}: {err}"})
             say(f"{n}/{len(order)} seed {ds.seed}: FAILED {type(err).__name__}: {err}")

@@ -279,6 +279,44 @@ def test_shards_split_one_run_without_overlap(monkeypatch):
         run_benchmark(shard=(2, 2), **kw)
 
 
+def test_the_drakecreep_kinds_nominal_may_fit_other_fields_for_a_development_study(monkeypatch):
+    """``uncertain`` reaches ``diagnose_drive`` on every dataset of the run (a study of another nominal, such as one
+    with ``loads.constant_force``), and is refused before any dataset with a ``p_p_cascade`` kind or a field the
+    fit cannot take."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap import benchmark, drive_fit
+
+    seen = []
+    monkeypatch.setattr(benchmark, "evaluate", lambda ds, **kw: seen.append(kw["uncertain"]) or
+                        {"seed": ds.seed, "withheld": [], "claimed": [], "seconds": 0.0})
+    monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
+    kw = dict(seed=DEV_SEEDS, kinds=("drakecreep",), n_per_effect=0, n_null=2, n_ool=0, n_no_candidate=0,
+              audit=False, n_samples=300)
+    paths = ("table.seal_force", "loads.constant_force")
+    run_benchmark(uncertain=list(paths), **kw)
+    assert seen == [paths, paths]
+    for kinds, bad, fragment in ((("p_p_cascade",), paths, "drakecreep alone"), (("drakecreep",), ("table.colour",), "fields among"),
+                                 (("drakecreep",), paths[:1] * 2, "distinct")):
+        with pytest.raises(InputError, match=fragment):
+            run_benchmark(**dict(kw, kinds=kinds), uncertain=bad)
+    monkeypatch.undo()
+
+    class Stop(Exception):
+        pass
+
+    def fake(train, test, **kwargs):
+        seen.append(kwargs.get("uncertain"))
+        raise Stop
+
+    monkeypatch.setattr(drive_fit, "diagnose_drive", fake)
+    ds = SimpleNamespace(kind="drakecreep", train=[], test=[])
+    for given in (paths, None):
+        with pytest.raises(Stop):
+            benchmark.evaluate(ds, uncertain=given)
+    assert seen[-2:] == [paths, None]  # None: diagnose_drive's own default
+
+
 def test_a_study_names_a_dataset_by_seed_withheld_effect_and_axis():
     """``SEED:WITHHELD:AXIS`` (the development studies' datasets): ``null`` for none; a bad part is named."""
     from drakecreep.gap.benchmark import dataset_spec
