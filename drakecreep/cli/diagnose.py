@@ -41,7 +41,8 @@ def add_parser(subparsers):
                    "name; without --train: odd indices; parts of one split run: 2, 3, 6, 7, ...; three runs or "
                    "parts: 1, 2)")
     p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
-                   "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous)")
+                   "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous; add "
+                   "loads.constant_force for a constant axial force such as a drive's offset)")
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
                    "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind drakecreep runs: "
