@@ -942,9 +942,15 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         backend = "leaf"  # a fractional delay is a second sampling offset, which the compiled path refuses
     start = _time.perf_counter()
     t = run.t - run.t[0]
-    # the diagram starts at rest with the screw wound up by the axial load (the load case's fx, with
-    # loads.constant_force), its position feedback reading x_ref0; the run's first motor reading is that state
-    x_origin = float(run.x_motor[0]) - initial_conditions(params, Scenario(load_case=int(load_case)))["x_ref0"]
+    # the diagram starts at rest with its table at 0 and the screw wound up by the axial load (the load case's fx,
+    # with loads.constant_force): the motor at theta0, the position feedback reading x_ref0. The run's first
+    # readings are that state: the origin is where the run's feedback sensor puts the diagram's
+    rest = initial_conditions(params, Scenario(load_case=int(load_case)))
+    if ctrl.position_feedback == "table" and run.x_table is not None:
+        x_origin = float(run.x_table[0])
+    else:
+        x_origin = float(run.x_motor[0]) - (rest["x_ref0"] if ctrl.position_feedback == "motor"
+                                            else rest["theta0"] * params.screw.lead / (2 * math.pi))
     params = _lead_error_at(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)

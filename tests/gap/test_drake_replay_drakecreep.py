@@ -152,18 +152,21 @@ def test_an_asymmetric_friction_is_an_offset_on_both_legs_compiled_and_leaf():
         assert np.mean(fast.u[window] - base.u[window]) == pytest.approx(expected, rel=0.05)
 
 
-@pytest.mark.parametrize("load_case, constant_force", [(3, 0.0), (0, 25.0)])
-def test_a_run_under_an_axial_load_replays_from_where_it_started(load_case, constant_force):
+@pytest.mark.parametrize("load_case, constant_force, feedback", [(3, 0.0, "motor"), (0, 25.0, "motor"),
+                                                                   (3, 0.0, "table")])
+def test_a_run_under_an_axial_load_replays_from_where_it_started(load_case, constant_force, feedback):
     """At rest under an axial load (the load case's fx, ``loads.constant_force``) the screw is wound up and the
     motor encoder reads that: a run recorded so, replayed with its own params, starts in the same equilibrium,
     not with a step of the reference. The force command agrees to within a few encoder counts from the first
     sample (one count of the encoder's grid is where the run's first reading cannot say the motor was), and the
-    whole run moves by the constant force."""
-    rig = with_value(_rig(), "loads.constant_force", constant_force)
+    whole run moves by the constant force. With the scale closing the position loop the table's first reading is
+    the origin."""
+    rig = with_value(with_value(_rig(), "loads.constant_force", constant_force), "controller.position_feedback",
+                     feedback)
     blank = _run(rig)
     sim = replay_drakecreep(blank, load_case=load_case)
     run = dataclasses.replace(blank, x_motor=sim.x_motor, x_table=sim.x_table, u=sim.u)
-    assert abs(sim.x_motor[0]) > 0.0  # the wound-up screw's first reading: the case is not trivial
+    assert abs(sim.x_motor[0] - sim.x_table[0]) > 1e-8  # the screw wound up at rest: the case is not trivial
     again = replay_drakecreep(run, load_case=load_case)
     count = rig.screw.lead / rig.sensors.encoder_counts_per_rev
     per_count = rig.controller.velocity_gain * count / rig.controller.velocity_period
