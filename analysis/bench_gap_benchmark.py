@@ -25,6 +25,7 @@ import argparse
 import json
 import time
 
+from drakecreep.cli._common import names
 from drakecreep.files import write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
@@ -145,10 +146,7 @@ def main():
             benchmark_specs(seed, args.kinds, library=args.library)
         except InputError as err:
             ap.error(str(err))
-    def items(text):
-        return None if text is None else tuple(p.strip() for p in text.split(",") if p.strip())
-
-    uncertain, effects = items(args.uncertain), items(args.effects)
+    uncertain, effects = (None if text is None else names(text) for text in (args.uncertain, args.effects))
     try:  # run_benchmark's checks, before any dataset is generated
         check_uncertain(args.kinds, uncertain)
         check_effects(args.kinds, effects)

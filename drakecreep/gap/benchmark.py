@@ -756,16 +756,14 @@ def check_uncertain(kinds, uncertain):
     """
     if uncertain is None:
         return None
-    from drakecreep.gap.drive_fit import FITTABLE
+    from drakecreep.gap.drive_fit import check_fields
 
     uncertain = tuple(uncertain)
     if any(k != "drakecreep" for k in kinds):
         raise InputError("uncertain", ",".join(uncertain), "only with kinds drakecreep alone")
-    for path in uncertain:
-        if path not in FITTABLE:
-            raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
-    if not uncertain or len(set(uncertain)) != len(uncertain):
-        raise InputError("uncertain", ",".join(uncertain), "distinct fields, at least one")
+    if not uncertain:
+        raise InputError("uncertain", "", "distinct fields, at least one")
+    check_fields(uncertain)
     return uncertain
 
 

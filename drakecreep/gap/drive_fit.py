@@ -100,6 +100,7 @@ __all__ = [
     "FittedParameter",
     "EffectResult",
     "DriveDiagnosis",
+    "check_fields",
     "diagnose_drive",
     "fit_drive",
 ]
@@ -126,6 +127,13 @@ _UPPER = {p: 0.9 for p in _ASYMMETRY}
 #: from it by runs in both directions or with stops; from runs that slide one way throughout the fit says they are
 #: not separable.
 _LINEAR = ("loads.constant_force",)
+
+
+def _lower(path):
+    """A fitted field's lower bound: its range's (:data:`_LOWER`, else 0), ``-inf`` for a :data:`_LINEAR` field."""
+    return -math.inf if path in _LINEAR else _LOWER.get(path, 0.0)
+
+
 #: Estimates whose correlation exceeds this are reported as not separable.
 SEPARABILITY = 0.95
 #: Shortest run accepted (samples and seconds): the position loop needs a few periods to show anything.
@@ -325,7 +333,7 @@ class DriveDiagnosis:
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
         for f in self.fitted:
-            ci = _interval(f.lower, f.upper, ".4g", None if f.path in _LINEAR else _LOWER.get(f.path, 0.0))
+            ci = _interval(f.lower, f.upper, ".4g", _lower(f.path))
             lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {ci}; params file {f.prior:.4g})")
         lines += [f"  warning: {w}" for w in self.warnings]
         for c in self.candidates:
@@ -382,8 +390,8 @@ class DriveDiagnosis:
 def _interval(lower, upper, fmt=".3g", floor=0.0):
     """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
     ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
-    as 1e-302 .. 1e+306. ``floor=None``: a field of :data:`_LINEAR` (no lower bound), bounded when finite."""
-    if floor is None:
+    as 1e-302 .. 1e+306. ``floor=-inf``: a field of :data:`_LINEAR` (no lower bound), bounded when finite."""
+    if floor == -math.inf:
         return f"{lower:{fmt}} .. {upper:{fmt}}" if math.isfinite(lower) and math.isfinite(upper) else \
             "not bounded by these runs"
     if not (lower > floor and math.isfinite(upper)):
@@ -416,6 +424,15 @@ def claims_withheld(oscillation):
 
 # --------------------------------------------------------------------------- checks (before any work)
 
+def check_fields(uncertain):
+    """Raise :class:`InputError` unless ``uncertain`` names distinct fields of :data:`FITTABLE`."""
+    for path in uncertain:
+        if path not in FITTABLE:
+            raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
+    if len(set(uncertain)) != len(uncertain):
+        raise InputError("uncertain", ",".join(uncertain), "distinct fields")
+
+
 def _check_inputs(train, test, uncertain, effects, load_case):
     train, test = list(train), list(test)
     if not train:
@@ -440,15 +457,12 @@ def _check_inputs(train, test, uncertain, effects, load_case):
         replay_params(r, prior)  # the declared sensor resolutions fit the params' lead
     prior.load_case(load_case)
     uncertain = tuple(uncertain)
+    check_fields(uncertain)
     for path in uncertain:
-        if path not in FITTABLE:
-            raise InputError("uncertain", path, "fields among " + ", ".join(FITTABLE))
-        if path not in _LINEAR and get_value(prior, path) <= _LOWER.get(path, 0.0):
-            raise InputError("uncertain", path, f"a field whose params value is above {_LOWER.get(path, 0.0):g}")
+        if get_value(prior, path) <= _lower(path):
+            raise InputError("uncertain", path, f"a field whose params value is above {_lower(path):g}")
         if path in _UPPER and get_value(prior, path) >= _UPPER[path]:
             raise InputError("uncertain", path, f"a field whose params value is below {_UPPER[path]:g}")
-    if len(set(uncertain)) != len(uncertain):
-        raise InputError("uncertain", uncertain, "distinct fields")
     names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else tuple(effects)
     for n in names:
         if n not in EFFECTS:
@@ -555,7 +569,7 @@ def _coordinates(prior, paths):
     """Per fitted field: lower bound, start, theta's upper bound and the linear scale (NaN for the fields fitted
     as ``lower + (start - lower) exp(theta)``)."""
     v0 = np.array([get_value(prior, p) for p in paths], dtype=float)
-    lo = np.array([-np.inf if p in _LINEAR else _LOWER.get(p, 0.0) for p in paths])
+    lo = np.array([_lower(p) for p in paths])
     # theta's upper bound: the fitted range, or less where the field's range ends first
     top = np.array([min(_BOUND, math.log((_UPPER[p] - lo[i]) / (v0[i] - lo[i]))) if p in _UPPER else _BOUND
                     for i, p in enumerate(paths)])
@@ -659,7 +673,7 @@ def fit_drive(runs, prior, paths, replayer, max_nfev=20, base=None, details=Fals
         fitted.append(FittedParameter(p, float(val), float(lo_i), float(hi_i), float(v0[i]), field_unit(prior, p)))
         # a decade of a bounded field; 2.3 Coulomb levels of a linear one (the same width in theta)
         if not np.isfinite(sd[i]) or 2 * z * sd[i] > math.log(10.0):
-            ci = _interval(lo_i, hi_i, floor=None if p in _LINEAR else lo[i])
+            ci = _interval(lo_i, hi_i, floor=lo[i])
             warnings.append(f"{p} is poorly determined by these runs (95 % interval {ci})")
     if sol.status == 0:  # least_squares stopped by max_nfev: the values are where it stopped, not a minimum
         warnings.append(f"the output-error fit of {', '.join(paths)} stopped after {sol.nfev} evaluations "
