@@ -131,7 +131,8 @@ class DrakeReplayResult:
     ``x_motor``, ``x_table``: positions at the sample instants [m]; ``u``: controller output of each sample
     [unit of u]; ``force``: the force ``u_gain u_applied + f_ext`` [N] at the end of sample interval
     ``[t_k, t_k+1)`` (without a computation delay: held over the whole interval);
-    ``wall_time``: seconds the simulation took.
+    ``wall_time``: seconds the simulation took; ``integrator_steps``: steps the error-controlled integrator took
+    (0 where the replay does not count them).
     """
 
     run: object
@@ -141,6 +142,7 @@ class DrakeReplayResult:
     force: np.ndarray
     parameters: dict = field(default_factory=dict)
     wall_time: float = 0.0
+    integrator_steps: int = 0
 
     @property
     def x_sim(self):
@@ -1009,7 +1011,8 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     x_table = x_table + x_origin
     force = u * run.u_gain + f_ext
     return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
-                             wall_time=_time.perf_counter() - start)
+                             wall_time=_time.perf_counter() - start,
+                             integrator_steps=int(simulator.get_integrator().get_num_steps_taken()))
 
 
 #: ``(path, value)`` settings that make a params file quick to replay, for studies and tests that generate

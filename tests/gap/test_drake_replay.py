@@ -223,6 +223,9 @@ def test_drakecreep_kind_replays_its_own_simulation():
     assert np.max(np.abs(back.x_motor - run.x_motor)) < 1e-7
     assert np.max(np.abs(back.x_table - run.x_table)) < 1e-7
     assert np.linalg.norm(back.u - run.u) < 0.01 * np.linalg.norm(run.u)
+    # the integrator stops at every speed-loop tick at least (analysis/bench_replay_drakecreep.py --speeds)
+    ticks = (run.t[-1] - run.t[0]) / preset("rigid_axis").controller.velocity_period
+    assert back.integrator_steps >= ticks
 
 
 def test_drakecreep_kind_force_is_the_command_computed_at_the_sample():
