@@ -60,6 +60,11 @@ Steps:
 5. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
    claimed effects' amplitudes (a missing effect biases them and widens their intervals); ``fitted`` and
    ``test_errors`` are those of the final model.
+6. **Where the rest lies** (``where``, "unexplained" in the JSON and the summary): the final model's held-out
+   residual, measured minus replayed force, by regime, frequency band and residual-input independence (its
+   cross-correlation with the reference speed and a known external force), and for runs with a linear scale
+   whether the position gap is before or after the screw (:func:`drakecreep.gap.where.locate`, the EMPS
+   diagnosis's decomposition).
 
 Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
 """
@@ -83,7 +88,7 @@ from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, 
                                          rms_force_error)
 from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscillation_log_errors,
                                       sustained_oscillation)
-from drakecreep.gap.where import oscillation_line
+from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 
 __all__ = [
@@ -288,6 +293,10 @@ class DriveDiagnosis:
         cannot follow an oscillation whose phase is free, so no claim rests on its samples; on more than half of the
         training runs (:func:`claims_withheld`) only the delay search runs, and the one claim possible is a delay
         on the held-out spectrum (``spectral``, :func:`_spectral_delay`).
+    where : dict
+        What the augmented params file still does not explain on the held-out runs, and where
+        (:func:`drakecreep.gap.where.locate` of their replays): by regime, frequency band, residual-input
+        independence, and for runs with a linear scale before or after the screw.
     """
 
     prior: DriveParams
@@ -305,6 +314,7 @@ class DriveDiagnosis:
     seconds: float = 0.0
     nominal: DriveParams | None = None
     oscillation: dict | None = None
+    where: dict = field(default_factory=dict)
 
     def oscillation_lines(self):
         """Lines of text on :attr:`oscillation` (none without one)."""
@@ -357,7 +367,7 @@ class DriveDiagnosis:
                          "held-out force error is the oscillation's)")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
-        return lines + self.oscillation_lines()
+        return lines + self.oscillation_lines() + (where_lines(self.where) if self.where else [])
 
     def save_params(self, path):
         """Write the augmented :class:`DriveParams` as YAML (:func:`drakecreep.params.save_params`)."""
@@ -384,6 +394,7 @@ class DriveDiagnosis:
             "simulations": self.simulations,
             "seconds": self.seconds,
             "oscillation": self.oscillation,
+            "unexplained": self.where,
         })
 
 
@@ -1301,11 +1312,14 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         before = replay.count
         current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
         fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
-        current_errors = replay.errors(test, current)
+        final_sims = replay(test, current)
+        current_errors = _errors_of(test, final_sims)
         say(f"refitted {', '.join(uncertain)} with {' + '.join(claimed)} ({replay.count - before} replays; "
             f"{replay.count} in all)")
+    else:  # the final model's held-out replays: the nominal's, or those of the claims without a refit
+        final_sims = nominal_sims if current is params else replay(test, current)
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
                           replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0,
-                          nominal=params, oscillation=oscillation)
+                          nominal=params, oscillation=oscillation, where=locate(test, final_sims))

@@ -2,7 +2,8 @@
 
 :func:`where_gap` replays the held-out runs through the (augmented) Drake model with every parameter fixed and
 decomposes what it still does not explain, measured force minus replayed force, with the functions of
-:mod:`drakecreep.gap.residuals`:
+:mod:`drakecreep.gap.residuals` (:func:`locate` does the decomposition of replays made elsewhere, e.g. the
+``kind: drakecreep`` diagnosis's replays of its augmented params file):
 
 * ``regimes``: share of the residual energy and of the time in each regime (dwell, stick, reversal,
   acceleration, constant speed);
@@ -15,7 +16,8 @@ decomposes what it still does not explain, measured force minus replayed force, 
   :func:`~drakecreep.gap.residuals.sustained_oscillation`), or None.
 
 ``diagnose_drake`` stores it as :attr:`~drakecreep.gap.drake_diagnosis.DrakeDiagnosis.where` ("unexplained":
-what is left after the claimed effects, and where).
+what is left after the claimed effects, and where), ``diagnose_drive`` as
+:attr:`~drakecreep.gap.drive_fit.DriveDiagnosis.where`.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from drakecreep.gap.drake_replay import make_replay
 from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, regime_shares,
                                       sustained_oscillation)
 
-__all__ = ["where_gap", "where_lines", "oscillation_line"]
+__all__ = ["where_gap", "locate", "where_lines", "oscillation_line"]
 
 
 def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
@@ -56,9 +58,32 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         ``diverged``: the labels of runs whose replay diverged (non-finite), left out of the rest (all of them: no
         regimes, bands or independence, ``force_rms_N`` NaN and ``oscillation`` None).
     """
+    sims = [make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters) for run in runs]
+    return locate(runs, sims, table_simulated=flexible, lags=lags)
+
+
+def locate(runs, sims, *, table_simulated=True, lags=25):
+    """Decompose the residual of ``runs`` against their replays ``sims`` (:func:`where_gap`'s decomposition).
+
+    Parameters
+    ----------
+    runs : sequence of drakecreep.gap.measured.MeasuredRun
+        Held-out runs, of either controller kind.
+    sims : sequence of drakecreep.gap.drake_replay.DrakeReplayResult
+        Their replays, in the same order (``force``, ``x_motor`` and ``x_table`` on the runs' samples).
+    table_simulated : bool
+        The replay's ``x_table`` is the table's own (a two-mass axis: the ``kind: drakecreep`` diagram always);
+        False for a rigid axis, whose table is its motor.
+    lags : int
+        Largest lag of the independence test [samples].
+
+    Returns
+    -------
+    dict
+        As :func:`where_gap`.
+    """
     residuals, labels, tests, split, diverged, forces = [], [], {}, {}, [], ([], [])
-    for run in runs:
-        sim = make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters)
+    for run, sim in zip(runs, sims):
         e = run.force - sim.force
         if not np.all(np.isfinite(e)):
             diverged.append(run.label)
@@ -75,7 +100,7 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
                 tests.setdefault(name, []).append(dict(res, run=run.label))
         if run.x_table is not None:
             split[run.label] = motor_table_split(run.x_motor, run.x_table, sim.x_motor,
-                                                 sim.x_table if flexible else None)
+                                                 sim.x_table if table_simulated else None)
     indep = {}
     for name, results in tests.items():  # the worst run (largest |r| relative to its band), independent in all
         worst = max(results, key=lambda r: r["max_abs"] / r["band"])

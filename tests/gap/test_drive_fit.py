@@ -17,7 +17,7 @@ import pytest
 from drakecreep import cli
 from drakecreep.errors import InputError
 from drakecreep.gap import drive_fit
-from drakecreep.gap.drake_replay import quick_replay_params, simulated_runs
+from drakecreep.gap.drake_replay import quick_replay_params, replay_drakecreep, simulated_runs
 from drakecreep.gap.drive_fit import DriveDiagnosis, diagnose_drive
 from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
 from drakecreep.gap.truth import out_and_back
@@ -349,6 +349,33 @@ def test_null_dataset_makes_no_claim():
     assert seal.contains(RIG.table.seal_force)
     assert result.params.disturbance == RIG.disturbance
     assert result.oscillation is None
+    # what is left on the held-out runs is the noise on u (2 N rms, white): nothing correlates with the inputs
+    assert 0.8 * NOISE < result.where["force_rms_N"] < 1.25 * NOISE
+    assert all(r["independent"] for r in result.where["independence"].values())
+
+
+def test_an_effect_outside_the_candidates_is_located_where_it_lies():
+    """A 6 N force ripple at 17.3 Hz that no candidate may explain (none is named): the held-out residual is
+    reported as unexplained, its energy in the band of 17.3 Hz with the spectrum's peak there, its level what
+    the ripple moves the loop's command by (the truth's replay against the params file's; the loop reacts to the
+    ripple, so this is not 6 / sqrt(2) N) and the noise together; in the summary and the JSON."""
+    truth = RIG
+    for path, value in (("disturbance.force_ripple", 6.0), ("disturbance.ripple_frequency", 17.3)):
+        truth = with_value(truth, path, value)
+    runs = _runs(truth, seed=5)
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
+    w = result.where
+    assert result.claimed == () and not w["diverged"]
+    moved = np.concatenate([replay_drakecreep(r, truth).force - replay_drakecreep(r, RIG).force for r in runs[2:]])
+    assert w["force_rms_N"] == pytest.approx(math.hypot(np.sqrt(np.mean(moved ** 2)), NOISE), rel=0.1)
+    welch_bin = 1e3 / 256  # Hz: Welch segments of 256 samples at 1 kHz
+    assert abs(w["bands"]["peak_hz"] - 17.3) < welch_bin
+    (band,) = [b for b in w["bands"]["bands"] if b["lo_Hz"] <= 17.3 < b["hi_Hz"]]
+    assert band["share"] > 0.5
+    assert set(w["split"]) == {r.label for r in runs[2:] if r.x_table is not None}
+    text = "\n".join(result.summary())
+    assert "unexplained: held-out force residual" in text and "by frequency" in text
+    assert json.loads(json.dumps(result.to_json()))["unexplained"]["bands"]["peak_hz"] == w["bands"]["peak_hz"]
 
 
 def test_switch_candidates_find_the_nut_drag_on_the_screw():
