@@ -18,7 +18,8 @@ relaxation rate of each LuGre bristle state while sliding, ``sigma0 |v| / Fc`` (
 about 5.2 N, and the nut on the screw, about 113 N; ``sigma0`` the assumed 1e8 N/m), with the step at which
 Runge-Kutta 3 stays stable on it, ``2.51 / rate`` (the real-axis limit of every three-stage, third-order
 explicit Runge-Kutta method): where that step is below the tick's 250 us, the bristles, not the controller, set
-the step, and the replay's cost grows with the speed.
+the step, and the replay's cost grows with the speed. Beside it, the same replay with Radau 3 (implicit, stable on
+the bristles, its step set by the tick; each step dearer, its Jacobian by differences of the compiled system).
 
 Run from the repository root: ``PYTHONPATH=. python analysis/bench_replay_drakecreep.py [--repeat N] [--speeds]``
 """
@@ -88,7 +89,9 @@ def speeds(declared, repeat):
     print(f"paper preset: sigma0 {sigma0:.3g} N/m (assumed); sliding levels Fc: table (guides, seal) {fc_table:.2f} N, "
           f"nut {fc_nut:.1f} N; speed-loop tick {tick * 1e6:.0f} us; {repeat} replay(s) per speed after a first one")
     print(f"{'speed [mm/s]':>12s} {'CPU s/replay':>12s} {'steps/tick':>10s} {'table rate [1/s]':>16s} "
-          f"{'table stable step [us]':>22s} {'nut rate [1/s]':>14s} {'nut stable step [us]':>20s}")
+          f"{'table stable step [us]':>22s} {'nut rate [1/s]':>14s} {'nut stable step [us]':>20s} "
+          f"{'radau3 CPU s':>12s} {'radau3 steps/tick':>17s}")
+    implicit = with_value(declared, "simulation.integrator", "radau3")
     for v in (0.5e-3, 0.7e-3, 1e-3, 1.5e-3, 2e-3, 3e-3):
         (run,) = simulated_runs(declared, (v,), declared=declared, n=1500, noise=2.0, seed=42, leg=0.6,
                                 starts=(0.05, 0.8))
@@ -97,10 +100,16 @@ def speeds(declared, repeat):
         for _ in range(repeat):
             result = replay_drakecreep(run, declared)
         seconds = (time.process_time() - start) / repeat
+        replay_drakecreep(run, implicit)
+        start = time.process_time()
+        for _ in range(repeat):
+            stiff = replay_drakecreep(run, implicit)
+        stiff_seconds = (time.process_time() - start) / repeat
         ticks = (run.t[-1] - run.t[0]) / tick
         rates = [sigma0 * v / fc for fc in (fc_table, fc_nut)]
         print(f"{v * 1e3:12.2f} {seconds:12.3f} {result.integrator_steps / ticks:10.2f} {rates[0]:16.3g} "
-              f"{RK3_LIMIT / rates[0] * 1e6:22.1f} {rates[1]:14.3g} {RK3_LIMIT / rates[1] * 1e6:20.1f}", flush=True)
+              f"{RK3_LIMIT / rates[0] * 1e6:22.1f} {rates[1]:14.3g} {RK3_LIMIT / rates[1] * 1e6:20.1f} "
+              f"{stiff_seconds:12.3f} {stiff.integrator_steps / ticks:17.2f}", flush=True)
 
 
 if __name__ == "__main__":

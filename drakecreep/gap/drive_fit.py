@@ -1322,4 +1322,5 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
                           replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0,
-                          nominal=params, oscillation=oscillation, where=locate(test, final_sims))
+                          nominal=params, oscillation=oscillation,
+                          where=locate(test, final_sims, lead=prior.screw.lead))

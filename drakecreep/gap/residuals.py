@@ -139,54 +139,79 @@ def _stretches(mask):
     return list(zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1)))
 
 
-def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_segment=8, min_speed=None):
+def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_segment=8, min_speed=None,
+                   segment=None):
     """Spectrum of a residual resampled against position, in orders (cycles per ``period`` of travel).
 
     Monotone stretches of motion (``|v| > min_speed``) are resampled on a uniform position grid of
-    ``period / points_per_period`` and passed through Welch's method; the spectra are averaged.
+    ``period / points_per_period`` and passed through Welch's method; the spectra are averaged, weighted by
+    their length. Several runs (lists of arrays) are pooled that way, each with its own stretches, so runs at
+    other speeds add up in orders where their time frequencies differ.
 
     Parameters
     ----------
-    x, v, residual : array_like
+    x, v, residual : array_like, or sequences of them (one per run)
         Measured position [m], speed [m/s] and the residual, same length.
     period : float
         Travel of one cycle [m] (screw lead, motor revolution at the table, or 1e-3 for per-mm).
     points_per_period, periods_per_segment : int
-        Resampling density and Welch segment length.
+        Resampling density and Welch segment length (``periods_per_segment`` periods).
     min_speed : float, optional
-        Default: 20 % of the largest speed.
+        Default: 20 % of each run's largest speed.
+    segment : float or "auto", optional
+        Travel of a Welch segment [m] instead of ``periods_per_segment`` periods. ``"auto"``: the shorter of
+        ``periods_per_segment`` periods and the travel of the shortest stretch of at least half the longest's,
+        so every such stretch is used whole (short runs, e.g. a few mm at creep speeds, cover less than one
+        lead: the resolution is then ``period / segment`` orders).
 
     Returns
     -------
     dict
         ``orders``, ``psd`` (arrays), ``peak_order``, ``peak_share`` (energy within +-1 bin of the peak /
         total), ``peak_ratio`` (peak / median PSD of the 8 bins on either side, the peak's 3 bins left
-        out: a local prominence, insensitive to the low-pass filter's roll-off), ``n_segments``.
+        out: a local prominence, insensitive to the low-pass filter's roll-off), ``n_segments``,
+        ``resolution`` (orders per bin).
     """
-    x, v, r = (np.asarray(a, dtype=float) for a in (x, v, residual))
     if period <= 0:
         raise InputError("period", period, "a travel > 0 m")
-    if min_speed is None:
-        min_speed = 0.2 * np.max(np.abs(v))
+    many = isinstance(x, (list, tuple)) and len(x) > 0 and np.ndim(x[0]) == 1  # one array per run
+    records = list(zip(x, v, residual)) if many else [(x, v, residual)]
     step = period / points_per_period
+    stretches = []
+    for xr, vr, rr in records:
+        xr, vr, rr = (np.asarray(a, dtype=float) for a in (xr, vr, rr))
+        floor = 0.2 * float(np.max(np.abs(vr))) if min_speed is None else min_speed
+        for sign in (1.0, -1.0):
+            for a, b in _stretches(sign * vr > floor):
+                xs, rs = xr[a:b], rr[a:b]
+                if sign < 0:
+                    xs, rs = xs[::-1], rs[::-1]
+                keep = np.concatenate([[True], np.diff(xs) > 0])
+                xs, rs = xs[keep], rs[keep]
+                if xs.size >= 4:
+                    stretches.append((xs, rs))
     nper = points_per_period * periods_per_segment
+    if isinstance(segment, str):
+        if segment != "auto":
+            raise InputError("segment", segment, "a travel > 0 m or 'auto'")
+        travels = np.array([xs[-1] - xs[0] for xs, _ in stretches])
+        if travels.size:  # every stretch of at least half the longest's travel is used, whole
+            nper = min(nper, int(np.min(travels[travels >= 0.5 * travels.max()]) / step))
+    elif segment is not None:
+        nper = int(segment / step)
     psds, weights = [], []
-    for sign in (1.0, -1.0):
-        for a, b in _stretches(sign * v > min_speed):
-            xs, rs = x[a:b], r[a:b]
-            if sign < 0:
-                xs, rs = xs[::-1], rs[::-1]
-            if xs.size < 4 or xs[-1] - xs[0] < nper * step:
+    if nper >= 8:
+        for xs, rs in stretches:
+            if xs[-1] - xs[0] < nper * step:
                 continue
-            keep = np.concatenate([[True], np.diff(xs) > 0])
-            xs, rs = xs[keep], rs[keep]
             grid = np.arange(xs[0], xs[-1], step)
             rr = np.interp(grid, xs, rs)
             f, p = signal.welch(rr, fs=1.0 / step, nperseg=nper, detrend="linear")
             psds.append(p)
             weights.append(grid.size)
     if not psds:
-        return {"orders": [], "psd": [], "peak_order": None, "peak_share": 0.0, "peak_ratio": 0.0, "n_segments": 0}
+        return {"orders": [], "psd": [], "peak_order": None, "peak_share": 0.0, "peak_ratio": 0.0, "n_segments": 0,
+                "resolution": None}
     psd = np.average(np.array(psds), axis=0, weights=weights)
     orders = f * period
     band = orders >= 0.75
@@ -197,7 +222,8 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
     around = np.r_[psd[max(k - 8, idx[0]): max(k - 1, idx[0])], psd[k + 2: k + 9]]
     med = float(np.median(around)) if around.size else 0.0
     return {"orders": orders, "psd": psd, "peak_order": float(orders[k]), "peak_share": share,
-            "peak_ratio": float(psd[k] / med) if med > 0 else 0.0, "n_segments": len(psds)}
+            "peak_ratio": float(psd[k] / med) if med > 0 else 0.0, "n_segments": len(psds),
+            "resolution": float(orders[1] - orders[0])}
 
 
 def time_spectrum(residual, dt, nperseg=1024):

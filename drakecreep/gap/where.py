@@ -12,6 +12,12 @@ decomposes what it still does not explain, measured force minus replayed force, 
   residual with the reference speed and the known external force, with a 99 % family-wise band): a residual
   correlated with an input is a model error, not noise;
 * ``split``: for runs with a linear scale (``x_table``), the position gap before or after the screw;
+* ``orders``: the residual against the measured position, pooled over the runs in orders (cycles per screw
+  revolution when the lead is known, else per 10 mm of travel; :func:`~drakecreep.gap.residuals.order_spectrum`):
+  an effect fixed to the screw or the travel (lead error, cogging) peaks at one order on runs of any speed, where
+  its time frequency moves with the speed;
+* ``operating``: the residual's RMS and energy by operating point, in five bins each of speed, position and drive
+  force (:func:`~drakecreep.gap.residuals.operating_map`);
 * ``oscillation``: a sustained oscillation of the measured force that the replay lacks (an unstable real loop,
   :func:`~drakecreep.gap.residuals.sustained_oscillation`), or None.
 
@@ -25,10 +31,13 @@ from __future__ import annotations
 import numpy as np
 
 from drakecreep.gap.drake_replay import make_replay
-from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, regime_shares,
-                                      sustained_oscillation)
+from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, operating_map,
+                                      order_spectrum, regime_shares, sustained_oscillation)
 
-__all__ = ["where_gap", "locate", "where_lines", "oscillation_line"]
+__all__ = ["where_gap", "locate", "where_lines", "oscillation_line", "ORDER_TRAVEL"]
+
+#: Travel of one cycle [m] of the order spectrum when the screw's lead is not known (EMPS runs): 10 mm.
+ORDER_TRAVEL = 1e-2
 
 
 def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
@@ -62,7 +71,7 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
     return locate(runs, sims, table_simulated=flexible, lags=lags)
 
 
-def locate(runs, sims, *, table_simulated=True, lags=25):
+def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
     """Decompose the residual of ``runs`` against their replays ``sims`` (:func:`where_gap`'s decomposition).
 
     Parameters
@@ -76,19 +85,28 @@ def locate(runs, sims, *, table_simulated=True, lags=25):
         False for a rigid axis, whose table is its motor.
     lags : int
         Largest lag of the independence test [samples].
+    lead : float, optional
+        The screw's lead [m]: orders are then cycles per screw revolution; without it, per
+        :data:`ORDER_TRAVEL` of travel.
 
     Returns
     -------
     dict
-        As :func:`where_gap`.
+        As :func:`where_gap`, with ``orders`` (``cycle_m``, the travel of one cycle, ``peak_order``, ``period_m``
+        of the peak, ``peak_share``, ``peak_ratio``, ``resolution`` [orders], ``n_segments``; ``peak_order`` None
+        when no stretch of motion is long enough) and ``operating``
+        (:func:`~drakecreep.gap.residuals.operating_map`: ``speed`` [m/s], ``position`` [m] and ``force`` [N]).
     """
     residuals, labels, tests, split, diverged, forces = [], [], {}, {}, [], ([], [])
+    motion = ([], [])  # measured position and speed of each run kept
     for run, sim in zip(runs, sims):
         e = run.force - sim.force
         if not np.all(np.isfinite(e)):
             diverged.append(run.label)
             continue
         residuals.append(e)
+        motion[0].append(np.asarray(run.x_motor, dtype=float))
+        motion[1].append(np.gradient(run.x_motor, run.dt))
         forces[0].append(run.force)
         forces[1].append(sim.force)
         labels.append(classify_regimes(run.t, run.x_ref, np.gradient(run.x_motor, run.dt)))
@@ -108,11 +126,21 @@ def locate(runs, sims, *, table_simulated=True, lags=25):
                        "independent": all(r["independent"] for r in results), "run": worst["run"]}
     if not residuals:
         return {"regimes": {}, "bands": None, "independence": {}, "split": {}, "force_rms_N": float("nan"),
-                "diverged": diverged, "oscillation": None}
+                "diverged": diverged, "oscillation": None, "orders": None, "operating": None}
     flat = np.concatenate(residuals)
+    cycle = float(lead) if lead else ORDER_TRAVEL
+    spec = order_spectrum(motion[0], motion[1], residuals, cycle, segment="auto")
+    orders = {"cycle_m": cycle, "per_revolution": bool(lead), "n_segments": spec["n_segments"],
+              "peak_order": spec["peak_order"], "resolution": spec["resolution"], "peak_share": spec["peak_share"],
+              "peak_ratio": spec["peak_ratio"],
+              "period_m": cycle / spec["peak_order"] if spec["peak_order"] else None}
+    operating = operating_map(flat, np.abs(np.concatenate(motion[1])), np.concatenate(motion[0]),
+                              np.abs(np.concatenate(forces[0])))
+    operating["force"] = operating.pop("load")
     return {"regimes": regime_shares(flat, np.concatenate(labels)), "bands": frequency_bands(residuals, runs[0].dt),
             "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2))),
-            "diverged": diverged, "oscillation": sustained_oscillation(*forces, runs[0].dt)}
+            "diverged": diverged, "oscillation": sustained_oscillation(*forces, runs[0].dt), "orders": orders,
+            "operating": operating}
 
 
 def where_lines(where):
@@ -130,6 +158,20 @@ def where_lines(where):
     b = where["bands"]
     lines.append("  by frequency: " + ", ".join(f"{r['lo_Hz']:g}-{r['hi_Hz']:.0f} Hz {100 * r['share']:.0f} %"
                                                 for r in b["bands"]) + f" (peak {b['peak_hz']:.3g} Hz)")
+    o = where.get("orders")
+    if o and o["peak_order"]:
+        per = (f"cycles per screw revolution, lead {1e3 * o['cycle_m']:g} mm" if o["per_revolution"] else
+               f"cycles per {1e3 * o['cycle_m']:g} mm of travel")
+        lines.append(f"  by order ({per}; bins of {o['resolution']:.2g}): peak at order {o['peak_order']:.3g}, a "
+                     f"{1e3 * o['period_m']:.3g} mm period, {100 * o['peak_share']:.0f} % of the energy within a bin "
+                     f"of it, {o['peak_ratio']:.3g} x its neighbours")
+    elif o:
+        lines.append("  by order: no stretch of motion long enough")
+    if where.get("operating"):
+        lines.append("  by operating point (5 bins each, the bin with the largest rms): " + "; ".join(
+            _top_bin(where["operating"][axis], name, scale, unit, where["force_rms_N"])
+            for axis, name, scale, unit in (("speed", "speed", 1e3, "mm/s"), ("position", "position", 1e3, "mm"),
+                                            ("force", "drive force", 1.0, "N"))))
     for name, r in where["independence"].items():
         verdict = "independent" if r["independent"] else \
             f"CORRELATED (|r| {r['max_abs']:.2f} > band {r['band']:.2f} at lag {r['lag_of_max']} samples, run {r['run']})"
@@ -140,6 +182,12 @@ def where_lines(where):
     if where.get("oscillation"):
         lines.append("  " + oscillation_line(where["oscillation"], "held-out runs"))
     return lines
+
+
+def _top_bin(rows, name, scale, unit, rms):
+    top = max(rows, key=lambda r: r["rms"])
+    return (f"{name} {scale * top['lo']:.3g}-{scale * top['hi']:.3g} {unit}, {top['rms'] / rms:.2g} x the whole's rms "
+            f"({100 * top['energy_share']:.0f} % of the energy)")
 
 
 def oscillation_line(oscillation, runs="runs"):

@@ -365,6 +365,21 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
             parts.append(table(["input", "independent", "largest |r|", "band", "at lag [samples]", "worst run"], rows))
         if where.get("oscillation"):
             parts.append(f"<p><b>Unstable?</b> {escape(oscillation_line(where['oscillation'], 'held-out runs'))}</p>")
+        o = where.get("orders")
+        if o and o["peak_order"]:
+            per = "per screw revolution" if o["per_revolution"] else f"per {1e3 * o['cycle_m']:g} mm of travel"
+            parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): the "
+                         f"residual peaks at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period, "
+                         f"{100 * o['peak_share']:.0f} % of its energy within a bin of it ({o['peak_ratio']:.3g} times "
+                         "its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
+                         "any speed; one fixed in time does not.</p>")
+        if where.get("operating"):
+            rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
+                     f"{100 * r['energy_share']:.1f}"]
+                    for axis, name, scale in (("speed", "speed [mm/s]", 1e3), ("position", "position [mm]", 1e3),
+                                              ("force", "drive force [N]", 1.0))
+                    for r in where["operating"][axis]]
+            parts.append(table(["operating point", "bin", "rms [N]", "share of the residual energy [%]"], rows))
         if where["split"]:
             parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
                                [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]

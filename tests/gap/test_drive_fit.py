@@ -378,6 +378,19 @@ def test_an_effect_outside_the_candidates_is_located_where_it_lies():
     assert json.loads(json.dumps(result.to_json()))["unexplained"]["bands"]["peak_hz"] == w["bands"]["peak_hz"]
 
 
+def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_order():
+    """A 2 um lead error at lead / 12 that no candidate may explain: the held-out residual peaks at order 12 of the
+    screw's revolution (within a bin), and on every run with a linear scale the position gap is after the screw
+    (the encoder on the motor does not see it, the scale does)."""
+    truth = with_value(RIG, "disturbance.lead_error_amplitude", 2e-6)
+    runs = _runs(truth, seed=2)
+    w = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=()).where
+    o = w["orders"]
+    assert o["per_revolution"] and o["cycle_m"] == RIG.screw.lead
+    assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > 0.5
+    assert w["split"] and all(s["where"] == "after the screw" for s in w["split"].values())
+
+
 def test_switch_candidates_find_the_nut_drag_on_the_screw():
     """The friction-law and nut-side candidates set a word, not a number (they once failed on it)."""
     truth = with_value(RIG, "friction.nut_friction_on", "screw")

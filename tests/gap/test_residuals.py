@@ -58,6 +58,28 @@ def test_order_spectrum_finds_a_periodic_residual_in_position():
         order_spectrum(X_REF, V, r, 0.0)
 
 
+def test_order_spectrum_pools_runs_at_other_speeds_and_short_travels():
+    """A residual fixed to the screw (order 12 of a 5 mm lead) on runs at 20 and 35 mm/s, each leg 6-10 mm of
+    travel, shorter than the default segment of 8 leads: ``segment="auto"`` fits the segment to the stretches and
+    the pooled spectrum peaks at order 12, while the two runs' time spectra peak 1.75 times apart."""
+    lead, runs = 5e-3, []
+    rng = np.random.default_rng(3)
+    for speed in (0.02, 0.035):
+        x = out_and_back(speed, 0.0, n=1000, leg=0.3, starts=(0.05, 0.5))
+        v = np.gradient(x, 1e-3)
+        runs.append((x, v, np.sin(2 * np.pi * 12 * x / lead) + 0.1 * rng.normal(size=x.size)))
+    xs, vs, rs = (list(a) for a in zip(*runs))
+    assert order_spectrum(xs, vs, rs, lead)["n_segments"] == 0  # 40 mm segments: no leg is that long
+    spec = order_spectrum(xs, vs, rs, lead, segment="auto")
+    assert spec["n_segments"] == 4
+    assert abs(spec["peak_order"] - 12.0) <= spec["resolution"]
+    assert spec["peak_ratio"] > 10
+    peaks = [time_spectrum(r, 1e-3, nperseg=256)["peak_hz"] for r in rs]
+    assert peaks[1] / peaks[0] == pytest.approx(1.75, rel=0.15)
+    with pytest.raises(InputError):
+        order_spectrum(xs, vs, rs, lead, segment="longest")
+
+
 def test_time_spectrum_peak():
     r = np.sin(2 * np.pi * 40 * T)
     assert time_spectrum(r, 1e-3)["peak_hz"] == pytest.approx(40, abs=1.0)
