@@ -240,7 +240,8 @@ def operating_map(residual, speed, position, load, bins=5):
     Returns
     -------
     dict
-        ``{"speed": [{"lo", "hi", "rms", "energy_share"}, ...], "position": [...], "load": [...]}``.
+        ``{"speed": [{"lo", "hi", "rms", "energy_share", "time_share"}, ...], "position": [...], "load": [...]}``
+        (``time_share``: the bin's share of the samples).
     """
     r = np.asarray(residual, dtype=float)
     total = float(np.sum(r * r)) or 1.0
@@ -260,7 +261,7 @@ def operating_map(residual, speed, position, load, bins=5):
             m = which == i
             rows.append({"lo": float(edges[i]), "hi": float(edges[i + 1]),
                          "rms": float(np.sqrt(np.mean(r[m] ** 2))) if m.any() else 0.0,
-                         "energy_share": float(np.sum(r[m] ** 2) / total)})
+                         "energy_share": float(np.sum(r[m] ** 2) / total), "time_share": float(np.mean(m))})
         out[name] = rows
     return out
 

@@ -187,7 +187,7 @@ def where_lines(where):
 def _top_bin(rows, name, scale, unit, rms):
     top = max(rows, key=lambda r: r["rms"])
     return (f"{name} {scale * top['lo']:.3g}-{scale * top['hi']:.3g} {unit}, {top['rms'] / rms:.2g} x the whole's rms "
-            f"({100 * top['energy_share']:.0f} % of the energy)")
+            f"({100 * top['energy_share']:.0f} % of the energy in {100 * top['time_share']:.0f} % of the samples)")
 
 
 def oscillation_line(oscillation, runs="runs"):

@@ -375,11 +375,12 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                          "any speed; one fixed in time does not.</p>")
         if where.get("operating"):
             rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
-                     f"{100 * r['energy_share']:.1f}"]
+                     f"{100 * r['energy_share']:.1f}", f"{100 * r['time_share']:.1f}"]
                     for axis, name, scale in (("speed", "speed [mm/s]", 1e3), ("position", "position [mm]", 1e3),
                                               ("force", "drive force [N]", 1.0))
                     for r in where["operating"][axis]]
-            parts.append(table(["operating point", "bin", "rms [N]", "share of the residual energy [%]"], rows))
+            parts.append(table(["operating point", "bin", "rms [N]", "share of the residual energy [%]",
+                                "share of the samples [%]"], rows))
         if where["split"]:
             parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
                                [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]

@@ -103,6 +103,8 @@ def test_operating_map_bins_cover_the_energy():
     m = operating_map(r, V, X_REF, V * 100, bins=4)
     assert sum(b["energy_share"] for b in m["speed"]) == pytest.approx(1.0)
     assert m["speed"][-1]["rms"] > m["speed"][0]["rms"]
+    for rows in m.values():
+        assert sum(b["time_share"] for b in rows) == pytest.approx(1.0)
 
 
 def test_frequency_bands_find_a_30_hz_residual():
@@ -192,3 +194,4 @@ def test_oscillation_log_errors_compare_the_band_rms_whatever_the_phase():
     assert e[0] < 0.1 and abs(e[1] - np.log(2.0)) < 0.05 and e[2] > np.log(10.0) and e[3] > np.log(10.0)
     with pytest.raises(InputError, match="simulated"):
         oscillation_log_errors([measured], [], 1e-3)
+
