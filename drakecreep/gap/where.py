@@ -28,13 +28,15 @@ what is left after the claimed effects, and where), ``diagnose_drive`` as
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drakecreep.gap.drake_replay import make_replay
 from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, operating_map,
                                       order_spectrum, regime_shares, sustained_oscillation)
 
-__all__ = ["where_gap", "locate", "where_lines", "oscillation_line", "ORDER_TRAVEL"]
+__all__ = ["where_gap", "locate", "where_lines", "period_range", "oscillation_line", "ORDER_TRAVEL"]
 
 #: Travel of one cycle [m] of the order spectrum when the screw's lead is not known (EMPS runs): 10 mm.
 ORDER_TRAVEL = 1e-2
@@ -163,8 +165,9 @@ def where_lines(where):
         per = (f"cycles per screw revolution, lead {1e3 * o['cycle_m']:g} mm" if o["per_revolution"] else
                f"cycles per {1e3 * o['cycle_m']:g} mm of travel")
         lines.append(f"  by order ({per}; bins of {o['resolution']:.2g}): peak at order {o['peak_order']:.3g}, a "
-                     f"{1e3 * o['period_m']:.3g} mm period, {100 * o['peak_share']:.0f} % of the energy within a bin "
-                     f"of it, {o['peak_ratio']:.3g} x its neighbours")
+                     f"{1e3 * o['period_m']:.3g} mm period ({period_range(o)} within a bin), "
+                     f"{100 * o['peak_share']:.0f} % of the energy within a bin of it, {o['peak_ratio']:.3g} x its "
+                     "neighbours")
     elif o:
         lines.append("  by order: no stretch of motion long enough")
     if where.get("operating"):
@@ -182,6 +185,14 @@ def where_lines(where):
     if where.get("oscillation"):
         lines.append("  " + oscillation_line(where["oscillation"], "held-out runs"))
     return lines
+
+
+def period_range(orders):
+    """The travel periods within a bin of an order spectrum's peak, as text in mm (``orders``: ``locate``'s)."""
+    o = orders
+    lo = o["cycle_m"] / (o["peak_order"] + o["resolution"])
+    hi = o["cycle_m"] / (o["peak_order"] - o["resolution"]) if o["peak_order"] > o["resolution"] else math.inf
+    return f"{1e3 * lo:.3g}-{1e3 * hi:.3g} mm" if math.isfinite(hi) else f"over {1e3 * lo:.3g} mm"
 
 
 def _top_bin(rows, name, scale, unit, rms):

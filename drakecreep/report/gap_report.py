@@ -11,7 +11,7 @@ import numpy as np
 from drakecreep.files import to_jsonable
 from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
-from drakecreep.gap.where import oscillation_line
+from drakecreep.gap.where import oscillation_line, period_range
 
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
 
@@ -369,7 +369,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         if o and o["peak_order"]:
             per = "per screw revolution" if o["per_revolution"] else f"per {1e3 * o['cycle_m']:g} mm of travel"
             parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): the "
-                         f"residual peaks at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period, "
+                         f"residual peaks at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period "
+                         f"({period_range(o)} within a bin), "
                          f"{100 * o['peak_share']:.0f} % of its energy within a bin of it ({o['peak_ratio']:.3g} times "
                          "its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
                          "any speed; one fixed in time does not.</p>")
