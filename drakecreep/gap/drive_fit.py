@@ -61,7 +61,8 @@ Steps:
    claimed effects' amplitudes (a missing effect biases them and widens their intervals); ``fitted`` and
    ``test_errors`` are those of the final model.
 6. **Where the rest lies** (``where``, "unexplained" in the JSON and the summary): the final model's held-out
-   residual, measured minus replayed force, by regime, frequency band and residual-input independence (its
+   residual, measured minus replayed force, by regime, frequency band, order of the screw's revolution (against
+   the measured position), operating point (speed, position, drive force) and residual-input independence (its
    cross-correlation with the reference speed and a known external force), and for runs with a linear scale
    whether the position gap is before or after the screw (:func:`drakecreep.gap.where.locate`, the EMPS
    diagnosis's decomposition).
@@ -295,8 +296,9 @@ class DriveDiagnosis:
         on the held-out spectrum (``spectral``, :func:`_spectral_delay`).
     where : dict
         What the augmented params file still does not explain on the held-out runs, and where
-        (:func:`drakecreep.gap.where.locate` of their replays): by regime, frequency band, residual-input
-        independence, and for runs with a linear scale before or after the screw.
+        (:func:`drakecreep.gap.where.locate` of their replays): by regime, frequency band, order of the screw's
+        revolution, operating point, residual-input independence, and for runs with a linear scale before or
+        after the screw.
     """
 
     prior: DriveParams

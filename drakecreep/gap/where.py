@@ -67,7 +67,8 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         ``force_rms_N`` of the residual, ``oscillation``
         (:func:`~drakecreep.gap.residuals.sustained_oscillation` of the measured and replayed force, or None);
         ``diverged``: the labels of runs whose replay diverged (non-finite), left out of the rest (all of them: no
-        regimes, bands or independence, ``force_rms_N`` NaN and ``oscillation`` None).
+        regimes, bands or independence, ``force_rms_N`` NaN and ``oscillation`` None); ``orders`` (per
+        :data:`ORDER_TRAVEL` of travel) and ``operating`` as :func:`locate` gives them.
     """
     sims = [make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters) for run in runs]
     return locate(runs, sims, table_simulated=flexible, lags=lags)
@@ -107,11 +108,12 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
             diverged.append(run.label)
             continue
         residuals.append(e)
+        speed = np.gradient(run.x_motor, run.dt)
         motion[0].append(np.asarray(run.x_motor, dtype=float))
-        motion[1].append(np.gradient(run.x_motor, run.dt))
+        motion[1].append(speed)
         forces[0].append(run.force)
         forces[1].append(sim.force)
-        labels.append(classify_regimes(run.t, run.x_ref, np.gradient(run.x_motor, run.dt)))
+        labels.append(classify_regimes(run.t, run.x_ref, speed))
         inputs = {"reference speed": np.gradient(run.x_ref, run.dt)}
         if run.f_ext is not None and np.any(run.f_ext):
             inputs["external force"] = run.f_ext
