@@ -42,6 +42,9 @@ unchanged (its thresholds are not tuned on this benchmark).
 "unexplained"; no-candidate effects answered with no claim; median audit shrink of the claimed model relative
 to the true effect's (``(1 - E_claimed / E_nominal) / (1 - E_true / E_nominal)`` with ``E`` the mean over audit
 runs of the squared relative force error; no claim = no shrink); claims that make the audit replay worse.
+Each row also keeps where the diagnosis located what it left unexplained on its held-out runs (``where``:
+:func:`drakecreep.gap.where.where_summary`: regime, bands, order peak, correlated inputs, screw side), so an
+effect outside the library can be checked for where it was found, not only for being unclaimed.
 """
 
 from __future__ import annotations
@@ -59,6 +62,7 @@ from drakecreep.gap import truth as T
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.screen import NOT_SCREENED, SLOW_SHARE
 from drakecreep.gap.truth import out_and_back
+from drakecreep.gap.where import where_summary
 
 __all__ = [
     "DEV_SEEDS",
@@ -551,7 +555,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
                replay_null=res.replay_null,
                test_force_nominal=rms_force_error(res.nominal_test_errors),
                test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
-               warnings=list(res.warnings), oscillation=res.oscillation,
+               warnings=list(res.warnings), oscillation=res.oscillation, where=where_summary(res.where),
                claimed_model={"fitted": {f.path: f.value for f in res.fitted},
                               "effects": {c.name: dict(c.values) for c in res.candidates if c.name in claimed}})
     if audit:
@@ -663,6 +667,7 @@ def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="
                training_run_moves=[[float(v) for v in m] for m in res.null_moves],
                test_force_nominal=rms_force_error(res.nominal_test_errors),
                test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,
+               where=where_summary(res.where),
                claimed_model={"parameters": {k: float(v) for k, v in res.model["parameters"].items()},
                               "flexible": bool(res.model["flexible"]), "delay": float(res.model["delay"])})
     if audit:

@@ -36,7 +36,7 @@ from drakecreep.gap.drake_replay import make_replay
 from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, operating_map,
                                       order_spectrum, regime_shares, sustained_oscillation)
 
-__all__ = ["where_gap", "locate", "where_lines", "period_range", "oscillation_line", "ORDER_TRAVEL"]
+__all__ = ["where_gap", "locate", "where_lines", "where_summary", "period_range", "oscillation_line", "ORDER_TRAVEL"]
 
 #: Travel of one cycle [m] of the order spectrum when the screw's lead is not known (EMPS runs): 10 mm.
 ORDER_TRAVEL = 1e-2
@@ -187,6 +187,32 @@ def where_lines(where):
     if where.get("oscillation"):
         lines.append("  " + oscillation_line(where["oscillation"], "held-out runs"))
     return lines
+
+
+def where_summary(where):
+    """The figures of a :func:`locate` result that say where the gap lies, as a small plain dict (for benchmark
+    rows): ``force_rms_N``; ``regime`` (the regime whose share of the energy most exceeds its share of the time)
+    and its two shares; ``bands`` (share per band, lower edge [Hz] as key) and ``peak_hz``; the order spectrum's
+    ``order`` (``peak_order``, ``period_m``, ``peak_share``, ``peak_ratio``, ``resolution``, ``cycle_m``);
+    ``correlated`` (the inputs the residual is not independent of); ``split`` (run label -> before / after the
+    screw / both). Empty for an empty ``where``; without bands (every replay diverged) only ``diverged``.
+    """
+    if not where:
+        return {}
+    if where.get("bands") is None:
+        return {"diverged": list(where.get("diverged") or [])}
+    regimes = {k: v for k, v in where["regimes"].items() if v["time_share"] > 0}
+    top = max(regimes, key=lambda k: regimes[k]["energy_share"] / regimes[k]["time_share"]) if regimes else None
+    o = where.get("orders") or {}
+    return {"force_rms_N": where["force_rms_N"], "diverged": list(where.get("diverged") or []),
+            "regime": top, "regime_energy_share": regimes[top]["energy_share"] if top else None,
+            "regime_time_share": regimes[top]["time_share"] if top else None,
+            "bands": {f"{b['lo_Hz']:g}": b["share"] for b in where["bands"]["bands"]},
+            "peak_hz": where["bands"]["peak_hz"],
+            "order": {k: o.get(k) for k in ("peak_order", "period_m", "peak_share", "peak_ratio", "resolution",
+                                            "cycle_m")} if o else None,
+            "correlated": [name for name, r in where["independence"].items() if not r["independent"]],
+            "split": {label: v["where"] for label, v in where["split"].items()}}
 
 
 def period_range(orders):

@@ -144,6 +144,8 @@ def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     assert set(row["claimed_model"]["fitted"]) == {"table.seal_force", "nut.preload_torque", "friction.viscous"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
     assert row["oscillation"] is None and "audit_oscillation_nepers" not in row  # a stable null: no spectral audit
+    # where the diagnosis located what it left unexplained on the held-out runs
+    assert row["where"]["force_rms_N"] > 0 and sum(row["where"]["bands"].values()) == pytest.approx(1.0)
     assert row["worse"] is (bool(row["claimed"]) and row["audit"]["claimed"]["energy"] > row["audit"]["nominal"]["energy"])
 
 
@@ -227,6 +229,7 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     assert row["expected"] == "position_ripple" and row["claimed"] == ["position_ripple"]
     assert row["audit_shrink"] > 0.3 and not row["worse"]
     assert row["true_shrink"] == pytest.approx(row["audit_shrink"])
+    assert row["where"]["force_rms_N"] > 0 and row["where"]["order"]["cycle_m"] == pytest.approx(1e-2)
     # the per-run log ratios the rows carry are the ones the claim's statistic is made of
     ranked = row["ranking"][0]
     for key, runs in (("log_error_ratio", "run_log_error_ratios"), ("level_log_error_ratio", "run_level_log_error_ratios")):

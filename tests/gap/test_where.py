@@ -9,7 +9,7 @@ import pytest
 from drakecreep.gap.drake_replay import DrakeReplay, axis_from_idim
 from drakecreep.gap.idim import PUBLISHED_IDIM
 from drakecreep.gap.measured import load_emps
-from drakecreep.gap.where import where_gap, where_lines
+from drakecreep.gap.where import where_gap, where_lines, where_summary
 
 TRUTH = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3, coulomb_asym=4.0, viscous_asym=-40.0)
 NOISE = 0.5  # N on the force
@@ -71,6 +71,7 @@ def test_runs_whose_replay_diverged_are_named_and_left_out(runs, monkeypatch):
     assert "nan" not in "\n".join(lines) and f"diverged on held-out run {runs[1].label}" in lines[0]
     gone = where_gap(runs[1:2], TRUTH)
     assert gone["bands"] is None and math.isnan(gone["force_rms_N"])
+    assert where_summary(gone) == {"diverged": [runs[1].label]}
     assert where_lines(gone) == [f"unexplained: not located (the model's replay diverged on held-out run "
                                  f"{runs[1].label})"]
 
@@ -107,3 +108,11 @@ def test_a_force_fixed_to_the_travel_peaks_at_its_order_and_the_operating_map_ho
     assert plain["peak_ratio"] < o["peak_ratio"] / 10
     text = "\n".join(where_lines(w))
     assert f"peak at order {o['peak_order']:.3g}" in text and "by operating point" in text
+    # the benchmark rows' summary of it
+    sm = where_summary(w)
+    assert sm["order"]["period_m"] == o["period_m"] and sm["force_rms_N"] == w["force_rms_N"]
+    assert sum(sm["bands"].values()) == pytest.approx(1.0) and sm["regime"] in w["regimes"]
+    share = w["regimes"][sm["regime"]]
+    assert share["energy_share"] / share["time_share"] == max(
+        v["energy_share"] / v["time_share"] for v in w["regimes"].values() if v["time_share"] > 0)
+    assert set(sm["split"]) == {r.label for r in shaken} and where_summary({}) == {}
