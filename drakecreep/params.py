@@ -467,7 +467,11 @@ class DisturbanceParams(_Params):
     pushes the table as hard as the fundamental.
     ``load_ripple``: the axial load of the load case (the paper's air cylinders) pulsates as
     ``Fx (1 + r sin(2 pi f t + ripple_phase))``; ``force_ripple`` adds ``-A sin(2 pi f t + ripple_phase)`` to the
-    push on the table. See
+    push on the table.
+    ``cogging``: a load torque on the motor fixed to its angle (a servo motor's cogging, a support bearing's
+    defect), ``(Ph / 2 pi) [c sin(psi + phase) + c2 sin(2 psi + phase2)]`` with ``psi = 2 pi x / period`` for the
+    motor's travel ``x = theta Ph / 2 pi``: ``c``, ``c2`` are its amplitudes at the table's scale (N), ``period``
+    the lead over its order per motor revolution. Unlike the lead error the encoder sees its motion. See
     :mod:`drakecreep.model.disturbances`.
     """
 
@@ -487,11 +491,26 @@ class DisturbanceParams(_Params):
     ripple_frequency: float = _q(5.0, "Hz", 0.0, 1e4, lo_open=True, doc="frequency f of both ripples")
     ripple_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                              doc="phase of both ripples at t = 0, a simulation's start (a replayed run's first sample)")
+    cogging_force: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude c of a cogging torque on the motor, at the "
+                                                       "table's scale (torque x 2 pi / lead)")
+    cogging_period: float = _q(5.0e-3 / 6.0, "m", 0.0, 0.1, lo_open=True,
+                               doc="travel per cycle of the cogging: the lead over its order per motor revolution")
+    cogging_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
+                              doc="phase of the cogging at the screw's position 0")
+    cogging_2_force: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude c2 of the cogging's second harmonic (travel period "
+                                                         "cogging_period / 2)")
+    cogging_2_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
+                                doc="phase of the cogging's second harmonic at the screw's position 0")
 
     @property
     def has_lead_error(self):
         """Whether either harmonic of the lead error is switched on."""
         return self.lead_error_amplitude > 0.0 or self.lead_error_2_amplitude > 0.0
+
+    @property
+    def has_cogging(self):
+        """Whether either harmonic of the cogging is switched on."""
+        return self.cogging_force > 0.0 or self.cogging_2_force > 0.0
 
 
 #: friction compensation methods (:mod:`drakecreep.studies.compensation`)

@@ -46,7 +46,8 @@ def add_parser(subparsers):
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
                    "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind drakecreep runs: "
-                   "lead_error, force_ripple, stribeck, law_coulomb, ...; asymmetric_friction only when named)")
+                   "lead_error, force_ripple, stribeck, law_coulomb, ...; asymmetric_friction and cogging only "
+                   "when named)")
     p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
                    "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "
                    "sticks below the breakaway force, the share of the friction that sticks fitted; slower), "

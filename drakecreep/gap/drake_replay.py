@@ -879,19 +879,24 @@ def replay_params(run, params=None, quantize=True):
     return dataclasses.replace(params, sensors=sensors)
 
 
-def _lead_error_at(params, x_origin):
-    """``params`` with the lead error's phase moved from the screw's position 0 to ``x_origin`` [m] (the run's
-    first motor position, where the replayed diagram starts): the error is fixed to the screw, not to the run."""
-    d = params.disturbance
-    if not d.has_lead_error or x_origin == 0.0:
-        return params
+def _phases_at(params, x_origin):
+    """``params`` with the phases of what is fixed to the screw and the motor (the lead error, the cogging) moved
+    from the screw's position 0 to ``x_origin`` [m] (the motor's travel at the replayed diagram's angle 0; the
+    run's first position, where the diagram starts): they are fixed to the machine, not to the run."""
     from drakecreep.params import with_value
 
-    turn = 2.0 * math.pi * x_origin / d.lead_error_period
-    params = with_value(params, "disturbance.lead_error_phase", math.remainder(d.lead_error_phase + turn,
-                                                                                2.0 * math.pi))
-    return with_value(params, "disturbance.lead_error_2_phase", math.remainder(d.lead_error_2_phase + 2.0 * turn,
-                                                                                2.0 * math.pi))
+    d = params.disturbance
+    if x_origin == 0.0:
+        return params
+    for on, period, phases in ((d.has_lead_error, d.lead_error_period, ("lead_error_phase", "lead_error_2_phase")),
+                               (d.has_cogging, d.cogging_period, ("cogging_phase", "cogging_2_phase"))):
+        if not on:
+            continue
+        turn = 2.0 * math.pi * x_origin / period
+        for harmonic, name in enumerate(phases, start=1):
+            value = getattr(d, name) + harmonic * turn
+            params = with_value(params, f"disturbance.{name}", math.remainder(value, 2.0 * math.pi))
+    return params
 
 
 def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="compiled"):
@@ -906,7 +911,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     diagram starts at rest, in equilibrium under ``load_case``, its position feedback reading the first sample:
     under an axial load the screw is wound up, ``initial_conditions``' ``x_ref0``); the lead error, fixed to the screw, keeps
     its phase at the run's absolute start position ``x_motor[0]`` (``disturbance.lead_error_phase`` is its
-    phase at the screw's position 0).
+    phase at the screw's position 0), and so does the cogging, fixed to the motor (``disturbance.cogging_phase``).
 
     ``backend="compiled"`` (default) simulates the diagram compiled into ``SymbolicVectorSystem`` systems
     (:func:`drakecreep.sim.compiled.compile_diagram`, the reference and ``f_ext`` its ``inputs`` port, fed
@@ -953,7 +958,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     else:
         x_origin = float(run.x_motor[0]) - (rest["x_ref0"] if ctrl.position_feedback == "motor"
                                             else rest["theta0"] * params.screw.lead / (2 * math.pi))
-    params = _lead_error_at(params, x_origin)
+    params = _phases_at(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)
     reference = TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr])))

@@ -171,16 +171,22 @@ QUADRATURE_STEPS = 3
 _OSCILLATION_EFFECT = "control_delay"
 #: Lead-error periods tried: the lead divided by these harmonics.
 LEAD_HARMONICS = (1, 2, 3, 4, 6, 12)
+#: Cogging orders tried [cycles per motor revolution]: its period is the lead over one of these. A servo motor's
+#: cogging order is a whole number (the slots' and poles' least common multiple, or a low harmonic of it from
+#: their tolerances); the benchmark's truths draw 1-6.
+COGGING_ORDERS = tuple(range(1, 13))
 
 #: The periodic effects' amplitude, period or frequency, and phase fields (:func:`_quadrature_effect`).
 _PERIODIC = {"lead_error": ("disturbance.lead_error_amplitude", "disturbance.lead_error_period",
                             "disturbance.lead_error_phase"),
-             "force_ripple": ("disturbance.force_ripple", "disturbance.ripple_frequency", "disturbance.ripple_phase")}
+             "force_ripple": ("disturbance.force_ripple", "disturbance.ripple_frequency", "disturbance.ripple_phase"),
+             "cogging": ("disturbance.cogging_force", "disturbance.cogging_period", "disturbance.cogging_phase")}
 #: The lead error's second harmonic (period ``disturbance.lead_error_period / 2``): amplitude and phase.
 _LEAD_SECOND = ("disturbance.lead_error_2_amplitude", "disturbance.lead_error_2_phase")
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _LEAD_SECOND[0]),
-               "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY}
+               "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY,
+               "cogging": ("disturbance.cogging_force",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -197,12 +203,16 @@ EFFECTS = {
                      "samples) fitted by a search over the delay",
     "asymmetric_friction": "direction-dependent friction (friction.coulomb_asymmetry and viscous_asymmetry); in "
                            "steady sliding a Coulomb asymmetry pushes as a constant force offset would",
+    "cogging": "a load torque on the motor fixed to its angle (disturbance.cogging_force and cogging_phase, period "
+               "the lead over a whole order per revolution; the fundamental only)",
 }
 #: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
 #: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
 #: otherwise and which a drive's current offset or an inclined axis gives; how often it would be claimed on data
 #: with an offset and no asymmetry has not been measured on development datasets (docs/gap_drakecreep_kind.md).
-ON_REQUEST = ("asymmetric_friction",)
+#: ``cogging`` (session 58) has not been run on development datasets either: how often it would be claimed on
+#: nulls, or instead of a lead error of the same period, is not known.
+ON_REQUEST = ("asymmetric_friction", "cogging")
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
 #: replay takes no fractional delay: a fraction adds a second sampling offset), up to 4 ms at a 4 kHz speed loop;
 #: the best is refined by halving the gaps to its neighbours down to one sample.
@@ -211,7 +221,6 @@ DELAY_GRID = (0, 1, 2, 4, 8, 12, 16)
 NOT_IN_MODEL = {
     "position_friction": "no position-dependent friction field in DriveParams",
     "load_friction": "load dependence is fixed by the load case (nut.load_friction_coefficient is fittable as uncertain)",
-    "cogging": "no motor cogging field in DriveParams",
     "backlash": "no lost-motion field in DriveParams",
     "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
     "quantization": "the sensor resolutions are declared in the run metadata (replayed as declared), not fitted",
@@ -1095,9 +1104,11 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
     (``oscillation``: :func:`_delay_effect`'s; ``uncertain``: the fields the Stribeck candidate refits with its
     curve)."""
     scale = _force_scale(runs)
-    if name in _PERIODIC:  # the lead error over the lead's harmonics, the ripple at the residual's peaks
+    if name in _PERIODIC:  # the lead error and the cogging over the lead's harmonics, the ripple at the residual's peaks
         if name == "lead_error":
             grid, trial = [base.screw.lead / k for k in LEAD_HARMONICS], 1e-6
+        elif name == "cogging":
+            grid, trial = [base.screw.lead / k for k in COGGING_ORDERS], 0.1 * scale
         else:
             grid, trial = _ripple_frequencies(runs, base_sims), 0.1 * scale
         values, sse = _quadrature_effect(runs, base, _PERIODIC[name], grid, trial, replayer, base_sims, scale)

@@ -20,7 +20,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drakecreep.model.compensators import add_compensation
 from drakecreep.model.controller import CascadeController, force_limit
-from drakecreep.model.disturbances import add_disturbances
+from drakecreep.model.disturbances import add_disturbances, cogging_force
 from drakecreep.model.motor import Motor
 from drakecreep.model.nut_friction import add_nut_friction
 from drakecreep.model.reference import FeedReference
@@ -86,8 +86,9 @@ def initial_conditions(params, scenario):
     Returns
     -------
     dict
-        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``x_ref0`` (m, where the position
-        feedback reads at rest), ``theta_counted0`` (rad).
+        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``command0`` (N, the force command that
+        holds it: ``force0`` plus the cogging's load at ``theta0``, :func:`~drakecreep.model.disturbances.cogging_force`),
+        ``x_ref0`` (m, where the position feedback reads at rest), ``theta_counted0`` (rad).
     """
     load = params.load_case(scenario.load_case)
     ratio = params.screw.lead / (2.0 * math.pi)
@@ -96,7 +97,10 @@ def initial_conditions(params, scenario):
     theta0 = stretch / ratio
     theta_counted = quantize(theta0, encoder_resolution(params.sensors.encoder_counts_per_rev))
     x_ref0 = theta_counted * ratio if params.controller.position_feedback == "motor" else 0.0
-    return dict(theta0=theta0, force0=force0, x_ref0=x_ref0, theta_counted0=theta_counted)
+    command0 = force0
+    if params.disturbance.has_cogging:
+        command0 = force0 + float(cogging_force(params.disturbance, theta0 * ratio))
+    return dict(theta0=theta0, force0=force0, command0=command0, x_ref0=x_ref0, theta_counted0=theta_counted)
 
 
 def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, drive=None, reference=None,
@@ -145,13 +149,13 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
 
     builder = DiagramBuilder()
     motor_x0 = [ic["theta0"], 0.0] + (
-        [ic["force0"] * params.screw.lead / (2 * math.pi)] if params.motor.current_loop_time_constant > 0 else []
+        [ic["command0"] * params.screw.lead / (2 * math.pi)] if params.motor.current_loop_time_constant > 0 else []
     )
     s = {}
     s["reference"] = (FeedReference(scenario.feed, params.simulation.acceleration_time, ic["x_ref0"])
                       if reference is None else reference)
     s["controller"] = CascadeController(
-        gains, params.screw.lead, force_limit(params), initial_force=ic["force0"], initial_angle=ic["theta_counted0"]
+        gains, params.screw.lead, force_limit(params), initial_force=ic["command0"], initial_angle=ic["theta_counted0"]
     )
     s["motor"] = Motor(params.motor, load_inertia=screw_inertia(params.screw), initial_state=motor_x0)
     if drive == "constant_speed":
@@ -180,7 +184,7 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
         ports = add_nut_friction(builder, s, params, scenario, ports)
     if "controller" in s:
         ports = add_compensation(builder, s, params, scenario, ports, angle0=ic["theta_counted0"],
-                                 torque0=ic["force0"] * params.screw.lead / (2 * math.pi))
+                                 torque0=ic["command0"] * params.screw.lead / (2 * math.pi))
     if external_force is not None:
         from pydrake.systems.primitives import Adder
 

@@ -1,6 +1,6 @@
 """Periodic disturbances of a real feed drive that the base model leaves out (off by default).
 
-Both are written once for float, AutoDiffXd and symbolic Expression, so the compiled fast path keeps
+All are written once for float, AutoDiffXd and symbolic Expression, so the compiled fast path keeps
 working; :func:`add_disturbances` wires them into the diagram only when their amplitude is non-zero
 (the diagram of the ``paper`` preset is unchanged).
 
@@ -18,6 +18,12 @@ LoadRipple
     A force ``-(A + r_l Fx) sin(2 pi f t + phi)`` added to the screw's push on the table: ``A`` a vibration of
     fixed frequency that does not depend on the load, ``r_l Fx`` a pulsation of the axial load of the
     load case (the paper's air cylinders). The table-speed ripple it causes does not depend on the feed.
+Cogging
+    A load torque on the motor fixed to its angle, ``r F(x)`` with ``r = Ph / 2 pi``, ``x = r theta`` the motor's
+    travel and ``F(x) = c sin(psi + phi) + c2 sin(2 psi + phi2)``, ``psi = 2 pi x / P`` (:func:`cogging_force`:
+    a servo motor's cogging or a support bearing's defect, at ``P`` = the lead over its order per motor
+    revolution, and its second harmonic; ``phi``, ``phi2`` their phases at the screw's position 0). The motor
+    encoder sees the motion it causes; its force does not depend on the feed, its frequency does.
 """
 
 import math
@@ -30,7 +36,8 @@ from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.model._scalar import vector
 
-__all__ = ["LeadError", "LeadError_", "LoadRipple", "LoadRipple_", "add_disturbances", "sin", "cos"]
+__all__ = ["LeadError", "LeadError_", "LoadRipple", "LoadRipple_", "Cogging", "Cogging_", "cogging_force",
+           "add_disturbances", "add_load_torque", "sin", "cos"]
 
 
 def sin(x):
@@ -137,8 +144,60 @@ def LoadRipple_(T):
     return Impl
 
 
+def cogging_force(disturbance, x):
+    """The cogging's load [N, at the table's scale] at the motor's travel ``x`` [m] (``theta Ph / 2 pi``) for
+    :class:`~drakecreep.params.DisturbanceParams` ``disturbance``; ``x`` a float, numpy array, AutoDiffXd or
+    Expression (the one implementation: :class:`Cogging` and the start equilibrium use it)."""
+    d = disturbance
+    psi = 2.0 * math.pi * x / d.cogging_period
+    force = d.cogging_force * sin(psi + d.cogging_phase)
+    if d.cogging_2_force > 0.0:
+        force = force + d.cogging_2_force * sin(2.0 * psi + d.cogging_2_phase)
+    return force
+
+
+@TemplateSystem.define("Cogging_")
+def Cogging_(T):
+    class Impl(LeafSystem_[T]):
+        """Cogging load torque on the motor: input ``motor_state`` (2, ``[theta (rad), omega (rad/s)]``), output
+        ``torque`` (1, N m) ``= (Ph / 2 pi) F(theta Ph / 2 pi)`` (:func:`cogging_force`), added to the load."""
+
+        def _construct(self, disturbance, lead, converter=None):
+            LeafSystem_[T].__init__(self, converter=converter)
+            self.disturbance = disturbance
+            self.lead = float(lead)
+            self.ratio = self.lead / (2.0 * math.pi)
+            self._u_motor_state = self.DeclareVectorInputPort("motor_state", 2)
+            self.DeclareVectorOutputPort("torque", 1, self._calc)
+
+        def _construct_copy(self, other, converter=None):
+            Impl._construct(self, other.disturbance, other.lead, converter=converter)
+
+        def _calc(self, context, output):
+            theta = self._u_motor_state.Eval(context)[0]
+            output.SetAtIndex(0, self.ratio * cogging_force(self.disturbance, self.ratio * theta))
+
+    return Impl
+
+
 LeadError = LeadError_[None]
 LoadRipple = LoadRipple_[None]
+Cogging = Cogging_[None]
+
+
+def add_load_torque(builder, systems, ports, system, name, output, sum_name):
+    """Add ``system`` (named ``name``, fed the motor's state on its ``motor_state`` input) whose ``output`` port is
+    a torque on the motor's load, through an adder ``sum_name`` before ``ports["load_torque"]``; return the
+    updated ports (``load_torque``: the adder's other input)."""
+    system = builder.AddSystem(system)
+    system.set_name(name)
+    total = builder.AddSystem(Adder(2, 1))
+    total.set_name(sum_name)
+    systems[name], systems[sum_name] = system, total
+    builder.Connect(systems["motor"].GetOutputPort("motor_state"), system.GetInputPort("motor_state"))
+    builder.Connect(system.GetOutputPort(output), total.get_input_port(1))
+    builder.Connect(total.get_output_port(0), ports["load_torque"])
+    return dict(ports, load_torque=total.get_input_port(0))
 
 
 def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
@@ -177,6 +236,9 @@ def add_disturbances(builder, systems, params, scenario, ports, angle0=0.0):
         builder.Connect(torque_sum.get_output_port(0), ports["load_torque"])
         ports["nut_motion"] = lead.GetInputPort("motor_state")
         ports["load_torque"] = torque_sum.get_input_port(0)
+    if d.has_cogging:
+        ports = add_load_torque(builder, systems, ports, Cogging(d, params.screw.lead), "cogging", "torque",
+                                "cogging_torque_sum")
     amplitude = d.force_ripple + d.load_ripple * abs(params.load_case(scenario.load_case).fx)
     if amplitude > 0.0:
         ripple = builder.AddSystem(LoadRipple(amplitude, d.ripple_frequency, d.ripple_phase))

@@ -13,10 +13,10 @@ import dataclasses
 import math
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
-from pydrake.systems.primitives import Adder
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.model._scalar import vector
+from drakecreep.model.disturbances import add_load_torque
 from drakecreep.model.friction import make_friction_law
 from drakecreep.model.nut_table import friction_split
 
@@ -98,14 +98,6 @@ def add_nut_friction(builder, systems, params, scenario, ports):
     fc, fs = nut_friction_levels(params, params.load_case(scenario.load_case))
     if fc <= 0.0:
         return ports
-    ports = dict(ports)
-    nut = builder.AddSystem(NutFriction(nut_friction_params(params.friction), fc, fs, params.screw.lead))
-    nut.set_name("nut_friction")
-    total = builder.AddSystem(Adder(2, 1))
-    total.set_name("motor_load_sum")
-    systems["nut_friction"], systems["motor_load_sum"] = nut, total
-    builder.Connect(systems["motor"].GetOutputPort("motor_state"), nut.GetInputPort("motor_state"))
-    builder.Connect(nut.GetOutputPort("friction_torque"), total.get_input_port(1))
-    builder.Connect(total.get_output_port(0), ports["load_torque"])
-    ports["load_torque"] = total.get_input_port(0)
-    return ports
+    return add_load_torque(builder, systems, ports, NutFriction(nut_friction_params(params.friction), fc, fs,
+                                                                 params.screw.lead),
+                           "nut_friction", "friction_torque", "motor_load_sum")

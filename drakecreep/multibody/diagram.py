@@ -440,6 +440,11 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         raise InputError(f"disturbance.{field}", getattr(d, field),
                          "0 with the multibody model (its ScrewJoint has an exact lead; the lead error is a "
                          "two-mass model effect)")
+    if params.disturbance.has_cogging:
+        d = params.disturbance
+        field = "cogging_force" if d.cogging_force > 0.0 else "cogging_2_force"
+        raise InputError(f"disturbance.{field}", getattr(d, field),
+                         "0 with the multibody model (the cogging is a two-mass model effect)")
     s = {}
 
     def put(name, system):

@@ -39,7 +39,7 @@ def unsupported(params):
         if getattr(p.friction, name) != 0.0:
             return (f"friction.{name}", getattr(p.friction, name), "0 (the plain-Python equations are symmetric)")
     d = p.disturbance
-    if d.has_lead_error or d.force_ripple > 0 or d.load_ripple > 0:
+    if d.has_lead_error or d.has_cogging or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")
     if p.sensors.scale_interpolation_error > 0 and p.controller.position_feedback == "table":
         return ("sensors.scale_interpolation_error", p.sensors.scale_interpolation_error,

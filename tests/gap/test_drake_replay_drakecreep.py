@@ -81,7 +81,7 @@ def test_coarser_declared_encoder_changes_the_replay():
 def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
     """A run that starts at ``x0`` meets the lead error at phase ``phi + 2 pi x0 / P``: its replay is the replay of
     the same run started at 0 with that phase, and differs from a run at another position."""
-    from drakecreep.gap.drake_replay import _lead_error_at
+    from drakecreep.gap.drake_replay import _phases_at
 
     rig = with_value(_rig(), "disturbance.lead_error_phase", 0.4)
     period = rig.disturbance.lead_error_period
@@ -95,24 +95,49 @@ def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
     assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
     plain = replay_drakecreep(at0, rig)
     assert np.max(np.abs(plain.x_table - b.x_table)) > 0.2 * rig.disturbance.lead_error_amplitude
-    assert _lead_error_at(rig, 0.0) is rig
+    assert _phases_at(rig, 0.0) is rig
     off = with_value(rig, "disturbance.lead_error_amplitude", 0.0)
-    assert _lead_error_at(off, x0) is off
+    assert _phases_at(off, x0) is off
     with pytest.raises(InputError, match="disturbance.lead_error_phase"):
         with_value(rig, "disturbance.lead_error_phase", 7.0)
+
+
+def _started_elsewhere(rig, period, name):
+    """A run of ``rig`` at 0, the same run started ``x0`` (three and an eighth periods) along, and ``rig`` with the
+    phases of ``name`` (its fundamental 0.4 rad, its second harmonic -1.3 rad in ``rig``) moved to ``x0``."""
+    x0 = 0.123 * period + 3 * period
+    at0 = _run(rig)
+    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
+    shifted = with_value(with_value(rig, f"disturbance.{name}_phase",
+                                    math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi)),
+                         f"disturbance.{name}_2_phase", math.remainder(-1.3 + 4 * math.pi * x0 / period, 2 * math.pi))
+    return at0, moved, shifted, x0
+
+
+def test_cogging_is_fixed_to_the_motor_not_to_the_run():
+    """A run that starts at ``x0`` meets the cogging at ``phi + 2 pi x0 / P`` and its second harmonic at
+    ``phi2 + 4 pi x0 / P``: its replay is that of the same run started at 0 with those phases (the start in
+    equilibrium either way), and differs from the run at 0 with the phases as written."""
+    from drakecreep.gap.drake_replay import _phases_at
+
+    rig = with_value(_rig(), "disturbance.lead_error_amplitude", 0.0)  # the cogging alone
+    for path, value in (("disturbance.cogging_force", 4.0), ("disturbance.cogging_phase", 0.4),
+                        ("disturbance.cogging_2_force", 1.5), ("disturbance.cogging_2_phase", -1.3)):
+        rig = with_value(rig, path, value)
+    at0, moved, shifted, x0 = _started_elsewhere(rig, rig.disturbance.cogging_period, "cogging")
+    assert _phases_at(rig, x0) == shifted
+    a = replay_drakecreep(moved, rig)
+    b = replay_drakecreep(at0, shifted)
+    assert np.max(np.abs((a.x_motor - x0) - b.x_motor)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
+    plain = replay_drakecreep(at0, rig)
+    assert np.max(np.abs(plain.u - b.u)) > 1.0  # N: the cogging's 4 N at another phase
 
 
 def test_the_lead_errors_second_harmonic_is_fixed_to_the_screw_too():
     """The second harmonic turns twice per period: a run from ``x0`` meets it at ``phi2 + 4 pi x0 / P``."""
     rig = with_value(with_value(with_value(_rig(), "disturbance.lead_error_phase", 0.4),
                                 "disturbance.lead_error_2_amplitude", 0.7e-6), "disturbance.lead_error_2_phase", -1.3)
-    period = rig.disturbance.lead_error_period
-    x0 = 0.123 * period + 3 * period
-    at0 = _run(rig)
-    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
-    shifted = with_value(with_value(rig, "disturbance.lead_error_phase",
-                                    math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi)),
-                         "disturbance.lead_error_2_phase", math.remainder(-1.3 + 4 * math.pi * x0 / period, 2 * math.pi))
+    at0, moved, shifted, x0 = _started_elsewhere(rig, rig.disturbance.lead_error_period, "lead_error")
     a = replay_drakecreep(moved, rig)
     b = replay_drakecreep(at0, shifted)
     assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6

@@ -343,7 +343,7 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
 
 def test_null_dataset_makes_no_claim():
     runs = _runs(RIG, seed=3)
-    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=CANDIDATES)
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=CANDIDATES + ("cogging",))
     assert result.claimed == ()
     (seal,) = result.fitted
     assert seal.contains(RIG.table.seal_force)
@@ -389,6 +389,29 @@ def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_o
     assert o["per_revolution"] and o["cycle_m"] == RIG.screw.lead
     assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > 0.5
     assert w["split"] and all(s["where"] == "after the screw" for s in w["split"].values())
+
+
+def test_a_cogging_named_is_fitted_claimed_and_kept_in_the_params():
+    """An 8 N cogging at order 4 (a 1.25 mm period) that the params file lacks, with ``cogging`` named (it is not a
+    default candidate): its order is found on the grid, its amplitude and phase fitted, it is claimed on three
+    held-out runs and kept, refitted beside the seal force; the held-out error falls below half. (On two held-out
+    runs the same fit, 2.96 -> 0.77 % and 1.89 -> 0.60 %, stays under the Student bar of one degree of freedom.)"""
+    truth = RIG
+    for path, value in (("disturbance.cogging_force", 8.0), ("disturbance.cogging_period", RIG.screw.lead / 4),
+                        ("disturbance.cogging_phase", 0.7)):
+        truth = with_value(truth, path, value)
+    runs = simulated_runs(truth, SPEEDS + (0.022,), declared=RIG, n=N, noise=NOISE, seed=600)
+    assert "cogging" not in drive_fit.NOT_IN_MODEL and "cogging" in drive_fit.ON_REQUEST
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("cogging",))
+    assert result.claimed == ("cogging",)
+    d = result.params.disturbance
+    assert d.cogging_period == pytest.approx(RIG.screw.lead / 4)
+    assert d.cogging_force == pytest.approx(8.0, rel=0.1)
+    assert abs(math.remainder(d.cogging_phase - 0.7, 2 * math.pi)) < 0.2
+    seal, cogging = result.fitted
+    assert cogging.path == "disturbance.cogging_force" and seal.contains(truth.table.seal_force)
+    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
+    assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
 
 
 def test_switch_candidates_find_the_nut_drag_on_the_screw():
@@ -529,8 +552,8 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
         diagnose_drive(good[:1], good[1:], uncertain=("screw.lead",))
     assert err.value.field == "uncertain"
     with pytest.raises(InputError) as err:
-        diagnose_drive(good[:1], good[1:], effects=("cogging",))
-    assert err.value.field == "effects" and "cogging" in drive_fit.NOT_IN_MODEL
+        diagnose_drive(good[:1], good[1:], effects=("backlash",))
+    assert err.value.field == "effects" and "backlash" in drive_fit.NOT_IN_MODEL
     with pytest.raises(InputError) as err:
         diagnose_drive([_blank("x", kind="p_p_cascade")], good[1:])
     assert err.value.field in ("controller.kind", "controller.sample_time")

@@ -118,3 +118,63 @@ def test_load_ripple_phase_and_scalar_copies():
         ctx.SetTime(t)
         assert ripple.get_output_port(0).Eval(ctx)[0] == pytest.approx(-3.0 * math.sin(2 * math.pi * 17.0 * t - 1.2),
                                                                        rel=1e-12)
+
+
+def test_cogging_torque_its_harmonics_and_scalar_copies():
+    """``torque = r [c sin(psi + phi) + c2 sin(2 psi + phi2)]`` with ``psi = 2 pi r theta / P``: a load torque fixed
+    to the motor angle; the AutoDiffXd and symbolic copies keep every setting; the second harmonic alone switches
+    it into the diagram."""
+    from drakecreep.model.disturbances import Cogging
+    from drakecreep.params import preset
+
+    p = preset("paper")
+    for path, value in (("disturbance.cogging_force", 3.0), ("disturbance.cogging_period", 5e-3 / 4),
+                        ("disturbance.cogging_phase", 0.8), ("disturbance.cogging_2_force", 1.2),
+                        ("disturbance.cogging_2_phase", -2.1)):
+        p = with_value(p, path, value)
+    d, lead = p.disturbance, p.screw.lead
+    r = lead / (2 * math.pi)
+    cog = Cogging(d, lead)
+    for copy in (cog, cog.ToAutoDiffXd(), cog.ToSymbolic()):
+        assert copy.disturbance == d and copy.lead == lead
+    for theta in (0.0, 0.37, -5.0, 123.4):
+        ctx = cog.CreateDefaultContext()
+        cog.GetInputPort("motor_state").FixValue(ctx, [theta, 3.0])
+        psi = 2 * math.pi * r * theta / (5e-3 / 4)
+        expected = r * (3.0 * math.sin(psi + 0.8) + 1.2 * math.sin(2 * psi - 2.1))
+        assert cog.GetOutputPort("torque").Eval(ctx)[0] == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    second = with_value(preset("paper"), "disturbance.cogging_2_force", 1.0)
+    assert second.disturbance.has_cogging and not preset("paper").disturbance.has_cogging
+    names = {s.get_name() for s in build_diagram(second, Scenario(feed=1e-3, duration=0.1)).diagram.GetSystems()}
+    assert {"cogging", "cogging_torque_sum"} <= names
+
+
+@pytest.mark.parametrize("case", [0, 3])
+def test_a_cogging_diagram_starts_at_rest_its_command_holding_the_cogging(paper, case):
+    """At the start the controller's force (and the current loop's torque) hold the screw's load and the
+    cogging's at the start angle, so nothing moves: every derivative is 0. Without that the paper rig would
+    start with a kick of the cogging's force (here 20 N at its crest)."""
+    import numpy as np
+
+    from drakecreep.model.diagram import initial_conditions
+
+    p = with_value(with_value(paper, "disturbance.cogging_force", 20.0), "disturbance.cogging_phase", math.pi / 2)
+    scenario = Scenario(feed=1e-3, load_case=case)
+    ic = initial_conditions(p, scenario)
+    x0 = ic["theta0"] * p.screw.lead / (2 * math.pi)  # the motor's travel at rest: the screw wound up by the load
+    expected = 20.0 * math.sin(2 * math.pi * x0 / p.disturbance.cogging_period + math.pi / 2)
+    assert ic["command0"] - ic["force0"] == pytest.approx(expected, rel=1e-12)
+    assert abs(expected) > 15.0
+    drive = build_diagram(p, scenario)
+    c = drive.diagram.CreateDefaultContext()
+    np.testing.assert_allclose(drive.diagram.EvalTimeDerivatives(c).CopyToVector(), 0.0, atol=1e-9)
+
+
+def test_cogging_compiles_and_matches_the_leaf_systems(short_paper):
+    p = with_value(with_value(short_paper, "disturbance.cogging_force", 4.0), "disturbance.cogging_phase", 0.3)
+    scenario = Scenario(feed=1e-3, load_case=3, duration=0.4)
+    fast = simulate(p, scenario, backend="compiled").metrics
+    leaf = simulate(p, scenario, backend="leaf").metrics
+    assert fast.max_fluctuation == pytest.approx(leaf.max_fluctuation, rel=0.02)
+    plain = simulate(short_paper, scenario, backend="compiled").metrics
+    assert fast.max_fluctuation != pytest.approx(plain.max_fluctuation, rel=0.02)  # it acts

@@ -189,3 +189,6 @@ def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
     with pytest.raises(InputError) as err:
         build_multibody_diagram(with_value(paper, "disturbance.lead_error_amplitude", 1e-6), scenario, options)
     assert err.value.field == "disturbance.lead_error_amplitude"
+    with pytest.raises(InputError) as err:  # the cogging is the two-mass model's too
+        build_multibody_diagram(with_value(paper, "disturbance.cogging_2_force", 1.0), scenario, options)
+    assert err.value.field == "disturbance.cogging_2_force"
