@@ -74,7 +74,7 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_replay_drakecreep.py", ("--repeat", "0"), "--repeat: got 0"),
     ("bench_gap_benchmark.py", ("--uncertain", "loads.constant_force"), "uncertain: got 'loads.constant_force'; "
                                                                       "allowed: only with kinds drakecreep alone"),
-    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,cogging"), "effects: got 'cogging'"),
+    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,backlash"), "effects: got 'backlash'"),
 ])
 def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, args, field):
     env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
