@@ -181,12 +181,13 @@ _PERIODIC = {"lead_error": ("disturbance.lead_error_amplitude", "disturbance.lea
                             "disturbance.lead_error_phase"),
              "force_ripple": ("disturbance.force_ripple", "disturbance.ripple_frequency", "disturbance.ripple_phase"),
              "cogging": ("disturbance.cogging_force", "disturbance.cogging_period", "disturbance.cogging_phase")}
-#: The lead error's second harmonic (period ``disturbance.lead_error_period / 2``): amplitude and phase.
-_LEAD_SECOND = ("disturbance.lead_error_2_amplitude", "disturbance.lead_error_2_phase")
+#: The second harmonics (period half the fundamental's) of the periodic effects that have one: amplitude and phase.
+_SECOND = {"lead_error": ("disturbance.lead_error_2_amplitude", "disturbance.lead_error_2_phase"),
+           "cogging": ("disturbance.cogging_2_force", "disturbance.cogging_2_phase")}
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
-_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _LEAD_SECOND[0]),
+_AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _SECOND["lead_error"][0]),
                "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY,
-               "cogging": ("disturbance.cogging_force",)}
+               "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0])}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -204,7 +205,7 @@ EFFECTS = {
     "asymmetric_friction": "direction-dependent friction (friction.coulomb_asymmetry and viscous_asymmetry); in "
                            "steady sliding a Coulomb asymmetry pushes as a constant force offset would",
     "cogging": "a load torque on the motor fixed to its angle (disturbance.cogging_force and cogging_phase, period "
-               "the lead over a whole order per revolution; the fundamental only)",
+               "the lead over a whole order per revolution, with its second harmonic, cogging_2_force and _2_phase)",
 }
 #: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
 #: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
@@ -839,19 +840,21 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     return out
 
 
-def _lead_second_harmonic(runs, base, values, sse, trial, replayer, scale):
-    """The lead error of one harmonic ``values`` (SSE ``sse``) with a second harmonic: ``(values, sse)``.
+def _second_harmonic(name, runs, base, values, sse, trial, replayer, scale):
+    """The periodic effect ``name`` (the lead error or the cogging) of one harmonic ``values`` (SSE ``sse``) with a
+    second harmonic: ``(values, sse)``.
 
-    A lead error's drive force grows with the square of its order, so a second harmonic of a quarter of the
-    fundamental's amplitude pushes as hard as the fundamental, and the one-harmonic fit may have found either.
-    Two readings, each one more quadrature fit (:func:`_quadrature_effect`, about six replays): the harmonic found
-    is the fundamental and its second harmonic is added, or (when twice its period is still a whole fraction of
-    the lead) it is the second harmonic of a fundamental of twice its period, which is added. The better of the
+    The one-harmonic fit may have found either harmonic: a lead error's drive force grows with the square of its
+    order, so a second harmonic of a quarter of the fundamental's amplitude pushes as hard as the fundamental, and a
+    cogging's second harmonic can be the larger. Two readings, each one more quadrature fit
+    (:func:`_quadrature_effect`, about six replays): the harmonic found is the fundamental and its second harmonic
+    is added, or (when twice its period is still a whole fraction of the lead) it is the second harmonic of a
+    fundamental of twice its period, which is added. The better of the
     two is kept if its two more fields lower the SSE by more than noise would: a chi-square test at ``ALPHA`` on
     two degrees of freedom, the one-harmonic residual's variance inflated for its lag-1 autocorrelation as in
     :func:`fit_drive`'s intervals."""
-    amp, period, phase = _PERIODIC["lead_error"]
-    amp2, phase2 = _LEAD_SECOND
+    amp, period, phase = _PERIODIC[name]
+    amp2, phase2 = _SECOND[name]
     if not values.get(amp, 0.0) > 0.0:
         return values, sse
     found = dict(values, **{amp2: 0.0, phase2: 0.0})
@@ -1114,8 +1117,8 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         values, sse = _quadrature_effect(runs, base, _PERIODIC[name], grid, trial, replayer, base_sims, scale)
         if not values:
             return {}, 0.0
-        if name == "lead_error":
-            values, sse = _lead_second_harmonic(runs, base, values, sse, trial, replayer, scale)
+        if name in _SECOND:
+            values, sse = _second_harmonic(name, runs, base, values, sse, trial, replayer, scale)
     elif name == "stribeck":
         start = base if base.friction.law != "coulomb" else with_value(base, "friction.law", "stribeck")
         paths = ("friction.static_ratio", "friction.stribeck_velocity")
