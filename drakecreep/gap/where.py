@@ -15,7 +15,10 @@ decomposes what it still does not explain, measured force minus replayed force, 
 * ``orders``: the residual against the measured position, pooled over the runs in orders (cycles per screw
   revolution when the lead is known, else per 10 mm of travel; :func:`~drakecreep.gap.residuals.order_spectrum`):
   an effect fixed to the screw or the travel (lead error, cogging) peaks at one order on runs of any speed, where
-  its time frequency moves with the speed;
+  its time frequency moves with the speed. A peak alone does not tell it from an effect fixed in time: on short
+  runs the bins are coarse (the segment is the runs' travel), and two held-out runs at 25 and 35 mm/s put a
+  17.3 Hz force ripple's residual 93 % within a bin of one order peak (the test rig of
+  ``tests/gap/test_drive_fit.py``), as much as a lead error's (80 %) or a cogging's (93 %);
 * ``operating``: the residual's RMS and energy by operating point, in five bins each of speed, position and drive
   force (:func:`~drakecreep.gap.residuals.operating_map`);
 * ``oscillation``: a sustained oscillation of the measured force that the replay lacks (an unstable real loop,

@@ -373,7 +373,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                          f"({period_range(o)} within a bin), "
                          f"{100 * o['peak_share']:.0f} % of its energy within a bin of it ({o['peak_ratio']:.3g} times "
                          "its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
-                         "any speed; one fixed in time does not.</p>")
+                         "any speed, one fixed in time spreads over the orders as the runs' speeds differ; bins as "
+                         "coarse as the runs' travel allows, or runs of like speeds, may not show the difference.</p>")
         if where.get("operating"):
             rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
                      f"{100 * r['energy_share']:.1f}", f"{100 * r['time_share']:.1f}"]
