@@ -14,6 +14,8 @@ Inputs are plain arrays on a uniform time grid: the measured run and the closed-
 * :func:`independence`: the residual-input independence test of system identification (cross-correlation
   of the residual with each input over lags, with its confidence band);
 * :func:`frequency_bands`: share of the residual energy in frequency bands (Welch PSD);
+* :func:`fixed_to`: is a periodic residual fixed to the travel or to time (its peak frequency run by run against
+  the speed)?
 * :func:`motor_table_split`: for runs with a linear scale, is the gap before or after the screw?
 * :func:`dominant_oscillation` and :func:`sustained_oscillation`: does the measured force carry an oscillation
   (an unstable loop's limit cycle) that the replay does not? A replay sample by sample cannot follow an
@@ -39,6 +41,7 @@ __all__ = [
     "whiteness",
     "BANDS_HZ",
     "frequency_bands",
+    "fixed_to",
     "independence",
     "motor_table_split",
     "OSCILLATION_MIN_HZ",
@@ -350,6 +353,64 @@ def frequency_bands(residual, dt, bands=BANDS_HZ, nperseg=1024):
     k = 1 + int(np.argmax(psd[1:]))
     top = max(rows, key=lambda r: r["share"])
     return {"bands": rows, "peak_hz": float(f[k]), "top": top}
+
+
+def fixed_to(residuals, speeds, labels, dt, nperseg=256):
+    """Is a periodic residual fixed to the travel or to time? Its peak frequency at constant speed, run by run.
+
+    In each run the residual's constant-speed stretches (``labels`` of :func:`classify_regimes`) give a Welch
+    spectrum (segments of ``nperseg`` samples, or the longest stretch's length when shorter) and its peak frequency
+    ``f``, beside the run's mean speed ``v`` there. A force fixed to the travel (period ``P``) has ``f = v / P``;
+    one fixed in time the same ``f`` at every speed. Each peak is known to within half the spectrum's bin, so a
+    model fits the runs when every peak lies within a bin of it: ``f = c v`` (``c`` by least squares) and
+    ``f = const``; the verdict is the one model that fits, else "cannot tell" (both fit: runs at like speeds or
+    bins too coarse; neither: the peaks are not one effect's).
+
+    Parameters
+    ----------
+    residuals, speeds, labels : sequences of array_like
+        Per run: the residual, the measured speed [m/s] and the regime labels, same length.
+    dt : float
+        Sample time [s].
+    nperseg : int
+        Welch segment length [samples].
+
+    Returns
+    -------
+    dict
+        ``verdict`` (``"travel"``, ``"time"`` or ``"cannot tell"``), ``runs`` (per run with a constant-speed
+        stretch: ``speed`` [m/s], ``peak_Hz``), ``resolution_Hz`` (the coarsest bin), ``period_m`` (``1 / c`` when
+        the verdict is the travel, else None).
+    """
+    runs = []
+    for r, v, lab in zip(residuals, speeds, labels):
+        r, v = np.asarray(r, dtype=float), np.asarray(v, dtype=float)
+        stretches = [(a, b) for a, b in _stretches(np.asarray(lab) == "constant_speed") if b - a >= 16]
+        if not stretches:
+            continue
+        seg = int(min(nperseg, max(b - a for a, b in stretches)))
+        psds, w = [], []
+        for a, b in stretches:
+            if b - a < seg:
+                continue
+            f, p = signal.welch(r[a:b], fs=1.0 / dt, nperseg=seg, detrend="linear")
+            psds.append(p)
+            w.append(b - a)
+        psd = np.average(np.array(psds), axis=0, weights=w)
+        k = 1 + int(np.argmax(psd[1:]))
+        m = np.concatenate([np.arange(a, b) for a, b in stretches])
+        runs.append({"speed": float(np.mean(np.abs(v[m]))), "peak_Hz": float(f[k]), "bin_Hz": float(f[1] - f[0])})
+    if len(runs) < 2:
+        return {"verdict": "cannot tell", "runs": runs, "resolution_Hz": None, "period_m": None}
+    f = np.array([x["peak_Hz"] for x in runs])
+    v = np.array([x["speed"] for x in runs])
+    tol = max(x["bin_Hz"] for x in runs)
+    c = float(v @ f / (v @ v)) if v @ v > 0 else 0.0
+    travel = bool(c > 0 and np.all(np.abs(f - c * v) <= tol))
+    time = bool(np.all(np.abs(f - np.mean(f)) <= tol))
+    verdict = "travel" if travel and not time else ("time" if time and not travel else "cannot tell")
+    return {"verdict": verdict, "runs": [{"speed": x["speed"], "peak_Hz": x["peak_Hz"]} for x in runs],
+            "resolution_Hz": tol, "period_m": 1.0 / c if verdict == "travel" else None}
 
 
 def _acf(x, lags):

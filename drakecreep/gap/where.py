@@ -19,6 +19,9 @@ decomposes what it still does not explain, measured force minus replayed force, 
   runs the bins are coarse (the segment is the runs' travel), and two held-out runs at 25 and 35 mm/s put a
   17.3 Hz force ripple's residual 93 % within a bin of one order peak (the test rig of
   ``tests/gap/test_drive_fit.py``), as much as a lead error's (80 %) or a cogging's (93 %);
+* ``fixed``: whether the residual's peak is fixed to the travel or to time, from its peak frequency at constant
+  speed run by run against the runs' speeds (:func:`~drakecreep.gap.residuals.fixed_to`): what the order peak
+  alone cannot say;
 * ``operating``: the residual's RMS and energy by operating point, in five bins each of speed, position and drive
   force (:func:`~drakecreep.gap.residuals.operating_map`);
 * ``oscillation``: a sustained oscillation of the measured force that the replay lacks (an unstable real loop,
@@ -36,8 +39,8 @@ import math
 import numpy as np
 
 from drakecreep.gap.drake_replay import make_replay
-from drakecreep.gap.residuals import (classify_regimes, frequency_bands, independence, motor_table_split, operating_map,
-                                      order_spectrum, regime_shares, sustained_oscillation)
+from drakecreep.gap.residuals import (classify_regimes, fixed_to, frequency_bands, independence, motor_table_split,
+                                      operating_map, order_spectrum, regime_shares, sustained_oscillation)
 
 __all__ = ["where_gap", "locate", "where_lines", "where_summary", "period_range", "oscillation_line", "ORDER_TRAVEL"]
 
@@ -98,7 +101,7 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
     Returns
     -------
     dict
-        As :func:`where_gap`, with ``orders`` (``cycle_m``, the travel of one cycle, ``peak_order``, ``period_m``
+        As :func:`where_gap`, with ``fixed`` (:func:`~drakecreep.gap.residuals.fixed_to`), ``orders`` (``cycle_m``, the travel of one cycle, ``peak_order``, ``period_m``
         of the peak, ``peak_share``, ``peak_ratio``, ``resolution`` [orders], ``n_segments``; ``peak_order`` None
         when no stretch of motion is long enough) and ``operating``
         (:func:`~drakecreep.gap.residuals.operating_map`: ``speed`` [m/s], ``position`` [m] and ``force`` [N]).
@@ -133,7 +136,7 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
                        "independent": all(r["independent"] for r in results), "run": worst["run"]}
     if not residuals:
         return {"regimes": {}, "bands": None, "independence": {}, "split": {}, "force_rms_N": float("nan"),
-                "diverged": diverged, "oscillation": None, "orders": None, "operating": None}
+                "diverged": diverged, "oscillation": None, "orders": None, "operating": None, "fixed": None}
     flat = np.concatenate(residuals)
     cycle = float(lead) if lead else ORDER_TRAVEL
     spec = order_spectrum(motion[0], motion[1], residuals, cycle, segment="auto")
@@ -147,7 +150,7 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
     return {"regimes": regime_shares(flat, np.concatenate(labels)), "bands": frequency_bands(residuals, runs[0].dt),
             "independence": indep, "split": split, "force_rms_N": float(np.sqrt(np.mean(flat ** 2))),
             "diverged": diverged, "oscillation": sustained_oscillation(*forces, runs[0].dt), "orders": orders,
-            "operating": operating}
+            "operating": operating, "fixed": fixed_to(residuals, motion[1], labels, runs[0].dt)}
 
 
 def where_lines(where):
@@ -175,6 +178,14 @@ def where_lines(where):
                      "neighbours")
     elif o:
         lines.append("  by order: no stretch of motion long enough")
+    fx = where.get("fixed")
+    if fx and fx["runs"]:
+        peaks = ", ".join(f"{1e3 * r['speed']:.3g} mm/s {r['peak_Hz']:.3g} Hz" for r in fx["runs"])
+        verdict = {"travel": f"the travel (its frequency grows with the speed: a {1e3 * (fx['period_m'] or 0):.3g} mm "
+                             "period)", "time": "time (one frequency at every speed)"}.get(
+            fx["verdict"], "cannot tell (runs at like speeds, bins too coarse, or peaks of no one effect)")
+        lines.append(f"  fixed to {verdict}; peak at constant speed per run: {peaks} (bins of "
+                     f"{fx['resolution_Hz']:.3g} Hz)" if fx["resolution_Hz"] else f"  fixed to {verdict}")
     if where.get("operating"):
         lines.append("  by operating point (5 bins each, the bin with the largest rms): " + "; ".join(
             _top_bin(where["operating"][axis], name, scale, unit, where["force_rms_N"])
@@ -196,7 +207,8 @@ def where_summary(where):
     """The figures of a :func:`locate` result that say where the gap lies, as a small plain dict (for benchmark
     rows): ``force_rms_N``; ``regime`` (the regime whose share of the energy most exceeds its share of the time)
     and its two shares; ``bands`` (share per band, lower edge [Hz] as key) and ``peak_hz``; the order spectrum's
-    ``order`` (``peak_order``, ``period_m``, ``peak_share``, ``peak_ratio``, ``resolution``, ``cycle_m``);
+    ``order`` (``peak_order``, ``period_m``, ``peak_share``, ``peak_ratio``, ``resolution``, ``cycle_m``); ``fixed``
+    (:func:`~drakecreep.gap.residuals.fixed_to`'s verdict);
     ``correlated`` (the inputs the residual is not independent of); ``split`` (run label -> before / after the
     screw / both). Empty for an empty ``where``; without bands (every replay diverged) only ``diverged``.
     """
@@ -214,6 +226,7 @@ def where_summary(where):
             "peak_hz": where["bands"]["peak_hz"],
             "order": {k: o.get(k) for k in ("peak_order", "period_m", "peak_share", "peak_ratio", "resolution",
                                             "cycle_m")} if o else None,
+            "fixed": (where.get("fixed") or {}).get("verdict"),
             "correlated": [name for name, r in where["independence"].items() if not r["independent"]],
             "split": {label: v["where"] for label, v in where["split"].items()}}
 

@@ -375,6 +375,15 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                          "its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
                          "any speed, one fixed in time spreads over the orders as the runs' speeds differ; bins as "
                          "coarse as the runs' travel allows, or runs of like speeds, may not show the difference.</p>")
+        fx = where.get("fixed")
+        if fx and fx["runs"] and fx["resolution_Hz"]:
+            verdict = {"travel": f"the travel: its frequency grows with the speed, a {1e3 * (fx['period_m'] or 0):.3g} mm "
+                                 "period", "time": "time: one frequency at every speed"}.get(
+                fx["verdict"], "cannot tell: runs at like speeds, bins too coarse, or peaks of no one effect")
+            parts.append(f"<p>Fixed to {escape(verdict)} (the residual's peak at constant speed, run by run, bins of "
+                         f"{fx['resolution_Hz']:.3g} Hz).</p>")
+            parts.append(table(["speed [mm/s]", "peak [Hz]"],
+                               [[f"{1e3 * r['speed']:.3g}", f"{r['peak_Hz']:.3g}"] for r in fx["runs"]]))
         if where.get("operating"):
             rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
                      f"{100 * r['energy_share']:.1f}", f"{100 * r['time_share']:.1f}"]

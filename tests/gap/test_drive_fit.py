@@ -373,6 +373,10 @@ def test_an_effect_outside_the_candidates_is_located_where_it_lies():
     (band,) = [b for b in w["bands"]["bands"] if b["lo_Hz"] <= 17.3 < b["hi_Hz"]]
     assert band["share"] > 0.5
     assert set(w["split"]) == {r.label for r in runs[2:] if r.x_table is not None}
+    # one peak frequency at both speeds; with constant-speed stretches of 0.12 s (bins of 8 Hz) at 25 and 35 mm/s
+    # a force fixed to the travel would fit the two peaks too, so the verdict may be "cannot tell", never "travel"
+    assert w["fixed"]["verdict"] in ("time", "cannot tell")
+    assert max(abs(r["peak_Hz"] - 17.3) for r in w["fixed"]["runs"]) <= w["fixed"]["resolution_Hz"]
     text = "\n".join(result.summary())
     assert "unexplained: held-out force residual" in text and "by frequency" in text
     assert json.loads(json.dumps(result.to_json()))["unexplained"]["bands"]["peak_hz"] == w["bands"]["peak_hz"]
@@ -389,6 +393,8 @@ def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_o
     assert o["per_revolution"] and o["cycle_m"] == RIG.screw.lead
     assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > 0.5
     assert w["split"] and all(s["where"] == "after the screw" for s in w["split"].values())
+    # and fixed to the travel: its peak frequency at constant speed grows with the held-out runs' speeds
+    assert w["fixed"]["verdict"] == "travel" and w["fixed"]["period_m"] == pytest.approx(RIG.screw.lead / 12, rel=0.1)
 
 
 def test_a_cogging_named_is_fitted_claimed_and_kept_in_the_params():

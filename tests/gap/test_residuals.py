@@ -195,3 +195,27 @@ def test_oscillation_log_errors_compare_the_band_rms_whatever_the_phase():
     with pytest.raises(InputError, match="simulated"):
         oscillation_log_errors([measured], [], 1e-3)
 
+
+
+def test_fixed_to_tells_a_force_fixed_to_the_travel_from_one_fixed_in_time():
+    """Runs at 10, 20 and 30 mm/s, 1 s at constant speed each: a residual of 1 mm travel period peaks at 10, 20 and
+    30 Hz (fixed to the travel, its period found), one at 25 Hz at 25 Hz in every run (fixed in time); runs at one
+    speed cannot tell them apart, nor can noise alone be either."""
+    from drakecreep.gap.residuals import fixed_to
+
+    dt, rng = 1e-3, np.random.default_rng(5)
+    t = np.arange(1000) * dt
+    speeds = (0.01, 0.02, 0.03)
+    labels = [np.array(["constant_speed"] * t.size)] * 3
+    vs = [np.full(t.size, v) for v in speeds]
+    travel = [np.sin(2 * np.pi * v * t / 1e-3) + 0.1 * rng.normal(size=t.size) for v in speeds]
+    timed = [np.sin(2 * np.pi * 25.0 * t) + 0.1 * rng.normal(size=t.size) for _ in speeds]
+    a = fixed_to(travel, vs, labels, dt)
+    assert a["verdict"] == "travel" and a["period_m"] == pytest.approx(1e-3, rel=0.05)
+    assert [r["peak_Hz"] for r in a["runs"]] == pytest.approx([10.0, 20.0, 30.0], abs=a["resolution_Hz"])
+    assert fixed_to(timed, vs, labels, dt)["verdict"] == "time"
+    same = [np.full(t.size, 0.02)] * 3
+    assert fixed_to(timed, same, labels, dt)["verdict"] == "cannot tell"
+    noise = [rng.normal(size=t.size) for _ in speeds]
+    assert fixed_to(noise, vs, labels, dt)["verdict"] == "cannot tell"
+    assert fixed_to(travel[:1], vs[:1], labels[:1], dt)["verdict"] == "cannot tell"  # one run says nothing
