@@ -181,11 +181,13 @@ def where_lines(where):
     fx = where.get("fixed")
     if fx and fx["runs"]:
         peaks = ", ".join(f"{1e3 * r['speed']:.3g} mm/s {r['peak_Hz']:.3g} Hz" for r in fx["runs"])
-        verdict = {"travel": f"the travel (its frequency grows with the speed: a {1e3 * (fx['period_m'] or 0):.3g} mm "
-                             "period)", "time": "time (one frequency at every speed)"}.get(
-            fx["verdict"], "cannot tell (runs at like speeds, bins too coarse, or peaks of no one effect)")
-        lines.append(f"  fixed to {verdict}; peak at constant speed per run: {peaks} (bins of "
-                     f"{fx['resolution_Hz']:.3g} Hz)" if fx["resolution_Hz"] else f"  fixed to {verdict}")
+        verdict = {"travel": f"fixed to the travel (its frequency grows with the speed: a "
+                             f"{1e3 * (fx['period_m'] or 0):.3g} mm period)",
+                   "time": "fixed to time (one frequency at every speed)"}.get(
+            fx["verdict"], "fixed to the travel or to time: cannot tell (runs at like speeds, bins too coarse, or "
+                           "peaks of no one effect)")
+        lines.append(f"  {verdict}; peak at constant speed per run: {peaks} (bins of {fx['resolution_Hz']:.3g} Hz)"
+                     if fx["resolution_Hz"] else f"  {verdict}")
     if where.get("operating"):
         lines.append("  by operating point (5 bins each, the bin with the largest rms): " + "; ".join(
             _top_bin(where["operating"][axis], name, scale, unit, where["force_rms_N"])

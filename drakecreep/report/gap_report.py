@@ -377,11 +377,13 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                          "coarse as the runs' travel allows, or runs of like speeds, may not show the difference.</p>")
         fx = where.get("fixed")
         if fx and fx["runs"] and fx["resolution_Hz"]:
-            verdict = {"travel": f"the travel: its frequency grows with the speed, a {1e3 * (fx['period_m'] or 0):.3g} mm "
-                                 "period", "time": "time: one frequency at every speed"}.get(
-                fx["verdict"], "cannot tell: runs at like speeds, bins too coarse, or peaks of no one effect")
-            parts.append(f"<p>Fixed to {escape(verdict)} (the residual's peak at constant speed, run by run, bins of "
-                         f"{fx['resolution_Hz']:.3g} Hz).</p>")
+            verdict = {"travel": f"Fixed to the travel: its frequency grows with the speed, a "
+                                 f"{1e3 * (fx['period_m'] or 0):.3g} mm period",
+                       "time": "Fixed to time: one frequency at every speed"}.get(
+                fx["verdict"], "Fixed to the travel or to time: cannot tell (runs at like speeds, bins too coarse, or "
+                               "peaks of no one effect)")
+            parts.append(f"<p>{escape(verdict)}; the residual's peak at constant speed, run by run, bins of "
+                         f"{fx['resolution_Hz']:.3g} Hz:</p>")
             parts.append(table(["speed [mm/s]", "peak [Hz]"],
                                [[f"{1e3 * r['speed']:.3g}", f"{r['peak_Hz']:.3g}"] for r in fx["runs"]]))
         if where.get("operating"):
