@@ -173,7 +173,8 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
         ``orders``, ``psd`` (arrays), ``peak_order``, ``peak_share`` (energy within +-1 bin of the peak /
         total), ``peak_ratio`` (peak / median PSD of the 8 bins on either side, the peak's 3 bins left
         out: a local prominence, insensitive to the low-pass filter's roll-off), ``n_segments``,
-        ``resolution`` (orders per bin).
+        ``resolution`` (orders per bin), ``flat_share`` (the ``peak_share`` of a flat spectrum, the share of the
+        bins at orders >= 0.75 within +-1 bin of the peak: coarse bins make any peak hold most of the energy).
     """
     if period <= 0:
         raise InputError("period", period, "a travel > 0 m")
@@ -214,7 +215,7 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
             weights.append(grid.size)
     if not psds:
         return {"orders": [], "psd": [], "peak_order": None, "peak_share": 0.0, "peak_ratio": 0.0, "n_segments": 0,
-                "resolution": None}
+                "resolution": None, "flat_share": None}
     psd = np.average(np.array(psds), axis=0, weights=weights)
     orders = f * period
     band = orders >= 0.75
@@ -226,7 +227,8 @@ def order_spectrum(x, v, residual, period, points_per_period=32, periods_per_seg
     med = float(np.median(around)) if around.size else 0.0
     return {"orders": orders, "psd": psd, "peak_order": float(orders[k]), "peak_share": share,
             "peak_ratio": float(psd[k] / med) if med > 0 else 0.0, "n_segments": len(psds),
-            "resolution": float(orders[1] - orders[0])}
+            "resolution": float(orders[1] - orders[0]),
+            "flat_share": float((min(k + 2, idx[-1] + 1) - max(k - 1, idx[0])) / idx.size)}
 
 
 def time_spectrum(residual, dt, nperseg=1024):

@@ -102,7 +102,8 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
     -------
     dict
         As :func:`where_gap`, with ``fixed`` (:func:`~drakecreep.gap.residuals.fixed_to`), ``orders`` (``cycle_m``, the travel of one cycle, ``peak_order``, ``period_m``
-        of the peak, ``peak_share``, ``peak_ratio``, ``resolution`` [orders], ``n_segments``; ``peak_order`` None
+        of the peak, ``peak_share``, ``flat_share``, ``peak_ratio``, ``resolution`` [orders], ``n_segments``;
+        ``peak_order`` None
         when no stretch of motion is long enough) and ``operating``
         (:func:`~drakecreep.gap.residuals.operating_map`: ``speed`` [m/s], ``position`` [m] and ``force`` [N]).
     """
@@ -142,7 +143,7 @@ def locate(runs, sims, *, table_simulated=True, lags=25, lead=None):
     spec = order_spectrum(motion[0], motion[1], residuals, cycle, segment="auto")
     orders = {"cycle_m": cycle, "per_revolution": bool(lead), "n_segments": spec["n_segments"],
               "peak_order": spec["peak_order"], "resolution": spec["resolution"], "peak_share": spec["peak_share"],
-              "peak_ratio": spec["peak_ratio"],
+              "peak_ratio": spec["peak_ratio"], "flat_share": spec["flat_share"],
               "period_m": cycle / spec["peak_order"] if spec["peak_order"] else None}
     operating = operating_map(flat, np.abs(np.concatenate(motion[1])), np.concatenate(motion[0]),
                               np.abs(np.concatenate(forces[0])))
@@ -174,8 +175,8 @@ def where_lines(where):
                f"cycles per {1e3 * o['cycle_m']:g} mm of travel")
         lines.append(f"  by order ({per}; bins of {o['resolution']:.2g}): peak at order {o['peak_order']:.3g}, a "
                      f"{1e3 * o['period_m']:.3g} mm period ({period_range(o)} within a bin), "
-                     f"{100 * o['peak_share']:.0f} % of the energy within a bin of it, {o['peak_ratio']:.3g} x its "
-                     "neighbours")
+                     f"{100 * o['peak_share']:.0f} % of the energy within a bin of it (a flat spectrum's "
+                     f"{100 * o['flat_share']:.0f} %), {o['peak_ratio']:.3g} x its neighbours")
     elif o:
         lines.append("  by order: no stretch of motion long enough")
     fx = where.get("fixed")

@@ -371,8 +371,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
             parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): the "
                          f"residual peaks at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period "
                          f"({period_range(o)} within a bin), "
-                         f"{100 * o['peak_share']:.0f} % of its energy within a bin of it ({o['peak_ratio']:.3g} times "
-                         "its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
+                         f"{100 * o['peak_share']:.0f} % of its energy within a bin of it (a flat spectrum's "
+                         f"{100 * o['flat_share']:.0f} %; {o['peak_ratio']:.3g} times its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
                          "any speed, one fixed in time spreads over the orders as the runs' speeds differ; bins as "
                          "coarse as the runs' travel allows, or runs of like speeds, may not show the difference.</p>")
         fx = where.get("fixed")

@@ -391,7 +391,7 @@ def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_o
     w = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=()).where
     o = w["orders"]
     assert o["per_revolution"] and o["cycle_m"] == RIG.screw.lead
-    assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > 0.5
+    assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > max(0.5, 2 * o["flat_share"])
     assert w["split"] and all(s["where"] == "after the screw" for s in w["split"].values())
     # and fixed to the travel: its peak frequency at constant speed grows with the held-out runs' speeds
     assert w["fixed"]["verdict"] == "travel" and w["fixed"]["period_m"] == pytest.approx(RIG.screw.lead / 12, rel=0.1)

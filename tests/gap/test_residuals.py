@@ -74,6 +74,9 @@ def test_order_spectrum_pools_runs_at_other_speeds_and_short_travels():
     assert spec["n_segments"] == 4
     assert abs(spec["peak_order"] - 12.0) <= spec["resolution"]
     assert spec["peak_ratio"] > 10
+    # the share a flat spectrum would hold within a bin of the peak: three bins of those at orders >= 0.75
+    assert spec["flat_share"] == pytest.approx(3 / np.count_nonzero(spec["orders"] >= 0.75))
+    assert spec["peak_share"] > 2 * spec["flat_share"]
     peaks = [time_spectrum(r, 1e-3, nperseg=256)["peak_hz"] for r in rs]
     assert peaks[1] / peaks[0] == pytest.approx(1.75, rel=0.15)
     with pytest.raises(InputError):
