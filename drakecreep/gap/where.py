@@ -74,7 +74,7 @@ def where_gap(runs, parameters, *, flexible=False, delay=0.0, lags=25):
         (:func:`~drakecreep.gap.residuals.sustained_oscillation` of the measured and replayed force, or None);
         ``diverged``: the labels of runs whose replay diverged (non-finite), left out of the rest (all of them: no
         regimes, bands or independence, ``force_rms_N`` NaN and ``oscillation`` None); ``orders`` (per
-        :data:`ORDER_TRAVEL` of travel) and ``operating`` as :func:`locate` gives them.
+        :data:`ORDER_TRAVEL` of travel), ``operating`` and ``fixed`` as :func:`locate` gives them.
     """
     sims = [make_replay(run, flexible=flexible, delay=delay, free=()).simulate(parameters) for run in runs]
     return locate(runs, sims, table_simulated=flexible, lags=lags)
