@@ -348,6 +348,29 @@ class DriveDiagnosis:
                          + spectral["reason"])
         return lines
 
+    def hints(self):
+        """Candidates not run that the unexplained residual points to, as lines of text (none when it points nowhere).
+
+        Only a residual that ``where`` finds **fixed to the travel** (:func:`drakecreep.gap.residuals.fixed_to`: its
+        peak frequency at constant speed grows with the held-out runs' speeds) points anywhere: after the screw
+        (every run with a linear scale says so) to a lead error; before it, or without a scale to tell, to a
+        cogging or a lead error. An order peak alone does not (a force ripple fixed in time can hold most of the
+        order spectrum's energy within a bin of one peak on short runs). A hint claims nothing: only a diagnosis
+        run with the candidate can.
+        """
+        fixed = (self.where or {}).get("fixed") or {}
+        if fixed.get("verdict") != "travel":
+            return []
+        sides = {v["where"] for v in self.where.get("split", {}).values()}
+        wanted = ["lead_error"] if sides == {"after the screw"} else ["cogging", "lead_error"]
+        missing = [n for n in wanted if n not in {c.name for c in self.candidates}]
+        if not missing:
+            return []
+        side = sides.pop() if len(sides) == 1 and sides <= {"after the screw", "before the screw"} else \
+            "on either side of the screw (no scale to tell, or the runs differ)"
+        return [f"hint: the unexplained residual is fixed to the travel (a {1e3 * fixed['period_m']:.3g} mm period), "
+                f"{side}; not run: {', '.join(missing)} (name with --effects)"]
+
     def summary(self):
         """Lines of text (units labelled)."""
         lines = [f"held-out force error: params file {rms_force_error(self.prior_test_errors):.3f} %, "
@@ -379,7 +402,7 @@ class DriveDiagnosis:
                          "held-out force error is the oscillation's)")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
-        return lines + self.oscillation_lines() + (where_lines(self.where) if self.where else [])
+        return lines + self.oscillation_lines() + (where_lines(self.where) if self.where else []) + self.hints()
 
     def save_params(self, path):
         """Write the augmented :class:`DriveParams` as YAML (:func:`drakecreep.params.save_params`)."""
@@ -407,6 +430,7 @@ class DriveDiagnosis:
             "seconds": self.seconds,
             "oscillation": self.oscillation,
             "unexplained": self.where,
+            "hints": self.hints(),
         })
 
 

@@ -377,6 +377,7 @@ def test_an_effect_outside_the_candidates_is_located_where_it_lies():
     # a force fixed to the travel would fit the two peaks too, so the verdict may be "cannot tell", never "travel"
     assert w["fixed"]["verdict"] in ("time", "cannot tell")
     assert max(abs(r["peak_Hz"] - 17.3) for r in w["fixed"]["runs"]) <= w["fixed"]["resolution_Hz"]
+    assert result.hints() == []  # nothing fixed to the travel: no periodic candidate is pointed to
     text = "\n".join(result.summary())
     assert "unexplained: held-out force residual" in text and "by frequency" in text
     assert json.loads(json.dumps(result.to_json()))["unexplained"]["bands"]["peak_hz"] == w["bands"]["peak_hz"]
@@ -388,13 +389,18 @@ def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_o
     (the encoder on the motor does not see it, the scale does)."""
     truth = with_value(RIG, "disturbance.lead_error_amplitude", 2e-6)
     runs = _runs(truth, seed=2)
-    w = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=()).where
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
+    w = result.where
     o = w["orders"]
     assert o["per_revolution"] and o["cycle_m"] == RIG.screw.lead
     assert abs(o["peak_order"] - 12.0) <= o["resolution"] and o["peak_share"] > max(0.5, 2 * o["flat_share"])
     assert w["split"] and all(s["where"] == "after the screw" for s in w["split"].values())
     # and fixed to the travel: its peak frequency at constant speed grows with the held-out runs' speeds
     assert w["fixed"]["verdict"] == "travel" and w["fixed"]["period_m"] == pytest.approx(RIG.screw.lead / 12, rel=0.1)
+    # which points to the candidate that was not run (a hint, not a claim), in the summary and the JSON
+    (hint,) = result.hints()
+    assert "after the screw" in hint and "not run: lead_error" in hint and "cogging" not in hint
+    assert hint in result.summary() and result.to_json()["hints"] == [hint]
 
 
 def test_a_cogging_named_is_fitted_claimed_and_kept_in_the_params():
