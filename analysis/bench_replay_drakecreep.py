@@ -81,10 +81,12 @@ RK3_LIMIT = 2.5127
 
 def speeds(declared, repeat):
     """Per speed: CPU time of a replay, steps per speed-loop tick, each bristle state's rate and stable step."""
-    from drakecreep.model.nut_table import friction_split
+    from drakecreep.model.nut_friction import nut_friction_levels
+    from drakecreep.model.nut_table import table_friction_levels
 
     sigma0 = declared.friction.bristle_stiffness
-    fc_table, fc_nut = friction_split(declared, declared.load_case(0))
+    load = declared.load_case(0)
+    fc_table, fc_nut = table_friction_levels(declared, load)[0], nut_friction_levels(declared, load)[0]
     tick = declared.controller.velocity_period
     print(f"paper preset: sigma0 {sigma0:.3g} N/m (assumed); sliding levels Fc: table (guides, seal) {fc_table:.2f} N, "
           f"nut {fc_nut:.1f} N; speed-loop tick {tick * 1e6:.0f} us; {repeat} replay(s) per speed after a first one")

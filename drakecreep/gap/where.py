@@ -42,7 +42,8 @@ from drakecreep.gap.drake_replay import make_replay
 from drakecreep.gap.residuals import (classify_regimes, fixed_to, frequency_bands, independence, motor_table_split,
                                       operating_map, order_spectrum, regime_shares, sustained_oscillation)
 
-__all__ = ["where_gap", "locate", "where_lines", "where_summary", "period_range", "oscillation_line", "ORDER_TRAVEL"]
+__all__ = ["where_gap", "locate", "where_lines", "where_summary", "order_peak", "fixed_verdict", "period_range",
+           "oscillation_line", "ORDER_TRAVEL"]
 
 #: Travel of one cycle [m] of the order spectrum when the screw's lead is not known (EMPS runs): 10 mm.
 ORDER_TRAVEL = 1e-2
@@ -173,20 +174,13 @@ def where_lines(where):
     if o and o["peak_order"]:
         per = (f"cycles per screw revolution, lead {1e3 * o['cycle_m']:g} mm" if o["per_revolution"] else
                f"cycles per {1e3 * o['cycle_m']:g} mm of travel")
-        lines.append(f"  by order ({per}; bins of {o['resolution']:.2g}): peak at order {o['peak_order']:.3g}, a "
-                     f"{1e3 * o['period_m']:.3g} mm period ({period_range(o)} within a bin), "
-                     f"{100 * o['peak_share']:.0f} % of the energy within a bin of it (a flat spectrum's "
-                     f"{100 * o['flat_share']:.0f} %), {o['peak_ratio']:.3g} x its neighbours")
+        lines.append(f"  by order ({per}; bins of {o['resolution']:.2g}): {order_peak(o)}")
     elif o:
         lines.append("  by order: no stretch of motion long enough")
     fx = where.get("fixed")
     if fx and fx["runs"]:
         peaks = ", ".join(f"{1e3 * r['speed']:.3g} mm/s {r['peak_Hz']:.3g} Hz" for r in fx["runs"])
-        verdict = {"travel": f"fixed to the travel (its frequency grows with the speed: a "
-                             f"{1e3 * (fx['period_m'] or 0):.3g} mm period)",
-                   "time": "fixed to time (one frequency at every speed)"}.get(
-            fx["verdict"], "fixed to the travel or to time: cannot tell (runs at like speeds, bins too coarse, or "
-                           "peaks of no one effect)")
+        verdict = fixed_verdict(fx)
         lines.append(f"  {verdict}; peak at constant speed per run: {peaks} (bins of {fx['resolution_Hz']:.3g} Hz)"
                      if fx["resolution_Hz"] else f"  {verdict}")
     if where.get("operating"):
@@ -232,6 +226,23 @@ def where_summary(where):
             "fixed": (where.get("fixed") or {}).get("verdict"),
             "correlated": [name for name, r in where["independence"].items() if not r["independent"]],
             "split": {label: v["where"] for label, v in where["split"].items()}}
+
+
+def order_peak(orders):
+    """The order spectrum's peak of a :func:`locate` result as a phrase (edge units: mm, %)."""
+    o = orders
+    return (f"peak at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period ({period_range(o)} within a "
+            f"bin), {100 * o['peak_share']:.0f} % of the energy within a bin of it (a flat spectrum's "
+            f"{100 * o['flat_share']:.0f} %), {o['peak_ratio']:.3g} x its neighbours")
+
+
+def fixed_verdict(fixed):
+    """:func:`~drakecreep.gap.residuals.fixed_to`'s verdict as a phrase (edge unit: mm)."""
+    if fixed["verdict"] == "travel":
+        return f"fixed to the travel (its frequency grows with the speed: a {1e3 * fixed['period_m']:.3g} mm period)"
+    if fixed["verdict"] == "time":
+        return "fixed to time (one frequency at every speed)"
+    return "fixed to the travel or to time: cannot tell (runs at like speeds, bins too coarse, or peaks of no one effect)"
 
 
 def period_range(orders):

@@ -11,7 +11,7 @@ import numpy as np
 from drakecreep.files import to_jsonable
 from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
-from drakecreep.gap.where import oscillation_line, period_range
+from drakecreep.gap.where import fixed_verdict, order_peak, oscillation_line
 
 __all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
 
@@ -368,22 +368,16 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         o = where.get("orders")
         if o and o["peak_order"]:
             per = "per screw revolution" if o["per_revolution"] else f"per {1e3 * o['cycle_m']:g} mm of travel"
-            parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): the "
-                         f"residual peaks at order {o['peak_order']:.3g}, a {1e3 * o['period_m']:.3g} mm period "
-                         f"({period_range(o)} within a bin), "
-                         f"{100 * o['peak_share']:.0f} % of its energy within a bin of it (a flat spectrum's "
-                         f"{100 * o['flat_share']:.0f} %; {o['peak_ratio']:.3g} times its neighbours). An effect fixed to the screw or the travel peaks at one order on runs of "
-                         "any speed, one fixed in time spreads over the orders as the runs' speeds differ; bins as "
-                         "coarse as the runs' travel allows, or runs of like speeds, may not show the difference.</p>")
+            parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): "
+                         f"{escape(order_peak(o))}. An effect fixed to the screw or the travel peaks at one order on "
+                         "runs of any speed, one fixed in time spreads over the orders as the runs' speeds differ; "
+                         "bins as coarse as the runs' travel allows, or runs of like speeds, may not show the "
+                         "difference.</p>")
         fx = where.get("fixed")
         if fx and fx["runs"] and fx["resolution_Hz"]:
-            verdict = {"travel": f"Fixed to the travel: its frequency grows with the speed, a "
-                                 f"{1e3 * (fx['period_m'] or 0):.3g} mm period",
-                       "time": "Fixed to time: one frequency at every speed"}.get(
-                fx["verdict"], "Fixed to the travel or to time: cannot tell (runs at like speeds, bins too coarse, or "
-                               "peaks of no one effect)")
-            parts.append(f"<p>{escape(verdict)}; the residual's peak at constant speed, run by run, bins of "
-                         f"{fx['resolution_Hz']:.3g} Hz:</p>")
+            verdict = fixed_verdict(fx)
+            parts.append(f"<p>{escape(verdict[0].upper() + verdict[1:])}; the residual's peak at constant speed, run "
+                         f"by run, bins of {fx['resolution_Hz']:.3g} Hz:</p>")
             parts.append(table(["speed [mm/s]", "peak [Hz]"],
                                [[f"{1e3 * r['speed']:.3g}", f"{r['peak_Hz']:.3g}"] for r in fx["runs"]]))
         if where.get("operating"):
