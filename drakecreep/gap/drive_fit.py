@@ -292,6 +292,15 @@ class DriveDiagnosis:
         Largest relative change of the pooled held-out force-error energy when the uncertain fields are
         refitted with one training run left out: the shrink a claim must beat (None: not available, and
         then nothing is claimed).
+    null_test_force : tuple or None
+        The force error [%] of each held-out run (in the order of ``nominal_test_errors``) replayed with each of
+        those leave-one-out refits (one tuple per training run left out): the run-to-run variation run by run, so
+        that other claim statistics can be recounted on a benchmark's rows.
+    train_sse, train_variance : float or None
+        The nominal fit's sum of squared training residuals (force over the training runs' standard deviation)
+        and its residual variance inflated for the lag-1 autocorrelation (the ``s^2`` of its intervals): a
+        candidate's SSE reduction in units of that variance is ``train_gain * train_sse / train_variance``, the
+        chi-square statistic of its added fields (None without a fitted field).
     simulations : int
         Closed-loop replays run.
     seconds : float
@@ -322,6 +331,9 @@ class DriveDiagnosis:
     test_errors: dict
     not_ranked: dict = field(default_factory=lambda: dict(NOT_IN_MODEL))
     replay_null: float | None = None
+    null_test_force: tuple | None = None
+    train_sse: float | None = None
+    train_variance: float | None = None
     simulations: int = 0
     seconds: float = 0.0
     nominal: DriveParams | None = None
@@ -424,6 +436,9 @@ class DriveDiagnosis:
             "claimed": list(self.claimed),
             "test_errors": self.test_errors,
             "replay_null": self.replay_null,
+            "null_test_force": None if self.null_test_force is None else [list(r) for r in self.null_test_force],
+            "train_sse": self.train_sse,
+            "train_variance": self.train_variance,
             "not_ranked": dict(self.not_ranked),
             "params": params_to_dict(self.params),
             "simulations": self.simulations,
@@ -1194,18 +1209,20 @@ def _replay_null(train, test, fit, replayer, nominal_errors):
     ``fit`` is the nominal fit's :class:`_Fit`; each leave-one-out refit is its one Gauss-Newton step
     (:meth:`_Fit.without`), so the null costs the held-out replays only. Returns the largest relative change
     of the pooled held-out force-error energy (the shrink an effect must beat), or ``None`` when it cannot be
-    computed (one training run, or nothing fitted).
+    computed (one training run, or nothing fitted), and each refit's held-out force errors [%] run by run (a tuple
+    of tuples in the order of ``nominal_errors``; ``None`` with the null).
     """
     if len(train) < 2 or fit is None:
-        return None
+        return None, None
     labels = list(nominal_errors)
     e_nom = float(np.sum(_energy(nominal_errors, labels)))
     refits = [fit.without(i) for i in range(len(train))]
-    changes = []
+    changes, runs = [], []
     for errors in replayer.many_errors([(test, refit) for refit in refits]):
         e = float(np.sum(_energy(errors, labels)))
         changes.append(abs(1.0 - e / e_nom) if e_nom > 0 else 0.0)
-    return float(max(changes))
+        runs.append(tuple(float(errors[k]["force"]) for k in labels))
+    return float(max(changes)), tuple(runs)
 
 
 def _held_out(name, values, train_gain, test, current, current_errors, replayer, null):
@@ -1289,7 +1306,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     nominal_sims = replay(test, params)
     nominal_errors = _errors_of(test, nominal_sims)
     say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
-    null = _replay_null(train, test, fit, replay, nominal_errors) if names else None
+    null, null_runs = _replay_null(train, test, fit, replay, nominal_errors) if names else (None, None)
     if names:
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %"))
     base_sims = replay(train, params)
@@ -1361,6 +1378,9 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
                           prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
                           candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
-                          replay_null=null, simulations=replay.count, seconds=_time.perf_counter() - t0,
+                          replay_null=null, null_test_force=null_runs,
+                          train_sse=None if fit is None else float(fit.residual @ fit.residual),
+                          train_variance=None if fit is None else _effective_variance(fit.residual, len(fit.paths)),
+                          simulations=replay.count, seconds=_time.perf_counter() - t0,
                           nominal=params, oscillation=oscillation,
                           where=locate(test, final_sims, lead=prior.screw.lead))

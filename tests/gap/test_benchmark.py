@@ -142,6 +142,14 @@ def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     assert np.mean(np.subtract(nominal, switched)) == pytest.approx(ranked["nut_friction_side"]["gain"], abs=1e-9)
     ripple = ranked["force_ripple"]["test_force_runs"]
     assert ripple is None or len(ripple) == len(ds.test)
+    assert ranked["nut_friction_side"]["values"] == {"friction.nut_friction_on": "table"}  # the params file's: screw
+    # the run-to-run null run by run: each leave-one-out refit's held-out errors, whose largest pooled change is
+    # the null; and the training fit's SSE and variance, a candidate's chi-square statistic
+    null_runs = row["null_test_force_runs"]
+    assert len(null_runs) == len(ds.train) and all(len(r) == len(ds.test) for r in null_runs)
+    e_nom = np.sum(np.square(nominal))
+    assert max(abs(1 - np.sum(np.square(r)) / e_nom) for r in null_runs) == pytest.approx(row["replay_null"], rel=1e-9)
+    assert row["train_sse"] > 0 and row["train_variance"] > 0
     assert set(row["claimed_model"]["fitted"]) == {"table.seal_force", "nut.preload_torque", "friction.viscous"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
     assert row["oscillation"] is None and "audit_oscillation_nepers" not in row  # a stable null: no spectral audit

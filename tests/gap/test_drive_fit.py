@@ -13,6 +13,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from drakecreep import cli
 from drakecreep.errors import InputError
@@ -647,6 +648,14 @@ def test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null():
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("lead_error",))
     assert result.replay_null is not None and result.replay_null < 0.05
     assert result.claimed == ("lead_error",)
+    # the null run by run (one refit per training run left out), and the lead error's training SSE reduction in
+    # units of the fit's effective residual variance: far beyond a chi-square quantile of its fields
+    assert len(result.null_test_force) == 2 and all(len(r) == 3 for r in result.null_test_force)
+    e_nom = sum(e["force"] ** 2 for e in result.nominal_test_errors.values())
+    assert max(abs(1 - sum(f * f for f in r) / e_nom) for r in result.null_test_force) == pytest.approx(
+        result.replay_null, rel=1e-9)
+    (lead,) = [c for c in result.candidates if c.name == "lead_error"]
+    assert lead.train_gain * result.train_sse / result.train_variance > stats.chi2.ppf(0.999, 3)
     assert result.params.disturbance.lead_error_amplitude == pytest.approx(3e-6, rel=0.1)
 
 
