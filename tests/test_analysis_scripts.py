@@ -111,7 +111,7 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     claims = dcs.first_claims(rows[0])
     # (the log ratios, 0.01-1.05, differ as much as the points: a log-ratio bar does not pass it either)
     assert claims == {"points_t": None, "sign_flip": "lead_error", "t_or_sign_flip": "lead_error",
-                      "log_ratio_t": None}
+                      "log_ratio_t": None, "points_t_chi2": "n/a", "pooled_chi2": "n/a"}  # rows before 752729f
     assert set(dcs.first_claims(rows[1]).values()) == {None}
     assert set(dcs.first_claims(dict(rows[0], replay_null=None)).values()) == {None}  # as the product: no null
     table, scores = dcs.recount(rows)
@@ -123,6 +123,36 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
                          capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
     assert out.returncode == 0 and "t_or_sign_flip   top-1 at SNR >= 3: 1 / 1" in out.stdout, out.stdout + out.stderr
     (tmp_path / "bad.json").write_text("[1, 2]")
+    assert "n/a" in out.stdout and "pooled_chi2      top-1 at SNR >= 3: 0 / 0" in out.stdout
     bad = subprocess.run([sys.executable, str(ANALYSIS / "drive_claim_statistics.py"), str(tmp_path / "bad.json")],
                          capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
     assert bad.returncode == 2 and "rows: got" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
+    """Study 3br's two rules on rows that carry the training fit's SSE and variance: development dataset 104011's
+    case, a lead error of very different per-run gains (Student bar failed) above a flat curve of tiny, alike gains
+    (Student bar passed, training gain 0.2 %). ``points_t`` claims the flat curve; with the training chi-square
+    test it is out (0.15 against the 5 % quantile of two degrees of freedom, 5.99), and the pooled test alone
+    claims the lead error (50 against 7.81 for its three fields)."""
+    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
+    dcs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dcs)
+    nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
+    lead = dict(_ranked("lead_error", [9.9, 11.5, 12.0, 10.8, 14.0]),
+                values={"disturbance.lead_error_amplitude": 2e-6, "disturbance.lead_error_period": 4e-4,
+                        "disturbance.lead_error_phase": 0.3})
+    flat = dict(_ranked("stribeck", [e - 0.02 for e in nominal], train_gain=0.0015),
+                values={"friction.static_ratio": 1.014, "friction.stribeck_velocity": 8e-4, "friction.law": "lugre",
+                        "table.seal_force": 4.7})
+    row = dict(_drive_row(4, "library", "lead_error", 4.8, nominal, [lead, flat], ["stribeck"]), replay_null=0.001,
+               train_sse=100.0, train_variance=1.0, uncertain=["table.seal_force"])
+    assert dcs.training_chi2(row, flat) == (pytest.approx(0.15), 2)  # the refitted uncertain field is no new one
+    assert dcs.training_chi2(row, lead) == (pytest.approx(50.0), 3)
+    claims = dcs.first_claims(row)
+    assert (claims["points_t"], claims["points_t_chi2"], claims["pooled_chi2"]) == ("stribeck", None, "lead_error")
+    null = dict(_drive_row(5, "null", None, 0.0, nominal, [flat], []), replay_null=0.001, train_sse=100.0,
+                train_variance=1.0, uncertain=["table.seal_force"])
+    _, scores = dcs.recount([row, null])
+    assert scores["pooled_chi2"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
+    assert scores["points_t"] == {"right": 0, "library": 1, "null_claims": 1, "nulls": 1, "wrong": 2}
