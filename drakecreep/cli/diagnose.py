@@ -207,7 +207,11 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     through the compiled diagram, candidate effects of the Drake model ranked and claimed on the held-out runs;
     with ``--out`` the augmented params file (``augmented_params.yaml``, for ``simulate/margins/report
     --params``), ``diagnosis.json`` and ``summary.txt``, the manifest last; ``--score`` replays the augmented
-    params, fixed, on the runs of another file.
+    params, fixed, on the runs of another file. While it runs, ``--out`` keeps what is known: the fitted params
+    file (``nominal_params.yaml``) as soon as the nominal fit ends, and ``ranking.json`` (the candidates so
+    far, ``"stage"`` and ``"complete": false``) after each candidate and once the claims are decided, so that a
+    failure or a stop late in the run (the refit with the claims takes a third of it) keeps them; at the end
+    ``ranking.json`` is the final ranking (``"stage": "final"``, ``"complete": true``).
     """
     import json
 
@@ -221,7 +225,20 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         kwargs["uncertain"] = names(args.uncertain)
     if getattr(args, "effects", None):
         kwargs["effects"] = names(args.effects)
-    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, **kwargs)
+    outset = OutputSet(args.out, "manifest.json").start() if args.out else None
+    extra = {"data": str(args.data), "train_runs": [r.label for r in train], "test_runs": [r.label for r in test]}
+
+    def keep(stage, partial):  # written atomically as the run goes: a late failure keeps them
+        if outset is None:
+            return
+        if stage == "nominal":
+            path = outset.write("nominal_params.yaml", partial.save_params)
+            say(f"the fitted params file is kept in {path}; ranking.json follows each candidate")
+        body = dict(partial.to_json(), stage=stage, complete=stage == "final", **extra)
+        body.pop("unexplained", None), body.pop("hints", None)  # known at the end only
+        outset.write_text("ranking.json", json.dumps(body, indent=1) + "\n")
+
+    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
     payload = result.to_json()
     lines = list(result.summary())
     if score_runs:
@@ -230,14 +247,15 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         payload["scored"] = {"data": str(args.score), "errors_percent": scored}
         lines.append(f"Scored on {args.score} (parameters fixed), errors in % of ||y||: " + "; ".join(
             f"{k}: position {e['position']:.3g}, force {e['force']:.3g}" for k, e in scored.items()))
-    payload.update(data=str(args.data), train_runs=[r.label for r in train], test_runs=[r.label for r in test])
-    if args.out:
-        with OutputSet(args.out, "manifest.json") as out:
-            out.write("augmented_params.yaml", result.save_params)
-            out.write_text("diagnosis.json", json.dumps(payload, indent=2) + "\n")
-            out.write_text("summary.txt", "\n".join(lines) + "\n")
-            out.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed)})
-        say(f"wrote {out.dir}/augmented_params.yaml, diagnosis.json, summary.txt")
+    payload.update(**extra)
+    if outset is not None:
+        outset.write("augmented_params.yaml", result.save_params)
+        outset.write_text("diagnosis.json", json.dumps(payload, indent=2) + "\n")
+        outset.write_text("summary.txt", "\n".join(lines) + "\n")
+        keep("final", result)
+        outset.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed)})
+        say(f"wrote {outset.dir}/augmented_params.yaml, diagnosis.json, summary.txt, nominal_params.yaml and "
+            "ranking.json")
     if args.json:
         print_json(payload)
     else:

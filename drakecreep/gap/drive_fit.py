@@ -1245,7 +1245,7 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
 
 
 def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0, max_nfev=20,
-                   progress=False, workers=1):
+                   progress=False, workers=1, on_stage=None):
     """Identify and augment the run's params file on ``kind: drakecreep`` runs (see the module docstring).
 
     Parameters
@@ -1268,6 +1268,12 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         Processes for the replays (the runs of one evaluation, and every column of a Jacobian, are independent;
         ``spawn`` processes, each imports Drake once, a few seconds). 1 replays in this process. The result
         does not depend on it.
+    on_stage : callable, optional
+        ``on_stage(stage, partial)`` with a :class:`DriveDiagnosis` of what is known so far, so that a caller
+        keeps it if a later step fails or is stopped: ``"nominal"`` after the nominal fit and its run-to-run
+        null (``params`` is the fitted params file, no candidate yet), ``"candidate"`` after each candidate's
+        held-out replay, ``"claims"`` once the claims are decided, before the refit with them (``params``
+        then holds the claimed effects on the nominal fit's values; its ``where`` is empty until the end).
 
     Returns
     -------
@@ -1289,18 +1295,20 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         raise InputError("workers", workers, "an integer >= 1")
     say = progress if callable(progress) else (
         (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None))
+    if on_stage is not None and not callable(on_stage):
+        raise InputError("on_stage", on_stage, "a callable or None")
     if workers == 1:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case),
-                               say, t0)
+                               say, t0, on_stage)
     import concurrent.futures as cf
     import multiprocessing
 
     with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev,
-                               _Replayer(load_case, pool), say, t0)
+                               _Replayer(load_case, pool), say, t0, on_stage)
 
 
-def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0):
+def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0, on_stage=None):
     prior_errors = replay.errors(test, prior)
     params, fitted, warnings, sse0, fit = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev, details=True)
     nominal_sims = replay(test, params)
@@ -1309,6 +1317,19 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     null, null_runs = _replay_null(train, test, fit, replay, nominal_errors) if names else (None, None)
     if names:
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %"))
+    known = dict(prior=prior, nominal=params, prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
+                 replay_null=null, null_test_force=null_runs,
+                 train_sse=None if fit is None else float(fit.residual @ fit.residual),
+                 train_variance=None if fit is None else _effective_variance(fit.residual, len(fit.paths)))
+
+    def stage(name, **now):  # what is known so far, for a caller that keeps it (on_stage)
+        if on_stage is not None:
+            now = dict(dict(params=params, fitted=fitted, warnings=warnings, candidates=(), claimed=(),
+                            test_errors=nominal_errors, oscillation=None), **now)
+            on_stage(name, DriveDiagnosis(**known, **now, simulations=replay.count,
+                                          seconds=_time.perf_counter() - t0))
+
+    stage("nominal")
     base_sims = replay(train, params)
     oscillation = sustained_oscillation([r.force for r in train], [s.force for s in base_sims], train[0].dt)
     if oscillation is not None:
@@ -1344,6 +1365,8 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         candidates.append(c)
         say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f}; "
             f"{replay.count - before} replays)")
+        stage("candidate", candidates=tuple(sorted(candidates, key=lambda c: -c.gain)), oscillation=oscillation,
+              warnings=warnings)
     candidates.sort(key=lambda c: -c.gain)
     claimed, current, current_errors = [], params, nominal_errors
     if withheld:
@@ -1360,6 +1383,8 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                 claimed.append(c.name)
                 current, current_errors = _with(current, c.values), again.test_errors
                 say(f"claimed {c.name}")
+    stage("claims", params=current, candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
+          oscillation=oscillation, warnings=warnings)
     if claimed and uncertain and not withheld:
         # the uncertain fields again, on the augmented model: a missing effect biases them and widens their
         # intervals (its residual is autocorrelated), so the values kept are the ones fitted with it in place
@@ -1375,12 +1400,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
             f"{replay.count} in all)")
     else:  # the final model's held-out replays: the nominal's, or those of the claims without a refit
         final_sims = nominal_sims if current is params else replay(test, current)
-    return DriveDiagnosis(prior=prior, params=current, fitted=fitted, warnings=warnings,
-                          prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
-                          candidates=tuple(candidates), claimed=tuple(claimed), test_errors=current_errors,
-                          replay_null=null, null_test_force=null_runs,
-                          train_sse=None if fit is None else float(fit.residual @ fit.residual),
-                          train_variance=None if fit is None else _effective_variance(fit.residual, len(fit.paths)),
-                          simulations=replay.count, seconds=_time.perf_counter() - t0,
-                          nominal=params, oscillation=oscillation,
+    return DriveDiagnosis(**known, params=current, fitted=fitted, warnings=warnings, candidates=tuple(candidates),
+                          claimed=tuple(claimed), test_errors=current_errors, simulations=replay.count,
+                          seconds=_time.perf_counter() - t0, oscillation=oscillation,
                           where=locate(test, final_sims, lead=prior.screw.lead))

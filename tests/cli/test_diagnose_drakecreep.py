@@ -56,7 +56,41 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     augmented = load_params(out / "augmented_params.yaml")
     assert augmented.disturbance.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
     manifest = json.loads((out / "manifest.json").read_text())
-    assert set(manifest["files"]) == {"augmented_params.yaml", "diagnosis.json", "summary.txt"}
+    assert set(manifest["files"]) == {"augmented_params.yaml", "diagnosis.json", "summary.txt",
+                                      "nominal_params.yaml", "ranking.json"}
+    # the fitted params file before any claim: its seal force carries the missing lead error's bias (3.1 N), the
+    # refit with the lead error comes back to the truth's (the params file's, 4.0 N)
+    nominal, truth = load_params(out / "nominal_params.yaml"), quick_replay_params(preset("paper")).table.seal_force
+    assert nominal.disturbance.lead_error_amplitude == 0.0
+    assert abs(augmented.table.seal_force - truth) < 0.5 * abs(nominal.table.seal_force - truth)
+    ranking = json.loads((out / "ranking.json").read_text())
+    assert ranking["stage"] == "final" and ranking["complete"] is True and ranking["claimed"] == ["lead_error"]
+    assert [c["name"] for c in ranking["candidates"]] == [c["name"] for c in result["candidates"]]
+
+
+def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, tmp_path, capsys, monkeypatch):
+    """A candidate that fails after another was replayed (here the delay search, made to raise): the run
+    exits 1 with one line, no manifest claims a complete run, and the folder keeps the fitted params file and
+    the ranking of the candidates done (the issue: a failure late in the pipeline keeps what was computed)."""
+    from drakecreep.gap import drive_fit
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("the delay search broke")
+
+    monkeypatch.setattr(drive_fit, "_delay_effect", broken)
+    path, _ = own_csv
+    out = tmp_path / "diag"
+    code = cli.main(["diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3", "--uncertain",
+                     "table.seal_force", "--effects", "nut_friction_side,control_delay", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and "the delay search broke" in err[-1] and "Traceback" not in "\n".join(err)
+    assert any("nominal_params.yaml" in line for line in err)  # the progress says where it is kept
+    assert not (out / "manifest.json").exists()
+    assert load_params(out / "nominal_params.yaml").table.seal_force > 0
+    ranking = json.loads((out / "ranking.json").read_text())
+    assert ranking["stage"] == "candidate" and ranking["complete"] is False and ranking["claimed"] == []
+    assert [c["name"] for c in ranking["candidates"]] == ["nut_friction_side"]
+    assert ranking["replay_null"] is not None and ranking["train_runs"] == ["r0", "r1"]
 
 
 def test_uncertain_is_refused_for_p_p_cascade_runs(capsys):
