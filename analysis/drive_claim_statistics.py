@@ -21,8 +21,9 @@ training fit's SSE and variance, and these two columns then read ``n/a`` and are
 
 * ``points_t_chi2``: ``points_t`` and the training chi-square test: the candidate's training SSE reduction in units
   of the nominal fit's effective residual variance, ``train_gain * train_sse / train_variance``, above the
-  ``1 - ALPHA`` quantile of a chi-square of ``k`` degrees of freedom, ``k`` the candidate's numeric fitted values
-  that the nominal fit did not already fit (at least 1);
+  ``1 - ALPHA`` quantile of a chi-square of ``k`` degrees of freedom, ``k`` the most fields the candidate can add
+  to the nominal (:data:`CANDIDATE_FIELDS`: a lead error's or a cogging's five with the second harmonic, a
+  ripple's three, whether or not the fit used them all; a switch of the law or the nut's side one);
 * ``pooled_chi2``: the training chi-square test and the pooled replay test alone, no bar on the per-run gains.
 
 Candidates are taken in the rows' order (by held-out gain), the first that passes is the first claim. Only development rows should inform a change of the rule; held-out rows
@@ -48,17 +49,22 @@ TRAINING_RULES = ("points_t_chi2", "pooled_chi2")
 NOT_AVAILABLE = "n/a"
 
 
+#: The most fields each candidate of ``diagnose_drive`` adds to the nominal: the degrees of freedom of its training
+#: chi-square test (fixed per candidate, so that the test does not hang on which harmonics a fit kept; the
+#: Stribeck candidate's refit of the uncertain fields adds none, they were fitted already)
+CANDIDATE_FIELDS = {"lead_error": 5, "cogging": 5, "force_ripple": 3, "stribeck": 2, "asymmetric_friction": 2,
+                    "control_delay": 1, "nut_friction_side": 1, "law_coulomb": 1, "law_stribeck": 1,
+                    "law_lugre": 1, "law_gms": 1}
+
+
 def training_chi2(row, candidate):
     """``(statistic, degrees of freedom)`` of ``candidate``'s training SSE reduction on ``row`` (None without the
-    training fit's SSE and variance): ``train_gain * train_sse / train_variance`` against a chi-square of the
-    candidate's numeric fitted values outside the row's uncertain fields."""
+    training fit's SSE and variance): ``train_gain * train_sse / train_variance`` against a chi-square of
+    :data:`CANDIDATE_FIELDS` degrees of freedom."""
     sse, var = row.get("train_sse"), row.get("train_variance")
-    if sse is None or var is None or not var > 0 or "values" not in candidate:
+    if sse is None or var is None or not var > 0:
         return None
-    uncertain = set(row.get("uncertain") or ())
-    k = sum(1 for key, v in candidate["values"].items()
-            if key not in uncertain and isinstance(v, (int, float)) and not isinstance(v, bool))
-    return candidate["train_gain"] * sse / var, max(k, 1)
+    return candidate["train_gain"] * sse / var, CANDIDATE_FIELDS[candidate["effect"]]
 
 
 def training_passes(row, candidate):

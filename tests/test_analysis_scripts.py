@@ -134,7 +134,7 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
     case, a lead error of very different per-run gains (Student bar failed) above a flat curve of tiny, alike gains
     (Student bar passed, training gain 0.2 %). ``points_t`` claims the flat curve; with the training chi-square
     test it is out (0.15 against the 5 % quantile of two degrees of freedom, 5.99), and the pooled test alone
-    claims the lead error (50 against 7.81 for its three fields)."""
+    claims the lead error (50 against 11.07 for its five fields)."""
     spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
     dcs = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dcs)
@@ -148,7 +148,10 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
     row = dict(_drive_row(4, "library", "lead_error", 4.8, nominal, [lead, flat], ["stribeck"]), replay_null=0.001,
                train_sse=100.0, train_variance=1.0, uncertain=["table.seal_force"])
     assert dcs.training_chi2(row, flat) == (pytest.approx(0.15), 2)  # the refitted uncertain field is no new one
-    assert dcs.training_chi2(row, lead) == (pytest.approx(50.0), 3)
+    assert dcs.training_chi2(row, lead) == (pytest.approx(50.0), 5)  # fundamental and second harmonic
+    from drakecreep.gap.drive_fit import EFFECTS
+
+    assert set(dcs.CANDIDATE_FIELDS) == set(EFFECTS)  # every candidate has its degrees of freedom
     claims = dcs.first_claims(row)
     assert (claims["points_t"], claims["points_t_chi2"], claims["pooled_chi2"]) == ("stribeck", None, "lead_error")
     null = dict(_drive_row(5, "null", None, 0.0, nominal, [flat], []), replay_null=0.001, train_sse=100.0,
@@ -156,3 +159,52 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
     _, scores = dcs.recount([row, null])
     assert scores["pooled_chi2"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
     assert scores["points_t"] == {"right": 0, "library": 1, "null_claims": 1, "nulls": 1, "wrong": 2}
+
+
+def _backfill_module():
+    spec = importlib.util.spec_from_file_location("btf", ANALYSIS / "backfill_training_fit.py")
+    btf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(btf)
+    return btf
+
+
+def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
+    """Study 3br's backfill on a small test-rig dataset standing in for a regenerated benchmark one: the nominal
+    fit rerun gives the row's held-out errors, so the SSE and variance are written (and give the training
+    chi-square of a recount); a row whose nominal errors differ by more than the tolerance is left as it was."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_replay import quick_replay_params, simulated_runs
+    from drakecreep.gap.drive_fit import _errors_of, _Replayer, fit_drive
+    from drakecreep.params import preset
+
+    rig = quick_replay_params(preset("paper"))
+    runs = simulated_runs(rig, (0.02, 0.03, 0.025, 0.035), declared=rig, n=400, noise=2.0, seed=5)
+    ds = SimpleNamespace(train=runs[:2], test=runs[2:])
+    btf = _backfill_module()
+    monkeypatch.setattr(btf, "generate_dataset", lambda seed, **kw: ds)
+    uncertain = ["table.seal_force"]
+    params = fit_drive(ds.train, rig, uncertain, _Replayer(0), max_nfev=20)[0]
+    nominal = [e["force"] for e in _errors_of(ds.test, _Replayer(0)(ds.test, params)).values()]
+    row = {"seed": 1, "withheld": [], "kind": "drakecreep", "axis": "rigid", "uncertain": uncertain,
+           "test_force_nominal_runs": nominal}
+    lines = []
+    new, diff = btf.backfill(row, say=lines.append)
+    assert diff < 1e-9 and new["train_sse"] > 0 and new["train_variance"] > 0 and new["backfilled"]["replays"] > 0
+    assert "train_sse" not in row  # a copy
+    off = dict(row, test_force_nominal_runs=[e + 0.01 for e in nominal])
+    same, diff = btf.backfill(off, say=lines.append)
+    assert same is off and diff == pytest.approx(0.01) and "not reproduced" in lines[-1]
+
+
+@pytest.mark.parametrize("args, field", [
+    (("--out", "x.json", "--tolerance", "0"), "--tolerance: got 0.0"),
+    (("--out", "x.json"), "rows: got"),  # held-out rows: refused
+])
+def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
+    out = subprocess.run([sys.executable, str(ANALYSIS / "backfill_training_fit.py"), str(rows), *args], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 2 and "Traceback" not in out.stderr and field in out.stderr.strip().splitlines()[-1]
+    assert not (tmp_path / "x.json").exists()
