@@ -14,7 +14,7 @@ import drakecreep
 PACKAGE = Path(drakecreep.__file__).parent
 
 #: each room and the rooms it may import (besides itself); the base modules may be imported by every room
-BASE = {"errors", "scenario", "params", "data", "files"}
+BASE = {"errors", "scenario", "params", "data", "files", "processes"}
 ALLOWED = {
     "model": set(),
     "paper": {"model"},

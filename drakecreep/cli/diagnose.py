@@ -238,7 +238,12 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         body.pop("unexplained", None), body.pop("hints", None)  # known at the end only
         outset.write_text("ranking.json", json.dumps(body, indent=1) + "\n")
 
-    result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
+    try:
+        result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
+    except BaseException:  # a failure or a stop (Ctrl-C): say what is kept, then the one-line error as always
+        if outset is not None and outset.files:
+            say(f"kept {' and '.join(sorted(outset.files))} in {outset.dir} (no manifest: the run did not finish)")
+        raise
     payload = result.to_json()
     lines = list(result.summary())
     if score_runs:

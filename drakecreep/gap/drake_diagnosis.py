@@ -126,7 +126,6 @@ import contextlib
 import dataclasses
 import functools
 import math
-import multiprocessing
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -146,6 +145,7 @@ from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, scre
 from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
 from drakecreep.params import MEASURED_AXIS_KIND
+from drakecreep.processes import process_pool
 
 __all__ = ["RankedEffect", "DrakeDiagnosis", "ClaimTest", "diagnose_drake", "fit_candidate", "paired_gain",
            "paired_log_ratio", "run_log_ratios", "training_run_null", "training_run_moves", "candidate_moves",
@@ -880,9 +880,8 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     with contextlib.ExitStack() as stack:
         # one pool for the ranking and the greedy step (each spawned process imports Drake once; processes start
         # on the first submissions); a single candidate is fitted here, without the processes' start-up
-        pool = None if workers == 1 or len(names) < 2 else stack.enter_context(cf.ProcessPoolExecutor(
-            min(workers, len(names)), mp_context=multiprocessing.get_context("spawn"),
-            initializer=set_replay_threads, initargs=(workers,)))
+        pool = None if workers == 1 or len(names) < 2 else stack.enter_context(process_pool(
+            min(workers, len(names)), set_replay_threads, (workers,)))  # a Ctrl-C or an error ends the workers
         fits_, own = {}, {}
         # the training-run null (training_run_null), beside the candidates' fits when there is a pool
         moves = _submit(pool, training_run_moves, test, nominal, nom_test)

@@ -1300,10 +1300,9 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
     if workers == 1:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case),
                                say, t0, on_stage)
-    import concurrent.futures as cf
-    import multiprocessing
+    from drakecreep.processes import process_pool
 
-    with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    with process_pool(workers) as pool:  # a Ctrl-C or an error ends the workers at once
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev,
                                _Replayer(load_case, pool), say, t0, on_stage)
 

@@ -28,7 +28,6 @@ import hashlib
 import itertools
 import json
 import math
-import multiprocessing
 import os
 import sys
 import time
@@ -41,6 +40,7 @@ from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.errors import InputError
 from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
+from drakecreep.processes import new_pool, stop_pool
 from drakecreep.scenario import Scenario
 
 __all__ = [
@@ -411,41 +411,13 @@ def _run_serial(todo, metric, retries, done):
             done(case, None, error)
 
 
-def _watch_parent(parent_pid, period=1.0):
-    """Pool worker initializer: exit as soon as the sweep's process is gone (SIGKILL leaves no one to stop us)."""
-    import threading
-
-    def watch():
-        while True:
-            time.sleep(period)
-            if os.getppid() != parent_pid:
-                os._exit(1)
-
-    threading.Thread(target=watch, name="drakecreep-parent-watch", daemon=True).start()
-
-
-def _stop_pool(pool):
-    """Cancel queued work and end the running workers now (Ctrl-C must not wait for every case)."""
-    processes = list(getattr(pool, "_processes", {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for proc in processes:
-        try:
-            proc.terminate()
-        except Exception:  # noqa: BLE001 - already gone
-            pass
-    for proc in processes:
-        proc.join(timeout=5)
-
-
 def _run_processes(todo, metric, retries, done, workers):
     attempts = {_unit_key(c): 0 for c in todo}
     pending = list(todo)
-    context = multiprocessing.get_context("spawn")
     retried = 0
     while pending:
         broken = []
-        pool = cf.ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_watch_parent,
-                                      initargs=(os.getpid(),))
+        pool = new_pool(workers)  # workers ignore SIGINT and exit with the sweep's process
         try:
             futures = {pool.submit(_work, case, metric): case for case in pending}
             for future in cf.as_completed(futures):
@@ -461,7 +433,7 @@ def _run_processes(todo, metric, retries, done, workers):
                     continue
                 done(case, row, None)
         except BaseException:
-            _stop_pool(pool)
+            stop_pool(pool)
             raise
         pool.shutdown(wait=True)
         retried += len(broken)

@@ -87,10 +87,9 @@ def _run_one(job):
 def _map(jobs, workers):
     if workers <= 1:
         return [_run_one(j) for j in jobs]
-    import concurrent.futures as cf
-    import multiprocessing
+    from drakecreep.processes import process_pool
 
-    with cf.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    with process_pool(workers) as pool:  # a Ctrl-C or an error ends the workers at once
         return list(pool.map(_run_one, jobs))
 
 

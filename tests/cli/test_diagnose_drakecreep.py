@@ -85,6 +85,7 @@ def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, 
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and "the delay search broke" in err[-1] and "Traceback" not in "\n".join(err)
     assert any("nominal_params.yaml" in line for line in err)  # the progress says where it is kept
+    assert "kept nominal_params.yaml and ranking.json in" in err[-2]
     assert not (out / "manifest.json").exists()
     assert load_params(out / "nominal_params.yaml").table.seal_force > 0
     ranking = json.loads((out / "ranking.json").read_text())

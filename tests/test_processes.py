@@ -1,0 +1,47 @@
+"""drakecreep.processes: pools whose workers stop with a Ctrl-C or an error of the parent, at once."""
+
+import os
+import signal
+import time
+
+import pytest
+
+from drakecreep.processes import process_pool
+
+
+def test_a_sigint_to_the_parent_alone_ends_a_pool_that_is_working():
+    """The hang ``drakecreep diagnose`` had (session 59): a SIGINT to the parent alone (``kill -INT``, ``timeout -s
+    INT``) while a worker was busy left the executor waiting for ever on a worker that never got its stop sentinel.
+    Now the interrupt goes on at once and the workers are gone."""
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        with process_pool(1) as pool:
+            pool.submit(time.sleep, 60.0)
+            while not pool._processes:  # the worker has started
+                time.sleep(0.05)
+            workers = list(pool._processes.values())
+            time.sleep(1.0)  # it is in the task
+            signal.raise_signal(signal.SIGINT)
+    assert time.perf_counter() - start < 30.0
+    assert not any(p.is_alive() for p in workers)
+
+
+def test_workers_ignore_sigint_and_run_the_initializer(tmp_path):
+    """A Ctrl-C in a terminal reaches every process of the group: the workers ignore it (no traceback of theirs),
+    the parent alone stops them. The initializer runs in each worker with its arguments."""
+    with process_pool(2, os.chdir, (str(tmp_path),)) as pool:
+        handler = pool.submit(signal.getsignal, signal.SIGINT).result()
+        cwd = pool.submit(os.getcwd).result()
+    assert handler == signal.SIG_IGN
+    assert os.path.samefile(cwd, tmp_path)
+
+
+def test_an_error_in_the_block_stops_the_workers_and_goes_on():
+    with pytest.raises(ValueError, match="stop"):
+        with process_pool(1) as pool:
+            pool.submit(time.sleep, 60.0)
+            while not pool._processes:
+                time.sleep(0.05)
+            workers = list(pool._processes.values())
+            raise ValueError("stop")
+    assert not any(p.is_alive() for p in workers)
