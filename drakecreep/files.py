@@ -336,6 +336,12 @@ def check_output_dir(path, field="--out"):
         raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
     if not os.access(path, os.W_OK | os.X_OK):
         raise InputError(field, str(path), "a writable folder")
+    try:  # what write_atomic will do (os.access says yes to root where a file system refuses, e.g. /sys)
+        fd, tmp = tempfile.mkstemp(dir=path, prefix=".drakecreep.", suffix=".check")
+    except OSError as err:
+        raise InputError(field, str(path), f"a writable folder ({err.strerror})") from None
+    os.close(fd)
+    os.unlink(tmp)
     return path
 
 

@@ -729,6 +729,12 @@ def with_value(params, path, value):
         if not rest:
             if index is not None:
                 raise InputError(name, value, "a path ending in a field, not a list item")
+            current = getattr(params, name)
+            if dataclasses.is_dataclass(current) and not isinstance(value, type(current)):
+                raise InputError(name, value, "a path to one of its fields (" + ", ".join(
+                    f"{name}.{f.name}" for f in dataclasses.fields(current)) + "), not the whole group")
+            if isinstance(current, tuple) and not isinstance(value, tuple):
+                raise InputError(name, value, f"a path to one of its items' fields ({name}[INDEX].FIELD)")
             return dataclasses.replace(params, **{name: value})
         child = getattr(params, name)
         if index is not None:

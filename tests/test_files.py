@@ -146,6 +146,19 @@ def test_output_dir_checks(tmp_path):
     assert check_output_dir(tmp_path / "new" / "dir").is_dir()
 
 
+def test_output_dir_is_probed_with_a_file(tmp_path, monkeypatch):
+    """os.access says yes to root where the file system refuses (/sys): the check creates a file, as the writes
+    will, so the refusal comes before the work (report --out /sys/kernel failed after 12.7 s of it before)."""
+    import tempfile
+
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(InputError, match=r"--out: got .*; allowed: a writable folder \(Permission denied\)"):
+        check_output_dir(tmp_path)
+
+
 def test_output_file_checks(tmp_path):
     (tmp_path / "afile").write_text("x")
     for bad, why in ((tmp_path, "existing folder"), (tmp_path / "afile" / "p.yaml", "existing file"),

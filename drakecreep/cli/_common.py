@@ -39,9 +39,22 @@ def distinct(values, option, text, allowed):
     return values
 
 
-def names(text):
-    """A comma-separated list of names as a tuple (blank items are skipped)."""
-    return tuple(x.strip() for x in text.split(",") if x.strip())
+def names(text, option=None):
+    """A comma-separated list of names as a tuple.
+
+    Without ``option`` blank items are skipped. With it (the option the list came from) a blank item or a name
+    given twice is an :class:`~drakecreep.errors.InputError` naming the option: ``--effects ,`` ran no candidate
+    at all, and ``--effects lead_error,lead_error`` fitted one twice.
+    """
+    items = [x.strip() for x in text.split(",")]
+    if option is None:
+        return tuple(x for x in items if x)
+    if not all(items):
+        raise InputError(option, text, "comma-separated names, none blank")
+    twice = sorted({x for x in items if items.count(x) > 1})
+    if twice:
+        raise InputError(option, text, f"each name once ({', '.join(twice)} given twice)")
+    return tuple(items)
 
 
 def positive_float(text):

@@ -125,7 +125,7 @@ def run(args):
     if getattr(args, "effects", None):
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED
 
-        effects = names(args.effects)
+        effects = names(args.effects, "--effects")
         for e in effects:
             if e != "control_delay" and e not in DRAKE_EFFECTS:
                 raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
@@ -222,9 +222,9 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     say = _say(args)
     kwargs = {}
     if args.uncertain:
-        kwargs["uncertain"] = names(args.uncertain)
+        kwargs["uncertain"] = names(args.uncertain, "--uncertain")
     if getattr(args, "effects", None):
-        kwargs["effects"] = names(args.effects)
+        kwargs["effects"] = names(args.effects, "--effects")
     outset = OutputSet(args.out, "manifest.json").start() if args.out else None
     extra = {"data": str(args.data), "train_runs": [r.label for r in train], "test_runs": [r.label for r in test]}
 

@@ -26,6 +26,9 @@ def run(args):
     from drakecreep.report.drawing import draw_diagram
     from drakecreep.scenario import Scenario
 
+    from drakecreep.files import check_output_file
+
+    check_output_file(args.out)  # before the diagram is built: the folder, writable
     params = params_from_args(args)
     continuous = None if args.controller is None else args.controller == "continuous"
     drive = build_diagram(params, Scenario(), continuous=continuous)

@@ -51,7 +51,7 @@ def run(args):
             raise InputError(option, n, f"an integer in [0, {MAX_DATASETS}]")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
-    effects = None if args.effects is None else check_effects(args.kinds, names(args.effects), "--effects")
+    effects = None if args.effects is None else check_effects(args.kinds, names(args.effects, "--effects"), "--effects")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
                         n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects)

@@ -24,7 +24,7 @@ def add_parser(subparsers):
                    help=f"local worker processes (default: all cores, {os.cpu_count()}); 1 runs in this process")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default out/sweep)")
-    p.add_argument("--retries", type=int, default=2, metavar="N", help="extra attempts of a failed case (default 2)")
+    p.add_argument("--retries", type=int, default=2, metavar="N", help="extra attempts of a failed case (default 2, at most 10)")
     p.add_argument("--batch", type=int, default=200, metavar="N",
                    help="simulate up to N compatible cases together in one Drake system (default 200; "
                         "1 = one case at a time)")
@@ -38,12 +38,12 @@ def add_parser(subparsers):
 def run(args):
     from drakecreep.files import check_output_dir
     from drakecreep.report.plots import plot_stability_map
-    from drakecreep.sim.sweep import MAX_CASES, connect_dask, load_spec, run_sweep
+    from drakecreep.sim.sweep import MAX_CASES, MAX_RETRIES, connect_dask, load_spec, run_sweep
 
     if args.scheduler is not None and args.workers:
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")
-    if args.retries < 0:
-        raise InputError("--retries", args.retries, "an integer >= 0")
+    if not 0 <= args.retries <= MAX_RETRIES:
+        raise InputError("--retries", args.retries, f"an integer in [0, {MAX_RETRIES}]")
     if args.batch is not None and args.batch < 1:
         raise InputError("--batch", args.batch, "an integer >= 1")
     if args.max_cases is not None and args.max_cases < 1:

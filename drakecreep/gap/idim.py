@@ -92,7 +92,12 @@ def filtered_derivatives(q, dt, cutoff=100.0, order=4):
     if not 0 < cutoff < nyquist:
         raise InputError("cutoff", cutoff, f"a frequency in (0, {nyquist:g}) Hz")
     b, a = signal.butter(order, cutoff / nyquist)
-    qf = signal.filtfilt(b, a, np.asarray(q, dtype=float))
+    q = np.asarray(q, dtype=float)
+    padlen = 3 * max(len(a), len(b))  # filtfilt's default padding
+    if q.size <= padlen:
+        raise InputError("samples", q.size, f"more than {padlen} samples per run (the zero-phase order-{order} "
+                                            "filter of the derivatives)")
+    qf = signal.filtfilt(b, a, q)
     dq = np.gradient(qf, dt)
     ddq = np.gradient(dq, dt)
     return qf, dq, ddq

@@ -584,6 +584,12 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     cols = {"run": signals["run"]} if "run" in signals else {}
     if "run" in cols:
         labels = np.array(cols["run"], dtype=object)
+        blank = [i for i, lab in enumerate(labels.tolist())
+                 if lab is None or (isinstance(lab, float) and math.isnan(lab))
+                 or str(lab).strip().lower() in ("", "nan", "none", "na", "<na>")]
+        if blank:  # (a NaN label equals no label: its rows would belong to no run)
+            raise InputError(f"{csv_path}: column run", f"no label at data row {blank[0] + 1} ({len(blank)} rows)",
+                             "a run label (text or a number) in every row")
         order = list(dict.fromkeys(labels.tolist()))
         groups = [(lab, np.flatnonzero(labels == lab)) for lab in order]
         for lab, idx in groups:  # a run's rows in two blocks would read as one run with a jump in time

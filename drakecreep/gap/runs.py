@@ -128,4 +128,6 @@ def pick(runs, spec, default_parity, option="--train", pairs=False):
             out.append(runs[int(item)])
         else:
             raise InputError(option, item, "a run label or index among " + ", ".join(labels))
+        if any(out[-1] is r for r in out[:-1]):  # a run twice would count as two (two held-out runs from one)
+            raise InputError(option, spec, f"each run once ({item} names a run given before)")
     return out

@@ -46,6 +46,7 @@ from drakecreep.scenario import Scenario
 __all__ = [
     "SCENARIO_FIELDS",
     "EXECUTORS",
+    "MAX_RETRIES",
     "CACHE_VERSION",
     "Case",
     "SweepResult",
@@ -67,6 +68,9 @@ __all__ = [
 #: ``"cascade"`` or ``"constant_speed"``, see :class:`drakecreep.model.drive_source.DriveScenario`)
 SCENARIO_FIELDS = ("feed", "load_case", "duration", "drive")
 EXECUTORS = ("serial", "processes", "dask")
+#: The most extra attempts of a failed case: a deterministic failure (a bad value) fails every attempt, so a
+#: large count only repeats it (99999999999 ran for ever)
+MAX_RETRIES = 10
 #: bump when the meaning of a cached row changes (simulation semantics, report keys)
 CACHE_VERSION = 1
 #: default largest number of cases of one sweep (``max_cases`` / ``--max-cases`` raise it): 100 000 cases
@@ -583,6 +587,8 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
         raise InputError("workers", workers, "an integer >= 1")
     if batch_size is not None and (isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1):
         raise InputError("batch_size", batch_size, "an integer >= 1")
+    if isinstance(retries, bool) or not isinstance(retries, int) or not 0 <= retries <= MAX_RETRIES:
+        raise InputError("retries", retries, f"an integer in [0, {MAX_RETRIES}]")
     start = time.perf_counter()
     metric = metric or feed_report
     cases = make_cases(base, points, scenario, metric)

@@ -159,6 +159,11 @@ SPECS = {
     "grid_with_n": ("axes:\n  table.mass: [30, 40]\nsample: {mode: grid, n: 3}\n", "sample"),
     "grid_with_seed": ("axes:\n  table.mass: [30, 40]\nsample: {seed: 3}\n", "sample"),
     "scenario_bad": ("scenario: {feed: fast}\naxes:\n  table.mass: [30]\n", "feed"),
+    # a whole parameter group set to a number (session 59's fuzzing: exit 1 with nothing on stderr as a base value,
+    # an AttributeError as an axis)
+    "group_as_axis": ("axes:\n  table: [1, 2]\n", "table.mass"),
+    "group_in_base": ("base: {set: {table: 1}}\naxes:\n  nut.mass: [0.3]\n", "not the whole group"),
+    "cases_as_number": ("base: {set: {loads.cases: 1}}\naxes:\n  nut.mass: [0.3]\n", "loads.cases"),
 }
 
 
@@ -218,6 +223,12 @@ MEASURED = {
     "meta_bomb_value": (GOOD_CSV.encode(), "u_units: N\nnotes: &n [1]\n" + _bomb_in_value().replace("x0:", "zz:"),
                         "zz"),
     "meta_list": (GOOD_CSV.encode(), "- 1\n", "u_units"),
+    # a run column with no label in some rows (NaN, empty): an IndexError before session 59
+    "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
+                      .encode(), GOOD_META, "column run"),
+    "run_label_empty": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,a\n")
+                        .replace("0.001,1e-06,1e-06,0.5,a\n", "0.001,1e-06,1e-06,0.5,\n").encode(), GOOD_META,
+                        "no label at data row 2"),
 }
 
 
@@ -271,6 +282,7 @@ def test_bad_mat_files(mangle, tmp_path, capsys):
     ["diagnose", "estimation", "--out", "{file}"],
     ["sweep", "{spec}", "--out", "{file}", "--workers", "1"],
     ["uncertainty", "--samples", "2", "--feeds", "0.1", "--duration", "1.2", "--workers", "1", "--out", "{file}"],
+    ["diagram", "--out", "{file}/d.svg"],
 ])
 def test_output_folder_is_checked_before_the_work(argv, tmp_path, capsys):
     afile = tmp_path / "afile"
@@ -357,11 +369,22 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["uncertainty", "--workers", "99999"], "--workers: '99999' must be <= 256"),
     (["sweep", "{tmp}/spec.yaml", "--workers", "100000"], "--workers: '100000' must be <= 256"),
     (["diagnose", "estimation", "--workers", "257"], "--workers: '257' must be <= 256"),
+    # session 59's fuzzing: a retry count that repeats a deterministic failure for ever, a held-out run counted
+    # twice (two held-out runs from one), blank or repeated candidates (',' ran none)
+    (["sweep", "{tmp}/spec.yaml", "--retries", "99999999999"], "--retries: got 99999999999; allowed: an integer in"),
+    (["diagnose", "{example}", "--test", "1,1"], "--test: got '1,1'; allowed: each run once"),
+    (["diagnose", "{example}", "--train", "0,0"], "--train: got '0,0'; allowed: each run once"),
+    (["diagnose", "{example}", "--effects", ","], "--effects: got ','; allowed: comma-separated names, none blank"),
+    (["diagnose", "{example}", "--effects", "position_ripple,position_ripple"], "given twice"),
+    (["gap-benchmark", "--effects", "stribeck,", "--n-per-effect", "1"], "--effects"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
     (tmp_path / "spec.yaml").write_text("axes:\n  table.mass: [30, 40]\n")
-    code, _, err = _run([a.format(tmp=tmp_path) for a in argv], capsys)
+    from drakecreep.data import example_path
+
+    example = example_path("emps_segment.csv")
+    code, _, err = _run([a.format(tmp=tmp_path, example=example) for a in argv], capsys)
     _one_line_exit_2(code, err, fragment)
 
 
