@@ -53,6 +53,7 @@ __all__ = [
     "MIN_U_GAIN",
     "MAX_U_GAIN",
     "MAX_SPEED",
+    "MAX_FORCE",
     "COLUMNS",
     "CONTROLLER_KINDS",
     "ControllerMeta",
@@ -92,6 +93,10 @@ MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
 #: milliseconds labelled ``us``, move a thousand times too fast), which would otherwise run a whole diagnosis on a
 #: model that cannot follow it
 MAX_SPEED = 10.0
+#: Largest plausible force [N]: the drive's ``u x u_gain`` or an external force. Feed drives push with up to
+#: tens of kN; 1e7 N leaves three decades. A larger sample is a unit error or a corrupt cell (one cell of 1e300
+#: ran a diagnosis to overflowing fits and a mass of 1e301 kg)
+MAX_FORCE = 1e7
 #: Share of a run's samples whose speed may exceed :data:`MAX_SPEED` (a reference step, an encoder glitch)
 _FAST_SHARE = 0.01
 #: Share of a position column's non-zero steps that may be shorter than half a declared count: a counting
@@ -351,6 +356,15 @@ class MeasuredRun:
                                  f"speeds of {speed:.3g} m/s (the {1 - _FAST_SHARE:.0%} quantile)",
                                  f"speeds up to {MAX_SPEED:g} m/s, a feed axis's (is a unit wrong? millimetres "
                                  "labelled m, or milliseconds labelled us, move a thousand times too fast)")
+        for name, gain in (("u", self.meta.u_gain), ("f_ext", 1.0)):
+            a = getattr(self, name)
+            if a is None:
+                continue
+            i = int(np.argmax(np.abs(a)))
+            if abs(float(a[i])) * gain > MAX_FORCE:
+                raise InputError(f"{name} (run {self.label})", f"{float(a[i]):.3g} at sample {i + 1}",
+                                 f"forces up to {MAX_FORCE:g} N" + (" (u x u_gain)" if name == "u" else "")
+                                 + " (is a unit wrong, or a cell corrupt?)")
         for name in _ARRAYS:
             a = getattr(self, name)
             if a is not None:

@@ -224,6 +224,7 @@ MEASURED = {
                         "zz"),
     "meta_list": (GOOD_CSV.encode(), "- 1\n", "u_units"),
     # a run column with no label in some rows (NaN, empty): an IndexError before session 59
+    "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),
     "run_label_empty": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,a\n")
