@@ -43,11 +43,13 @@ def run(args):
         raise InputError("--youngs-modulus", args.youngs_modulus, "in [1, 2000] GPa")
     if not 1 <= args.balls <= 10000:
         raise InputError("--balls", args.balls, "an integer in [1, 10000]")
-    for option, value, hi in (("--ball-diameter", args.ball_diameter, 1e3), ("--diameter", args.diameter, 1e4),
-                              ("--lead", args.lead, 1e3), ("--preload", args.preload, 1e7),
-                              ("--mass", args.mass, 1e5), ("--conformity", args.conformity, 10.0)):
-        if not (math.isfinite(value) and 0 < value <= hi):
-            raise InputError(option, value, f"a finite number in (0, {hi:g}]")
+    # lower bounds too: a 1e-300 kg nut overflowed the axial frequency to inf
+    for option, value, lo, hi in (("--ball-diameter", args.ball_diameter, 1e-2, 1e3),
+                                  ("--diameter", args.diameter, 1e-1, 1e4), ("--lead", args.lead, 1e-2, 1e3),
+                                  ("--preload", args.preload, 1e-6, 1e7), ("--mass", args.mass, 1e-6, 1e5),
+                                  ("--conformity", args.conformity, 1e-3, 10.0)):
+        if not (math.isfinite(value) and lo <= value <= hi):
+            raise InputError(option, value, f"a finite number in [{lo:g}, {hi:g}]")
     if not (math.isfinite(args.poisson) and 0.0 <= args.poisson < 0.5):
         raise InputError("--poisson", args.poisson, "in [0, 0.5)")
     steel = Material(args.youngs_modulus * 1e9, args.poisson)

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from drakecreep.errors import InputError
+from drakecreep.files import to_jsonable
 from drakecreep.paper.modal import FRF_COLUMNS, HammerTest, identify_frf, identify_hammer_test, read_hammer_csv
 
 __all__ = ["add_parser", "run"]
@@ -97,7 +98,7 @@ def run(args):
                                               "m_kg": fit.m, "c_Ns_per_m": fit.c},
     }
     if args.json:
-        print(json.dumps(out, indent=2))
+        print(json.dumps(to_jsonable(out), indent=2))  # a non-finite number as "inf", valid JSON
         return 0
     hp = out["half_power"]
     print(f"{args.file}: {kind}, band {ident.band[0]:.4g}-{ident.band[1]:.4g} Hz")

@@ -58,6 +58,9 @@ __all__ = [
 
 #: the columns of a measured FRF file and of a file of time records (``drakecreep modal``)
 FRF_COLUMNS = ("f_Hz", "re", "im")
+#: Range of the largest magnitude of a hammer-test file's signal columns (SI units): outside it the SDOF fit's
+#: stiffness, mass and damping under- or overflow
+MIN_MAGNITUDE, MAX_MAGNITUDE = 1e-20, 1e20
 TIME_COLUMNS = ("t", "force", "response")
 
 _FRF_POWERS = {"receptance": 0, "displacement": 0, "mobility": 1, "velocity": 1,
@@ -794,4 +797,11 @@ def read_hammer_csv(path):
     if not np.all(np.isfinite(data)):
         row = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
         raise InputError(f"{path}: data", f"NaN, inf or an empty cell at data row {row + 1}", "finite numbers")
+    # magnitudes no hammer test gives in SI units (a receptance of 1e-9 m/N, an accelerance of 1e2 m/s^2/N, forces of
+    # 1e3 N): beyond these the fit's k, m and c under- or overflow (an FRF scaled by 1e300 gave zeta = inf)
+    values = np.abs(data[:, 1:])
+    top = float(np.max(values))
+    if not MIN_MAGNITUDE <= top <= MAX_MAGNITUDE:
+        raise InputError(f"{path}: data", f"largest magnitude {top:.3g}", f"values whose largest magnitude is in "
+                         f"[{MIN_MAGNITUDE:g}, {MAX_MAGNITUDE:g}] (SI units; is a unit wrong?)")
     return header, data

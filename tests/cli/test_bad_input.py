@@ -7,6 +7,7 @@ all fail while the input is checked, so the whole module takes a few seconds.
 
 import time
 
+import numpy as np
 import pytest
 
 from drakecreep.cli import main
@@ -348,6 +349,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--youngs-modulus", "1e308"], "--youngs-modulus"),
     (["hertz", "--preload", "inf"], "--preload"),
     (["hertz", "--lead", "-1"], "--lead"),
+    (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),  # the axial frequency overflowed to inf, exit 0
+    (["modal", "{tmp}/frf_1e300.csv"], "largest magnitude"),  # zeta = inf in the JSON, exit 0
+    (["modal", "{tmp}/frf_1e-300.csv"], "largest magnitude"),  # zeta = 0 and k = 1.6e305, exit 0
     (["gap-benchmark", "--samples", "10"], "--samples"),
     (["gap-benchmark", "--n-per-effect", "0", "--n-null", "0", "--n-ool", "0"], "--n-per-effect"),
     (["margins", "--feed", "1e-300"], "--feed"),
@@ -381,6 +385,11 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
+    f = np.linspace(0.0, 300.0, 301)
+    for name, scale in (("1e300", 1e300), ("1e-300", 1e-300)):  # a receptance in SI units scaled far beyond any test
+        h = scale / (1.62e5 - 0.335 * (2 * np.pi * f) ** 2 + 1j * 1.68 * 2 * np.pi * f)
+        np.savetxt(tmp_path / f"frf_{name}.csv", np.column_stack([f, h.real, h.imag]), delimiter=",",
+                   header="f_Hz,re,im", comments="")
     (tmp_path / "spec.yaml").write_text("axes:\n  table.mass: [30, 40]\n")
     from drakecreep.data import example_path
 
