@@ -445,7 +445,7 @@ def _meta_from_dict(data, meta_path):
 
     where = str(meta_path)
     if not isinstance(data, dict):
-        raise InputError(where, data, "a YAML mapping with at least u_units and u_gain")
+        raise InputError(where, f"a YAML {type(data).__name__}", "a YAML mapping with at least u_units and u_gain")  # not echoed
     known = {"u_units", "u_gain", "params", "controller", "sensors", "source", "notes", "file"}
     for key in data:
         if key not in known:

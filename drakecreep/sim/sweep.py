@@ -779,7 +779,9 @@ def load_spec(path, max_cases=MAX_CASES):
     path = Path(path)
     data = load_yaml_file(path, str(path), "a YAML sweep spec (a mapping with axes)")
     if not isinstance(data, dict):
-        raise InputError(str(path), data, "a mapping with base, scenario, axes, sample, metrics, plot")
+        # the type, not the value: a file that is no spec (a path typo, a token) is never echoed
+        raise InputError(str(path), f"a YAML {type(data).__name__}", "a mapping with base, scenario, axes, sample, metrics, "
+                         "plot")
     known = {"base", "scenario", "axes", "sample", "metrics", "plot"}
     extra = sorted(set(data) - known)
     if extra:

@@ -145,7 +145,7 @@ def uncertainty_spec(name="paper"):
 
 def _spec_from_data(data, where, name=None):
     if not isinstance(data, dict) or set(data) - {"preset", "sample", "fixed"} or "sample" not in data:
-        raise InputError(where, data if not isinstance(data, dict) else sorted(data),
+        raise InputError(where, f"a YAML {type(data).__name__}" if not isinstance(data, dict) else sorted(data),
                          "a mapping with preset, sample and (optional) fixed")
     names = data.get("preset", "paper")
     names = [names] if isinstance(names, str) else names

@@ -349,7 +349,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--youngs-modulus", "1e308"], "--youngs-modulus"),
     (["hertz", "--preload", "inf"], "--preload"),
     (["hertz", "--lead", "-1"], "--lead"),
-    (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),  # the axial frequency overflowed to inf, exit 0
+    (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
+    (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),  # a file that is no spec is not echoed (a token was)
+    (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
+    (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0
     (["modal", "{tmp}/frf_1e300.csv"], "largest magnitude"),  # zeta = inf in the JSON, exit 0
     (["modal", "{tmp}/frf_1e-300.csv"], "largest magnitude"),  # zeta = 0 and k = 1.6e305, exit 0
     (["gap-benchmark", "--samples", "10"], "--samples"),
@@ -385,6 +388,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
+    (tmp_path / "token.txt").write_text("ghp_s3cr3tTOKEN\n")
     f = np.linspace(0.0, 300.0, 301)
     for name, scale in (("1e300", 1e300), ("1e-300", 1e-300)):  # a receptance in SI units scaled far beyond any test
         h = scale / (1.62e5 - 0.335 * (2 * np.pi * f) ** 2 + 1j * 1.68 * 2 * np.pi * f)
@@ -396,6 +400,7 @@ def test_bad_options(argv, fragment, tmp_path, capsys):
     example = example_path("emps_segment.csv")
     code, _, err = _run([a.format(tmp=tmp_path, example=example) for a in argv], capsys)
     _one_line_exit_2(code, err, fragment)
+    assert "s3cr3t" not in err
 
 
 def test_full_disk_is_one_line_exit_1(monkeypatch, capsys):
