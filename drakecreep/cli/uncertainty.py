@@ -91,8 +91,8 @@ def check_study(params, samples, feeds, load_cases, *, seed=0, duration=3.0, out
     if samples * per_rig > MAX_CASES:  # the rig sample alone would not fit in memory (1e11 rigs: 15 TiB)
         raise InputError("--samples", samples, f"at most {MAX_CASES // per_rig} rigs ({MAX_CASES} simulations "
                                                f"of {len(feeds)} feed(s) x {len(load_cases)} load case(s))")
-    if seed < 0:
-        raise InputError("--seed", seed, "an integer >= 0")
+    if not 0 <= seed < 2**63:  # as a sweep spec's seed
+        raise InputError("--seed", seed, "an integer in [0, 2**63)")
     if params.simulation.steady_start >= duration:
         raise InputError("--duration", duration,
                          f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window")

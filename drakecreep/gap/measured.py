@@ -88,6 +88,8 @@ _ARRAYS = ("t", "x_ref", "x_motor", "x_table", "u", "f_ext")
 #: Range of ``u_gain`` [N per unit of u]: drives span about 1e-3 to 1e5 N/A or N/V; outside these bounds the
 #: forces overflow or vanish in the identification
 MIN_U_GAIN, MAX_U_GAIN = 1e-9, 1e9
+#: Largest gain of a declared controller (``kp`` [1/s], ``kv`` [units of u per m/s]): no drive's is near it
+MAX_GAIN = 1e9
 #: Fastest plausible axis speed [m/s]: ball-screw feed drives traverse at up to about 2 m/s and linear motors at
 #: about 5. A position column faster than this, or its time, is in the wrong unit (millimetres labelled ``m``, or
 #: milliseconds labelled ``us``, move a thousand times too fast), which would otherwise run a whole diagnosis on a
@@ -106,15 +108,19 @@ _SUBCOUNT_SHARE = 0.02
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
 
-def _finite(name, value, lo=None, lo_open=False):
+def _finite(name, value, lo=None, lo_open=False, hi=None):
+    if isinstance(value, (str, bool)):  # a quoted number is text in YAML, as the params files hold it
+        raise InputError(name, value, "a finite number (not quoted)")
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise InputError(name, value, "a finite number") from None
-    if isinstance(value, bool) or not math.isfinite(x):
+    if not math.isfinite(x):
         raise InputError(name, value, "a finite number")
     if lo is not None and (x < lo or (lo_open and x == lo)):
         raise InputError(name, value, f"a finite number {'>' if lo_open else '>='} {lo}")
+    if hi is not None and x > hi:
+        raise InputError(name, value, f"a finite number <= {hi:g}")
     return x
 
 
@@ -164,7 +170,8 @@ class ControllerMeta:
         if self.feedback not in ("motor", "table"):
             raise InputError("controller.feedback", self.feedback, "one of motor, table")
         for name in ("kp", "kv"):
-            object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), 0.0))
+            # bounded as u_gain is: a gain of 1e300 replayed to overflow
+            object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), 0.0, hi=MAX_GAIN))
             if self.kind == "p_p_cascade" and getattr(self, name) == 0.0:
                 # Left out, a gain reads as 0: a P-P cascade without its position or velocity gain cannot
                 # have produced a tracking run, and its replay would diagnose an open loop.

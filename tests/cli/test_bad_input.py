@@ -225,6 +225,10 @@ MEASURED = {
                         "zz"),
     "meta_list": (GOOD_CSV.encode(), "- 1\n", "u_units"),
     # a run column with no label in some rows (NaN, empty): an IndexError before session 59
+    "meta_gain_quoted": (GOOD_CSV.encode(), GOOD_META + "controller: {kind: p_p_cascade, kp: '160', kv: 200}\n",
+                         "controller.kp: got '160'; allowed: a finite number (not quoted)"),
+    "meta_gain_huge": (GOOD_CSV.encode(), GOOD_META + "controller: {kind: p_p_cascade, kp: 160, kv: 1.0e+300}\n",
+                       "controller.kv: got 1e+300; allowed: a finite number <= 1e+09"),
     "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),
@@ -368,6 +372,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["uncertainty", "--feeds", "0.1,"], "no empty item"),
     (["uncertainty", "--load-cases", "1,,2"], "no empty item"),
     (["uncertainty", "--feeds", "0.1,0.1"], "distinct values"),
+    (["uncertainty", "--seed", "99999999999999999999999"], "--seed: got 99999999999999999999999"),
     (["uncertainty", "--load-cases", "2,2"], "distinct values"),
     (["simulate", "--out", "{tmp}/s", "--uncertainty", "99999999999"], "--uncertainty: got 99999999999"),
     (["simulate", "--out", "{tmp}/s", "--seed", "3"], "--seed: got 3; allowed: only with --uncertainty"),
