@@ -76,9 +76,19 @@ def add_params_options(parser, friction=True):
         )
 
 
+def existing_path(option, path):
+    """``path`` unless it does not exist: then an :class:`~drakecreep.errors.InputError` naming ``option`` (the
+    generic 'No such file or directory' line did not say which option the path came from)."""
+    from pathlib import Path
+
+    if path is not None and not Path(path).exists():
+        raise InputError(option, str(path), "an existing file (no such file or directory)")
+    return path
+
+
 def params_from_args(args):
     """:class:`~drakecreep.params.DriveParams` from ``--params``/``--preset`` and overrides."""
-    params = load_params(args.params) if args.params else preset(args.preset)
+    params = load_params(existing_path("--params", args.params)) if args.params else preset(args.preset)
     if getattr(args, "friction", None):
         params = with_value(params, "friction.law", args.friction)
     return params

@@ -19,7 +19,7 @@ import os
 import sys
 from pathlib import Path
 
-from drakecreep.cli._common import names, print_json, workers
+from drakecreep.cli._common import existing_path, names, print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
@@ -76,7 +76,7 @@ def run(args):
         if path and path not in EMPS_FILES and not Path(path).exists():
             raise InputError(option, path, "an existing file: a measured run (CSV, Parquet, HDF5, .mat with its "
                              "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
-    runs = load_runs(args.data, args.meta, split=False)
+    runs = load_runs(args.data, existing_path("--meta", args.meta), split=False)
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
     # both sets move both ways), into out-and-back cycles for the kind drakecreep branch

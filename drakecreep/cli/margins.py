@@ -39,6 +39,8 @@ def scenario_from_args(args, params):
     """The operating point's :class:`~drakecreep.scenario.Scenario` from ``--feed`` and ``--load-case``."""
     from drakecreep.scenario import Scenario
 
+    if not args.feed > 0:  # an operating point slides one way: its speed
+        raise InputError("--feed", args.feed, "a feed > 0 mm/s")
     feed = feed_from_mm_s(args.feed)
     if not 0 <= args.load_case <= len(params.loads.cases):
         raise InputError("--load-case", args.load_case, f"an integer in 0..{len(params.loads.cases)} (0 = unloaded)")

@@ -1,6 +1,7 @@
 """``drakecreep report``: a self-contained HTML servo-loop report (margins, Bode, Nyquist, loci, pole map, runs)."""
 
 from drakecreep.cli._common import add_params_options, number, params_from_args
+from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run"]
 
@@ -32,6 +33,8 @@ def run(args):
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
+    if not args.low_feed > 0:
+        raise InputError("--low-feed", args.low_feed, "a feed > 0 mm/s")
     low = feed_from_mm_s(args.low_feed, "--low-feed")
     check_output_dir(args.out)  # before the computation, not after it
     source = args.params if args.params else f"preset {args.preset}"

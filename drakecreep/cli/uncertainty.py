@@ -2,8 +2,8 @@
 
 import os
 
-from drakecreep.cli._common import (add_params_options, comma_items, distinct, feed_from_mm_s, params_from_args,
-                                    positive_float, print_json, workers)
+from drakecreep.cli._common import (add_params_options, comma_items, distinct, existing_path, feed_from_mm_s,
+                                    params_from_args, positive_float, print_json, workers)
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
@@ -74,7 +74,7 @@ def spec_from_args(args):
     from drakecreep.studies.uncertainty import load_uncertainty, uncertainty_spec
 
     if getattr(args, "spec", None):
-        return load_uncertainty(args.spec)
+        return load_uncertainty(existing_path("--spec", args.spec))
     if args.params:
         raise InputError("--spec", None, "an uncertainty spec file: with --params the preset's spec does not apply")
     return uncertainty_spec(args.preset)

@@ -162,8 +162,9 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
     try:
         wc = brentq(bw_gap, lo, hi, xtol=1e-6 * wb)
     except ValueError:
-        raise InputError("bandwidth", bandwidth_Hz,
-                         "a bandwidth this PI can place (no crossover in 0.3-1.2 x the target gives it)") from None
+        raise InputError("bandwidth", f"{bandwidth_Hz:g} Hz at a phase margin of {phase_margin_deg:g} deg",
+                         "a bandwidth and phase margin this PI can place together (no crossover in 0.3-1.2 x the "
+                         "target gives that bandwidth at that margin: lower either)") from None
     kv, ki, p = tuned(wc)
     kp = wb / POSITION_BANDWIDTH_RATIO
     p = with_value(p, "controller.position_gain", kp)

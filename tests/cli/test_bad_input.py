@@ -354,7 +354,16 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--preload", "inf"], "--preload"),
     (["hertz", "--lead", "-1"], "--lead"),
     (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
-    (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),  # a file that is no spec is not echoed (a token was)
+    (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),
+    # a missing file named by its option (the generic line said only 'No such file or directory')
+    (["simulate", "--params", "{tmp}/nothere.yaml"], "--params: got"),
+    (["diagnose", "{example}", "--meta", "{tmp}/nothere.yaml"], "--meta: got"),
+    (["uncertainty", "--spec", "{tmp}/nothere.yaml"], "--spec: got"),
+    # the option and mm/s, not the scenario's field in m/s; a placement that fails names both targets
+    (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed > 0 mm/s"),
+    (["report", "--out", "{tmp}/r", "--low-feed", "-0.1"], "--low-feed: got -0.1"),
+    (["margins", "--feed", "-1"], "--feed: got -1.0"),
+    (["tune", "--phase-margin", "89.999"], "at a phase margin of 89.999 deg"),  # a file that is no spec is not echoed (a token was)
     (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
     (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0
     (["modal", "{tmp}/frf_1e300.csv"], "largest magnitude"),  # zeta = inf in the JSON, exit 0

@@ -33,7 +33,7 @@ def test_simulate_text(tmp_path, capsys):
     (["simulate", "--load-case", "9"], "--load-case"),
     (["simulate", "--duration", "0.5"], "--duration"),
     (["simulate", "--friction", "maxwell"], "--friction"),
-    (["simulate", "--params", "/no/such/file.yaml"], "No such file"),
+    (["simulate", "--params", "/no/such/file.yaml"], "--params: got '/no/such/file.yaml'; allowed: an existing file"),
     (["diagram", "--out", "x.jpg"], "--out"),
     (["nonsense"], "invalid choice"),
     # an option of no command: the command's own parser names itself and where its options are listed
