@@ -92,6 +92,8 @@ def write_atomic(path, write):
     others (0666 less the umask), like any file a program writes.
     """
     path = Path(path)
+    if path.is_dir():  # named before any work on the file (os.replace's error named the temporary file)
+        raise IsADirectoryError(errno.EISDIR, "a folder is in the way of the file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}")
     os.close(fd)

@@ -178,3 +178,15 @@ def test_csv_dialect_reads_the_separator_from_the_header_and_the_decimal_mark_fr
     assert csv_dialect(["t,x", "1.5,2"]) == (",", ".")
     assert csv_dialect(["t"]) == (",", ".")  # one column: nothing to tell, the default
     assert csv_dialect(["t;x", "1,5;2"], separator=";", decimal=".") == (";", ".")  # given values are kept
+
+
+def test_a_folder_in_the_way_of_a_file_is_named(tmp_path):
+    """os.replace onto a folder failed naming the hidden temporary file; the error names the target, and no
+    temporary file is left."""
+    from drakecreep.files import write_text
+
+    (tmp_path / "params.yaml").mkdir()
+    with pytest.raises(IsADirectoryError) as err:
+        write_text(tmp_path / "params.yaml", "x")
+    assert err.value.filename == str(tmp_path / "params.yaml")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["params.yaml"]
