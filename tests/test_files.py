@@ -183,8 +183,6 @@ def test_csv_dialect_reads_the_separator_from_the_header_and_the_decimal_mark_fr
 def test_a_folder_in_the_way_of_a_file_is_named(tmp_path):
     """os.replace onto a folder failed naming the hidden temporary file; the error names the target, and no
     temporary file is left."""
-    from drakecreep.files import write_text
-
     (tmp_path / "params.yaml").mkdir()
     with pytest.raises(IsADirectoryError) as err:
         write_text(tmp_path / "params.yaml", "x")
