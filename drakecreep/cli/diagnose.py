@@ -240,7 +240,9 @@ def _run_drakecreep_kind(args, train, test, score_runs):
 
     try:
         result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
-    except BaseException:  # a failure or a stop (Ctrl-C): say what is kept, then the one-line error as always
+    except BaseException as err:  # a failure or a stop (Ctrl-C): say what is kept, then the one-line error as always
+        if isinstance(err, InputError) and err.field in ("uncertain", "effects"):  # checked before any work
+            raise InputError(f"--{err.field}", err.value, err.allowed) from None  # the option, not the parameter
         if outset is not None and outset.files:
             say(f"kept {' and '.join(sorted(outset.files))} in {outset.dir} (no manifest: the run did not finish)")
         raise
