@@ -158,6 +158,11 @@ def idim_start(runs, instruments=None, **preprocess):
     full[cols] = theta
     std[cols] = np.sqrt(np.diag(cov))
     names = {"M": "mass", "Fv": "viscous", "Fc": "coulomb", "offset": "offset"}
+    if Z is None and not full[0] > 0:  # least squares on the measured signals: named in their terms (the axis
+        # refused it as 'axis.mass'); an instrumental-variable mass that is not positive is the caller's to drop
+        raise InputError("u", f"a drive force whose inverse-dynamics mass is {full[0]:.3g} kg",
+                         "a u that pushes the axis the way it accelerates (is the sign of u or u_gain, or the "
+                         "direction of x_motor, reversed?)")
     if full[2] < 0:
         warnings.append(f"IDIM gives a negative Coulomb level ({full[2]:.3g} N): set to 0")
         full[2] = 0.0

@@ -659,6 +659,12 @@ def check_recorded(run):
                              f"{steps.min():.3g} m), so it moves by less than a count (a unit error?)")
     if not np.any(run.u):
         raise InputError(f"u (run {run.label})", "zero throughout", "the drive command the controller gave")
+    if run.x_table is not None and np.ptp(run.x_table) == 0.0 and np.ptp(run.x_motor) > 0.0:
+        # a scale that reads nothing while the motor moves (unplugged, or the wrong column): every replay error
+        # relative to it was a division by zero ('y: got all zero')
+        raise InputError(f"x_table (run {run.label})", "constant while x_motor moves",
+                         "the linear scale's reading of the table, or no x_table column (a motion within one count "
+                         "of the scale cannot be scored against it)")
 
 
 def save_measured(data, csv_path, meta_path=None):

@@ -229,6 +229,8 @@ MEASURED = {
                          "controller.kp: got '160'; allowed: a finite number (not quoted)"),
     "meta_gain_huge": (GOOD_CSV.encode(), GOOD_META + "controller: {kind: p_p_cascade, kp: 160, kv: 1.0e+300}\n",
                        "controller.kv: got 1e+300; allowed: a finite number <= 1e+09"),
+    "x_table_constant": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,x_table\n").replace("0.5\n", "0.5,0\n")
+                         .encode(), GOOD_META, "x_table (run run): got 'constant while x_motor moves'"),
     "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),

@@ -217,6 +217,14 @@ def test_a_non_positive_instrumental_mass_keeps_the_least_squares_start(runs, mo
     assert not any("did not stay finite" in w for w in idf.warnings)
 
 
+def test_a_drive_force_of_the_wrong_sign_is_named_in_the_measured_signals_terms(runs):
+    """u recorded with the opposite sign gives a negative least-squares mass: the error names u and the likely
+    cause, not the replay axis's field (it said 'axis.mass: got -94.56'; found by fuzzing)."""
+    flipped = [dataclasses.replace(r, u=-r.u) for r in runs]
+    with pytest.raises(InputError, match=r"^u: got 'a drive force whose inverse-dynamics mass is -"):
+        idim_start(flipped)
+
+
 def test_a_parameter_the_error_does_not_depend_on_alone_has_no_finite_interval():
     """Two parameters the replay error only sees as a sum get an infinite half-width and the warning (the
     pseudo-inverse gave them a finite, minimum-norm one); a third, identifiable one keeps its finite interval.
