@@ -50,6 +50,11 @@ def run(args):
                                   ("--conformity", args.conformity, 1e-3, 10.0)):
         if not (math.isfinite(value) and lo <= value <= hi):
             raise InputError(option, value, f"a finite number in [{lo:g}, {hi:g}]")
+    # in the options' own units (the model's checks named its fields, in rad and m)
+    if not (math.isfinite(args.contact_angle) and 0.0 < args.contact_angle < 90.0):
+        raise InputError("--contact-angle", args.contact_angle, "an angle in (0, 90) deg")
+    if not args.ball_diameter < args.diameter:
+        raise InputError("--ball-diameter", args.ball_diameter, f"a diameter below --diameter ({args.diameter:g} mm)")
     if not (math.isfinite(args.poisson) and 0.0 <= args.poisson < 0.5):
         raise InputError("--poisson", args.poisson, "in [0, 0.5)")
     steel = Material(args.youngs_modulus * 1e9, args.poisson)

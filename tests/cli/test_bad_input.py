@@ -356,6 +356,8 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--preload", "inf"], "--preload"),
     (["hertz", "--lead", "-1"], "--lead"),
     (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
+    (["hertz", "--contact-angle", "90"], "--contact-angle: got 90.0; allowed: an angle in (0, 90) deg"),
+    (["hertz", "--diameter", "1"], "--ball-diameter: got 3.175; allowed: a diameter below --diameter (1 mm)"),
     (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),
     # a missing file named by its option (the generic line said only 'No such file or directory')
     (["simulate", "--params", "{tmp}/nothere.yaml"], "--params: got"),
