@@ -797,6 +797,15 @@ def read_hammer_csv(path):
     if not np.all(np.isfinite(data)):
         row = int(np.flatnonzero(~np.all(np.isfinite(data), axis=1))[0])
         raise InputError(f"{path}: data", f"NaN, inf or an empty cell at data row {row + 1}", "finite numbers")
+    axis = data[:, 0]
+    name, unit = ("f_Hz", "Hz") if header == FRF_COLUMNS else ("t", "s")
+    if header == FRF_COLUMNS and np.any(axis < 0):  # (the band search then said 'frequency band: got (None, None)')
+        row = int(np.flatnonzero(axis < 0)[0])
+        raise InputError(f"{path}: {name}", f"{axis[row]:g} {unit} at data row {row + 1}", "frequencies >= 0 Hz")
+    if np.any(np.diff(axis) <= 0):
+        row = int(np.flatnonzero(np.diff(axis) <= 0)[0]) + 1
+        raise InputError(f"{path}: {name}", f"{axis[row]:g} {unit} at data row {row + 1} after {axis[row - 1]:g}",
+                         "values increasing row by row")
     # magnitudes no hammer test gives in SI units (a receptance of 1e-9 m/N, an accelerance of 1e2 m/s^2/N, forces of
     # 1e3 N): beyond these the fit's k, m and c under- or overflow (an FRF scaled by 1e300 gave zeta = inf)
     values = np.abs(data[:, 1:])
