@@ -90,6 +90,7 @@ from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, 
 from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscillation_log_errors,
                                       sustained_oscillation)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
+from drakecreep.model.controller import force_limit
 from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
 
 __all__ = [
@@ -145,6 +146,10 @@ SEPARABILITY = 0.95
 #: Shortest run accepted (samples and seconds): the position loop needs a few periods to show anything.
 MIN_SAMPLES = 50
 MIN_DURATION = 0.1
+#: Largest external force a run may carry, in units of the drive's force limit (peak torque through the lead,
+#: :func:`drakecreep.model.controller.force_limit`): the drive cannot have held the axis against much more, and the
+#: replay of such a run runs for minutes (a constant 1e5 N on the 10.6 kN paper preset: more than 120 s)
+MAX_EXTERNAL_FORCE = 2.0
 #: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
 _STEP = 0.1
 _BOUND = 4.0
@@ -518,6 +523,12 @@ def _check_inputs(train, test, uncertain, effects, load_case):
             raise InputError("params", f"run {r.label}", "the same params file for every run")
         replay_params(r, prior)  # the declared sensor resolutions fit the params' lead
     prior.load_case(load_case)
+    limit = MAX_EXTERNAL_FORCE * force_limit(prior)
+    for r in train + test:
+        if r.f_ext is not None and float(np.max(np.abs(r.f_ext))) > limit:
+            raise InputError(f"f_ext (run {r.label})", f"{float(np.max(np.abs(r.f_ext))):.3g} N",
+                             f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "
+                             "the params file's peak torque through the lead); is a unit wrong?")
     uncertain = tuple(uncertain)
     check_fields(uncertain)
     for path in uncertain:

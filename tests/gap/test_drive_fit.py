@@ -6,6 +6,7 @@ with a Stribeck law (regularised at 0.1 mm/s), the nut's friction on the table a
 loop, so that a 0.5 s run replays in well under a second.
 """
 
+import dataclasses
 import json
 import math
 import re
@@ -577,6 +578,12 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
     with pytest.raises(InputError) as err:
         diagnose_drive([_blank("x", params=other)], good[1:])
     assert err.value.field == "params"
+    # an external force the drive could not have held the axis against (1e5 N replayed for minutes; found by
+    # fuzzing): beyond twice the force limit, peak torque through the lead
+    pushed = dataclasses.replace(good[0], f_ext=np.full(N, 1e5))
+    with pytest.raises(InputError) as err:
+        diagnose_drive([pushed], good[1:])
+    assert err.value.field == "f_ext (run a)" and "x the drive's force limit" in err.value.allowed
 
 
 def test_leave_one_out_step_is_close_to_the_refit():
