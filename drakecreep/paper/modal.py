@@ -682,6 +682,11 @@ def identify_hammer_test(test: HammerTest, pulse_width, modal_mass=None, exp_tau
     kind = {"displacement": "receptance", "velocity": "mobility",
             "acceleration": "accelerance"}[test.response_type]
     lo, hi = frf.excited_band(drop_dB)
+    excited = np.count_nonzero((frf.f >= lo) & (frf.f <= hi) & (frf.f > 0.0))
+    if band is None and excited < 3:  # (identify_frf then said 'frequency band: got (20.0, 0.0)')
+        raise InputError("force", f"no band excited within {drop_dB:g} dB of the autospectrum's maximum "
+                                  f"({lo:g}-{hi:g} Hz)", "a recorded impulse, its autospectrum flat over the mode "
+                                                         "(or give the band with --fmin/--fmax)")
     if band is not None:
         lo = lo if band[0] is None else band[0]
         hi = hi if band[1] is None else band[1]

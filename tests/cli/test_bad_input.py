@@ -374,6 +374,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["modal", "{tmp}/frf_1e-300.csv"], "largest magnitude"),  # zeta = 0 and k = 1.6e305, exit 0
     (["modal", "{tmp}/frf_negative_f.csv"], "f_Hz: got '-100 Hz at data row 1'"),  # 'frequency band: got (None, None)'
     (["modal", "{tmp}/frf_repeated_f.csv"], "values increasing row by row"),
+    (["modal", "{tmp}/noise_t.csv"], "force: got \"no band excited within 10 dB"),  # said 'frequency band: ...'
     (["gap-benchmark", "--samples", "10"], "--samples"),
     (["gap-benchmark", "--n-per-effect", "0", "--n-null", "0", "--n-ool", "0"], "--n-per-effect"),
     (["margins", "--feed", "1e-300"], "--feed"),
@@ -411,6 +412,9 @@ def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "token.txt").write_text("ghp_s3cr3tTOKEN\n")
     f = np.linspace(0.0, 300.0, 301)
     h = 1.0 / (1.62e5 - 0.335 * (2 * np.pi * f) ** 2 + 1j * 1.68 * 2 * np.pi * f)
+    rng, t = np.random.default_rng(0), np.arange(4096) / 2000.0  # a time file of noise: no impulse
+    np.savetxt(tmp_path / "noise_t.csv", np.column_stack([t, rng.normal(size=t.size), rng.normal(size=t.size)]),
+               delimiter=",", header="t,force,response", comments="")
     for name, freq in (("negative_f", f - 100.0), ("repeated_f", np.where(f == 150.0, 149.0, f))):
         np.savetxt(tmp_path / f"frf_{name}.csv", np.column_stack([freq, h.real, h.imag]), delimiter=",",
                    header="f_Hz,re,im", comments="")
