@@ -114,12 +114,13 @@ def first_claims(row):
         return out
     passing = [c for c in row["ranking"] if c.get("test_force_runs") is not None and c.get("train_gain", 0.0) > 0
                and replay_test(np.square(nominal), np.square(c["test_force_runs"]), null)["passes"]]
+    trained = [training_passes(row, c) for c in passing]  # one verdict per candidate, for both training rules
     for rule in RULES:
         if rule in TRAINING_RULES:
-            if any(training_passes(row, c) is None for c in passing):
+            if None in trained:
                 out[rule] = NOT_AVAILABLE
                 continue
-            pool = [c for c in passing if training_passes(row, c)]
+            pool = [c for c, ok in zip(passing, trained) if ok]
         else:
             pool = passing
         out[rule] = next((c["effect"] for c in pool if held_out_passes(rule, nominal, c["test_force_runs"])), None)

@@ -234,8 +234,8 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         if stage == "nominal":
             path = outset.write("nominal_params.yaml", partial.save_params)
             say(f"the fitted params file is kept in {path}; ranking.json follows each candidate")
-        body = dict(partial.to_json(), stage=stage, complete=stage == "final", **extra)
-        body.pop("unexplained", None), body.pop("hints", None)  # known at the end only
+        body = {k: v for k, v in partial.to_json().items() if k not in ("unexplained", "hints")}  # known at the end
+        body.update(stage=stage, complete=stage == "final", **extra)
         outset.write_text("ranking.json", json.dumps(body, indent=1) + "\n")
 
     try:

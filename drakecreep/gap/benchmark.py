@@ -550,16 +550,14 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
-                "values": {k: (float(v) if isinstance(v, (int, float, np.floating)) else v)
-                           for k, v in c.values.items()},
+                "values": dict(c.values),
                 "test_force_runs": ([float(c.test_errors[k]["force"]) for k in labels]
                                     if all(k in c.test_errors for k in labels) else None)}
                for c in res.candidates]
     row = _row(ds, claimed, ranking, friction=res.params.friction.law, uncertain=list(kw.get("uncertain", DEFAULT_UNCERTAIN)),
                test_force_nominal_runs=[float(res.nominal_test_errors[k]["force"]) for k in labels],
                replay_null=res.replay_null,
-               null_test_force_runs=(None if res.null_test_force is None
-                                     else [list(r) for r in res.null_test_force]),
+               null_test_force_runs=res.null_test_force,
                train_sse=res.train_sse, train_variance=res.train_variance,
                test_force_nominal=rms_force_error(res.nominal_test_errors),
                test_force_claimed=rms_force_error(res.test_errors), diagnosis_seconds=res.seconds,

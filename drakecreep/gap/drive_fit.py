@@ -441,7 +441,7 @@ class DriveDiagnosis:
             "claimed": list(self.claimed),
             "test_errors": self.test_errors,
             "replay_null": self.replay_null,
-            "null_test_force": None if self.null_test_force is None else [list(r) for r in self.null_test_force],
+            "null_test_force": self.null_test_force,
             "train_sse": self.train_sse,
             "train_variance": self.train_variance,
             "not_ranked": dict(self.not_ranked),
