@@ -111,7 +111,8 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     claims = dcs.first_claims(rows[0])
     # (the log ratios, 0.01-1.05, differ as much as the points: a log-ratio bar does not pass it either)
     assert claims == {"points_t": None, "sign_flip": "lead_error", "t_or_sign_flip": "lead_error",
-                      "log_ratio_t": None, "points_t_chi2": "n/a", "pooled_chi2": "n/a"}  # rows before 752729f
+                      "log_ratio_t": None, "points_t_chi2": "n/a", "pooled_chi2": "n/a",  # rows before 752729f
+                      "t_or_pooled_20": "lead_error"}  # its pooled shrink, 76 %, is 76 run-to-run nulls
     assert set(dcs.first_claims(rows[1]).values()) == {None}
     assert set(dcs.first_claims(dict(rows[0], replay_null=None)).values()) == {None}  # as the product: no null
     table, scores = dcs.recount(rows)
@@ -159,6 +160,26 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
     _, scores = dcs.recount([row, null])
     assert scores["pooled_chi2"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
     assert scores["points_t"] == {"right": 0, "library": 1, "null_claims": 1, "nulls": 1, "wrong": 2}
+
+
+def test_drive_claim_statistics_lets_a_large_pooled_shrink_stand_for_the_student_bar():
+    """Study 3bs's rule: a candidate that fails the Student bar on its per-run gains is claimed when its pooled
+    held-out shrink is above 20 run-to-run nulls, and not when it is above the null but below 20 of them."""
+    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
+    dcs = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dcs)
+    nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
+    lead = _ranked("lead_error", [9.9, 11.5, 12.0, 10.8, 14.0])  # shrink 76 % of the pooled energy
+    row = _drive_row(1, "library", "lead_error", 5.0, nominal, [lead], [])
+    assert dcs.first_claims(row)["points_t"] is None
+    assert dcs.first_claims(row)["t_or_pooled_20"] == "lead_error"  # null 1 %: 76 nulls
+    assert dcs.first_claims(dict(row, replay_null=0.05))["t_or_pooled_20"] is None  # 15 nulls: not enough
+    # a null's candidate that helps four runs a little, unevenly: shrink 2.0 %, two nulls, Student bar failed
+    small = _ranked("force_ripple", [9.9, 11.9, 29.0, 10.9, 40.1], train_gain=0.04)
+    null = _drive_row(2, "null", None, 0.0, nominal, [small], [])
+    assert dcs.first_claims(null)["points_t"] is None and dcs.first_claims(null)["t_or_pooled_20"] is None
+    _, scores = dcs.recount([row, null])
+    assert scores["t_or_pooled_20"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
 
 
 def _backfill_module():
