@@ -48,6 +48,18 @@ class InputError(DrakecreepError, ValueError):
         super().__init__(f"{short_repr(field, 200) if not isinstance(field, str) else field[:200]}: "
                          f"got {short_repr(value)}; allowed: {str(allowed)[:600]}")
 
+    def __reduce__(self):
+        # rebuilt from its three parts, not from the message: a worker process's error reaches the parent whole
+        # (unpickling InputError(message) failed and broke the process pool: 'BrokenProcessPool', exit 1)
+        import pickle
+
+        value = self.value
+        try:
+            pickle.dumps(value)
+        except Exception:  # noqa: BLE001 - an unpicklable value travels as its bounded repr
+            value = short_repr(value)
+        return type(self), (self.field, value, self.allowed)
+
     @classmethod
     def unknown_field(cls, field, known):
         """A key that names no field of a mapping whose fields are ``known`` (the value is not echoed)."""
