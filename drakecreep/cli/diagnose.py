@@ -56,7 +56,7 @@ def add_parser(subparsers):
                    "fixed) on this file")
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
-                   "report --params, diagnosis.json, summary.txt)")
+                   "report --params, diagnosis.html, diagnosis.json, summary.txt)")
     p.add_argument("--workers", type=workers, metavar="N", default=os.cpu_count() or 1,
                    help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits, and as many "
                         f"threads in each for the runs of one evaluation; drakecreep: the runs and Jacobian columns; "
@@ -206,7 +206,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     :func:`drakecreep.gap.drive_fit.diagnose_drive`: the uncertain ``DriveParams`` fields fitted by output error
     through the compiled diagram, candidate effects of the Drake model ranked and claimed on the held-out runs;
     with ``--out`` the augmented params file (``augmented_params.yaml``, for ``simulate/margins/report
-    --params``), ``diagnosis.json`` and ``summary.txt``, the manifest last; ``--score`` replays the augmented
+    --params``), the report (``diagnosis.html``), ``diagnosis.json`` and ``summary.txt``, the manifest last; ``--score`` replays the augmented
     params, fixed, on the runs of another file. While it runs, ``--out`` keeps what is known: the fitted params
     file (``nominal_params.yaml``) as soon as the nominal fit ends, and ``ranking.json`` (the candidates so
     far, ``"stage"`` and ``"complete": false``) after each candidate and once the claims are decided, so that a
@@ -218,6 +218,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     from drakecreep.files import OutputSet
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.report.drive_report import write_drive_report
 
     say = _say(args)
     kwargs = {}
@@ -259,10 +260,12 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         outset.write("augmented_params.yaml", result.save_params)
         outset.write_text("diagnosis.json", json.dumps(payload, indent=2) + "\n")
         outset.write_text("summary.txt", "\n".join(lines) + "\n")
+        write_drive_report(result, outset, scored=payload.get("scored"), **extra)
         keep("final", result)
-        outset.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed)})
-        say(f"wrote {outset.dir}/augmented_params.yaml, diagnosis.json, summary.txt, nominal_params.yaml and "
-            "ranking.json")
+        outset.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed),
+                       "html": "diagnosis.html"})
+        say(f"wrote {outset.dir}/diagnosis.html, augmented_params.yaml, diagnosis.json, summary.txt, "
+            "nominal_params.yaml and ranking.json")
     if args.json:
         print_json(payload)
     else:

@@ -13,7 +13,7 @@ from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.where import fixed_verdict, order_peak, oscillation_line
 
-__all__ = ["drake_to_json_dict", "ranking_json", "write_drake_report"]
+__all__ = ["drake_to_json_dict", "ranking_json", "where_parts", "write_drake_report"]
 
 
 def ranking_json(nominal, nominal_test_errors, ranking):
@@ -196,6 +196,64 @@ def _edge(name, value):
     return value * factor, shown
 
 
+def where_parts(where):
+    """HTML parts of what a model still does not explain on the held-out runs, and where (a ``where`` dict of
+    :func:`drakecreep.gap.where.locate`): regimes, frequency bands, residual-input independence, an oscillation,
+    orders, fixed to the travel or to time, operating points, before or after the screw. Both diagnoses' reports."""
+    from drakecreep.report.html import escape, table
+
+    parts = []
+    if where:
+        parts.append("<h2>Unexplained: where the augmented model's held-out residual lies</h2>")
+        if where.get("diverged"):
+            parts.append("<p>The model's replay diverged on held-out run(s) "
+                         f"{escape(', '.join(where['diverged']))}; they are left out below.</p>")
+    if where and where.get("bands") is not None:
+        parts.append(f"<p>Measured minus replayed force, {where['force_rms_N']:.3g} N rms over the held-out runs.</p>")
+        parts.append(table(["regime", "share of the residual energy [%]", "share of the time [%]", "rms [N]"],
+                           [[k.replace("_", " "), f"{100 * v['energy_share']:.1f}", f"{100 * v['time_share']:.1f}",
+                             f"{v['rms']:.3g}"] for k, v in where["regimes"].items()]))
+        parts.append(table(["frequency band [Hz]", "share of the residual energy [%]", "rms [N]"],
+                           [[f"{b['lo_Hz']:g}-{b['hi_Hz']:.0f}", f"{100 * b['share']:.1f}", f"{b['rms']:.3g}"]
+                            for b in where["bands"]["bands"]]))
+        rows = [[name, "yes" if r["independent"] else "no", f"{r['max_abs']:.3f}", f"{r['band']:.3f}",
+                 str(r["lag_of_max"]), r["run"]] for name, r in where["independence"].items()]
+        if rows:
+            parts.append("<p>Residual-input independence (cross-correlation over ±25 samples against a 99 % "
+                         "family-wise band; a residual correlated with an input is a model error, not noise):</p>")
+            parts.append(table(["input", "independent", "largest |r|", "band", "at lag [samples]", "worst run"], rows))
+        if where.get("oscillation"):
+            parts.append(f"<p><b>Unstable?</b> {escape(oscillation_line(where['oscillation'], 'held-out runs'))}</p>")
+        o = where.get("orders")
+        if o and o["peak_order"]:
+            per = "per screw revolution" if o["per_revolution"] else f"per {1e3 * o['cycle_m']:g} mm of travel"
+            parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): "
+                         f"{escape(order_peak(o))}. An effect fixed to the screw or the travel peaks at one order on "
+                         "runs of any speed, one fixed in time spreads over the orders as the runs' speeds differ; "
+                         "bins as coarse as the runs' travel allows, or runs of like speeds, may not show the "
+                         "difference.</p>")
+        fx = where.get("fixed")
+        if fx and fx["runs"] and fx["resolution_Hz"]:
+            verdict = fixed_verdict(fx)
+            parts.append(f"<p>{escape(verdict[0].upper() + verdict[1:])}; the residual's peak at constant speed, run "
+                         f"by run, bins of {fx['resolution_Hz']:.3g} Hz:</p>")
+            parts.append(table(["speed [mm/s]", "peak [Hz]"],
+                               [[f"{1e3 * r['speed']:.3g}", f"{r['peak_Hz']:.3g}"] for r in fx["runs"]]))
+        if where.get("operating"):
+            rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
+                     f"{100 * r['energy_share']:.1f}", f"{100 * r['time_share']:.1f}"]
+                    for axis, name, scale in (("speed", "speed [mm/s]", 1e3), ("position", "position [mm]", 1e3),
+                                              ("force", "drive force [N]", 1.0))
+                    for r in where["operating"][axis]]
+            parts.append(table(["operating point", "bin", "rms [N]", "share of the residual energy [%]",
+                                "share of the samples [%]"], rows))
+        if where["split"]:
+            parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
+                               [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]
+                                for lab, v in where["split"].items()]))
+    return parts
+
+
 def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real gap diagnosis (Drake model)",
                        outset=None, **extra):
     """Write ``diagnosis.html`` and ``diagnosis.json`` of a typed Drake diagnosis into ``out_dir``.
@@ -231,7 +289,11 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         parts.append(f"<p>Data: <code>{escape(str(extra['data']))}</code>; training runs "
                      f"{escape(', '.join(extra.get('train_runs', [])))}; held-out runs "
                      f"{escape(', '.join(extra.get('test_runs', [])))}. Diagnosis {diagnosis.seconds:.0f} s.</p>")
-    parts.append("<h2>Answer</h2><ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
+    claimed = " + ".join(diagnosis.claimed) or "nothing"
+    parts.append(f"<h2>Answer</h2><p class='answer'><b>Claimed: {escape(claimed)}.</b> Held-out force error "
+                 f"{rms_force_error(diagnosis.nominal_test_errors):.3f} % (nominal) → "
+                 f"{rms_force_error(diagnosis.test_errors):.3f} % (augmented, closed-loop replay).</p>")
+    parts.append("<ul>" + "".join(f"<li>{escape(s)}</li>" for s in diagnosis.summary()) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when its closed-loop replay of the held-out runs "
                  f"(parameters fixed from the training runs) beats the current model, refitted by the same effort, "
                  f"by more than {k:.3g} standard errors of the per-run log error ratio (or with a sign-flip "
@@ -343,55 +405,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         rows = [[lab] + [f"{scored['nominal'][lab][s]:.4g} → {scored['augmented'][lab][s]:.4g}" for s in sig]
                 for lab in scored["augmented"]]
         parts.append(table(["run"] + [f"{s} error [%] nominal → augmented" for s in sig], rows))
-    where = diagnosis.where
-    if where:
-        parts.append("<h2>Unexplained: where the augmented model's held-out residual lies</h2>")
-        if where.get("diverged"):
-            parts.append("<p>The model's replay diverged on held-out run(s) "
-                         f"{escape(', '.join(where['diverged']))}; they are left out below.</p>")
-    if where and where.get("bands") is not None:
-        parts.append(f"<p>Measured minus replayed force, {where['force_rms_N']:.3g} N rms over the held-out runs.</p>")
-        parts.append(table(["regime", "share of the residual energy [%]", "share of the time [%]", "rms [N]"],
-                           [[k.replace("_", " "), f"{100 * v['energy_share']:.1f}", f"{100 * v['time_share']:.1f}",
-                             f"{v['rms']:.3g}"] for k, v in where["regimes"].items()]))
-        parts.append(table(["frequency band [Hz]", "share of the residual energy [%]", "rms [N]"],
-                           [[f"{b['lo_Hz']:g}-{b['hi_Hz']:.0f}", f"{100 * b['share']:.1f}", f"{b['rms']:.3g}"]
-                            for b in where["bands"]["bands"]]))
-        rows = [[name, "yes" if r["independent"] else "no", f"{r['max_abs']:.3f}", f"{r['band']:.3f}",
-                 str(r["lag_of_max"]), r["run"]] for name, r in where["independence"].items()]
-        if rows:
-            parts.append("<p>Residual-input independence (cross-correlation over ±25 samples against a 99 % "
-                         "family-wise band; a residual correlated with an input is a model error, not noise):</p>")
-            parts.append(table(["input", "independent", "largest |r|", "band", "at lag [samples]", "worst run"], rows))
-        if where.get("oscillation"):
-            parts.append(f"<p><b>Unstable?</b> {escape(oscillation_line(where['oscillation'], 'held-out runs'))}</p>")
-        o = where.get("orders")
-        if o and o["peak_order"]:
-            per = "per screw revolution" if o["per_revolution"] else f"per {1e3 * o['cycle_m']:g} mm of travel"
-            parts.append(f"<p>Against the measured position (orders {per}, bins of {o['resolution']:.2g}): "
-                         f"{escape(order_peak(o))}. An effect fixed to the screw or the travel peaks at one order on "
-                         "runs of any speed, one fixed in time spreads over the orders as the runs' speeds differ; "
-                         "bins as coarse as the runs' travel allows, or runs of like speeds, may not show the "
-                         "difference.</p>")
-        fx = where.get("fixed")
-        if fx and fx["runs"] and fx["resolution_Hz"]:
-            verdict = fixed_verdict(fx)
-            parts.append(f"<p>{escape(verdict[0].upper() + verdict[1:])}; the residual's peak at constant speed, run "
-                         f"by run, bins of {fx['resolution_Hz']:.3g} Hz:</p>")
-            parts.append(table(["speed [mm/s]", "peak [Hz]"],
-                               [[f"{1e3 * r['speed']:.3g}", f"{r['peak_Hz']:.3g}"] for r in fx["runs"]]))
-        if where.get("operating"):
-            rows = [[name, f"{scale * r['lo']:.3g}-{scale * r['hi']:.3g}", f"{r['rms']:.3g}",
-                     f"{100 * r['energy_share']:.1f}", f"{100 * r['time_share']:.1f}"]
-                    for axis, name, scale in (("speed", "speed [mm/s]", 1e3), ("position", "position [mm]", 1e3),
-                                              ("force", "drive force [N]", 1.0))
-                    for r in where["operating"][axis]]
-            parts.append(table(["operating point", "bin", "rms [N]", "share of the residual energy [%]",
-                                "share of the samples [%]"], rows))
-        if where["split"]:
-            parts.append(table(["run", "position gap", "motor rms [µm]", "transmission rms [µm]"],
-                               [[lab, v["where"], f"{1e6 * v['motor_rms_m']:.3g}", f"{1e6 * v['transmission_rms_m']:.3g}"]
-                                for lab, v in where["split"].items()]))
+    parts += where_parts(diagnosis.where)
     parts.append("<h2>Never ranked</h2>")
     parts.append(table(["effect", "why"], [[n, why] for n, why in diagnosis.not_ranked.items()]))
     for png, caption in _drake_figures(diagnosis, residuals):

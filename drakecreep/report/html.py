@@ -18,7 +18,7 @@ table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #ccc;padding
 th{background:#f3f3f3}td:first-child,th:first-child{text-align:left}img{max-width:100%;border:1px solid #eee}
 figure{margin:1em 0}figcaption{font-size:.9em;color:#555}
 .note{background:#f7f7ee;border-left:4px solid #cc9;padding:.5em 1em}pre{background:#f6f6f6;padding:.6em;overflow:auto;font-size:.85em}
-.bad{color:#b00;font-weight:bold}.good{color:#070}
+.bad{color:#b00;font-weight:bold}.good{color:#070}.answer{font-size:1.1em}
 """
 
 escape = html.escape

@@ -59,6 +59,10 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert {"diagnosis.html", "diagnosis.json", "augmented_model.yaml", "ranking.json"} <= set(manifest["files"])
     html = (out / "diagnosis.html").read_text()
     assert html.count("data:image/png;base64,") == 3 and "asymmetric_friction" in html
+    # the answer first: the claim and the held-out force error, nominal -> augmented
+    held = data["held_out_force_error_percent"]
+    assert (f"<b>Claimed: asymmetric_friction.</b> Held-out force error {held['nominal']:.3f} % (nominal) → "
+            f"{held['augmented']:.3f} % (augmented" in html)
     assert "Unexplained: where" in html and "Residual-input independence" in html
     assert "a friction along the travel, which is a level over a short run, needs one of the two" in html
     # which held-out runs carry each fitted candidate: a row per fitted candidate, a column per held-out run

@@ -56,8 +56,17 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     augmented = load_params(out / "augmented_params.yaml")
     assert augmented.disturbance.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
     manifest = json.loads((out / "manifest.json").read_text())
-    assert set(manifest["files"]) == {"augmented_params.yaml", "diagnosis.json", "summary.txt",
+    assert set(manifest["files"]) == {"augmented_params.yaml", "diagnosis.html", "diagnosis.json", "summary.txt",
                                       "nominal_params.yaml", "ranking.json"}
+    # the report leads with the answer: the claim and the held-out force error params file -> fitted -> augmented
+    html = (out / "diagnosis.html").read_text()
+    answer = html[html.index("<h2>Answer</h2>"):html.index("<h2>Fitted params file fields")]
+    errs = [f"{e:.3f} %" for e in (result["prior_test_errors"], result["nominal_test_errors"], result["test_errors"])
+            for e in [float(np.sqrt(np.mean([v["force"] ** 2 for v in e.values()])))]]
+    assert "Claimed: lead_error." in answer and all(e in answer for e in errs), answer
+    assert "table.seal_force" in html and "N</td>" in html  # the fitted field with its unit
+    assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
+    assert html.count("<img") == 2 and "Unexplained: where" in html
     # the fitted params file before any claim: its seal force carries the missing lead error's bias (3.1 N), the
     # refit with the lead error comes back to the truth's (the params file's, 4.0 N)
     nominal, truth = load_params(out / "nominal_params.yaml"), quick_replay_params(preset("paper")).table.seal_force

@@ -1,0 +1,164 @@
+"""Self-contained HTML report of the ``drakecreep`` kind's gap diagnosis (the project's own Drake model and params
+file, :func:`drakecreep.gap.drive_fit.diagnose_drive`), plots embedded as base64 PNG.
+
+What ``drakecreep diagnose --out`` writes beside ``augmented_params.yaml``, ``diagnosis.json`` and ``summary.txt``
+for runs of ``controller: {kind: drakecreep}``: the answer first (what is claimed, how far the held-out force error
+shrinks), then the fitted params file fields with their intervals, each candidate's training and held-out tests,
+every held-out run's errors, and where the augmented model's residual lies (:func:`where_parts`, shared with the
+``p_p_cascade`` kind's report).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drakecreep.gap.drake_replay import rms_force_error
+from drakecreep.report.gap_report import _fig_png, where_parts
+
+__all__ = ["edge_value", "write_drive_report"]
+
+#: SI unit -> (factor, unit at the edge) of a DriveParams field in the report; lengths in mm, or um below 1 mm
+_EDGE = {"m/s": (1e3, "mm/s"), "N/m": (1e-6, "N/um"), "N s/m": (1.0, "N s/m")}
+
+
+def edge_value(value, unit):
+    """``(value, unit)`` of an SI field value in the units feed-drive engineers read (mm/s, N/um; a length in mm,
+    or in um when it is below 1 mm); other units as they are."""
+    if unit == "m":
+        return (value * 1e6, "um") if abs(value) < 1e-3 else (value * 1e3, "mm")
+    factor, shown = _EDGE.get(unit, (1.0, unit))
+    return value * factor, shown
+
+
+def _with_unit(value, unit):
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        return str(value)
+    v, u = edge_value(float(value), unit)
+    return f"{v:.4g}" + ("" if u in ("", "-") else f" {u}")
+
+
+def _figures(result):
+    import matplotlib.pyplot as plt
+
+    figs = []
+    ranked = [c for c in result.candidates if c.test_errors]
+    if ranked:
+        fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
+        y = np.arange(len(ranked))[::-1]
+        ax.barh(y + 0.2, [c.gain for c in ranked], 0.4, label="held-out gain (green: passes)",
+                color=["tab:green" if c.passes else "tab:gray" for c in ranked])
+        ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
+                label="its bar (t quantile x standard error of the per-run gains)")
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_yticks(y, [c.name for c in ranked])
+        ax.set_xlabel("held-out force error decrease [points of %]")
+        ax.legend(fontsize=8, loc="lower right")
+        figs.append((_fig_png(fig), "Which effect: each fitted candidate's held-out gain against its bar"))
+    labels = list(result.nominal_test_errors)
+    if labels:
+        fig, ax = plt.subplots(figsize=(8, 3))
+        x = np.arange(len(labels))
+        for k, (errors, name) in enumerate(((result.prior_test_errors, "params file"),
+                                            (result.nominal_test_errors, "fitted"),
+                                            (result.test_errors, "augmented: " + (" + ".join(result.claimed)
+                                                                                  or "nothing claimed")))):
+            ax.bar(x + 0.27 * (k - 1), [errors[lab]["force"] for lab in labels], 0.27, label=name)
+        ax.set_xticks(x, labels, rotation=30, fontsize=8)
+        ax.set_ylabel("force error [% of ||F||]")
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=3)
+        figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
+    return figs
+
+
+def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the project's Drake model)",
+                       scored=None, **extra):
+    """Write ``diagnosis.html`` of a :class:`drakecreep.gap.drive_fit.DriveDiagnosis` into an output set.
+
+    Parameters
+    ----------
+    result : drakecreep.gap.drive_fit.DriveDiagnosis
+    outset : drakecreep.files.OutputSet
+        The output set to write into (its manifest is committed by the caller).
+    title : str
+    scored : dict, optional
+        ``{"data": name, "errors_percent": {run label: replay errors [%]}}`` of the augmented params replayed,
+        fixed, on another file.
+    **extra
+        ``data``, ``train_runs``, ``test_runs`` (shown at the top).
+
+    Returns
+    -------
+    pathlib.Path
+        The HTML file.
+    """
+    from drakecreep.params import field_unit
+    from drakecreep.report.html import escape, figure, page, table
+
+    parts = [f"<h1>{escape(title)}</h1>"]
+    if extra.get("data"):
+        parts.append(f"<p>Data: <code>{escape(str(extra['data']))}</code>; training runs "
+                     f"{escape(', '.join(extra.get('train_runs', [])))}; held-out runs "
+                     f"{escape(', '.join(extra.get('test_runs', [])))}. Diagnosis {result.seconds:.0f} s, "
+                     f"{result.simulations} closed-loop replays of the Drake diagram.</p>")
+    claimed = " + ".join(result.claimed) or "nothing"
+    parts.append(f"<h2>Answer</h2><p class='answer'><b>Claimed: {escape(claimed)}.</b> Held-out force error "
+                 f"{rms_force_error(result.prior_test_errors):.3f} % (params file) → "
+                 f"{rms_force_error(result.nominal_test_errors):.3f} % (fitted) → "
+                 f"{rms_force_error(result.test_errors):.3f} % (augmented, closed-loop replay). The augmented "
+                 "params file is <code>augmented_params.yaml</code> beside this page "
+                 "(<code>drakecreep simulate/margins/report --params</code> take it).</p>")
+    # the claim's reason when nothing is claimed, what is left unexplained, the hints (the headline has the rest)
+    parts.append("<ul>" + "".join(f"<li>{escape(line.strip())}</li>" for line in result.summary()
+                                  if line.startswith(("claimed: nothing", "hint", "unexplained", "explained")))
+                 + "</ul>")
+    parts.append("<p class='note'>A candidate is claimed only when it lowers the training runs' force error, its "
+                 "closed-loop replay of the held-out runs (parameters fixed from the training runs) beats the fitted "
+                 "params file by more than the t quantile times the standard error of the per-run gains, and the "
+                 "pooled held-out force-error energy shrinks by more than the run-to-run null (the largest change "
+                 "when the uncertain fields are refitted with one training run left out"
+                 + ("" if result.replay_null is None else f": {100 * result.replay_null:.2f} %")
+                 + "), with most held-out runs better.</p>")
+    parts.append("<h2>Fitted params file fields (training runs, closed-loop output error)</h2>")
+    prior = result.prior
+    parts.append(table(["field", "value", "95 % interval", "params file"],
+                       [[f.path, _with_unit(f.value, f.unit),
+                         f"{_with_unit(f.lower, f.unit)} – {_with_unit(f.upper, f.unit)}",
+                         _with_unit(f.prior, f.unit)] for f in result.fitted]))
+    if result.warnings:
+        parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in result.warnings) + "</ul>")
+    rows = []
+    for c in result.candidates:
+        fitted = bool(c.values or c.test_errors)
+        rt = c.replay or {}
+        rows.append([c.name, f"{100 * c.train_gain:+.2f}" if fitted else "-",
+                     f"{c.gain:+.3f} (bar {c.threshold:.3f})" if fitted else "-",
+                     f"{100 * rt['shrink']:+.2f} ({rt['runs_better']} of {len(rt['log_ratios'])} runs better)"
+                     if fitted and rt.get("log_ratios") else "-",
+                     "yes" if c.name in result.claimed else "passes, not claimed" if c.passes else "no",
+                     c.reason,
+                     "; ".join(f"{k} = {_with_unit(v, field_unit(prior, k))}" for k, v in c.values.items())])
+    parts.append("<h2>Which effect: the candidates, best held-out gain first</h2>")
+    parts.append(table(["effect", "training gain [% of SSE]", "held-out gain [points of %]",
+                        "pooled held-out shrink [%]", "claimed", "why", "fitted fields"], rows))
+    parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
+    sig = [s for s in ("position", "velocity", "acceleration", "force", "table_position")
+           if all(s in e for e in result.test_errors.values())]
+    parts.append(table(["held-out run"] + [f"{s.replace('_', ' ')} error [%] params file → fitted → augmented"
+                                           for s in sig],
+                       [[lab] + [f"{result.prior_test_errors[lab][s]:.4g} → {result.nominal_test_errors[lab][s]:.4g}"
+                                 f" → {result.test_errors[lab][s]:.4g}" for s in sig]
+                        for lab in result.test_errors]))
+    if scored:
+        errs = scored["errors_percent"]
+        parts.append(f"<h2>Scored on {escape(str(scored.get('data', '')))} (the augmented params, fixed)</h2>")
+        parts.append(table(["run", "position error [%]", "force error [%]"],
+                           [[lab, f"{e['position']:.4g}", f"{e['force']:.4g}"] for lab, e in errs.items()]))
+    if result.oscillation:
+        parts.append("<h2>An oscillation of the measured runs</h2><ul>"
+                     + "".join(f"<li>{escape(line.strip())}</li>" for line in result.oscillation_lines()) + "</ul>")
+    parts += where_parts(result.where)
+    parts.append("<h2>Never ranked</h2>")
+    parts.append(table(["effect", "why"], [[n, why] for n, why in result.not_ranked.items()]))
+    for png, caption in _figures(result):
+        parts.append(figure(png, caption))
+    return outset.write_text("diagnosis.html", page(title, parts))
