@@ -13,6 +13,12 @@ effect is screened on inverse dynamics, fitted in closed loop and replayed on th
 effects that pass are added greedily. --out writes ranking.json as soon as the ranking is known, then
 diagnosis.html, diagnosis.json and augmented_model.yaml; ``--score FILE`` replays the augmented model, every
 parameter fixed, on another file (e.g. the EMPS validation set), whole runs.
+
+Runs of controller kind drakecreep (the project's PI cascade, a params file in the metadata) are replayed through
+that params file's drive diagram (docs/gap_drakecreep_kind.md): the --uncertain values are fitted by output error
+with 95 % intervals, the Drake model's candidate effects are fitted and claimed on the held-out runs. --out writes
+nominal_params.yaml when the nominal fit ends and ranking.json after each candidate, then diagnosis.html,
+diagnosis.json, summary.txt and augmented_params.yaml (for simulate, margins and report --params).
 """
 
 import os
@@ -30,7 +36,7 @@ __all__ = ["add_parser", "run", "load_runs", "pick"]
 def add_parser(subparsers):
     """Register ``diagnose``."""
     p = subparsers.add_parser("diagnose", help="sim-to-real gap diagnosis of measured runs (where, which effect, shrink)",
-                              description="\n\n".join(__doc__.split("\n\n")[:3]))
+                              description="\n\n".join(__doc__.split("\n\n")[:4]))
     p.add_argument("data", metavar="DATA", help="EMPS .mat file (or 'estimation'), or a measured run "
                    "(CSV/Parquet/HDF5/.mat + metadata YAML; see docs/measured_format.md)")
     p.add_argument("--meta", metavar="FILE", help="metadata YAML of a CSV (default: beside it)")

@@ -139,3 +139,11 @@ def test_nominal_friction_is_refused_for_drakecreep_runs(own_csv, capsys):
     assert cli.main(["diagnose", str(path), "--nominal-friction", "lugre"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--nominal-friction" in err[0]
+
+
+def test_help_describes_the_drakecreep_kind_and_what_it_writes(capsys):
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["diagnose", "--help"])
+    out = " ".join(capsys.readouterr().out.split())
+    assert stop.value.code == 0
+    assert "Runs of controller kind drakecreep" in out and "augmented_params.yaml (for simulate, margins" in out
