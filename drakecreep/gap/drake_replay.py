@@ -83,6 +83,11 @@ def check_replayable(run):
         raise InputError("controller", None, "a controller in the run metadata (p_p_cascade or drakecreep)")
     if ctrl.kind == "drakecreep" and run.meta.params is None:
         raise InputError("params", None, "a drakecreep params file in the metadata for controller kind drakecreep")
+    if ctrl.kind == "drakecreep":
+        from drakecreep.sim.simulation import check_step_budget  # pydrake: not at import
+
+        # a params file's max_step or velocity_period of 1e-9 s replayed for days
+        check_step_budget(run.meta.params, float(run.t[-1] - run.t[0]))
     if ctrl.kind == "p_p_cascade" and abs(ctrl.sample_time - run.dt) > 1e-6 * run.dt:
         raise InputError("controller.sample_time", ctrl.sample_time, f"the run's sample time {run.dt:g} s")
     if run.n < 20:

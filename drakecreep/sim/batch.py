@@ -26,7 +26,7 @@ from drakecreep.model.nut_friction import nut_friction_levels
 from drakecreep.sim.baseline import BaselineModel
 from drakecreep.errors import InputError
 from drakecreep.sim.metrics import feed_metrics
-from drakecreep.sim.simulation import check_log_period, make_simulator, target_accuracy
+from drakecreep.sim.simulation import check_log_period, check_step_budget, make_simulator, target_accuracy
 
 __all__ = ["BatchedFeedDrive", "batch_key", "simulate_batch"]
 
@@ -259,6 +259,8 @@ def simulate_batch(cases):
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration, sim.steady_start)
+    for case_params, case_scenario in cases:
+        check_step_budget(case_params, case_scenario.duration)
     models = [BaselineModel(p, s) for p, s in cases]
     builder = DiagramBuilder()
     plant = builder.AddSystem(BatchedFeedDrive(models))

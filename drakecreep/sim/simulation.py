@@ -48,8 +48,8 @@ from drakecreep.sim.metrics import feed_metrics
 from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
 
-__all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "target_accuracy", "FIXED_STEP",
-           "ACCURACY_BY_LAW", "MAX_SAMPLES", "MIN_WINDOW_SAMPLES", "MODELS",
+__all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "check_step_budget", "target_accuracy",
+           "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS",
            "MAX_TABLE_SPEED", "MIN_STEP"]
 
 #: integrators without error control: they step at ``max_step``
@@ -57,6 +57,11 @@ FIXED_STEP = ("runge_kutta2",)
 #: most recorded samples of one run: 2e6 samples of the ~20 signals are ~0.3 GB in memory and a 0.5 GB CSV;
 #: a finer log (``log_period: 1e-8`` over seconds) would take minutes and gigabytes and show nothing more
 MAX_SAMPLES = 2_000_000
+#: most steps a run's settings may force: ``duration / simulation.max_step`` (every integrator steps at least that
+#: often) and ``duration / controller.velocity_period`` (a sampled controller's updates). The defaults force 5e3
+#: and 2e4 over 5 s, the longest run (3600 s) 3.6e6 and 1.4e7, about 15 minutes; a ``max_step`` or a
+#: ``velocity_period`` of 1e-9 s forced 5e9 steps over 5 s, a run of days that looked like a hang
+MAX_STEPS = 20_000_000
 #: Fewest recorded samples in the metrics window: the creep metrics difference the logged speed and count its
 #: stick-slip cycles; with fewer the result had no metrics at all, reported as a run that went well
 MIN_WINDOW_SAMPLES = 20
@@ -209,6 +214,19 @@ def check_log_period(log_period, duration, steady_start=None):
                          "duration or an earlier simulation.steady_start widens it)")
 
 
+def check_step_budget(params, duration):
+    """Refuse a ``simulation.max_step`` or (sampled controller) ``controller.velocity_period`` that forces more than
+    :data:`MAX_STEPS` steps over ``duration``, before the run starts."""
+    limits = [("simulation.max_step", params.simulation.max_step, "integrator steps per run")]
+    if params.controller.sampled:
+        limits.append(("controller.velocity_period", params.controller.velocity_period,
+                       "controller samples per run; or controller.sampled: false"))
+    for name, period, what in limits:
+        if duration / period > MAX_STEPS:
+            raise InputError(name, period, f">= {duration / MAX_STEPS:.3g} s for a {duration:g} s run (at most "
+                                           f"{MAX_STEPS:.0e} {what})")
+
+
 def _unit_tag(unit):
     return unit.replace(" ", "").replace("/", "_per_").replace("^", "")
 
@@ -322,6 +340,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     if sim.steady_start >= scenario.duration:
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration, sim.steady_start)
+    check_step_budget(params, scenario.duration)
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))

@@ -220,7 +220,7 @@ def make_cases(base, points, scenario=None, metric=None):
     InputError
         Naming the path and value of the first invalid point.
     """
-    from drakecreep.sim.simulation import check_log_period  # pydrake, as simulate below: not at import
+    from drakecreep.sim.simulation import check_log_period, check_step_budget  # pydrake, as simulate: not at import
 
     metric = metric or feed_report
     defaults = dataclasses.asdict(scenario) if isinstance(scenario, Scenario) else dict(scenario or {})
@@ -242,6 +242,7 @@ def make_cases(base, points, scenario=None, metric=None):
         if params.simulation.steady_start >= scen.duration:
             raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
         check_log_period(params.simulation.log_period, scen.duration, params.simulation.steady_start)
+        check_step_budget(params, scen.duration)
         params.load_case(scen.load_case)  # validates the load case number
         cases.append(Case(index=index, point=dict(point), params=params, scenario=scen,
                           key=case_key(params, scen, name)))

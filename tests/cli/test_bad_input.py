@@ -79,6 +79,10 @@ PARAM_TEXTS = {
     "log_period_tiny": ("simulation: {log_period: 1.0e-8}\n", "simulation.log_period"),
     # 19 samples in the 19 s metrics window: the run used to end "ok" with no metrics at all
     "log_period_coarse": ("simulation: {log_period: 1.0}\n", "at least 20 recorded samples in the metrics window"),
+    # 2e10 integrator steps or controller samples over the 20 s run: it ran for days
+    "max_step_tiny": ("simulation: {max_step: 1.0e-9}\n", "simulation.max_step"),
+    "velocity_period_tiny": ("controller: {velocity_period: 1.0e-9, position_period: 1.0e-9}\n",
+                             "controller.velocity_period"),
     "seed_like_bool": ("controller: {anti_windup: 3}\n", "anti_windup"),
     "binary_nul": ("table:\x00\x01\x02 {mass: 3}\n", "UTF-8"),
 }
@@ -90,7 +94,7 @@ def test_bad_parameter_files(name, tmp_path, capsys):
     path = tmp_path / f"{name}.yaml"
     path.write_text(text)
     argv = ["simulate", "--params", str(path), "--duration", "20", "--out", str(tmp_path / "out")]
-    if name.startswith("log_period"):
+    if name.startswith(("log_period", "max_step", "velocity_period")):
         argv += ["--load-case", "0"]
     code, _, err = _run(argv, capsys)
     _one_line_exit_2(code, err, fragment)
@@ -165,6 +169,7 @@ SPECS = {
     "group_as_axis": ("axes:\n  table: [1, 2]\n", "table.mass"),
     "group_in_base": ("base: {set: {table: 1}}\naxes:\n  nut.mass: [0.3]\n", "not the whole group"),
     "cases_as_number": ("base: {set: {loads.cases: 1}}\naxes:\n  nut.mass: [0.3]\n", "loads.cases"),
+    "max_step_tiny": ("axes:\n  simulation.max_step: [1.0e-3, 1.0e-9]\n", "simulation.max_step"),
 }
 
 

@@ -393,3 +393,21 @@ def test_sampled_replay_keeps_a_limit_cycle_the_default_accuracy_misses():
     assert drake_replay_errors(fast)["force"] > 100 and drake_replay_errors(tight)["force"] > 100
     loose = DrakeReplay(run, flexible=True).simulate(p)
     assert np.ptp(loose.u[-300:]) < 0.5 * sat and drake_replay_errors(loose)["force"] < 20
+
+
+@pytest.mark.parametrize("path", ["simulation.max_step", "controller.velocity_period"])
+def test_a_drakecreep_run_whose_params_force_billions_of_steps_is_refused_before_the_replay(path):
+    """A metadata params file with a max_step (or a speed-loop period) of 1e-9 s replayed an 8 s run for days."""
+    from drakecreep.gap.drake_replay import check_replayable
+    from drakecreep.params import preset, with_value
+
+    p = with_value(preset("rigid_axis"), path, 1e-9)
+    if path == "controller.velocity_period":
+        p = with_value(p, "controller.position_period", 1e-9)
+    t = np.arange(8000) * 1e-3
+    x = 1e-3 * np.sin(t)
+    meta = MeasuredMeta(u_units="N", u_gain=1.0, params=p, controller=ControllerMeta(kind="drakecreep"))
+    run = MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.cos(t), meta=meta)
+    with pytest.raises(InputError, match=f"^{path}: got 1e-09; .*for a 7.999 s run"):
+        check_replayable(run)
+    check_replayable(dataclasses.replace(run, meta=dataclasses.replace(meta, params=preset("rigid_axis"))))

@@ -94,6 +94,17 @@ def test_steady_window_must_fit(paper):
         simulate(paper, Scenario(duration=0.5))
 
 
+@pytest.mark.parametrize("settings", [{"simulation.max_step": 1e-9},
+                                      {"controller.velocity_period": 1e-9, "controller.position_period": 1e-9}])
+def test_settings_that_force_billions_of_steps_are_refused_before_the_run(short_paper, settings):
+    # a max_step or a sampled controller's period of 1e-9 s forced 1e9 steps per simulated second: a run of days
+    p = short_paper
+    for path, value in settings.items():
+        p = with_value(p, path, value)
+    with pytest.raises(InputError, match=f"^{list(settings)[0]}: .*[(]at most 2e[+]07"):
+        simulate(p, Scenario(duration=1.0), wall_limit=5.0)  # (it ran to the wall limit: status 'stopped')
+
+
 def test_gms_friction_runs_in_the_drake_diagram_and_sticks_at_low_feed():
     """friction.law: gms plugs into NutTable like LuGre (N states); the compiled path runs it."""
     from drakecreep.params import preset, with_value
