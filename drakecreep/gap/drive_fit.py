@@ -323,6 +323,10 @@ class DriveDiagnosis:
         (:func:`drakecreep.gap.where.locate` of their replays): by regime, frequency band, order of the screw's
         revolution, operating point, residual-input independence, and for runs with a linear scale before or
         after the screw.
+    residuals : dict or None
+        One held-out run's measured minus replayed force [N] and motor position [m], fitted and augmented
+        (``{"label", "t", "nominal": {"force", "position"}, "augmented": {...}}``, the first held-out run; for the
+        report's figure, not in :meth:`to_json`).
     """
 
     prior: DriveParams
@@ -344,6 +348,7 @@ class DriveDiagnosis:
     nominal: DriveParams | None = None
     oscillation: dict | None = None
     where: dict = field(default_factory=dict)
+    residuals: dict | None = field(default=None, repr=False, compare=False)
 
     def oscillation_lines(self):
         """Lines of text on :attr:`oscillation` (none without one)."""
@@ -1413,4 +1418,12 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     return DriveDiagnosis(**known, params=current, fitted=fitted, warnings=warnings, candidates=tuple(candidates),
                           claimed=tuple(claimed), test_errors=current_errors, simulations=replay.count,
                           seconds=_time.perf_counter() - t0, oscillation=oscillation,
-                          where=locate(test, final_sims, lead=prior.screw.lead))
+                          where=locate(test, final_sims, lead=prior.screw.lead),
+                          residuals=_residual_traces(test[0], nominal_sims[0], final_sims[0]))
+
+
+def _residual_traces(run, nominal, augmented):
+    """:attr:`DriveDiagnosis.residuals` of held-out ``run`` from its fitted and augmented replays."""
+    return {"label": run.label, "t": run.t - run.t[0],
+            **{key: {"force": run.force - sim.force, "position": run.x_motor - sim.x_motor}
+               for key, sim in (("nominal", nominal), ("augmented", augmented))}}

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakecreep.gap.drake_replay import rms_force_error
-from drakecreep.report.gap_report import _fig_png, where_parts
+from drakecreep.report.gap_report import _fig_png, residual_figure, where_parts
 
 __all__ = ["edge_value", "write_drive_report"]
 
@@ -67,6 +67,8 @@ def _figures(result):
         ax.set_ylabel("force error [% of ||F||]")
         ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=3)
         figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
+    if result.residuals:
+        figs.append(residual_figure(result.residuals, ("fitted", "augmented")))
     return figs
 
 

@@ -13,7 +13,7 @@ from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.where import fixed_verdict, order_peak, oscillation_line
 
-__all__ = ["drake_to_json_dict", "ranking_json", "where_parts", "write_drake_report"]
+__all__ = ["drake_to_json_dict", "ranking_json", "residual_figure", "where_parts", "write_drake_report"]
 
 
 def ranking_json(nominal, nominal_test_errors, ranking):
@@ -166,17 +166,26 @@ def _drake_figures(diagnosis, residuals=None):
         ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2)
         figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
     if residuals:
-        fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
-        t = residuals["t"]
-        for key, lab in (("nominal", "nominal"), ("augmented", "augmented")):
-            axes[0].plot(t, residuals[key]["force"], lw=0.6, label=lab)
-            axes[1].plot(t, 1e6 * residuals[key]["position"], lw=0.6, label=lab)
-        axes[0].set_ylabel("force residual [N]")
-        axes[1].set_ylabel("position residual [µm]")
-        axes[1].set_xlabel("time [s]")
-        axes[0].legend(fontsize=8)
-        figs.append((_fig_png(fig), f"Where: measured minus replayed, held-out run {residuals['label']}"))
+        figs.append(residual_figure(residuals))
     return figs
+
+
+def residual_figure(residuals, names=("nominal", "augmented")):
+    """``(png, caption)``: one held-out run's measured minus replayed force [N] and motor position [µm] of the
+    model before and after the claims (``residuals``: ``{"label", "t", "nominal": {"force", "position"},
+    "augmented": {...}}``), ``names`` their legend entries. Both diagnoses' reports."""
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+    t = residuals["t"]
+    for key, lab in zip(("nominal", "augmented"), names):
+        axes[0].plot(t, residuals[key]["force"], lw=0.6, label=lab)
+        axes[1].plot(t, 1e6 * np.asarray(residuals[key]["position"]), lw=0.6, label=lab)
+    axes[0].set_ylabel("force residual [N]")
+    axes[1].set_ylabel("position residual [µm]")
+    axes[1].set_xlabel("time [s]")
+    axes[0].legend(fontsize=8)
+    return _fig_png(fig), f"Where: measured minus replayed, held-out run {residuals['label']}"
 
 
 

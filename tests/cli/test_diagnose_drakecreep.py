@@ -66,7 +66,7 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     assert "Claimed: lead_error." in answer and all(e in answer for e in errs), answer
     assert "table.seal_force" in html and "N</td>" in html  # the fitted field with its unit
     assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
-    assert html.count("<img") == 2 and "Unexplained: where" in html
+    assert html.count("<img") == 3 and "Unexplained: where" in html  # gains, errors by run, one run's residual
     # the fitted params file before any claim: its seal force carries the missing lead error's bias (3.1 N), the
     # refit with the lead error comes back to the truth's (the params file's, 4.0 N)
     nominal, truth = load_params(out / "nominal_params.yaml"), quick_replay_params(preset("paper")).table.seal_force
