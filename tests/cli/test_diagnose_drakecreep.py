@@ -47,7 +47,7 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     out = tmp_path / "diag"
     code = cli.main(["-q", "diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3",
                      "--uncertain", "table.seal_force", "--effects", "lead_error,stribeck",
-                     "--out", str(out), "--json"])
+                     "--out", str(out), "--json", "--score", str(path)])
     assert code == 0
     result = json.loads(capsys.readouterr().out)
     assert result["kind"] == "drakecreep.drive_diagnosis"
@@ -67,6 +67,9 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     assert "table.seal_force" in html and "N</td>" in html  # the fitted field with its unit
     assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
     assert html.count("<img") == 3 and "Unexplained: where" in html  # gains, errors by run, one run's residual
+    scored = result["scored"]["errors_percent"]  # the augmented params replayed, fixed, on the four runs
+    assert set(scored) == {"r0", "r1", "r2", "r3"} and "(the augmented params, fixed)" in html
+    assert f"<td>r1</td><td>{scored['r1']['position']:.4g}</td><td>{scored['r1']['force']:.4g}</td>" in html
     # the fitted params file before any claim: its seal force carries the missing lead error's bias (3.1 N), the
     # refit with the lead error comes back to the truth's (the params file's, 4.0 N)
     nominal, truth = load_params(out / "nominal_params.yaml"), quick_replay_params(preset("paper")).table.seal_force
