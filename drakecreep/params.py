@@ -184,7 +184,17 @@ class _Params:
             value = getattr(self, f.name)
             meta = f.metadata
             kind = hints[f.name]
-            if dataclasses.is_dataclass(kind) or typing.get_origin(kind) is tuple:
+            if dataclasses.is_dataclass(kind):
+                if not isinstance(value, kind):  # DriveParams(motor="x") failed deep in Drake, or not at all
+                    raise InputError(f.name, value, f"a {kind.__name__}")
+                continue
+            if typing.get_origin(kind) is tuple:
+                (item,) = {a for a in typing.get_args(kind) if a is not Ellipsis}
+                if isinstance(value, list):
+                    value = tuple(value)
+                    object.__setattr__(self, f.name, value)
+                if not isinstance(value, tuple) or not all(isinstance(v, item) for v in value):
+                    raise InputError(f.name, value, f"a tuple of {item.__name__}")
                 continue
             if kind is bool:
                 if not isinstance(value, bool):

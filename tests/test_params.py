@@ -4,8 +4,8 @@ import pytest
 
 from drakecreep.errors import InputError
 from drakecreep.params import (
-    DriveParams, get_value, load_params, params_from_dict, params_to_dict, preset, preset_text, save_params,
-    with_value,
+    DriveParams, LoadCase, LoadParams, get_value, load_params, params_from_dict, params_to_dict, preset, preset_text,
+    save_params, with_value,
 )
 
 
@@ -128,3 +128,23 @@ def test_a_measured_axis_model_is_refused_as_params_with_what_it_is(tmp_path):
     with pytest.raises(InputError, match="drakecreep.measured_axis.*load_model") as err:
         load_params(model)
     assert "unknown field" not in str(err.value)
+
+
+@pytest.mark.parametrize("build, field", [
+    (lambda: DriveParams(motor="x"), "motor"),
+    (lambda: DriveParams(motor=None), "motor"),
+    (lambda: DriveParams(screw=DriveParams().motor), "screw"),
+    (lambda: LoadParams(cases=(1, 2)), "cases"),
+    (lambda: LoadParams(cases="abc"), "cases"),
+    (lambda: LoadParams(cases=None), "cases"),
+    (lambda: with_value(DriveParams(), "loads.cases", (1, 2)), "loads.cases"),
+])
+def test_groups_and_lists_of_the_api_are_typed(build, field):
+    # they were accepted as given (DriveParams(motor="x") failed later, deep in the model, or not at all)
+    with pytest.raises(InputError, match=f"^{field}: got .*; allowed: a (tuple of )?[A-Z]"):
+        build()
+
+
+def test_a_list_of_load_cases_is_kept_as_a_tuple():
+    loads = LoadParams(cases=[LoadCase(fx=1.0)])
+    assert loads.cases == (LoadCase(fx=1.0),) and hash(loads)
