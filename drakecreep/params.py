@@ -11,6 +11,7 @@ assumption with its source.
 
 import dataclasses
 import math
+import numbers
 import re
 import typing
 from dataclasses import dataclass, field
@@ -204,10 +205,11 @@ class _Params:
                 if not isinstance(value, str) or (meta.get("choices") and value not in meta["choices"]):
                     raise InputError(f.name, value, _allowed(meta))
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
+            # numbers.Real and Integral: NumPy's scalars (np.float32, np.int64) are numbers too
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
                 raise InputError(f.name, value, _allowed(meta) if kind is float else "an integer")
             if kind is int and not isinstance(value, int):
-                if float(value).is_integer():
+                if isinstance(value, numbers.Integral) or float(value).is_integer():
                     value = int(value)
                     object.__setattr__(self, f.name, value)
                 else:
@@ -588,10 +590,14 @@ class DriveParams(_Params):
     def load_case(self, number):
         """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load. Its ``fx`` includes
         ``loads.constant_force``, so every model of the drive sees that force through this one method."""
+        allowed = f"an integer in 0..{len(self.loads.cases)} (0 = unloaded)"
+        if isinstance(number, bool) or not isinstance(number, numbers.Integral):  # True was case 1
+            raise InputError("load_case", number, allowed)
+        number = int(number)  # np.int64 too
         if number == 0:
             case = LoadCase()
-        elif not isinstance(number, int) or not 1 <= number <= len(self.loads.cases):
-            raise InputError("load_case", number, f"an integer in 0..{len(self.loads.cases)} (0 = unloaded)")
+        elif not 1 <= number <= len(self.loads.cases):
+            raise InputError("load_case", number, allowed)
         else:
             case = self.loads.cases[number - 1]
         if self.loads.constant_force == 0.0:

@@ -1,6 +1,7 @@
 """What to run: feed speed, load case and duration (the parameters say what the machine is)."""
 
 import math
+import numbers
 from dataclasses import dataclass
 
 from drakecreep.errors import InputError
@@ -30,11 +31,27 @@ class Scenario:
     duration: float = 5.0
 
     def __post_init__(self):
-        if isinstance(self.feed, bool) or not isinstance(self.feed, (int, float)) or not math.isfinite(self.feed) \
-                or self.feed == 0 or abs(self.feed) > MAX_FEED:
+        feed, duration = _finite_real(self.feed), _finite_real(self.duration)
+        if feed is None or feed == 0 or abs(feed) > MAX_FEED:
             raise InputError("feed", self.feed, f"a non-zero speed within +-{MAX_FEED} m/s")
-        if isinstance(self.load_case, bool) or not isinstance(self.load_case, int) or self.load_case < 0:
+        if isinstance(self.load_case, bool) or not isinstance(self.load_case, numbers.Integral) or self.load_case < 0:
             raise InputError("load_case", self.load_case, "an integer >= 0 (0 = unloaded)")
-        if isinstance(self.duration, bool) or not isinstance(self.duration, (int, float)) \
-                or not math.isfinite(self.duration) or not 0 < self.duration <= 3600:
+        if duration is None or not 0 < duration <= 3600:
             raise InputError("duration", self.duration, "a time in (0, 3600] s")
+        # NumPy's scalars (np.float32, np.int64) are numbers too: stored as Python's
+        object.__setattr__(self, "load_case", int(self.load_case))
+        for name, value in (("feed", feed), ("duration", duration)):
+            if not isinstance(getattr(self, name), (int, float)):
+                object.__setattr__(self, name, value)
+
+
+def _finite_real(value):
+    """``float(value)`` of a finite real number (NumPy's scalars too), else None (bool, text, NaN, inf, an integer
+    of hundreds of digits: float() overflowed, an 'internal error')."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None

@@ -148,3 +148,21 @@ def test_groups_and_lists_of_the_api_are_typed(build, field):
 def test_a_list_of_load_cases_is_kept_as_a_tuple():
     loads = LoadParams(cases=[LoadCase(fx=1.0)])
     assert loads.cases == (LoadCase(fx=1.0),) and hash(loads)
+
+
+def test_numpy_scalars_are_numbers():
+    # np.float32 and np.int64 were refused as 'a finite number' and 'an integer' (e.g. a value from np.arange)
+    import numpy as np
+
+    from drakecreep.params import MotorParams, SensorParams
+
+    assert MotorParams(rotor_inertia=np.float32(1e-4)).rotor_inertia == pytest.approx(1e-4)
+    counts = SensorParams(encoder_counts_per_rev=np.int64(4096)).encoder_counts_per_rev
+    assert counts == 4096 and type(counts) is int
+    paper = preset("paper")
+    assert paper.load_case(np.int64(2)) == paper.load_case(2)
+
+
+def test_true_is_no_load_case(paper):
+    with pytest.raises(InputError, match="^load_case: got True"):
+        paper.load_case(True)  # it was case 1
