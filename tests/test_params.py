@@ -67,6 +67,23 @@ def test_exponent_without_sign_is_a_float(tmp_path):
     assert load_params(path).nut.axial_stiffness == 4.2e7
 
 
+@pytest.mark.parametrize("text, shown", [("1:30", "'1:30'"), ("050", "'050'"), ("0b11", "'0b11'"),
+                                         ("1:30.5", "'1:30.5'")])
+def test_base_60_octal_and_binary_numbers_are_text(tmp_path, text, shown):
+    # YAML 1.1 read 'mass: 1:30' as 90 kg and 'mass: 050' as 40 kg, without a word
+    path = tmp_path / "p.yaml"
+    path.write_text(f"table: {{mass: {text}}}\n")
+    with pytest.raises(InputError, match=f"^table.mass: got {shown}; allowed: a finite number"):
+        load_params(path)
+
+
+def test_decimal_and_hex_integers_still_load(tmp_path):
+    path = tmp_path / "p.yaml"
+    path.write_text("table: {mass: 40}\nsensors: {encoder_counts_per_rev: 0x1000}\nnut: {mass: 0}\n")
+    p = load_params(path)
+    assert (p.table.mass, p.sensors.encoder_counts_per_rev, p.nut.mass) == (40.0, 4096, 0.0)
+
+
 @pytest.mark.parametrize(
     "data, field, fragment",
     [
