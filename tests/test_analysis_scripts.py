@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ANALYSIS = Path(__file__).resolve().parents[1] / "analysis"
@@ -229,3 +230,23 @@ def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
                          env=env, capture_output=True, text=True, timeout=300)
     assert out.returncode == 2 and "Traceback" not in out.stderr and field in out.stderr.strip().splitlines()[-1]
     assert not (tmp_path / "x.json").exists()
+
+
+def test_the_shipped_drive_example_is_what_its_script_makes():
+    """``drakecreep/data/examples/drive_lead_error.csv`` (runs of the project's controller) is what
+    ``analysis/make_drive_example.py`` writes: its runs, sample by sample, and its metadata's params file, the test
+    rig without the lead error the runs carry."""
+    from drakecreep.data import example_path
+    from drakecreep.gap.measured import load_measured
+
+    spec = importlib.util.spec_from_file_location("mde", ANALYSIS / "make_drive_example.py")
+    mde = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mde)
+    rig, runs = mde.example_runs()
+    shipped = load_measured(example_path("drive_lead_error.csv"))
+    assert [r.label for r in shipped.runs] == [r.label for r in runs] and len(runs) == len(mde.SPEEDS)
+    for got, want in zip(shipped.runs, runs):
+        np.testing.assert_allclose(got.x_motor, want.x_motor, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(got.u, want.u, rtol=1e-12, atol=1e-9)
+    assert shipped.meta.controller.kind == "drakecreep" and shipped.meta.params == rig
+    assert shipped.meta.params.disturbance.lead_error_amplitude == 0.0 and mde.LEAD_ERROR > 0
