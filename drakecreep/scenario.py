@@ -6,10 +6,12 @@ from dataclasses import dataclass
 
 from drakecreep.errors import InputError
 
-__all__ = ["Scenario", "MAX_FEED"]
+__all__ = ["Scenario", "MAX_FEED", "MAX_DURATION"]
 
 #: largest feed accepted (m/s); feed drives of this class reach 0.5-1 m/s rapid traverse
 MAX_FEED = 1.0
+#: longest simulated time of one run (s)
+MAX_DURATION = 3600.0
 
 
 @dataclass(frozen=True)
@@ -36,8 +38,8 @@ class Scenario:
             raise InputError("feed", self.feed, f"a non-zero speed within +-{MAX_FEED} m/s")
         if isinstance(self.load_case, bool) or not isinstance(self.load_case, numbers.Integral) or self.load_case < 0:
             raise InputError("load_case", self.load_case, "an integer >= 0 (0 = unloaded)")
-        if duration is None or not 0 < duration <= 3600:
-            raise InputError("duration", self.duration, "a time in (0, 3600] s")
+        if duration is None or not 0 < duration <= MAX_DURATION:
+            raise InputError("duration", self.duration, f"a time in (0, {MAX_DURATION:g}] s")
         # NumPy's scalars (np.float32, np.int64) are numbers too: stored as Python's
         object.__setattr__(self, "load_case", int(self.load_case))
         for name, value in (("feed", feed), ("duration", duration)):

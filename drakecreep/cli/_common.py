@@ -134,3 +134,13 @@ def feed_from_mm_s(value, option="--feed"):
     if not math.isfinite(value) or not 1e-4 <= abs(value) <= MAX_FEED * 1e3:
         raise InputError(option, value, f"a feed of magnitude in [1e-4, {MAX_FEED * 1e3:g}] mm/s")
     return value * 1e-3
+
+
+def check_duration(value, option="--duration"):
+    """``value`` (s, already > 0) unless it is beyond one run's longest, :data:`drakecreep.scenario.MAX_DURATION`:
+    an InputError naming the option (the scenario's message named its field, 'duration: got 1e9')."""
+    from drakecreep.scenario import MAX_DURATION
+
+    if not value <= MAX_DURATION:
+        raise InputError(option, value, f"a time in (0, {MAX_DURATION:g}] s")
+    return value

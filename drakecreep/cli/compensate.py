@@ -1,6 +1,7 @@
 """``drakecreep compensate``: friction compensation methods against none over feeds and loads."""
 
-from drakecreep.cli._common import add_params_options, comma_items, distinct, params_from_args, positive_float, print_json
+from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, params_from_args,
+                                    positive_float, print_json)
 from drakecreep.errors import InputError
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS
 
@@ -65,8 +66,7 @@ def run(args):
 
     feeds = _list(args.feeds, "--feeds", float, lambda v: 1e-4 <= v <= MAX_FEED * 1e3,
                   f"comma-separated feeds in [1e-4, {MAX_FEED * 1e3:g}] mm/s")
-    if not args.duration <= 3600:
-        raise InputError("--duration", args.duration, "in (0, 3600] s")
+    check_duration(args.duration)
     n = len(params.loads.cases)
     loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
     if not 1 <= args.workers <= 256:

@@ -63,7 +63,12 @@ def run(args):
     info = None
     if args.calibrate:
         rows = _rows_option(args.calibrate)
-        params, info = calibrate(params, rows)
+        try:
+            params, info = calibrate(params, rows)
+        except InputError as err:  # the option, not the library's parameter ('calibration_rows: got (1,)')
+            if err.field != "calibration_rows":
+                raise
+            raise InputError("--calibrate", args.calibrate, err.allowed) from None
         name = f"{name}, calibrated on rows {args.calibrate}"
     elif name == "paper":
         rows = ()

@@ -2,7 +2,8 @@
 
 import sys
 
-from drakecreep.cli._common import add_params_options, feed_from_mm_s, number, params_from_args, positive_float, print_json
+from drakecreep.cli._common import (add_params_options, check_duration, feed_from_mm_s, number, params_from_args,
+                                    positive_float, print_json)
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run"]
@@ -65,6 +66,7 @@ def run(args):
     feed = feed_from_mm_s(args.feed)
     if not 0 <= args.load_case <= len(params.loads.cases):
         raise InputError("--load-case", args.load_case, f"an integer in 0..{len(params.loads.cases)} (0 = unloaded)")
+    check_duration(args.duration)
     if params.simulation.steady_start >= args.duration:
         raise InputError(
             "--duration", args.duration,

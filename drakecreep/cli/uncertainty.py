@@ -2,8 +2,8 @@
 
 import os
 
-from drakecreep.cli._common import (add_params_options, comma_items, distinct, existing_path, feed_from_mm_s,
-                                    params_from_args, positive_float, print_json, workers)
+from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, existing_path,
+                                    feed_from_mm_s, params_from_args, positive_float, print_json, workers)
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
@@ -93,6 +93,7 @@ def check_study(params, samples, feeds, load_cases, *, seed=0, duration=3.0, out
                                                f"of {len(feeds)} feed(s) x {len(load_cases)} load case(s))")
     if not 0 <= seed < 2**63:  # as a sweep spec's seed
         raise InputError("--seed", seed, "an integer in [0, 2**63)")
+    check_duration(duration)
     if params.simulation.steady_start >= duration:
         raise InputError("--duration", duration,
                          f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window")

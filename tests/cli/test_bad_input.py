@@ -411,6 +411,11 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["diagnose", "{example}", "--effects", ","], "--effects: got ','; allowed: comma-separated names, none blank"),
     (["diagnose", "{example}", "--effects", "position_ripple,position_ripple"], "given twice"),
     (["gap-benchmark", "--effects", "stribeck,", "--n-per-effect", "1"], "--effects"),
+    # the options, not the library's names ('duration: got 1000000000.0', 'calibration_rows: got (1,)')
+    (["simulate", "--out", "{tmp}/s", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
+    (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
+    (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1"], "--calibrate: got '1'; allowed: two rows"),
+    (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
