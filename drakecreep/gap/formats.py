@@ -175,6 +175,11 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
         if signal not in QUANTITY and signal != "u":
             signals[signal] = values  # unknown: the caller names it
             continue
+        if values.dtype.kind in "bmMc":  # read as floats they were 0/1, nanoseconds since 1970, or the real part
+            kind = {"b": "true/false", "m": "time spans", "M": "dates and times", "c": "complex numbers"}
+            raise InputError(f"{path}: column {signal}", f"{kind[values.dtype.kind]} ({values.dtype})",
+                             "real numbers" + (" (seconds from the run's start, or a unit in the header: t[ms])"
+                                               if signal == "t" else ""))
         try:
             data = values.to_numpy(dtype=float)
         except (TypeError, ValueError):
