@@ -95,6 +95,7 @@ from drakecreep.params import DriveParams, field_unit, get_value, save_params, w
 
 __all__ = [
     "FITTABLE",
+    "NOT_BOUNDED",
     "DEFAULT_UNCERTAIN",
     "EFFECTS",
     "NOT_IN_MODEL",
@@ -156,6 +157,8 @@ _BOUND = 4.0
 #: Decades beyond which a fitted field's 95 % interval is reported as not bounded (the fitted range itself spans
 #: e^8, 3.5 decades).
 _UNBOUNDED = 6.0
+#: How an interval that says nothing (:meth:`FittedParameter.bounded`) reads.
+NOT_BOUNDED = "not bounded by these runs"
 #: Largest leave-one-out step of a fitted field in the fit's log coordinate (a factor e).
 _TRUST = 1.0
 #: Trials of the Stribeck candidate's start besides the nominal's own curve (:func:`_stribeck_start` scales each
@@ -249,6 +252,11 @@ class FittedParameter:
     def contains(self, value):
         """Whether ``value`` lies in the 95 % interval."""
         return self.lower <= value <= self.upper
+
+    def bounded(self):
+        """Whether the runs bound the field at all (an interval of more than :data:`_UNBOUNDED` decades above its
+        lower bound, or an infinite one, does not)."""
+        return _bounded(self.lower, self.upper, _lower(self.path))
 
 
 @dataclass(frozen=True)
@@ -459,18 +467,20 @@ class DriveDiagnosis:
         })
 
 
-def _interval(lower, upper, fmt=".3g", floor=0.0):
-    """A 95 % interval as text; one spanning more than :data:`_UNBOUNDED` decades above the field's lower bound
-    ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is clipped) as such, not
-    as 1e-302 .. 1e+306. ``floor=-inf``: a field of :data:`_LINEAR` (no lower bound), bounded when finite."""
+def _bounded(lower, upper, floor=0.0):
+    """Whether a 95 % interval says anything: not one spanning more than :data:`_UNBOUNDED` decades above the
+    field's lower bound ``floor`` (the Jacobian says the runs do not determine the field at all; its exponent is
+    clipped, 1e-302 .. 1e+306). ``floor=-inf``: a field of :data:`_LINEAR` (no lower bound), bounded when finite."""
     if floor == -math.inf:
-        return f"{lower:{fmt}} .. {upper:{fmt}}" if math.isfinite(lower) and math.isfinite(upper) else \
-            "not bounded by these runs"
+        return math.isfinite(lower) and math.isfinite(upper)
     if not (lower > floor and math.isfinite(upper)):
-        return "not bounded by these runs"
-    if math.log10(upper - floor) - math.log10(lower - floor) > _UNBOUNDED:  # as logs: the ratio can overflow
-        return "not bounded by these runs"
-    return f"{lower:{fmt}} .. {upper:{fmt}}"
+        return False
+    return math.log10(upper - floor) - math.log10(lower - floor) <= _UNBOUNDED  # as logs: the ratio can overflow
+
+
+def _interval(lower, upper, fmt=".3g", floor=0.0):
+    """A 95 % interval as text, or "not bounded by these runs" (:func:`_bounded`)."""
+    return f"{lower:{fmt}} .. {upper:{fmt}}" if _bounded(lower, upper, floor) else NOT_BOUNDED
 
 
 def claims_withheld(oscillation):

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakecreep.gap.drake_replay import rms_force_error
+from drakecreep.gap.drive_fit import NOT_BOUNDED
 from drakecreep.report.gap_report import _fig_png, residual_figure, where_parts
 
 __all__ = ["edge_value", "write_drive_report"]
@@ -124,8 +125,8 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
     prior = result.prior
     parts.append(table(["field", "value", "95 % interval", "params file"],
                        [[f.path, _with_unit(f.value, f.unit),
-                         f"{_with_unit(f.lower, f.unit)} – {_with_unit(f.upper, f.unit)}",
-                         _with_unit(f.prior, f.unit)] for f in result.fitted]))
+                         f"{_with_unit(f.lower, f.unit)} – {_with_unit(f.upper, f.unit)}" if f.bounded()
+                         else NOT_BOUNDED, _with_unit(f.prior, f.unit)] for f in result.fitted]))
     if result.warnings:
         parts.append("<ul>" + "".join(f"<li class='bad'>{escape(w)}</li>" for w in result.warnings) + "</ul>")
     rows = []
