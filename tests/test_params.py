@@ -77,6 +77,14 @@ def test_base_60_octal_and_binary_numbers_are_text(tmp_path, text, shown):
         load_params(path)
 
 
+def test_a_signed_number_with_a_leading_point_is_a_float(tmp_path):
+    # YAML 1.2 reads -.5 as -0.5; the hardened loader had left it text, so a valid negative asymmetry was refused
+    path = tmp_path / "p.yaml"
+    path.write_text("friction: {coulomb_asymmetry: -.05, viscous_asymmetry: +.02}\ntable: {seal_force: .5e1}\n")
+    p = load_params(path)
+    assert (p.friction.coulomb_asymmetry, p.friction.viscous_asymmetry, p.table.seal_force) == (-0.05, 0.02, 5.0)
+
+
 def test_decimal_and_hex_integers_still_load(tmp_path):
     path = tmp_path / "p.yaml"
     path.write_text("table: {mass: 40}\nsensors: {encoder_counts_per_rev: 0x1000}\nnut: {mass: 0}\n")
