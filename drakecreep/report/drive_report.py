@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from drakecreep.gap.drake_replay import rms_force_error
-from drakecreep.gap.drive_fit import NOT_BOUNDED
+from drakecreep.gap.drive_fit import NOT_BOUNDED, claims_withheld
 from drakecreep.report.gap_report import _fig_png, residual_figure, where_parts
 
 __all__ = ["edge_value", "write_drive_report"]
@@ -107,8 +107,10 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
     parts.append(f"<h2>Answer</h2><p class='answer'><b>Claimed: {escape(claimed)}.</b> Held-out force error "
                  f"{rms_force_error(result.prior_test_errors):.3f} % (params file) → "
                  f"{rms_force_error(result.nominal_test_errors):.3f} % (fitted) → "
-                 f"{rms_force_error(result.test_errors):.3f} % (augmented, closed-loop replay). The augmented "
-                 "params file is <code>augmented_params.yaml</code> beside this page "
+                 f"{rms_force_error(result.test_errors):.3f} % (augmented, closed-loop replay)"
+                 + (": the runs oscillate where the model does not, so these are the oscillation's errors and any "
+                    "claim is made on the held-out spectrum" if claims_withheld(result.oscillation) else "")
+                 + ". The augmented params file is <code>augmented_params.yaml</code> beside this page "
                  "(<code>drakecreep simulate/margins/report --params</code> take it).</p>")
     # the claim's reason when nothing is claimed, what is left unexplained, the hints (the headline has the rest)
     parts.append("<ul>" + "".join(f"<li>{escape(line.strip())}</li>" for line in result.summary()

@@ -158,7 +158,7 @@ def test_control_delay_is_found_between_the_grid_points(delay_case):
     assert result.oscillation is None  # a stable loop with a larger delay: no sustained oscillation
 
 
-def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
+def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed(tmp_path):
     """Truth: a computation delay of 24 samples, past the rig's stability limit (20-24): the measured force
     oscillates at about 30 Hz, and the model (params file 1 sample; the delay grid ends at 16) does not. The
     diagnosis says so and claims nothing on samples of an oscillation whose phase is free: only the delay search
@@ -179,6 +179,13 @@ def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed():
     (line,) = [x for x in result.summary() if x.strip().startswith("force_ripple")]
     assert "not fitted" in line and "held-out gain" not in line  # no gain is printed for what was not replayed
     assert result.to_json()["oscillation"]["freq_Hz"] == o["freq_Hz"]
+    # the report's answer says the errors are the oscillation's, and shows it by its frequency
+    from drakecreep.files import OutputSet
+    from drakecreep.report.drive_report import write_drive_report
+
+    html = write_drive_report(result, OutputSet(tmp_path, "manifest.json").start()).read_text()
+    assert "<b>Claimed: nothing.</b>" in html and "the runs oscillate where the model does not" in html
+    assert "<h2>An oscillation of the measured runs</h2>" in html and f"{o['freq_Hz']:.0f} Hz" in html
     sims = [drive_fit.replay_drakecreep(r, truth) for r in runs[:2]]
     seen = dict(o)
     drive_fit._reproduces(seen, "controller.computation_delay", 24.0, runs[:2], sims)
