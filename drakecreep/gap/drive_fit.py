@@ -407,6 +407,12 @@ class DriveDiagnosis:
                  f"fitted {rms_force_error(self.nominal_test_errors):.3f} %"
                  + ("" if self.replay_null is None else
                     f"; run-to-run null of the replay {100 * self.replay_null:.2f} %")]
+        n = len(self.nominal_test_errors)
+        if n == 2:  # one degree of freedom: the bar is wide unless the two runs gain alike
+            lines.append(f"  note: two held-out runs: a claim's held-out gain must exceed "
+                         f"{stats.t.ppf(1 - ALPHA, 1):.2f} standard errors of the two runs' gains, so an effect that "
+                         f"helps one run much more than the other is rarely claimed (three runs: "
+                         f"{stats.t.ppf(1 - ALPHA, 2):.2f}); hold out more runs where you can")
         for f in self.fitted:
             ci = _interval(f.lower, f.upper, ".4g", _lower(f.path))
             lines.append(f"  {f.path} = {f.value:.4g} {f.unit} (95 % CI {ci}; params file {f.prior:.4g})")

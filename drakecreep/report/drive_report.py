@@ -112,10 +112,11 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
                     "claim is made on the held-out spectrum" if claims_withheld(result.oscillation) else "")
                  + ". The augmented params file is <code>augmented_params.yaml</code> beside this page "
                  "(<code>drakecreep simulate/margins/report --params</code> take it).</p>")
-    # the claim's reason when nothing is claimed, what is left unexplained, the hints (the headline has the rest)
+    # the claim's reason when nothing is claimed, what is left unexplained, the hints, a note on the bar (the
+    # headline has the rest)
     parts.append("<ul>" + "".join(f"<li>{escape(line.strip())}</li>" for line in result.summary()
-                                  if line.startswith(("claimed: nothing", "hint", "unexplained", "explained")))
-                 + "</ul>")
+                                  if line.startswith(("claimed: nothing", "hint", "unexplained", "explained"))
+                                  or line.strip().startswith("note:")) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when it lowers the training runs' force error, its "
                  "closed-loop replay of the held-out runs (parameters fixed from the training runs) beats the fitted "
                  "params file by more than the t quantile times the standard error of the per-run gains, and the "

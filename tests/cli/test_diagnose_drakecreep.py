@@ -53,6 +53,8 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     assert result["kind"] == "drakecreep.drive_diagnosis"
     assert result["train_runs"] == ["r0", "r1"] and result["test_runs"] == ["r2", "r3"]
     assert result["claimed"] == ["lead_error"]  # the withheld effect, and nothing else
+    note = [line for line in (out / "summary.txt").read_text().splitlines() if "two held-out runs" in line]
+    assert len(note) == 1 and "6.31 standard errors" in note[0]  # the width of Student's bar on two runs, said
     augmented = load_params(out / "augmented_params.yaml")
     assert augmented.disturbance.lead_error_amplitude == pytest.approx(2e-6, rel=0.1)
     manifest = json.loads((out / "manifest.json").read_text())
@@ -64,6 +66,7 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     errs = [f"{e:.3f} %" for e in (result["prior_test_errors"], result["nominal_test_errors"], result["test_errors"])
             for e in [float(np.sqrt(np.mean([v["force"] ** 2 for v in e.values()])))]]
     assert "Claimed: lead_error." in answer and all(e in answer for e in errs), answer
+    assert "note: two held-out runs" in answer
     assert "table.seal_force" in html and "N</td>" in html  # the fitted field with its unit
     assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
     assert html.count("<img") == 3 and "Unexplained: where" in html  # gains, errors by run, one run's residual
