@@ -97,6 +97,21 @@ def _read_rows(ap, option, path):
     return data
 
 
+def _seed_list(text):
+    """argparse type of ``--skip-seeds``: comma-separated seeds or ranges ``a-b`` (inclusive) as a tuple of int."""
+    seeds = []
+    for item in text.split(","):
+        lo, _, hi = item.strip().partition("-")
+        try:
+            first, last = int(lo), int(hi or lo)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{item!r} is no seed or range of seeds (e.g. 114000-114003)") from None
+        if not 0 <= first <= last or last - first > 100000:
+            raise argparse.ArgumentTypeError(f"{item!r}: seeds >= 0, first <= last, at most 100000 in a range")
+        seeds += range(first, last + 1)
+    return tuple(seeds)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-per-effect", type=int, default=3, help="diagnosed datasets per library effect with SNR >= 3")
@@ -124,7 +139,13 @@ def main():
                          "development study of another nominal, e.g. with loads.constant_force")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
+    ap.add_argument("--skip-seeds", metavar="SEEDS", type=_seed_list, default=(),
+                    help="--seeds dev alone: datasets not to draw, comma-separated seeds or ranges (e.g. "
+                         "114000-114003,104000): those an earlier study looked at; the next datasets take their place")
     args = ap.parse_args()
+    if args.skip_seeds and args.seeds != "dev":
+        ap.error(f"--skip-seeds: got {args.skip_seeds!r} with --seeds {args.seeds}; allowed: with --seeds dev only "
+                 "(a held-out run draws its datasets as they come)")
     if args.score:
         by_seed = {}  # a resumed shard repeats the rows it resumed from: each dataset is scored once
         for path in args.score:
@@ -167,7 +188,7 @@ def main():
 
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
                         progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library,
-                        uncertain=uncertain, effects=effects)
+                        uncertain=uncertain, effects=effects, skip=args.skip_seeds)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, {', '.join(args.kinds)}, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "

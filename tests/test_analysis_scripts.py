@@ -76,6 +76,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_gap_benchmark.py", ("--uncertain", "loads.constant_force"), "uncertain: got 'loads.constant_force'; "
                                                                       "allowed: only with kinds drakecreep alone"),
     ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,backlash"), "effects: got 'backlash'"),
+    ("bench_gap_benchmark.py", ("--skip-seeds", "104000"), "--skip-seeds: got (104000,) with --seeds heldout"),
+    ("bench_gap_benchmark.py", ("--seeds", "dev", "--skip-seeds", "114003-114000"), "'114003-114000': seeds >= 0"),
 ])
 def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, args, field):
     env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))

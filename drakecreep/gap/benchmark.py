@@ -780,7 +780,7 @@ def check_uncertain(kinds, uncertain):
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
-                  done=(), shard=(0, 1), library=None, uncertain=None):
+                  done=(), shard=(0, 1), library=None, uncertain=None, skip=()):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -805,6 +805,10 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     uncertain : sequence of str, optional
         The fields the ``drakecreep`` kind's nominal fit takes as uncertain (``diagnose_drive``'s ``uncertain``;
         default its ``DEFAULT_UNCERTAIN``); refused with a ``p_p_cascade`` kind, whose diagnosis fits its own axis.
+    skip : collection of int
+        Seeds of datasets neither generated nor diagnosed, and not counted: a development study's fresh datasets
+        beyond the ones an earlier study already looked at (a library effect's next datasets with SNR >= 3 take
+        their place; nulls and effects outside the library are fewer by as many).
 
     Returns
     -------
@@ -822,7 +826,9 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
             or not 0 <= shard[0] < shard[1]):
         raise InputError("shard", shard, "(i, n) with integers 0 <= i < n")
     say = (lambda line: print(f"[gap-benchmark] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None)
-    specs = benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool, n_no_candidate, library)
+    skip = {int(x) for x in skip}
+    specs = [s for s in benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool, n_no_candidate, library)
+             if s[0] not in skip]
     kept, skipped, pos = {}, {}, 0
     while pos < len(specs):
         part = []

@@ -278,6 +278,26 @@ def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkey
     assert again["datasets"][0]["marker"] == "earlier"
 
 
+def test_skipped_seeds_are_neither_generated_nor_diagnosed(monkeypatch):
+    """A development study's fresh datasets: the seeds an earlier study looked at are left out, and a library
+    effect's next dataset with SNR >= 3 takes a skipped one's place."""
+    from drakecreep.gap import benchmark
+
+    monkeypatch.setattr(benchmark, "evaluate", lambda ds, **kw: {"seed": ds.seed, "withheld": list(ds.withheld),
+                                                                 "claimed": [], "seconds": 0.0})
+    monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
+    kw = dict(seed=DEV_SEEDS, kinds=("p_p_cascade",), n_per_effect=2, n_null=3, n_ool=0, n_no_candidate=0,
+              audit=False, tries=4, library=["time_ripple"])  # two time ripples at SNR >= 3 of the first four
+    whole = run_benchmark(**kw)["datasets"]
+    nulls = [r["seed"] for r in whole if not r["withheld"]]
+    ripples = [r["seed"] for r in whole if r["withheld"]]
+    assert len(nulls) == 3 and len(ripples) == 2
+    fresh = run_benchmark(skip=[nulls[0], ripples[0]], **kw)["datasets"]
+    assert sorted(r["seed"] for r in fresh if not r["withheld"]) == sorted(nulls[1:])
+    again = [r["seed"] for r in fresh if r["withheld"]]
+    assert len(again) == 2 and ripples[0] not in again and ripples[1] in again  # the next one took its place
+
+
 def test_shards_split_one_run_without_overlap(monkeypatch):
     from drakecreep.gap import benchmark
 
