@@ -30,6 +30,7 @@ from drakecreep.files import write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
                                       check_effects, check_uncertain, run_benchmark, score_rows)
+from study_cli import seed_list
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
            "median_relative_shrink_snr3": ">= 70 %", "claims_making_audit_worse": "0"}
@@ -97,21 +98,6 @@ def _read_rows(ap, option, path):
     return data
 
 
-def _seed_list(text):
-    """argparse type of ``--skip-seeds``: comma-separated seeds or ranges ``a-b`` (inclusive) as a tuple of int."""
-    seeds = []
-    for item in text.split(","):
-        lo, _, hi = item.strip().partition("-")
-        try:
-            first, last = int(lo), int(hi or lo)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{item!r} is no seed or range of seeds (e.g. 114000-114003)") from None
-        if not 0 <= first <= last or last - first > 100000:
-            raise argparse.ArgumentTypeError(f"{item!r}: seeds >= 0, first <= last, at most 100000 in a range")
-        seeds += range(first, last + 1)
-    return tuple(seeds)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-per-effect", type=int, default=3, help="diagnosed datasets per library effect with SNR >= 3")
@@ -139,7 +125,7 @@ def main():
                          "development study of another nominal, e.g. with loads.constant_force")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
-    ap.add_argument("--skip-seeds", metavar="SEEDS", type=_seed_list, default=(),
+    ap.add_argument("--skip-seeds", metavar="SEEDS", type=seed_list, default=(),
                     help="--seeds dev alone: datasets not to draw, comma-separated seeds or ranges (e.g. "
                          "114000-114003,104000): those an earlier study looked at; the next datasets take their place")
     args = ap.parse_args()

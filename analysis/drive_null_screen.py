@@ -16,10 +16,10 @@ import json
 
 import numpy as np
 
-from drakecreep.gap.claims import replay_test
 from drakecreep.gap.drake_replay import quick_replay_params, simulated_runs
 from drakecreep.gap.drive_fit import diagnose_drive
 from drakecreep.params import preset, with_value
+from study_cli import seed_list
 
 RANGES = (("table.seal_force", 2.0, 8.0), ("friction.viscous", 150.0, 280.0), ("nut.preload_torque", 0.07, 0.11))
 
@@ -35,34 +35,20 @@ def screen(seed):
     origins = tuple(float(v) for v in rng.uniform(0, 0.005, 6))
     runs = simulated_runs(truth, speeds, declared=rig, n=500, noise=2.0, seed=seed * 10, origins=origins)
     res = diagnose_drive(runs[0::2], runs[1::2])
-    labels = list(res.nominal_test_errors)
-    nom = np.array([res.nominal_test_errors[k]["force"] for k in labels])
     out = {"seed": seed, "claimed": list(res.claimed), "null": res.replay_null, "candidates": []}
     for c in res.candidates:
         if not c.test_errors:
             continue
-        e = np.array([c.test_errors[k]["force"] for k in labels])
-        rt = replay_test(nom ** 2, e ** 2, res.replay_null or 0.0)
+        rt = c.replay  # the diagnosis's own pooled test, against its run-to-run null
         out["candidates"].append({"name": c.name, "train_gain": c.train_gain, "student": bool(c.gain > c.threshold),
                                   "pooled": rt["passes"],
                                   "shrink_in_nulls": rt["shrink"] / res.replay_null if res.replay_null else None})
     return out
 
 
-def _seeds(text):
-    lo, _, hi = text.partition("-")
-    try:
-        first, last = int(lo), int(hi or lo)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r}: a seed or a range of seeds, e.g. 1-6") from None
-    if not 0 <= first <= last:
-        raise argparse.ArgumentTypeError(f"{text!r}: a range of seeds >= 0, first <= last")
-    return range(first, last + 1)
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--seeds", type=_seeds, default=range(1, 7), help="seeds, e.g. 1-6 (default)")
+    ap.add_argument("--seeds", type=seed_list, default=range(1, 7), help="seeds or ranges, e.g. 1-6 (default)")
     args = ap.parse_args()
     for seed in args.seeds:
         print(json.dumps(screen(seed)), flush=True)

@@ -81,3 +81,19 @@ def case_type(effects, axis, example):
                 raise argparse.ArgumentTypeError(f"got {text!r}; allowed: {allowed}")
         return (seed, effect) if axis == "none" else (seed, effect, ax)
     return case
+
+
+def seed_list(text):
+    """argparse type of a list of seeds (``--skip-seeds``, ``--seeds``): comma-separated seeds or ranges ``a-b``
+    (inclusive) as a tuple of int."""
+    seeds = []
+    for item in text.split(","):
+        lo, _, hi = item.strip().partition("-")
+        try:
+            first, last = int(lo), int(hi or lo)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{item!r} is no seed or range of seeds (e.g. 114000-114003)") from None
+        if not 0 <= first <= last or last - first > 100000:
+            raise argparse.ArgumentTypeError(f"{item!r}: seeds >= 0, first <= last, at most 100000 in a range")
+        seeds += range(first, last + 1)
+    return tuple(seeds)

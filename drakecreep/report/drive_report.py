@@ -14,20 +14,16 @@ import numpy as np
 
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.drive_fit import NOT_BOUNDED, claims_withheld
-from drakecreep.report.gap_report import _fig_png, residual_figure, where_parts
+from drakecreep.report.gap_report import EDGE_UNITS, _fig_png, errors_by_run_figure, residual_figure, where_parts
 
 __all__ = ["edge_value", "write_drive_report"]
 
-#: SI unit -> (factor, unit at the edge) of a DriveParams field in the report; lengths in mm, or um below 1 mm
-_EDGE = {"m/s": (1e3, "mm/s"), "N/m": (1e-6, "N/um"), "N s/m": (1.0, "N s/m")}
-
-
 def edge_value(value, unit):
-    """``(value, unit)`` of an SI field value in the units feed-drive engineers read (mm/s, N/um; a length in mm,
-    or in um when it is below 1 mm); other units as they are."""
-    if unit == "m":
-        return (value * 1e6, "um") if abs(value) < 1e-3 else (value * 1e3, "mm")
-    factor, shown = _EDGE.get(unit, (1.0, unit))
+    """``(value, unit)`` of an SI field value in the units feed-drive engineers read (:data:`EDGE_UNITS`: mm/s,
+    N/um, a length in mm, or in um when it is below 1 mm); other units as they are."""
+    if unit == "m" and abs(value) < 1e-3:
+        return value * 1e6, "um"
+    factor, shown = EDGE_UNITS.get(unit, (1.0, unit))
     return value * factor, shown
 
 
@@ -55,19 +51,10 @@ def _figures(result):
         ax.set_xlabel("held-out force error decrease [points of %]")
         ax.legend(fontsize=8, loc="lower right")
         figs.append((_fig_png(fig), "Which effect: each fitted candidate's held-out gain against its bar"))
-    labels = list(result.nominal_test_errors)
-    if labels:
-        fig, ax = plt.subplots(figsize=(8, 3))
-        x = np.arange(len(labels))
-        for k, (errors, name) in enumerate(((result.prior_test_errors, "params file"),
-                                            (result.nominal_test_errors, "fitted"),
-                                            (result.test_errors, "augmented: " + (" + ".join(result.claimed)
-                                                                                  or "nothing claimed")))):
-            ax.bar(x + 0.27 * (k - 1), [errors[lab]["force"] for lab in labels], 0.27, label=name)
-        ax.set_xticks(x, labels, rotation=30, fontsize=8)
-        ax.set_ylabel("force error [% of ||F||]")
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=3)
-        figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
+    if result.nominal_test_errors:
+        figs.append(errors_by_run_figure([
+            ("params file", result.prior_test_errors), ("fitted", result.nominal_test_errors),
+            ("augmented: " + (" + ".join(result.claimed) or "nothing claimed"), result.test_errors)]))
     if result.residuals:
         figs.append(residual_figure(result.residuals, ("fitted", "augmented")))
     return figs

@@ -13,7 +13,8 @@ from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.where import fixed_verdict, order_peak, oscillation_line
 
-__all__ = ["drake_to_json_dict", "ranking_json", "residual_figure", "where_parts", "write_drake_report"]
+__all__ = ["EDGE_UNITS", "drake_to_json_dict", "errors_by_run_figure", "ranking_json", "residual_figure", "where_parts",
+           "write_drake_report"]
 
 
 def ranking_json(nominal, nominal_test_errors, ranking):
@@ -154,20 +155,31 @@ def _drake_figures(diagnosis, residuals=None):
         ax.legend(fontsize=8, loc="lower right")
         figs.append((_fig_png(fig), "Which effect: held-out gain against the nominal model, per candidate "
                                     "(green: passes the claim threshold)"))
-    labels = list(diagnosis.nominal_test_errors)
-    if labels:
-        fig, ax = plt.subplots(figsize=(8, 3))
-        x = np.arange(len(labels))
-        ax.bar(x - 0.2, [diagnosis.nominal_test_errors[k]["force"] for k in labels], 0.4, label="nominal")
-        ax.bar(x + 0.2, [diagnosis.test_errors[k]["force"] for k in labels], 0.4,
-               label="augmented: " + (" + ".join(diagnosis.claimed) or "nothing claimed"))
-        ax.set_xticks(x, labels, rotation=30, fontsize=8)
-        ax.set_ylabel("force error [% of ||F||]")
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2)
-        figs.append((_fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"))
+    if diagnosis.nominal_test_errors:
+        figs.append(errors_by_run_figure([
+            ("nominal", diagnosis.nominal_test_errors),
+            ("augmented: " + (" + ".join(diagnosis.claimed) or "nothing claimed"), diagnosis.test_errors)]))
     if residuals:
         figs.append(residual_figure(residuals))
     return figs
+
+
+def errors_by_run_figure(series):
+    """``(png, caption)``: the closed-loop replay force error of every held-out run, one bar per model of
+    ``series`` (``[(legend, {run label: replay errors [%]}), ...]``, the runs of the first). Both diagnoses'
+    reports."""
+    import matplotlib.pyplot as plt
+
+    labels = list(series[0][1])
+    fig, ax = plt.subplots(figsize=(8, 3))
+    x = np.arange(len(labels))
+    width = 0.8 / len(series)
+    for k, (name, errors) in enumerate(series):
+        ax.bar(x + width * (k - (len(series) - 1) / 2), [errors[lab]["force"] for lab in labels], width, label=name)
+    ax.set_xticks(x, labels, rotation=30, fontsize=8)
+    ax.set_ylabel("force error [% of ||F||]")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=len(series))
+    return _fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"
 
 
 def residual_figure(residuals, names=("nominal", "augmented")):
@@ -190,7 +202,7 @@ def residual_figure(residuals, names=("nominal", "augmented")):
 
 
 #: SI unit of a MeasuredAxis parameter -> (factor, unit at the edge): mm/s, mm, N/um in the report
-_EDGE_UNITS = {"m/s": (1e3, "mm/s"), "m": (1e3, "mm"), "N/m": (1e-6, "N/um")}
+EDGE_UNITS = {"m/s": (1e3, "mm/s"), "m": (1e3, "mm"), "N/m": (1e-6, "N/um")}
 
 
 def _edge(name, value):
@@ -201,7 +213,7 @@ def _edge(name, value):
     if name in LEAD_ERROR:
         return value * 1e6, "um"
     unit = AXIS_UNITS[name]
-    factor, shown = _EDGE_UNITS.get(unit, (1.0, unit))
+    factor, shown = EDGE_UNITS.get(unit, (1.0, unit))
     return value * factor, shown
 
 
