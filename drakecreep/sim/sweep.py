@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from drakecreep.model.drive_source import scenario_with_drive
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, short_repr
 from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.processes import new_pool, stop_pool
@@ -98,13 +98,30 @@ def _axis_values(path, values):
     return [v.item() if isinstance(v, np.generic) else v for v in values]
 
 
+def _check_distinct(path, values):
+    """A grid axis with a value twice would run its cases twice (1 and 1.0 are the same value)."""
+    seen = []
+    hashed = set()
+    for v in values:
+        try:
+            if v in hashed:
+                raise InputError(f"axes.{path}", values, f"distinct values ({short_repr(v, 40)} is there twice)")
+            hashed.add(v)
+        except TypeError:  # an unhashable value (a list): compared one by one
+            if any(v == w for w in seen):
+                raise InputError(f"axes.{path}", values, f"distinct values ({short_repr(v, 40)} is there twice)") \
+                    from None
+            seen.append(v)
+
+
 def grid(axes, max_cases=MAX_CASES):
     """Every combination of the axes' values (the first axis varies slowest).
 
     Parameters
     ----------
     axes : mapping
-        ``path -> list of values``; paths are parameter paths or scenario fields.
+        ``path -> list of values``; paths are parameter paths or scenario fields. The values of an axis are
+        distinct (a value twice, ``1`` and ``1.0`` alike, is refused: its cases would run twice).
 
     max_cases : int
         Refuse grids of more points (an :class:`InputError` before any is made).
@@ -118,6 +135,8 @@ def grid(axes, max_cases=MAX_CASES):
         return [{}]
     names = list(axes)
     lists = [_axis_values(n, axes[n]) for n in names]
+    for name, values in zip(names, lists):
+        _check_distinct(name, values)
     _check_size(math.prod(len(v) for v in lists), max_cases, "the grid")
     return [dict(zip(names, combo)) for combo in itertools.product(*lists)]
 

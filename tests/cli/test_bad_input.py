@@ -200,7 +200,7 @@ def test_sweep_cap_can_be_raised(tmp_path):
     from drakecreep.errors import InputError
     from drakecreep.sim.sweep import grid
 
-    axes = {"table.mass": list(range(1, 31)), "feed": [1e-3] * 10}
+    axes = {"table.mass": list(range(1, 31)), "feed": [1e-3 * k for k in range(1, 11)]}
     with pytest.raises(InputError, match="max-cases"):
         grid(axes, max_cases=100)
     assert len(grid(axes, max_cases=300)) == 300

@@ -36,6 +36,16 @@ def test_grid_is_the_cartesian_product_first_axis_slowest():
         grid({"feed": []})
 
 
+def test_a_grid_axis_with_a_value_twice_is_refused_naming_it():
+    with pytest.raises(InputError, match=r"axes\.feed: .*distinct values \(0\.001 is there twice\)"):
+        grid({"nut.axial_stiffness": [1e7], "feed": [1e-3, 2e-3, 1e-3]})
+    with pytest.raises(InputError, match="axes.load_case"):
+        grid({"load_case": [1, 1.0]})  # equal values in two types
+    with pytest.raises(InputError, match=r"axes\.x: .*\[1\] is there twice"):
+        grid({"x": [[1], [2], [1]]})  # unhashable values too
+    assert len(grid({"x": [[1], [2]], "feed": [1e-3, 2e-3]})) == 4
+
+
 def test_random_sample_is_seeded_and_within_bounds():
     axes = {"nut.axial_stiffness": {"low": 1e6, "high": 1e8, "scale": "log"},
             "load_case": {"low": 1, "high": 3}, "friction.law": ["lugre", "stribeck"]}
