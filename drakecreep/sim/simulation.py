@@ -48,8 +48,8 @@ from drakecreep.sim.metrics import feed_metrics
 from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
 
-__all__ = ["SimulationResult", "simulate", "make_simulator", "check_log_period", "check_step_budget", "target_accuracy",
-           "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS",
+__all__ = ["SimulationResult", "simulate", "make_simulator", "check_run", "check_log_period", "check_step_budget",
+           "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS",
            "MAX_TABLE_SPEED", "MIN_STEP"]
 
 #: integrators without error control: they step at ``max_step``
@@ -288,6 +288,48 @@ def _guard(simulator, root, read_speeds, bounds, wall_limit):
     return report
 
 
+def check_run(params, scenario, *, backend=None, model="two_mass", multibody=None):
+    """Refuse a run :func:`simulate` would refuse, before it is built: a caller that runs many (a process pool)
+    checks them all first, so bad input gets its one line before any work.
+
+    Parameters
+    ----------
+    params, scenario, backend, model, multibody
+        As :func:`simulate`.
+
+    Returns
+    -------
+    str
+        The backend the run uses (``backend`` or ``params.simulation.backend``).
+
+    Raises
+    ------
+    InputError
+        An unknown model or backend, a fractional computation delay on the compiled backend, a metrics window
+        that starts after the run ends, too many recorded samples or steps (:func:`check_log_period`,
+        :func:`check_step_budget`).
+    """
+    sim = params.simulation
+    if model not in MODELS:
+        raise InputError("model", model, " or ".join(MODELS))
+    if model == "two_mass" and multibody is not None:
+        raise InputError("multibody", multibody, "None with model two_mass")
+    backend = backend or sim.backend
+    if backend not in ("compiled", "leaf"):
+        raise InputError("backend", backend, "compiled or leaf")
+    delay = params.controller.computation_delay
+    if backend == "compiled" and params.controller.sampled and not float(delay).is_integer():
+        # a fractional delay switches the command between samples: a second event timing, which the
+        # symbolic fast path (one sampler) does not have; the leaf systems run it exactly
+        raise InputError("controller.computation_delay", delay,
+                         "a whole number of samples with simulation.backend: compiled (fractional: backend leaf)")
+    if sim.steady_start >= scenario.duration:
+        raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
+    check_log_period(sim.log_period, scenario.duration, sim.steady_start)
+    check_step_budget(params, scenario.duration)
+    return backend
+
+
 def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass", multibody=None):
     """Simulate ``scenario`` on the drive described by ``params``, with a convergence check.
 
@@ -324,23 +366,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
                                    or not wall_limit > 0):
         raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
     sim = params.simulation
-    if model not in MODELS:
-        raise InputError("model", model, " or ".join(MODELS))
-    if model == "two_mass" and multibody is not None:
-        raise InputError("multibody", multibody, "None with model two_mass")
-    backend = backend or sim.backend
-    if backend not in ("compiled", "leaf"):
-        raise InputError("backend", backend, "compiled or leaf")
-    delay = params.controller.computation_delay
-    if backend == "compiled" and params.controller.sampled and not float(delay).is_integer():
-        # a fractional delay switches the command between samples: a second event timing, which the
-        # symbolic fast path (one sampler) does not have; the leaf systems run it exactly
-        raise InputError("controller.computation_delay", delay,
-                         "a whole number of samples with simulation.backend: compiled (fractional: backend leaf)")
-    if sim.steady_start >= scenario.duration:
-        raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
-    check_log_period(sim.log_period, scenario.duration, sim.steady_start)
-    check_step_budget(params, scenario.duration)
+    backend = check_run(params, scenario, backend=backend, model=model, multibody=multibody)
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))

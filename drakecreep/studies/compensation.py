@@ -8,7 +8,7 @@ from drakecreep.errors import InputError
 from drakecreep.files import write_atomic, write_text
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS, with_value
 from drakecreep.scenario import Scenario
-from drakecreep.sim.simulation import simulate
+from drakecreep.sim.simulation import check_run, simulate
 from drakecreep.studies.paper_reproduction import simulated_creep_boundary
 
 __all__ = [
@@ -85,6 +85,9 @@ def _run_one(job):
 
 
 def _map(jobs, workers):
+    for params, _, feed_mm_s, load_case, duration in jobs:  # every run's one-line refusal before any runs
+        check_run(params, Scenario(feed=feed_mm_s * 1e-3, load_case=load_case, duration=duration))
+        params.load_case(load_case)
     if workers <= 1:
         return [_run_one(j) for j in jobs]
     from drakecreep.processes import process_pool

@@ -164,6 +164,25 @@ def test_bad_method_is_an_input_error(short_paper):
         with_value(short_paper, "compensation.coulomb_factor", -1.0)
 
 
+def test_every_run_is_checked_before_any_runs(short_paper, monkeypatch):
+    """A run ``simulate`` would refuse is refused before the pool starts (it was refused in a worker)."""
+    import drakecreep.processes
+    import drakecreep.studies.compensation as compensation
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("a run started")
+
+    monkeypatch.setattr(drakecreep.processes, "process_pool", no_work)
+    monkeypatch.setattr(compensation, "simulate", no_work)
+    bad = with_value(short_paper, "simulation.log_period", 1e-9)
+    with pytest.raises(InputError, match=r"simulation\.log_period: got 1e-09"):
+        evaluate(bad, ("none", "dob"), feeds_mm_s=(1.0,), load_cases=(1,), duration=2.0, workers=2)
+    with pytest.raises(InputError, match="simulation.log_period"):
+        robustness(bad, ("dob",), feeds_mm_s=(1.0,), duration=2.0, workers=1)
+    with pytest.raises(InputError, match="load_case"):
+        evaluate(short_paper, ("none",), feeds_mm_s=(1.0,), load_cases=(9,), duration=2.0, workers=2)
+
+
 def test_write_report_is_atomic(tmp_path, monkeypatch):
     import drakecreep.files
     from drakecreep.studies.compensation import write_report
