@@ -6,7 +6,7 @@ and must then be the SI one; ``u`` must carry the unit of the metadata, ``u[V]``
 ========== ======== ===================================================================
 column     unit     meaning
 ========== ======== ===================================================================
-``t``      s        time, strictly increasing, uniform within ``dt_rtol``
+``t``      s        time, strictly increasing, uniform within ``dt_rtol``; any origin (a run starts at its first sample)
 ``x_ref``  m        reference position
 ``x_motor`` m       motor encoder position at the table (angle x lead / 2 pi)
 ``x_table`` m       optional: linear scale

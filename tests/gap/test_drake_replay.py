@@ -411,3 +411,21 @@ def test_a_drakecreep_run_whose_params_force_billions_of_steps_is_refused_before
     with pytest.raises(InputError, match=f"^{path}: got 1e-09; .*for a 7.999 s run"):
         check_replayable(run)
     check_replayable(dataclasses.replace(run, meta=dataclasses.replace(meta, params=preset("rigid_axis"))))
+
+
+def test_a_runs_time_origin_does_not_change_its_replay(run, nominal):
+    """A run starts at its first sample, whatever its clock reads (a negative start included): both controller
+    kinds replay the same run shifted in time to the same outputs, a time-fixed force ripple included."""
+    from drakecreep.params import preset, with_value
+
+    shifted = dataclasses.replace(run, t=run.t - 7.25)
+    again = DrakeReplay(shifted).simulate(axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-4))
+    assert np.array_equal(again.x_motor, nominal.x_motor) and np.array_equal(again.u, nominal.u)
+    rippled = with_value(with_value(preset("rigid_axis"), "disturbance.force_ripple", 5.0),
+                         "disturbance.ripple_frequency", 37.0)
+    own, _ = _own_run(rippled)
+    back = replay_drakecreep(own)
+    back_shifted = replay_drakecreep(dataclasses.replace(own, t=own.t - 3.1))
+    assert np.max(np.abs(back.u)) > 0
+    assert np.max(np.abs(back_shifted.x_motor - back.x_motor)) < 1e-12
+    assert np.max(np.abs(back_shifted.u - back.u)) < 1e-9 * np.max(np.abs(back.u))
