@@ -110,8 +110,18 @@ def run(args):
         raise InputError("--train", args.train, "at least one training run")
     # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
     score_runs = load_runs(args.score, None, split=own) if args.score else None
+    kind = "drakecreep" if own else "p_p_cascade"
     for r in score_runs or ():
         check_replayable(r)
+        if r.meta.controller.kind != kind:  # a p_p_cascade file scored through a params file: exit 0, 1e4 % errors
+            raise InputError("--score", args.score, f"runs of controller kind {kind}, like the diagnosed ones")
+        if own:  # what the replay at the end would refuse (a sensor resolution off the lead), before the diagnosis
+            from drakecreep.gap.drive_fit import check_run
+
+            try:
+                check_run(r, train[0].meta.params)
+            except InputError as err:
+                raise InputError(f"--score {args.score}: {err.field}", err.value, err.allowed) from None
     if own:
         if args.nominal_friction:
             raise InputError("--nominal-friction", args.nominal_friction, "only for runs of controller kind p_p_cascade (kind "
@@ -124,9 +134,6 @@ def run(args):
         raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
                          "at least two held-out runs (the claim threshold is their run-to-run spread; "
                          "choose with --train/--test)")
-    for r in score_runs or ():
-        if r.meta.controller.kind != "p_p_cascade":
-            raise InputError("--score", args.score, "runs of controller kind p_p_cascade, like the diagnosed ones")
     effects = None
     if getattr(args, "effects", None):
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED

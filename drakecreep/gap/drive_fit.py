@@ -109,6 +109,7 @@ __all__ = [
     "EffectResult",
     "DriveDiagnosis",
     "check_fields",
+    "check_run",
     "diagnose_drive",
     "fit_drive",
 ]
@@ -521,6 +522,34 @@ def check_fields(uncertain):
         raise InputError("uncertain", ",".join(uncertain), "distinct fields")
 
 
+def check_run(run, params=None, load_case=0):
+    """Raise :class:`InputError` unless ``run`` can be replayed with ``params`` (default its own params file).
+
+    Checked before any simulation, for the diagnosed runs and for runs the result is scored on: the run's
+    controller is of kind ``drakecreep`` with a params file (:func:`~drakecreep.gap.drake_replay.check_replayable`),
+    it has at least :data:`MIN_SAMPLES` samples over :data:`MIN_DURATION` s, its declared sensor resolutions fit
+    the lead of ``params`` (:func:`~drakecreep.gap.drake_replay.replay_params`), ``load_case`` is one of
+    ``params``' and its external force stays within :data:`MAX_EXTERNAL_FORCE` times the drive's force limit.
+    """
+    ctrl = run.meta.controller
+    if ctrl is None or ctrl.kind != "drakecreep":
+        raise InputError("controller.kind", None if ctrl is None else ctrl.kind,
+                         "drakecreep (the project's cascade; p_p_cascade runs go to the EMPS diagnosis)")
+    check_replayable(run)
+    duration = float(run.t[-1] - run.t[0])
+    if run.n < MIN_SAMPLES or duration < MIN_DURATION:
+        raise InputError("t", f"run {run.label}: {run.n} samples over {duration:.3g} s",
+                         f">= {MIN_SAMPLES} samples and >= {MIN_DURATION:g} s per run")
+    params = run.meta.params if params is None else params
+    replay_params(run, params)  # the declared sensor resolutions fit the params' lead
+    params.load_case(load_case)
+    limit = MAX_EXTERNAL_FORCE * force_limit(params)
+    if run.f_ext is not None and float(np.max(np.abs(run.f_ext))) > limit:
+        raise InputError(f"f_ext (run {run.label})", f"{float(np.max(np.abs(run.f_ext))):.3g} N",
+                         f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "
+                         "the params file's peak torque through the lead); is a unit wrong?")
+
+
 def _check_inputs(train, test, uncertain, effects, load_case):
     train, test = list(train), list(test)
     if not train:
@@ -529,27 +558,11 @@ def _check_inputs(train, test, uncertain, effects, load_case):
         raise InputError("test", len(test), ">= 2 held-out runs (the claim threshold is their spread)")
     prior = None
     for r in train + test:
-        ctrl = r.meta.controller
-        if ctrl is None or ctrl.kind != "drakecreep":
-            raise InputError("controller.kind", None if ctrl is None else ctrl.kind,
-                             "drakecreep (the project's cascade; p_p_cascade runs go to the EMPS diagnosis)")
-        check_replayable(r)
-        duration = float(r.t[-1] - r.t[0])
-        if r.n < MIN_SAMPLES or duration < MIN_DURATION:
-            raise InputError("t", f"run {r.label}: {r.n} samples over {duration:.3g} s",
-                             f">= {MIN_SAMPLES} samples and >= {MIN_DURATION:g} s per run")
+        check_run(r, load_case=load_case)
         if prior is None:
             prior = r.meta.params
         elif r.meta.params != prior:
             raise InputError("params", f"run {r.label}", "the same params file for every run")
-        replay_params(r, prior)  # the declared sensor resolutions fit the params' lead
-    prior.load_case(load_case)
-    limit = MAX_EXTERNAL_FORCE * force_limit(prior)
-    for r in train + test:
-        if r.f_ext is not None and float(np.max(np.abs(r.f_ext))) > limit:
-            raise InputError(f"f_ext (run {r.label})", f"{float(np.max(np.abs(r.f_ext))):.3g} N",
-                             f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "
-                             "the params file's peak torque through the lead); is a unit wrong?")
     uncertain = tuple(uncertain)
     check_fields(uncertain)
     for path in uncertain:

@@ -140,6 +140,48 @@ def test_diagnose_without_params_for_kind_drakecreep_is_one_line_exit_2(blank_cs
     assert len(err) == 1 and "params" in err[0]
 
 
+@pytest.fixture
+def no_diagnosis(monkeypatch):
+    """diagnose_drive made to fail: a refusal must come before it."""
+    from drakecreep.gap import drive_fit
+
+    def started(*args, **kwargs):
+        raise AssertionError("the diagnosis started")
+
+    monkeypatch.setattr(drive_fit, "diagnose_drive", started)
+
+
+def test_a_score_file_of_the_p_p_cascade_kind_is_refused_before_the_diagnosis(blank_csv, no_diagnosis, capsys):
+    """The EMPS example scored through the params file: it was replayed at the end, exit 0, force errors of 1e4 %."""
+    from drakecreep.data import example_path
+
+    path, _ = blank_csv
+    code = cli.main(["diagnose", str(path), "--workers", "1", "--score", str(example_path("emps_segment.csv"))])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert "--score: got " in err[0] and "runs of controller kind drakecreep" in err[0]
+
+
+def test_a_score_file_the_replay_refuses_is_refused_before_the_diagnosis(blank_csv, no_diagnosis, tmp_path, capsys):
+    """A declared encoder count that is no whole fraction of the lead: the replay of the scored runs refused it
+    after the whole diagnosis (its files written, exit 2); now before it, naming --score and the field."""
+    import yaml
+
+    path, yaml_path = blank_csv
+    meta = yaml.safe_load(yaml_path.read_text())
+    lead = preset("rigid_axis").screw.lead
+    meta["sensors"] = {"encoder_resolution": lead / 300000.5, "scale_resolution": 0.0}
+    score = tmp_path / "score.csv"
+    score.write_text(path.read_text())
+    score.with_suffix(".yaml").write_text(yaml.safe_dump(meta))
+    out = tmp_path / "out"
+    code = cli.main(["diagnose", str(path), "--workers", "1", "--score", str(score), "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert f"--score {score}: sensors.encoder_resolution: got " in err[0] and "whole fraction of the lead" in err[0]
+    assert not out.exists() or not any(out.iterdir())
+
+
 def test_nominal_friction_is_refused_for_drakecreep_runs(own_csv, capsys):
     path, _ = own_csv
     assert cli.main(["diagnose", str(path), "--nominal-friction", "lugre"]) == 2
