@@ -862,7 +862,7 @@ def replay_params(run, params=None, quantize=True):
     """
     import dataclasses
 
-    from drakecreep.params import DriveParams
+    from drakecreep.params import MAX_INT, DriveParams
 
     if params is None:
         check_replayable(run)
@@ -873,12 +873,19 @@ def replay_params(run, params=None, quantize=True):
     declared = run.meta.sensors
     if declared.encoder_resolution > 0:
         counts = params.screw.lead / declared.encoder_resolution
+        if counts > MAX_INT:  # 1e-30 m was 'encoder_counts_per_rev: got 4999999999999999791559868416', unwritten
+            raise InputError("sensors.encoder_resolution", declared.encoder_resolution,
+                             f"at least the lead / {MAX_INT} counts per revolution, {params.screw.lead / MAX_INT:.3g} m "
+                             "(or 0 for none)")
         if abs(counts - round(counts)) > 1e-6 * counts or round(counts) < 1:
             raise InputError("sensors.encoder_resolution", declared.encoder_resolution,
                              f"a whole fraction of the lead {params.screw.lead:g} m (lead / counts per revolution)")
         sensors = dataclasses.replace(sensors, encoder_counts_per_rev=int(round(counts)))
     if declared.scale_resolution > 0:
-        sensors = dataclasses.replace(sensors, scale_resolution=declared.scale_resolution)
+        try:
+            sensors = dataclasses.replace(sensors, scale_resolution=declared.scale_resolution)
+        except InputError as err:  # the metadata's key, not the params file's field the value goes to
+            raise InputError("sensors.scale_resolution", err.value, err.allowed) from None
     if not quantize:
         sensors = dataclasses.replace(sensors, encoder_counts_per_rev=0, scale_resolution=0.0)
     return dataclasses.replace(params, sensors=sensors)

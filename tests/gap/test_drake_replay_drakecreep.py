@@ -64,6 +64,14 @@ def test_declared_sensor_resolutions_replace_the_params_files():
     with pytest.raises(InputError) as err:
         replay_params(_run(rig, SensorMeta(encoder_resolution=rig.screw.lead / (2**16 + 0.5))))
     assert err.value.field == "sensors.encoder_resolution"
+    # beyond the params' counts per revolution (2**40), or a scale beyond its range: named by the metadata's key
+    # (1e-30 m was 'encoder_counts_per_rev: got 4999999999999999791559868416')
+    with pytest.raises(InputError) as err:
+        replay_params(_run(rig, SensorMeta(encoder_resolution=1e-30)))
+    assert err.value.field == "sensors.encoder_resolution" and "or 0 for none" in err.value.allowed
+    with pytest.raises(InputError) as err:
+        replay_params(_run(rig, SensorMeta(scale_resolution=1.0)))
+    assert err.value.field == "sensors.scale_resolution" and "0.001" in err.value.allowed
     with pytest.raises(InputError, match="backend"):
         replay_drakecreep(_run(rig), backend="fast")
 
