@@ -108,6 +108,10 @@ def run(args):
         check_replayable(r)
     if not train:
         raise InputError("--train", args.train, "at least one training run")
+    if len(test) < 2:  # both kinds (the drakecreep kind's library said 'test: got 1')
+        raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
+                         "at least two held-out runs (the claim threshold is their run-to-run spread; "
+                         "choose with --train/--test)")
     # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
     score_runs = load_runs(args.score, None, split=own) if args.score else None
     kind = "drakecreep" if own else "p_p_cascade"
@@ -130,10 +134,6 @@ def run(args):
     if args.uncertain:
         raise InputError("--uncertain", args.uncertain, "only for runs of controller kind drakecreep "
                          "(p_p_cascade runs fit viscous, Coulomb and offset)")
-    if len(test) < 2:
-        raise InputError("--test", args.test or f"{len(test)} run(s) of {', '.join(r.label for r in runs)}",
-                         "at least two held-out runs (the claim threshold is their run-to-run spread; "
-                         "choose with --train/--test)")
     effects = None
     if getattr(args, "effects", None):
         from drakecreep.gap.drake_effects import DRAKE_EFFECTS, NOT_RANKED

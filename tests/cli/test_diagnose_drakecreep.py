@@ -37,7 +37,7 @@ def blank_csv(tmp_path_factory):
     t = np.arange(N) * 1e-3
     runs = tuple(MeasuredRun(t=t, x_ref=out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6)),
                              x_motor=out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6)), u=np.ones(N),
-                             meta=meta, label=f"r{i}") for i, v in enumerate((0.02, 0.03)))
+                             meta=meta, label=f"r{i}") for i, v in enumerate((0.02, 0.03, 0.025)))
     _, yaml_path = save_measured(MeasuredData(runs=runs, meta=meta), folder / "blank.csv")
     return folder / "blank.csv", yaml_path
 
@@ -180,6 +180,16 @@ def test_a_score_file_the_replay_refuses_is_refused_before_the_diagnosis(blank_c
     assert code == 2 and len(err) == 1, err
     assert f"--score {score}: sensors.encoder_resolution: got " in err[0] and "whole fraction of the lead" in err[0]
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_one_held_out_run_names_the_option(blank_csv, no_diagnosis, capsys):
+    """One run held out: the library's 'test: got 1' named no option; now --test, as for p_p_cascade."""
+    path, _ = blank_csv
+    assert cli.main(["diagnose", str(path), "--workers", "1", "--train", "r0,r1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--test: got '1 run(s) of r0, r1, r2'" in err[0] and "at least two held-out runs" in err[0]
+    assert cli.main(["diagnose", str(path), "--workers", "1", "--test", "r1"]) == 2
+    assert "--test: got 'r1'" in capsys.readouterr().err
 
 
 def test_nominal_friction_is_refused_for_drakecreep_runs(own_csv, capsys):
