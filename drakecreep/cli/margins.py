@@ -6,7 +6,7 @@ from drakecreep.cli._common import add_params_options, feed_from_mm_s, number, p
 from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 
-__all__ = ["add_parser", "run", "scenario_from_args"]
+__all__ = ["add_parser", "run", "scenario_from_args", "check_feed"]
 
 _ROWS = (
     ("gain_margin_dB", "gain margin", "dB", "{:.1f}"),
@@ -44,7 +44,25 @@ def scenario_from_args(args, params):
     feed = feed_from_mm_s(args.feed)
     if not 0 <= args.load_case <= len(params.loads.cases):
         raise InputError("--load-case", args.load_case, f"an integer in 0..{len(params.loads.cases)} (0 = unloaded)")
-    return Scenario(feed=feed, load_case=args.load_case)
+    scenario = Scenario(feed=feed, load_case=args.load_case)
+    check_feed(params, scenario, "--feed", args.feed)
+    return scenario
+
+
+def check_feed(params, scenario, option, mm_s):
+    """Raise :class:`InputError` naming ``option`` (a feed of ``mm_s`` mm/s) when the drive cannot slide steadily at
+    ``scenario``'s feed: the force it takes is beyond the drive's limit (the operating point said 'feed: got 0.001',
+    the scenario's field in m/s, and blamed the feed for what is mostly the params' load and friction)."""
+    from drakecreep.model.controller import force_limit
+    from drakecreep.servo.linearize import sliding_force
+
+    if params.friction.law == "gms":  # no steady sliding to linearize: the operating point says so
+        return
+    force, limit = sliding_force(params, scenario), force_limit(params)
+    if abs(force) >= limit:
+        raise InputError(option, mm_s, f"a feed in mm/s the drive can slide at: at load case {scenario.load_case} it "
+                         f"takes {force:.4g} N, beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
+                         "screw.lead; the load and the friction take most of it at a low feed)")
 
 
 def print_margins(summary):

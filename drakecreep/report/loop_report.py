@@ -28,7 +28,7 @@ from drakecreep.servo.polemap import friction_slope_crossings, parameter_locus, 
 from drakecreep.scenario import Scenario
 from drakecreep.model.screw import screw_inertia
 
-__all__ = ["build_report", "MARGIN_ROWS"]
+__all__ = ["build_report", "check_sliding", "MARGIN_ROWS", "LOCI", "CROSSING_SPEEDS"]
 
 #: rows of the margins table: key, label, format
 MARGIN_ROWS = (
@@ -44,6 +44,37 @@ MARGIN_ROWS = (
     ("closed_loop_stable", "closed loop stable", None),
     ("open_loop_unstable_poles", "open-loop unstable poles", None),
 )
+
+#: the root loci: parameter and values (stiffness scale, feed [m/s], table mass [kg]), at the operating feed
+LOCI = (("stiffness", np.geomspace(0.25, 4.0, 25)), ("feed", np.geomspace(0.02e-3, 3e-3, 40)),
+        ("mass", np.geomspace(10.0, 400.0, 25)))
+#: feeds [m/s] bracketing the speeds where a pole crosses the imaginary axis
+CROSSING_SPEEDS = np.geomspace(0.005e-3, 3e-3, 30)
+
+
+def check_sliding(params, load_case, feeds, source="the params"):
+    """Raise :class:`InputError` unless the drive slides steadily wherever the report linearizes it: at ``feeds``
+    [m/s], the loci's (:data:`LOCI`) and the crossings' (:data:`CROSSING_SPEEDS`), its force within the drive's
+    limit. A params file whose drive cannot hold its load and friction was refused in the loci, after the loop
+    analysis, as 'feed: got 2e-05' (a speed of the feed locus, in m/s)."""
+    from drakecreep.model.controller import force_limit
+    from drakecreep.servo.linearize import sliding_force
+
+    if params.friction.law == "gms":  # no steady sliding to linearize: the loop analysis says so
+        return
+    speeds = dict(LOCI)["feed"]
+    cases = [(params, v, None) for v in (*feeds, *speeds, *CROSSING_SPEEDS)]
+    cases += [(with_value(params, "table.mass", float(m)), feeds[0], float(m)) for m in dict(LOCI)["mass"]]
+    lo, hi = 1e3 * min(*feeds, *speeds, *CROSSING_SPEEDS), 1e3 * max(*feeds, *speeds, *CROSSING_SPEEDS)
+    for p, v, mass in cases:
+        force, limit = sliding_force(p, Scenario(feed=float(v), load_case=load_case)), force_limit(p)
+        if abs(force) >= limit:
+            where = f"{1e3 * v:.3g} mm/s" + (f" with a table mass of {mass:.3g} kg (the mass locus)" if mass else "")
+            raise InputError("params", f"{source}, load case {load_case}: {force:.4g} N to slide at {where}",
+                             f"a drive whose limit {limit:.4g} N (motor.peak_torque through screw.lead) holds it "
+                             f"sliding at the report's feeds, {lo:.3g} to {hi:.3g} mm/s, and table masses, "
+                             f"{dict(LOCI)['mass'][0]:g} to {dict(LOCI)['mass'][-1]:g} kg")
+
 
 def _img(path):
     return figure(path)
@@ -97,6 +128,7 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
         if v <= 0:
             raise InputError(name, v, "> 0")
     params.load_case(load_case)
+    check_sliding(params, load_case, (feed, low_feed), source)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     timings = {}
@@ -114,13 +146,8 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
     t = lap("loops", t)
 
     low = Scenario(feed=low_feed, load_case=load_case)
-    loci = [
-        parameter_locus(params, scenario, "stiffness", np.geomspace(0.25, 4.0, 25)),
-        parameter_locus(params, scenario, "feed", np.geomspace(0.02e-3, 3e-3, 40)),
-        parameter_locus(params, scenario, "mass", np.geomspace(10.0, 400.0, 25)),
-    ]
-    speeds = np.geomspace(0.005e-3, 3e-3, 30)
-    crossings = {m: friction_slope_crossings(params, load_case, speeds, m) for m in ("mechanism", "closed_loop")}
+    loci = [parameter_locus(params, scenario, name, values) for name, values in LOCI]
+    crossings = {m: friction_slope_crossings(params, load_case, CROSSING_SPEEDS, m) for m in ("mechanism", "closed_loop")}
     t = lap("loci", t)
     pm = pole_map(params, low, k_scales=np.geomspace(0.25, 4.0, map_size[0]), n_damping=map_size[1],
                   sim_grid=sim_grid)

@@ -52,6 +52,7 @@ from drakecreep.model.nut_table import NutTable, friction_levels, moving_mass
 __all__ = [
     "OperatingPoint",
     "operating_point",
+    "sliding_force",
     "linearize_plant",
     "linearize_controller",
     "linearize_closed_loop",
@@ -134,6 +135,29 @@ def nut_on_table(params):
     return with_value(params, "friction.nut_friction_on", "table")
 
 
+def _sliding(params, scenario):
+    """The friction law and its levels ``(law, fc, fs)``, the steady friction and spring forces, the motor torque
+    and the force command at ``scenario``'s feed and load case."""
+    load = params.load_case(scenario.load_case)
+    ratio = params.screw.lead / (2.0 * math.pi)
+    law = make_friction_law(params.friction)
+    fc, fs = friction_levels(params, load)
+    friction = float(law.steady_state_force(scenario.feed, fc, fs))
+    spring = load.fx + friction
+    torque = spring * ratio + params.motor.viscous_damping * scenario.feed / ratio
+    return (law, fc, fs), friction, spring, torque, torque / ratio
+
+
+def sliding_force(params, scenario):
+    """The force command [N] that holds the drive sliding steadily at ``scenario``'s feed and load case.
+
+    The load's axial force, the friction at that speed and the motor's viscous drag, at the table (the ball
+    nut's friction lumped on the table, :func:`nut_on_table`). :func:`operating_point` exists only while its
+    magnitude stays below :func:`drakecreep.model.controller.force_limit`.
+    """
+    return _sliding(nut_on_table(params), scenario)[-1]
+
+
 def operating_point(params, scenario):
     """Steady sliding state of ``build_diagram(params, scenario, continuous=True, ideal_sensors=True)``.
 
@@ -159,15 +183,9 @@ def operating_point(params, scenario):
     params = nut_on_table(params)
     g = params.controller
     v = scenario.feed
-    load = params.load_case(scenario.load_case)
     ratio = params.screw.lead / (2.0 * math.pi)
-    law = make_friction_law(params.friction)
-    fc, fs = friction_levels(params, load)
-    friction = float(law.steady_state_force(v, fc, fs))
-    spring = load.fx + friction
+    (law, fc, fs), friction, spring, torque, force_cmd = _sliding(params, scenario)
     omega = v / ratio
-    torque = spring * ratio + params.motor.viscous_damping * omega
-    force_cmd = torque / ratio
     if abs(force_cmd) >= force_limit(params):
         raise InputError("feed", v, f"a feed whose force {force_cmd:.4g} N is below the drive limit {force_limit(params):.4g} N")
     if g.position_gain == 0.0 and g.velocity_feedforward != 1.0:

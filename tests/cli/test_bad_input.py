@@ -494,3 +494,33 @@ def test_tune_write_target_is_checked_before_the_tuning(target, tmp_path, capsys
     code, _, err = _run(["tune", "--write", target.format(tmp=tmp_path)], capsys)
     _one_line_exit_2(code, err, "--write")
     assert (tmp_path / "afile").read_text() == "keep me\n"
+
+
+def test_a_drive_that_cannot_slide_names_the_feed_option_or_the_params(tmp_path, monkeypatch, capsys):
+    """margins, tune and report at a feed whose force is beyond the drive's limit said 'feed: got 0.001' (the
+    scenario's field in m/s); the report, for its own loci's speeds, 'feed: got 2e-05' after the loop analysis."""
+    from drakecreep.params import preset, save_params, with_value
+    from drakecreep.report import loop_report
+
+    weak = tmp_path / "weak.yaml"
+    save_params(with_value(preset("paper"), "motor.peak_torque", 0.001), weak)
+    for argv in (["margins"], ["tune"], ["report", "--out", str(tmp_path / "r")]):
+        code, _, err = _run(argv + ["--params", str(weak), "--load-case", "0"], capsys)
+        _one_line_exit_2(code, err, "--feed: got 1.0; allowed: a feed in mm/s the drive can slide at: at load case 0")
+    # Stribeck friction that rises at low speed: 1 mm/s slides, 0.1 mm/s and the loci's 0.02 mm/s do not
+    stribeck = preset("paper")
+    for path, value in (("motor.peak_torque", 0.6), ("friction.law", "stribeck"), ("friction.static_ratio", 3.0),
+                        ("friction.stribeck_velocity", 5e-4)):
+        stribeck = with_value(stribeck, path, value)
+    save_params(stribeck, tmp_path / "stribeck.yaml")
+    stribeck = tmp_path / "stribeck.yaml"
+
+    def started(*args, **kwargs):
+        raise AssertionError("the loop analysis started")
+
+    monkeypatch.setattr(loop_report, "analyze_loops", started)
+    code, _, err = _run(["report", "--params", str(stribeck), "--out", str(tmp_path / "r")], capsys)
+    _one_line_exit_2(code, err, "--low-feed: got 0.1; allowed: a feed in mm/s the drive can slide at")
+    code, _, err = _run(["report", "--params", str(stribeck), "--out", str(tmp_path / "r"), "--low-feed", "1"], capsys)
+    _one_line_exit_2(code, err, "params: got '", "stribeck.yaml, load case 3: ", "N to slide at 0.02 mm/s'",
+                     "the report's feeds, 0.005 to 3 mm/s")
