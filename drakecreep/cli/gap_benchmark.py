@@ -41,8 +41,9 @@ MAX_SAMPLES = 1_000_000
 def run(args):
     """Run and print the scores (each dataset takes minutes: its kind's diagnosis fits every candidate)."""
     from drakecreep.errors import InputError
-    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, check_effects, run_benchmark
+    from drakecreep.gap.benchmark import DEV_SEEDS, HELDOUT_SEEDS, check_effects, check_kinds, run_benchmark
 
+    check_kinds(args.kinds, "--kinds")
     if not 600 <= args.samples <= MAX_SAMPLES:
         raise InputError("--samples", args.samples, f"an integer in [600, {MAX_SAMPLES}] samples per run (1 kHz)")
     for option in ("--n-per-effect", "--n-null", "--n-ool"):

@@ -91,6 +91,7 @@ __all__ = [
     "true_effect_fit",
     "audit_replay",
     "evaluate",
+    "check_kinds",
     "check_effects",
     "check_uncertain",
     "run_benchmark",
@@ -730,6 +731,26 @@ def benchmark_specs(seed, kinds=DEFAULT_KINDS, n_per_effect=10, tries=4.0, n_nul
     return specs
 
 
+def check_kinds(kinds, field="kinds"):
+    """``kinds`` as a tuple of distinct :data:`BENCHMARK_KINDS`, for :func:`run_benchmark`.
+
+    Raises
+    ------
+    InputError
+        Naming ``field``: an unknown kind, none, or a kind twice (its datasets were drawn, diagnosed and scored
+        twice: ``--kinds p_p_cascade p_p_cascade`` doubled every null and out-of-library row).
+    """
+    kinds = tuple(kinds)
+    if not kinds:
+        raise InputError(field, kinds, "one or more of " + ", ".join(BENCHMARK_KINDS))
+    for k in kinds:
+        if k not in BENCHMARK_KINDS:
+            raise InputError(field, k, "one of " + ", ".join(BENCHMARK_KINDS))
+        if kinds.count(k) > 1:
+            raise InputError(field, " ".join(kinds), f"each kind once ({k} is there twice)")
+    return kinds
+
+
 def check_effects(kinds, effects, field="effects"):
     """``effects`` (the diagnosis's candidates) as a tuple, checked for :func:`run_benchmark`; None stays None
     (every candidate of each kind).
@@ -817,9 +838,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         the error; not scored), ``low_snr_skipped`` (per effect) and ``short`` (effects that did not reach
         ``n_per_effect`` datasets with SNR >= 3).
     """
-    kinds = tuple(kinds)
-    for k in kinds:
-        _check_kind(k)
+    kinds = check_kinds(kinds)
     uncertain = check_uncertain(kinds, uncertain)
     effects = check_effects(kinds, effects)
     if (not isinstance(shard, tuple) or len(shard) != 2 or not all(isinstance(x, int) for x in shard)

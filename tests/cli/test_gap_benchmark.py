@@ -48,7 +48,10 @@ def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv
 @pytest.mark.parametrize("argv, field", [(["--n-per-effect", "999999999"], "--n-per-effect"),
                                          (["--n-null", "5000"], "--n-null"),
                                          (["--n-ool", "99999"], "--n-ool"),
-                                         (["--samples", "99999999999"], "--samples")])
+                                         (["--samples", "99999999999"], "--samples"),
+                                         # each null and out-of-library dataset was drawn, diagnosed and scored twice
+                                         (["--kinds", "p_p_cascade", "p_p_cascade", "--n-per-effect", "1"], "--kinds"),
+                                         (["--kinds", "drakecreep", "p_p_cascade", "drakecreep"], "--kinds")])
 def test_gap_benchmark_refuses_sizes_that_never_end_before_starting(capsys, monkeypatch, argv, field):
     import drakecreep.gap.benchmark as benchmark
 
@@ -59,3 +62,15 @@ def test_gap_benchmark_refuses_sizes_that_never_end_before_starting(capsys, monk
     assert cli.main(["gap-benchmark"] + argv) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and err.startswith(f"drakecreep gap-benchmark: error: {field}: got ")
+
+
+def test_check_kinds_refuses_a_kind_twice():
+    from drakecreep.errors import InputError
+    from drakecreep.gap.benchmark import check_kinds
+
+    assert check_kinds(["drakecreep", "p_p_cascade"]) == ("drakecreep", "p_p_cascade")
+    for kinds, allowed in ((("p_p_cascade", "p_p_cascade"), "each kind once (p_p_cascade is there twice)"),
+                           ((), "one or more of"), (("pid",), "one of")):
+        with pytest.raises(InputError) as err:
+            check_kinds(kinds)
+        assert err.value.field == "kinds" and allowed in err.value.allowed
