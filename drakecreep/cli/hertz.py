@@ -46,8 +46,7 @@ def run(args):
     # lower bounds too: a 1e-300 kg nut overflowed the axial frequency to inf
     for option, value, lo, hi in (("--ball-diameter", args.ball_diameter, 1e-2, 1e3),
                                   ("--diameter", args.diameter, 1e-1, 1e4), ("--lead", args.lead, 1e-2, 1e3),
-                                  ("--preload", args.preload, 1e-6, 1e7), ("--mass", args.mass, 1e-6, 1e5),
-                                  ("--conformity", args.conformity, 1e-3, 10.0)):
+                                  ("--preload", args.preload, 1e-6, 1e7), ("--mass", args.mass, 1e-6, 1e5)):
         if not (math.isfinite(value) and lo <= value <= hi):
             raise InputError(option, value, f"a finite number in [{lo:g}, {hi:g}]")
     # in the options' own units (the model's checks named its fields, in rad and m)
@@ -55,6 +54,9 @@ def run(args):
         raise InputError("--contact-angle", args.contact_angle, "an angle in (0, 90) deg")
     if not args.ball_diameter < args.diameter:
         raise InputError("--ball-diameter", args.ball_diameter, f"a diameter below --diameter ({args.diameter:g} mm)")
+    if not (math.isfinite(args.conformity) and 1.0 < args.conformity <= 10.0):  # the model said 'conformity: got 1.0'
+        raise InputError("--conformity", args.conformity, "a groove/ball radius ratio in (1, 10] (the groove wider "
+                         "than the ball)")
     if not (math.isfinite(args.poisson) and 0.0 <= args.poisson < 0.5):
         raise InputError("--poisson", args.poisson, "in [0, 0.5)")
     steel = Material(args.youngs_modulus * 1e9, args.poisson)

@@ -363,6 +363,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
     (["hertz", "--contact-angle", "90"], "--contact-angle: got 90.0; allowed: an angle in (0, 90) deg"),
     (["hertz", "--diameter", "1"], "--ball-diameter: got 3.175; allowed: a diameter below --diameter (1 mm)"),
+    (["hertz", "--conformity", "1"], "--conformity: got 1.0; allowed: a groove/ball radius ratio in (1, 10]"),
+    (["hertz", "--conformity", "0.9"], "--conformity: got 0.9"),  # the model's 'conformity: got 0.9'
+    (["hertz", "--conformity", "1e9"], "--conformity: got 1000000000.0"),
     (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),
     # a missing file named by its option (the generic line said only 'No such file or directory')
     (["simulate", "--params", "{tmp}/nothere.yaml"], "--params: got"),
