@@ -56,8 +56,9 @@ def _estimate_pulse_width(force, dt):
 
 def run(args):
     """Read the file, identify, print."""
-    if args.mass is not None and not (math.isfinite(args.mass) and args.mass > 0):
-        raise InputError("--mass", args.mass, "> 0 kg")
+    # bounded as hertz --mass: 1e300 kg printed k = 4.852e+305 N/m, exit 0
+    if args.mass is not None and not (math.isfinite(args.mass) and 1e-6 <= args.mass <= 1e5):
+        raise InputError("--mass", args.mass, "a modal mass in [1e-06, 100000] kg")
     if args.exp_tau is not None and not (math.isfinite(args.exp_tau) and args.exp_tau > 0):
         raise InputError("--exp-tau", args.exp_tau, "> 0 s")
     if args.pulse_width is not None and not (math.isfinite(args.pulse_width) and args.pulse_width > 0):

@@ -102,6 +102,9 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--pulse-width", "1e-3"], "--pulse-width: got 0.001; allowed: only with a t,force,response file"),
     ("frf", ["--fmin", "nan"], "--fmin: got nan"),
     ("frf", ["--fmax", "inf"], "--fmax: got inf"),
+    ("frf", ["--mass", "1e300"], "--mass: got 1e+300; allowed: a modal mass in [1e-06, 100000] kg"),  # k = 5e305
+    ("frf", ["--mass", "1e-300"], "--mass: got 1e-300"),
+    ("frf", ["--mass", "0"], "--mass: got 0.0"),
 ])
 def test_modal_options_name_themselves(kind, options, field, tmp_path, capsys):
     path = tmp_path / "m.csv"
