@@ -64,8 +64,11 @@ def run(args):
     if args.pulse_width is not None and not (math.isfinite(args.pulse_width) and args.pulse_width > 0):
         raise InputError("--pulse-width", args.pulse_width, "> 0 s")  # -1 was reported as a bad frequency band
     for option, value in (("--fmin", args.fmin), ("--fmax", args.fmax)):
-        if value is not None and not math.isfinite(value):
-            raise InputError(option, value, "a finite frequency in Hz")
+        if value is not None and not (math.isfinite(value) and value >= 0.0):
+            raise InputError(option, value, "a finite frequency >= 0 Hz")
+    if args.fmin is not None and args.fmax is not None and not args.fmax > args.fmin:
+        # the band search said 'frequency band: got (200.0, 100.0)'
+        raise InputError("--fmax", args.fmax, f"a frequency above --fmin ({args.fmin:g} Hz)")
     header, data = read_hammer_csv(args.file)
     if header == FRF_COLUMNS and args.pulse_width is not None:
         raise InputError("--pulse-width", args.pulse_width, "only with a t,force,response file (this one is an FRF)")

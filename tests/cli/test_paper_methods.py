@@ -105,6 +105,10 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--mass", "1e300"], "--mass: got 1e+300; allowed: a modal mass in [1e-06, 100000] kg"),  # k = 5e305
     ("frf", ["--mass", "1e-300"], "--mass: got 1e-300"),
     ("frf", ["--mass", "0"], "--mass: got 0.0"),
+    # the band search said 'frequency band: got (200.0, 100.0)'; a negative end was taken as given
+    ("frf", ["--fmin", "200", "--fmax", "100"], "--fmax: got 100.0; allowed: a frequency above --fmin (200 Hz)"),
+    ("frf", ["--fmin", "100", "--fmax", "100"], "--fmax: got 100.0"),
+    ("frf", ["--fmin", "-5"], "--fmin: got -5.0; allowed: a finite frequency >= 0 Hz"),
 ])
 def test_modal_options_name_themselves(kind, options, field, tmp_path, capsys):
     path = tmp_path / "m.csv"
