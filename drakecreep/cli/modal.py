@@ -26,9 +26,9 @@ def add_parser(subparsers):
     p.add_argument("--mass", type=float, metavar="KG",
                    help="modal mass for k = m wn^2, c = 2 zeta m wn (half-power)")
     p.add_argument("--frf-type", choices=("receptance", "mobility", "accelerance"),
-                   default="receptance", help="kind of FRF in an f_Hz,re,im file")
+                   help="kind of FRF in an f_Hz,re,im file (default receptance)")
     p.add_argument("--response", choices=("displacement", "velocity", "acceleration"),
-                   default="acceleration", help="kind of response in a t,force,response file")
+                   help="kind of response in a t,force,response file (default acceleration)")
     p.add_argument("--pulse-width", type=float, metavar="S",
                    help="impulse duration for the force window (default: estimated from the force)")
     p.add_argument("--exp-tau", type=float, metavar="S",
@@ -70,26 +70,29 @@ def run(args):
         # the band search said 'frequency band: got (200.0, 100.0)'
         raise InputError("--fmax", args.fmax, f"a frequency above --fmin ({args.fmin:g} Hz)")
     header, data = read_hammer_csv(args.file)
-    if header == FRF_COLUMNS and args.pulse_width is not None:
-        raise InputError("--pulse-width", args.pulse_width, "only with a t,force,response file (this one is an FRF)")
+    # an option of the other kind of file was ignored without a word (--response velocity on an FRF)
+    for option, value, frf in (("--pulse-width", args.pulse_width, False), ("--response", args.response, False),
+                               ("--frf-type", args.frf_type, True)):
+        if value is not None and (header == FRF_COLUMNS) != frf:
+            raise InputError(option, value, "only with an f_Hz,re,im file (this one is a time record)" if frf
+                             else "only with a t,force,response file (this one is an FRF)")
     band = None
     if args.fmin is not None or args.fmax is not None:
         band = (args.fmin, args.fmax)
     if header == FRF_COLUMNS:
         f = data[:, 0]
         _uniform_step(f, "f_Hz")
-        ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], args.frf_type, args.mass, band,
-                             args.exp_tau)
-        kind = args.frf_type
+        kind = args.frf_type or "receptance"
+        ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], kind, args.mass, band, args.exp_tau)
     else:
         dt = _uniform_step(data[:, 0], "t")
         force = data[:, 1]
         if not np.any(force != 0.0):
             raise InputError("force", "all zero", "a recorded impulse")
         width = args.pulse_width if args.pulse_width is not None else _estimate_pulse_width(force, dt)
-        test = HammerTest(data[:, 0], force[None, :], data[:, 2][None, :], 1.0 / dt, args.response)
+        kind = args.response or "acceleration"
+        test = HammerTest(data[:, 0], force[None, :], data[:, 2][None, :], 1.0 / dt, kind)
         ident = identify_hammer_test(test, width, args.mass, args.exp_tau, band=band)
-        kind = args.response
     fit = ident.fit
     out = {
         "input": {"file": str(args.file), "kind": kind, "modal_mass_kg": args.mass},

@@ -109,6 +109,9 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--fmin", "200", "--fmax", "100"], "--fmax: got 100.0; allowed: a frequency above --fmin (200 Hz)"),
     ("frf", ["--fmin", "100", "--fmax", "100"], "--fmax: got 100.0"),
     ("frf", ["--fmin", "-5"], "--fmin: got -5.0; allowed: a finite frequency >= 0 Hz"),
+    # an option of the other kind of file was ignored without a word
+    ("frf", ["--response", "velocity"], "--response: got 'velocity'; allowed: only with a t,force,response file"),
+    ("time", ["--frf-type", "mobility"], "--frf-type: got 'mobility'; allowed: only with an f_Hz,re,im file"),
 ])
 def test_modal_options_name_themselves(kind, options, field, tmp_path, capsys):
     path = tmp_path / "m.csv"
