@@ -1,6 +1,6 @@
 """``drakecreep reproduce-paper``: Tables 8-9 of the seed paper side by side with the model, Figs. 11-12."""
 
-from drakecreep.cli._common import print_json
+from drakecreep.cli._common import existing_path, print_json
 from drakecreep.errors import InputError
 from drakecreep.params import PRESETS
 
@@ -50,6 +50,7 @@ def _rows_option(text):
 
 
 def run(args):
+    from drakecreep.files import check_output_dir
     from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
     from drakecreep.params import load_params, preset
 
@@ -57,7 +58,8 @@ def run(args):
         raise InputError("--sensitivity", True, "only with --validate")
     explicit = args.params is not None or args.preset is not None
     args.preset = args.preset or "paper_calibrated"
-    params = load_params(args.params) if args.params else preset(args.preset)
+    params = load_params(existing_path("--params", args.params)) if args.params else preset(args.preset)
+    check_output_dir(args.out)  # before the calibration and the runs ('File exists: afile' came after 48 s of them)
     name = args.params or args.preset
     rows = CALIBRATION_ROWS
     info = None

@@ -40,3 +40,21 @@ def test_compensate_bad_arguments_exit_2(tmp_path, capsys):
     assert main(["compensate", "--feeds", "abc", "--out", str(tmp_path)]) == 2
     assert main(["compensate", "--load-cases", "9", "--out", str(tmp_path)]) == 2
     assert "--load-cases" in capsys.readouterr().err
+
+
+def test_reproduce_paper_checks_out_before_the_calibration(tmp_path, capsys, monkeypatch):
+    """--out on an existing file said 'File exists: afile' after the calibration (48 s); a missing --params file
+    'No such file or directory: nothere.yaml'. Both name their option now, before any work."""
+    from drakecreep.studies import paper_reproduction
+
+    def started(*args, **kwargs):
+        raise AssertionError("the calibration started")
+
+    monkeypatch.setattr(paper_reproduction, "calibrate", started)
+    (tmp_path / "afile").write_text("")
+    assert main(["reproduce-paper", "--out", str(tmp_path / "afile"), "--calibrate", "4,6"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--out: got " in err[0] and "a folder (this is an existing file)" in err[0]
+    assert main(["reproduce-paper", "--out", str(tmp_path / "o"), "--params", str(tmp_path / "nothere.yaml")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--params: got " in err[0]
