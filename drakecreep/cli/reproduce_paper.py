@@ -51,7 +51,7 @@ def _rows_option(text):
 
 def run(args):
     from drakecreep.files import check_output_dir
-    from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, write_report
+    from drakecreep.studies.paper_reproduction import CALIBRATION_ROWS, calibrate, paper_rows, write_report
     from drakecreep.params import load_params, preset
 
     if args.sensitivity and not args.validate:
@@ -59,6 +59,10 @@ def run(args):
     explicit = args.params is not None or args.preset is not None
     args.preset = args.preset or "paper_calibrated"
     params = load_params(existing_path("--params", args.params)) if args.params else preset(args.preset)
+    need = max(r["load_case"] for r in paper_rows())
+    if len(params.loads.cases) < need:  # (the rows said 'load_case: got 3', a library field)
+        raise InputError("--params", args.params, f"a params file with the paper's load cases 1-{need} (loads.cases; "
+                         f"it has {len(params.loads.cases)})")
     check_output_dir(args.out)  # before the calibration and the runs ('File exists: afile' came after 48 s of them)
     name = args.params or args.preset
     rows = CALIBRATION_ROWS

@@ -58,3 +58,22 @@ def test_reproduce_paper_checks_out_before_the_calibration(tmp_path, capsys, mon
     assert main(["reproduce-paper", "--out", str(tmp_path / "o"), "--params", str(tmp_path / "nothere.yaml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--params: got " in err[0]
+
+
+def test_reproduce_paper_names_a_params_file_without_the_papers_load_cases(tmp_path, capsys, monkeypatch):
+    """A params file with two load cases said 'load_case: got 3; allowed: an integer in 0..2' (a library field)."""
+    import dataclasses
+
+    from drakecreep.params import preset, save_params
+    from drakecreep.studies import paper_reproduction
+
+    def started(*args, **kwargs):
+        raise AssertionError("the rows started")
+
+    monkeypatch.setattr(paper_reproduction, "write_report", started)
+    p = preset("paper")
+    path = tmp_path / "two.yaml"
+    save_params(dataclasses.replace(p, loads=dataclasses.replace(p.loads, cases=p.loads.cases[:2])), path)
+    assert main(["reproduce-paper", "--out", str(tmp_path / "o"), "--params", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--params: got " in err[0] and "the paper's load cases 1-3 (loads.cases; it has 2)" in err[0]
