@@ -31,7 +31,10 @@ def run(args):
     check_output_file(args.out)  # before the diagram is built: the folder, writable
     params = params_from_args(args)
     continuous = None if args.controller is None else args.controller == "continuous"
-    drive = build_diagram(params, Scenario(), continuous=continuous)
+    # the default scenario's load case, or the last one a params file has (one without load cases said
+    # 'load_case: got 3', an option diagram does not have): the blocks drawn are the same for every load case
+    scenario = Scenario(load_case=min(Scenario().load_case, len(params.loads.cases)))
+    drive = build_diagram(params, scenario, continuous=continuous)
     path = draw_diagram(drive.diagram, args.out)
     print(f"wrote {path}")
     return 0
