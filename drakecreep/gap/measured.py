@@ -783,6 +783,8 @@ def load_emps(path=None):
                          "the EMPS variables t, qm, qg, vir, gtau, kp, kv")
 
     def array(name):
+        if np.iscomplexobj(mat[name]):  # as floats, the real part alone with a ComplexWarning (read_signals refuses it)
+            raise InputError(f"{path}: {name}", f"complex numbers ({mat[name].dtype})", "real numbers")
         try:
             return np.asarray(mat[name], dtype=float)
         except (TypeError, ValueError):

@@ -441,6 +441,22 @@ def test_emps_estimation_loader():
     assert np.max(np.abs(counts - np.round(counts))) < 1e-6
 
 
+@pytest.mark.parametrize("name", ["vir", "qm", "gtau"])
+def test_an_emps_file_of_complex_signals_is_refused_by_name(tmp_path, name):
+    """A complex vir was read as its real part with a ComplexWarning and diagnosed (the measured files refuse it)."""
+    import scipy.io
+
+    t = np.arange(3000) * 1e-3
+    mat = dict(t=t, qm=0.1 * np.sin(2 * np.pi * t), qg=0.1 * np.sin(2 * np.pi * t), vir=np.cos(t), gtau=35.15,
+               kp=160.18, kv=243.45)
+    mat[name] = mat[name] + 1j
+    scipy.io.savemat(tmp_path / "DATA_EMPS.mat", mat)
+    with pytest.raises(InputError) as err:
+        load_emps(tmp_path / "DATA_EMPS.mat")
+    assert err.value.field.endswith(f"DATA_EMPS.mat: {name}") and err.value.value == "complex numbers (complex128)"
+    assert err.value.allowed == "real numbers"
+
+
 def test_emps_controller_law_reproduces_the_recorded_output():
     """The documented law, fed the recorded qm and qg, gives the recorded u (after removing the pulses)."""
     for which, worst in (("estimation", 0.01), ("validation", 0.1)):
