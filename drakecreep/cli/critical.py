@@ -28,6 +28,8 @@ OVERRIDES = {
     "fs": ("breakaway", 1.0, False),
     "fd": ("coulomb", 1.0, False),
 }
+#: the overrides' units, as their options take them
+_UNITS = {"stiffness": "N/um", "damping": "N s/m", "mass": "kg", "fs": "N", "fd": "N"}
 
 
 def add_parser(subparsers):
@@ -66,10 +68,13 @@ def _drive(args):
         # the bounds of a parameter file's fields (params.ABSURD): 1e300 or 1e-300 overflowed to inf results
         lo, hi = 1.0 / ABSURD / unit, min(ABSURD / unit, 1e5 if option == "mass" else math.inf)
         if not (math.isfinite(value) and ((value == 0 and zero_ok) or lo <= value <= hi)):
-            raise InputError("--" + option, value, f"{'0 or ' if zero_ok else ''}a number in [{lo:g}, {hi:g}]")
+            raise InputError("--" + option, value,
+                             f"{'0 or ' if zero_ok else ''}a number in [{lo:g}, {hi:g}] {_UNITS[option]}")
         changes[field] = value * unit
     drive = dataclasses.replace(drive, **changes)
     if drive.breakaway < drive.coulomb:
+        if args.fs is None:  # the option given, not the params' value it contradicts ('--fs: got 7.781' for --fd 10)
+            raise InputError("--fd", args.fd, f"<= Fs ({drive.breakaway:g} N, the parameters' breakaway; or give --fs)")
         raise InputError("--fs", drive.breakaway, f">= Fd ({drive.coulomb:g} N)")
     source = args.params or f"preset {args.preset}"
     return drive, source + (" with " + ", ".join("--" + o for o in OVERRIDES if getattr(args, o) is not None)

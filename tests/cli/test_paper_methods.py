@@ -143,6 +143,20 @@ def test_critical_refuses_overflowing_values(argv, field, capsys):
     assert captured.out == "" and err.count("\n") == 0 and err.startswith(f"drakecreep critical: error: {field}: got")
 
 
+@pytest.mark.parametrize("argv, line", [
+    # the unit of the option (N/um, not the model's N/m) in what is allowed
+    (["--stiffness", "-1"], "--stiffness: got -1.0; allowed: a number in [1e-26, 1e+14] N/um"),
+    (["--damping", "-5"], "--damping: got -5.0; allowed: 0 or a number in [1e-20, 1e+20] N s/m"),
+    (["--mass", "0"], "--mass: got 0.0; allowed: a number in [1e-20, 100000] kg"),
+    # --fd above the parameters' Fs named --fd, not '--fs: got 12.234376764999999', an option not given
+    (["--fd", "100"], "--fd: got 100.0; allowed: <= Fs (12.2344 N, the parameters' breakaway; or give --fs)"),
+    (["--fs", "1", "--fd", "2"], "--fs: got 1.0; allowed: >= Fd (2 N)"),
+])
+def test_critical_names_the_option_given_in_its_unit(argv, line, capsys):
+    assert cli.main(["critical"] + argv) == 2
+    assert capsys.readouterr().err.strip() == f"drakecreep critical: error: {line}"
+
+
 def test_critical_at_the_bounds_is_finite(capsys):
     assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-20", "--damping", "0"]) == 0
     out = json.loads(capsys.readouterr().out)
