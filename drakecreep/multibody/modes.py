@@ -29,7 +29,7 @@ from drakecreep.model.motor import motor_inertia
 from drakecreep.model.screw import screw_inertia
 from drakecreep.multibody.plant import BodyGroup
 
-__all__ = ["Mode", "ModalResult", "LABELS", "RIGID_BODY_HZ", "EQUILIBRIUM_RTOL", "static_equilibrium", "linearize_mechanics",
+__all__ = ["Mode", "ModalResult", "LABELS", "RIGID_BODY_HZ", "STEP_ROUNDOFF", "static_equilibrium", "linearize_mechanics",
            "modal_analysis", "two_mass_axial_frequency"]
 
 #: (body group, motion) -> label; motion is "tx".."tz" (translation) or "rx".."rz" (rotation about an axis)
@@ -177,12 +177,11 @@ def linearize_mechanics(drive, context=None):
     return mass, stiffness, damping
 
 
-#: Share of the first generalized-force residual (the load of gravity, 380 N on the paper rig) that the static
-#: equilibrium may leave (38 uN there): the round-off of the stiff joints holds the residual at 0.7e-6 N with 12
-#: screw segments, 1-2.5e-6 N with 50-100 and 4e-6 N with 150 however many Newton steps follow, above the absolute
-#: 1e-6 N from about 50 segments on ('modes --segments 60', in the allowed 2-400, ended in 'internal error:
-#: RuntimeError: static equilibrium not reached'); 400 segments reach it too
-EQUILIBRIUM_RTOL = 1e-7
+#: A Newton step of the static equilibrium at most this many machine epsilons of the coordinates (at least 1 m or
+#: rad) moves nothing: the residual is then the round-off of the stiff joints, 0.1-0.7e-6 N with 12 screw segments,
+#: 1-4e-6 N with 60-150, rigid joints or not, however many steps follow. An absolute 1e-6 N alone ended 'modes
+#: --segments 60' (allowed: 2-400) in 'internal error: RuntimeError: static equilibrium not reached'.
+STEP_ROUNDOFF = 64
 
 
 def static_equilibrium(drive, context=None, tolerance=1e-6, max_iterations=10):
@@ -195,26 +194,24 @@ def static_equilibrium(drive, context=None, tolerance=1e-6, max_iterations=10):
     Returns
     -------
     float
-        Largest remaining generalized force (N or N m): below ``tolerance``, or after ``max_iterations`` steps
-        at most :data:`EQUILIBRIUM_RTOL` of the first one (the load of gravity; the round-off floor); raises
-        RuntimeError above both.
+        Largest remaining generalized force (N or N m): below ``tolerance``, or where the next step is at the
+        coordinates' round-off (:data:`STEP_ROUNDOFF`); raises RuntimeError if neither within ``max_iterations``.
     """
     plant = drive.plant
     pc = _plant_context(drive, context)
     plant.SetVelocities(pc, np.zeros(plant.num_velocities()))
     _, stiffness, _ = linearize_mechanics(drive, pc)
-    first = None
+    residual = math.inf
     for _ in range(max_iterations):
         f = _generalized_forces(plant, pc)
         residual = float(np.max(np.abs(f)))
-        first = residual if first is None else first
         if residual <= tolerance:
             return residual
         step = np.linalg.lstsq(stiffness, f, rcond=1e-12)[0]
-        plant.SetPositions(pc, plant.GetPositions(pc) + plant.MapVelocityToQDot(pc, step))
-    residual = float(np.max(np.abs(_generalized_forces(plant, pc))))
-    if first is not None and residual <= max(tolerance, EQUILIBRIUM_RTOL * first):  # at the round-off floor
-        return residual
+        q = plant.GetPositions(pc)
+        if np.max(np.abs(step)) <= STEP_ROUNDOFF * np.finfo(float).eps * max(1.0, float(np.max(np.abs(q)))):
+            return residual  # as exact as the floats allow
+        plant.SetPositions(pc, q + plant.MapVelocityToQDot(pc, step))
     raise RuntimeError(f"static equilibrium not reached: residual {residual:.3g} after {max_iterations} steps")
 
 
