@@ -1,6 +1,6 @@
 """``drakecreep params``: print a preset's YAML (with its sources) or check a parameter file."""
 
-from drakecreep.cli._common import print_json
+from drakecreep.cli._common import existing_path, print_json
 
 __all__ = ["add_parser", "run"]
 
@@ -27,7 +27,7 @@ def run(args):
     from drakecreep.params import load_params, params_to_dict, preset, preset_text
 
     if args.check:
-        params = load_params(args.check)
+        params = load_params(existing_path("--check", args.check))  # said 'No such file or directory: x.yaml'
     elif not args.json:
         print(preset_text(args.preset), end="")
         return 0

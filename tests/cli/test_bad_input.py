@@ -369,6 +369,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),
     # a missing file named by its option (the generic line said only 'No such file or directory')
     (["simulate", "--params", "{tmp}/nothere.yaml"], "--params: got"),
+    (["params", "--check", "{tmp}/nothere.yaml"], "--check: got"),  # 'No such file or directory: ...'
     (["diagnose", "{example}", "--meta", "{tmp}/nothere.yaml"], "--meta: got"),
     (["uncertainty", "--spec", "{tmp}/nothere.yaml"], "--spec: got"),
     # the option and mm/s, not the scenario's field in m/s; a placement that fails names both targets
