@@ -14,8 +14,10 @@ def add_parser(subparsers):
         description="Print a preset as commented YAML (SI units; assumptions and their sources in the "
         "comments), or load and validate --check FILE.",
     )
-    p.add_argument("--preset", default="paper", choices=PRESETS, help="preset to print (default: paper)")
-    p.add_argument("--check", metavar="FILE", help="validate a parameter file and print it resolved (defaults filled)")
+    # one or the other: '--check FILE --preset rigid_axis' printed the file, the preset ignored without a word
+    which = p.add_mutually_exclusive_group()
+    which.add_argument("--preset", choices=PRESETS, help="preset to print (default: paper)")
+    which.add_argument("--check", metavar="FILE", help="validate a parameter file and print it resolved (defaults filled)")
     p.add_argument("--json", action="store_true", help="print as JSON instead of YAML")
     p.set_defaults(func=run)
     return p
@@ -26,6 +28,7 @@ def run(args):
 
     from drakecreep.params import load_params, params_to_dict, preset, preset_text
 
+    args.preset = args.preset or "paper"
     if args.check:
         params = load_params(existing_path("--check", args.check))  # said 'No such file or directory: x.yaml'
     elif not args.json:

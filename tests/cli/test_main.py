@@ -92,3 +92,16 @@ def test_diagram_dot_and_svg(tmp_path):
         pytest.skip("Graphviz 'dot' not installed")
     assert main(["diagram", "--out", str(tmp_path / "d.svg")]) == 0
     assert (tmp_path / "d.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_params_check_and_preset_are_one_or_the_other(tmp_path, capsys):
+    """'params --check FILE --preset rigid_axis' printed the file and ignored the preset without a word."""
+    from drakecreep.params import preset, save_params
+
+    save_params(preset("paper"), tmp_path / "p.yaml")
+    with pytest.raises(SystemExit) as stop:
+        main(["params", "--check", str(tmp_path / "p.yaml"), "--preset", "rigid_axis"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert stop.value.code == 2 and "not allowed with argument" in err[-1]
+    assert main(["params", "--check", str(tmp_path / "p.yaml")]) == 0 and main(["params", "--json"]) == 0
+    capsys.readouterr()
