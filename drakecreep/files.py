@@ -188,7 +188,7 @@ def csv_dialect(lines, separator=None, decimal=None):
     return separator, decimal
 
 
-def read_csv_frame(source, field, allowed, separator=None, decimal=None):
+def read_csv_frame(source, field, allowed, separator=None, decimal=None, text_columns=()):
     """A CSV as a pandas DataFrame, the one CSV reader of measured runs and hammer tests.
 
     ``#`` lines are comments. The separator and the decimal mark come from :func:`csv_dialect` unless given.
@@ -205,6 +205,9 @@ def read_csv_frame(source, field, allowed, separator=None, decimal=None):
     allowed : str
         What a readable file is, for the message of an unreadable one.
     separator, decimal : str, optional
+    text_columns : sequence of str
+        Columns read as text, as written (labels: read as numbers, ``1`` and ``1.0`` were one label, ``007`` was
+        ``7.0``).
 
     Raises
     ------
@@ -230,7 +233,7 @@ def read_csv_frame(source, field, allowed, separator=None, decimal=None):
         with warnings.catch_warnings():
             warnings.simplefilter("error", pd.errors.ParserWarning)
             frame = pd.read_csv(source, comment="#", skipinitialspace=True, skip_blank_lines=True, index_col=False,
-                                sep=separator, decimal=decimal)
+                                sep=separator, decimal=decimal, dtype={c: str for c in text_columns} or None)
     except pd.errors.ParserWarning:
         raise InputError(field, "data rows with more values than the header has column names",
                          "one value per header column (a trailing comma on every line is allowed)") from None

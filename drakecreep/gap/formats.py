@@ -66,13 +66,14 @@ SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t"}
 DECIMALS = (".", ",")
 
 
-def _frame(path, fmt, key, separator=None, decimal=None):
+def _frame(path, fmt, key, separator=None, decimal=None, run_column="run"):
     import pandas as pd
 
     if fmt == "csv":
         from drakecreep.files import read_csv_frame
 
-        return read_csv_frame(path, str(path), "a CSV with a header line and data rows", separator, decimal)
+        return read_csv_frame(path, str(path), "a CSV with a header line and data rows", separator, decimal,
+                              text_columns=(run_column,))  # run labels as written: 1 and 1.0 are two runs
     if fmt == "parquet":
         try:
             return pd.read_parquet(path)
@@ -139,7 +140,7 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise InputError(str(path), path.suffix or "(no suffix)", "a file ending in " + ", ".join(FORMATS))
-    frame = _frame(path, fmt, key, separator, decimal)
+    frame = _frame(path, fmt, key, separator, decimal, run_column=str((columns or {}).get("run", "run")))
     if frame.shape[1] == 0 or frame.shape[0] == 0:
         raise InputError(str(path), "no data", "a header line and data rows")
     mapping = dict(columns or {})

@@ -517,3 +517,18 @@ def test_save_measured_keeps_the_old_file_when_writing_fails(tmp_path, monkeypat
     monkeypatch.setattr(measured.np, "column_stack", real)
     assert calls["n"] == 1 and csv_path.read_text() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["runs.csv", "runs.yaml"]  # no temporary left
+
+
+def test_run_labels_are_read_as_written(tmp_path):
+    """A numeric run column was read as numbers: labels 1 and 1.0 were one run (two runs merged without a word when
+    the time ran on), 007 became '7.0'."""
+    lines = ["t[s],x_ref[m],x_motor[m],u[N],run"]
+    for k, label in enumerate(("1", "1.0", "007")):
+        for i in range(30):
+            n = 30 * k + i
+            lines.append(f"{n * 1e-3},{n * 1e-5},{n * 1e-5},1.5,{label}")
+    (tmp_path / "runs.csv").write_text("\n".join(lines) + "\n")
+    (tmp_path / "runs.yaml").write_text("u_units: N\nu_gain: 1.0\n")
+    data = load_measured(tmp_path / "runs.csv")
+    assert data.labels == ("1", "1.0", "007")
+    assert [r.n for r in data.runs] == [30, 30, 30]
