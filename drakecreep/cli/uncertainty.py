@@ -74,7 +74,8 @@ def spec_from_args(args):
     from drakecreep.studies.uncertainty import load_uncertainty, uncertainty_spec
 
     if getattr(args, "spec", None):
-        return load_uncertainty(existing_path("--spec", args.spec))
+        # the preset's spec: one of rigid_axis's ran on paper, reported as rigid_axis's (with --params: any)
+        return load_uncertainty(existing_path("--spec", args.spec), None if args.params else args.preset)
     if args.params:
         raise InputError("--spec", None, "an uncertainty spec file: with --params the preset's spec does not apply")
     return uncertainty_spec(args.preset)

@@ -116,16 +116,18 @@ class UncertaintySpec:
         return [d.path for d in self.distributions]
 
 
-def load_uncertainty(path):
+def load_uncertainty(path, preset_name=None):
     """Read an uncertainty spec (YAML; see ``presets/paper_uncertainty.yaml``).
+
+    ``preset_name``: the preset it is to be used with, which its ``preset`` must name (default: its first).
 
     Raises
     ------
     InputError
-        For bad YAML, an unknown key, a bad distribution or an unknown parameter path.
+        For bad YAML, an unknown key, a bad distribution, an unknown parameter path, or a spec of other presets.
     """
     path = Path(path)
-    return _spec_from_data(load_yaml_file(path, str(path), "a YAML uncertainty spec"), str(path))
+    return _spec_from_data(load_yaml_file(path, str(path), "a YAML uncertainty spec"), str(path), preset_name)
 
 
 def uncertainty_spec(name="paper"):
@@ -151,6 +153,8 @@ def _spec_from_data(data, where, name=None):
     names = [names] if isinstance(names, str) else names
     if not isinstance(names, list) or not names or any(n not in PRESETS for n in names):
         raise InputError("preset", names, "a preset name or a list of them: " + ", ".join(PRESETS))
+    if name is not None and name not in names:  # its ranges and fixed values are another preset's assumptions
+        raise InputError(f"{where}: preset", names, f"a spec of the preset it is used with, {name} (or choose --preset)")
     name = name or names[0]
     sample = data["sample"]
     if not isinstance(sample, dict) or not sample:

@@ -84,6 +84,25 @@ def test_spec_file_errors_name_the_key(tmp_path):
         uncertainty_spec("rigid_axis")
 
 
+def test_a_spec_of_another_preset_is_refused(tmp_path, capsys, monkeypatch):
+    """A spec naming rigid_axis ran on the paper preset (the default) and its JSON said preset 'rigid_axis'."""
+    spec = tmp_path / "u.yaml"
+    spec.write_text("preset: rigid_axis\nsample:\n  motor.peak_torque: {dist: uniform, low: 6, high: 10, source: s}\n")
+    assert load_uncertainty(spec, "rigid_axis").preset == "rigid_axis"
+    with pytest.raises(InputError) as err:
+        load_uncertainty(spec, "paper")
+    assert err.value.field == f"{spec}: preset" and "paper" in err.value.allowed
+    import drakecreep.sim.sweep as sweep
+
+    def started(*args, **kwargs):
+        raise AssertionError("the rigs ran")
+
+    monkeypatch.setattr(sweep, "run_sweep", started)
+    assert main(["uncertainty", "--spec", str(spec), "--samples", "1", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "preset: got ['rigid_axis']; allowed: a spec of the preset it is used with, paper" in err[0]
+
+
 def test_summary_shares_and_percentiles_from_a_known_table():
     table = pd.DataFrame(dict(
         feed=[1e-4] * 4 + [2e-4] * 4, load_case=[3] * 8, status=["ok"] * 7 + ["failed: x"],
