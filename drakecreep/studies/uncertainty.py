@@ -168,6 +168,9 @@ def _spec_from_data(data, where, name=None):
         current = get_value(base, dist.path)  # raises for an unknown path
         if isinstance(current, (bool, str)):
             raise InputError(f"sample.{path}", current, "a numeric parameter")
+        if isinstance(current, int):  # its draws were refused one by one: 'got 1363.0383126785457; allowed: an integer'
+            raise InputError(f"sample.{path}", current, "a real-valued parameter (an integer one cannot take the "
+                             "distribution's values)")
         for bound in (dist.low, dist.high):
             with_value(base, dist.path, bound)  # each bound is a valid value of the field
         dists.append(dist)

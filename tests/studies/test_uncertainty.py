@@ -82,6 +82,12 @@ def test_spec_file_errors_name_the_key(tmp_path):
         load_uncertainty(bad)
     with pytest.raises(InputError, match="preset"):
         uncertainty_spec("rigid_axis")
+    # an integer field: its first draw was refused as 'sensors.encoder_counts_per_rev: got 1363.04...'
+    bad.write_text("preset: paper\nsample:\n  sensors.encoder_counts_per_rev: {dist: uniform, low: 1000, high: 2000, "
+                   "source: s}\n")
+    with pytest.raises(InputError) as err:
+        load_uncertainty(bad)
+    assert err.value.field == "sample.sensors.encoder_counts_per_rev" and "real-valued" in err.value.allowed
 
 
 def test_a_spec_of_another_preset_is_refused(tmp_path, capsys, monkeypatch):
