@@ -171,8 +171,11 @@ def _spec_from_data(data, where, name=None):
         if isinstance(current, int):  # its draws were refused one by one: 'got 1363.0383126785457; allowed: an integer'
             raise InputError(f"sample.{path}", current, "a real-valued parameter (an integer one cannot take the "
                              "distribution's values)")
-        for bound in (dist.low, dist.high):
-            with_value(base, dist.path, bound)  # each bound is a valid value of the field
+        for key, bound in (("low", dist.low), ("high", dist.high)):
+            try:
+                with_value(base, dist.path, bound)  # each bound is a valid value of the field
+            except InputError as err:  # the spec's key ('motor.peak_torque: got 1e+300' named the params field)
+                raise InputError(f"sample.{path}.{key}", bound, f"a value of {dist.path}: {err.allowed}") from None
         dists.append(dist)
     fixed = data.get("fixed") or {}
     if not isinstance(fixed, dict):
