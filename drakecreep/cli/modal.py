@@ -54,6 +54,25 @@ def _estimate_pulse_width(force, dt):
     return max((idx[-1] - idx[0] + 1) * dt, 2 * dt)
 
 
+def _identify(args, header, data, band):
+    """The identification of an FRF or a time record, and the kind of its FRF or response."""
+    if header == FRF_COLUMNS:
+        f = data[:, 0]
+        _uniform_step(f, "f_Hz")
+        kind = args.frf_type or "receptance"
+        ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], kind, args.mass, band, args.exp_tau)
+    else:
+        dt = _uniform_step(data[:, 0], "t")
+        force = data[:, 1]
+        if not np.any(force != 0.0):
+            raise InputError("force", "all zero", "a recorded impulse")
+        width = args.pulse_width if args.pulse_width is not None else _estimate_pulse_width(force, dt)
+        kind = args.response or "acceleration"
+        test = HammerTest(data[:, 0], force[None, :], data[:, 2][None, :], 1.0 / dt, kind)
+        ident = identify_hammer_test(test, width, args.mass, args.exp_tau, band=band)
+    return ident, kind
+
+
 def run(args):
     """Read the file, identify, print."""
     # bounded as hertz --mass: 1e300 kg printed k = 4.852e+305 N/m, exit 0
@@ -79,20 +98,12 @@ def run(args):
     band = None
     if args.fmin is not None or args.fmax is not None:
         band = (args.fmin, args.fmax)
-    if header == FRF_COLUMNS:
-        f = data[:, 0]
-        _uniform_step(f, "f_Hz")
-        kind = args.frf_type or "receptance"
-        ident = identify_frf(f, data[:, 1] + 1j * data[:, 2], kind, args.mass, band, args.exp_tau)
-    else:
-        dt = _uniform_step(data[:, 0], "t")
-        force = data[:, 1]
-        if not np.any(force != 0.0):
-            raise InputError("force", "all zero", "a recorded impulse")
-        width = args.pulse_width if args.pulse_width is not None else _estimate_pulse_width(force, dt)
-        kind = args.response or "acceleration"
-        test = HammerTest(data[:, 0], force[None, :], data[:, 2][None, :], 1.0 / dt, kind)
-        ident = identify_hammer_test(test, width, args.mass, args.exp_tau, band=band)
+    try:
+        ident, kind = _identify(args, header, data, band)
+    except InputError as err:  # the option, not the library's parameter
+        if err.field != "exp_tau":
+            raise
+        raise InputError("--exp-tau", err.value, err.allowed) from None
     fit = ident.fit
     out = {
         "input": {"file": str(args.file), "kind": kind, "modal_mass_kg": args.mass},

@@ -635,6 +635,11 @@ def identify_frf(f, H, frf_type="receptance", modal_mass=None, band=None, exp_ta
     hp = half_power(f, H, frf_type, fmin, fmax)
     fn, zeta = hp.fn, hp.zeta
     if exp_tau is not None:
+        decay = 2.0 * np.pi * fn * zeta  # of the windowed record; the window's own share is 1/tau
+        if not 1.0 / exp_tau < decay:  # no damping of its own left: zeta -0.82 (exit 0), or an OverflowError
+            raise InputError("exp_tau", exp_tau, f"a longer window time constant: 1/tau = {1.0 / exp_tau:.3g} 1/s is "
+                             f"not below the decay rate zeta wn = {decay:.3g} 1/s of the windowed data, so the mode "
+                             "keeps no damping of its own (were the records windowed with it?)")
         fn, zeta = (float(v) for v in exponential_window_damping(fn, zeta, exp_tau))
     mass = float("nan") if modal_mass is None else float(modal_mass)
     k, c = (float(v) for v in modal_stiffness_damping(fn, zeta, mass))

@@ -109,6 +109,10 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--fmin", "200", "--fmax", "100"], "--fmax: got 100.0; allowed: a frequency above --fmin (200 Hz)"),
     ("frf", ["--fmin", "100", "--fmax", "100"], "--fmax: got 100.0"),
     ("frf", ["--fmin", "-5"], "--fmin: got -5.0; allowed: a finite frequency >= 0 Hz"),
+    # a window shorter than the data's decay: zeta = -0.82 (exit 0), at 1e-300 s an OverflowError (exit 1)
+    ("frf", ["--exp-tau", "1e-3"], "--exp-tau: got 0.001; allowed: a longer window time constant: 1/tau = 1e+03 1/s"),
+    ("frf", ["--exp-tau", "1e-300"], "--exp-tau: got 1e-300; allowed: a longer window time constant"),
+    ("time", ["--exp-tau", "1e-4"], "--exp-tau: got 0.0001; allowed: a longer window time constant"),
     # an option of the other kind of file was ignored without a word
     ("frf", ["--response", "velocity"], "--response: got 'velocity'; allowed: only with a t,force,response file"),
     ("time", ["--frf-type", "mobility"], "--frf-type: got 'mobility'; allowed: only with an f_Hz,re,im file"),
