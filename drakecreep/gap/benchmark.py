@@ -829,7 +829,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     skip : collection of int
         Seeds of datasets neither generated nor diagnosed, and not counted: a development study's fresh datasets
         beyond the ones an earlier study already looked at (a library effect's next datasets with SNR >= 3 take
-        their place; nulls and effects outside the library are fewer by as many).
+        their place, and a null's or an effect's outside the library the next of its kind).
 
     Returns
     -------
@@ -846,8 +846,24 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         raise InputError("shard", shard, "(i, n) with integers 0 <= i < n")
     say = (lambda line: print(f"[gap-benchmark] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None)
     skip = {int(x) for x in skip}
-    specs = [s for s in benchmark_specs(seed, kinds, n_per_effect, tries, n_null, n_ool, n_no_candidate, library)
+    # a skipped null or dataset outside the library is replaced by the next one of its kind (drawn beyond n_null,
+    # n_ool, n_no_candidate by as many as are skipped, then cut back): '--n-null 4' with the first four skipped
+    # drew no null at all
+    n_nc = n_ool if n_no_candidate is None else n_no_candidate
+    more = len(skip)
+    specs = [s for s in benchmark_specs(seed, kinds, n_per_effect, tries, n_null + more, n_ool + more, n_nc + more,
+                                        library)
              if s[0] not in skip]
+    wanted = {"null": n_null, "no_candidate": n_nc, "out_of_library": n_ool}
+    drawn, kept_specs = {}, []
+    for spec in specs:
+        category = category_of(spec[2], spec[1])
+        if category != "library":
+            drawn[spec[1:3]] = drawn.get(spec[1:3], 0) + 1
+            if drawn[spec[1:3]] > wanted[category]:
+                continue
+        kept_specs.append(spec)
+    specs = kept_specs
     kept, skipped, pos = {}, {}, 0
     while pos < len(specs):
         part = []

@@ -279,8 +279,8 @@ def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkey
 
 
 def test_skipped_seeds_are_neither_generated_nor_diagnosed(monkeypatch):
-    """A development study's fresh datasets: the seeds an earlier study looked at are left out, and a library
-    effect's next dataset with SNR >= 3 takes a skipped one's place."""
+    """A development study's fresh datasets: the seeds an earlier study looked at are left out, a library
+    effect's next dataset with SNR >= 3 takes a skipped one's place, and the next null a skipped null's."""
     from drakecreep.gap import benchmark
 
     monkeypatch.setattr(benchmark, "evaluate", lambda ds, **kw: {"seed": ds.seed, "withheld": list(ds.withheld),
@@ -293,7 +293,11 @@ def test_skipped_seeds_are_neither_generated_nor_diagnosed(monkeypatch):
     ripples = [r["seed"] for r in whole if r["withheld"]]
     assert len(nulls) == 3 and len(ripples) == 2
     fresh = run_benchmark(skip=[nulls[0], ripples[0]], **kw)["datasets"]
-    assert sorted(r["seed"] for r in fresh if not r["withheld"]) == sorted(nulls[1:])
+    fresh_nulls = sorted(r["seed"] for r in fresh if not r["withheld"])
+    assert len(fresh_nulls) == 3 and fresh_nulls[:2] == sorted(nulls[1:]) and fresh_nulls[2] == max(nulls) + 1
+    # every null skipped (session 61's run drew none of --n-null 4 this way): the next three in their place
+    after = run_benchmark(skip=nulls, **dict(kw, library=None, n_per_effect=0))["datasets"]
+    assert sorted(r["seed"] for r in after) == [max(nulls) + k for k in (1, 2, 3)]
     again = [r["seed"] for r in fresh if r["withheld"]]
     assert len(again) == 2 and ripples[0] not in again and ripples[1] in again  # the next one took its place
 
