@@ -39,6 +39,9 @@ def scenario_from_args(args, params):
     """The operating point's :class:`~drakecreep.scenario.Scenario` from ``--feed`` and ``--load-case``."""
     from drakecreep.scenario import Scenario
 
+    if params.friction.law == "gms" and getattr(args, "friction", None):  # the operating point said 'friction.law'
+        raise InputError("--friction", args.friction, "coulomb, stribeck or lugre (the linear analysis needs a smooth "
+                         "law)")
     if not args.feed > 0:  # an operating point slides one way: its speed
         raise InputError("--feed", args.feed, "a feed > 0 mm/s")
     feed = feed_from_mm_s(args.feed)

@@ -376,6 +376,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed > 0 mm/s"),
     (["report", "--out", "{tmp}/r", "--low-feed", "-0.1"], "--low-feed: got -0.1"),
     (["margins", "--feed", "-1"], "--feed: got -1.0"),
+    (["margins", "--friction", "gms"], "--friction: got 'gms'; allowed: coulomb, stribeck or lugre"),  # 'friction.law'
+    (["tune", "--friction", "gms"], "--friction: got 'gms'"),
+    (["report", "--out", "{tmp}/r", "--friction", "gms"], "--friction: got 'gms'"),
     (["tune", "--phase-margin", "89.999"], "at a phase margin of 89.999 deg"),  # a file that is no spec is not echoed (a token was)
     (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
     (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0
