@@ -9,7 +9,9 @@ loop, the friction slope and the sampling, all of which the linearization carrie
 2. The PI of the drive, ``C = kv + ki h(w)`` with ``h = T / (z - 1)`` (sampled) or ``1 / s``
    (continuous), is linear in ``(kv, ki)``; ``C(wc) Q(wc) = exp(j (phase_margin - 180 deg))`` is two real
    equations for the two gains: exact gain crossover at ``wc`` with exactly the target phase margin.
-3. ``wc`` is adjusted (Brent's method) until the closed velocity loop's -3 dB bandwidth is the target.
+3. ``wc`` is adjusted (Brent's method, in 0.3-1.2 times the target) until the closed velocity loop's -3 dB
+   bandwidth is the target; where an end of that range needs a negative gain (at low crossovers the plant's
+   own phase can leave a PI no way to the margin), the bracket is found among the crossovers it can reach.
 4. Position loop: ``kp = 2 pi f_bw / 4`` (1/s) -- the position loop crosses over about four times below
    the velocity-loop bandwidth, so that the closed velocity loop looks like unity to it.
 
@@ -29,7 +31,7 @@ from drakecreep.servo.linearize import linearize_plant, operating_point
 from drakecreep.servo.loops import analyze_loops, loop_margins, loop_transfer
 from drakecreep.params import with_value
 
-__all__ = ["TuningResult", "tune", "POSITION_BANDWIDTH_RATIO", "RULE"]
+__all__ = ["TuningResult", "tune", "POSITION_BANDWIDTH_RATIO", "RULE", "SCAN_POINTS"]
 
 #: velocity-loop bandwidth / position-loop gain (rad/s per 1/s)
 POSITION_BANDWIDTH_RATIO = 4.0
@@ -144,10 +146,15 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
     def tuned(wc):
         kv, ki = _gains_at(params, scenario, wc, phase_margin_deg, q_loop, sampled)
         if not (kv > 0 and ki >= 0):
-            raise InputError(
+            # ki < 0: the margin needs phase lead, which a PI has not; kv <= 0: more lag than its integral gives
+            hint = "a lower margin or bandwidth" if ki < 0 else "a higher margin or bandwidth"
+            err = InputError(
                 "phase-margin", phase_margin_deg,
-                f"a target a PI can reach at {wc / 2 / math.pi:.3g} Hz (it would need kv = {kv:.3g}, ki = {ki:.3g})",
+                f"a target a PI can reach at {wc / 2 / math.pi:.3g} Hz (it would need kv = {kv:.3g}, ki = {ki:.3g}): "
+                f"{hint}",
             )
+            err.needs = f"kv = {kv:.3g}, ki = {ki:.3g} at {wc / 2 / math.pi:.3g} Hz: {hint}"
+            raise err
         p = with_value(with_value(params, "controller.velocity_gain", kv), "controller.velocity_integral_gain", ki)
         return kv, ki, p
 
@@ -158,13 +165,7 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
         return (bw if math.isfinite(bw) else 0.0) - bandwidth_Hz
 
     wb = 2 * math.pi * bandwidth_Hz
-    lo, hi = 0.3 * wb, 1.2 * wb
-    try:
-        wc = brentq(bw_gap, lo, hi, xtol=1e-6 * wb)
-    except ValueError:
-        raise InputError("bandwidth", f"{bandwidth_Hz:g} Hz at a phase margin of {phase_margin_deg:g} deg",
-                         "a bandwidth and phase margin this PI can place together (no crossover in 0.3-1.2 x the "
-                         "target gives that bandwidth at that margin: lower either)") from None
+    wc = _crossover(bw_gap, 0.3 * wb, 1.2 * wb, f"{bandwidth_Hz:g} Hz at a phase margin of {phase_margin_deg:g} deg")
     kv, ki, p = tuned(wc)
     kp = wb / POSITION_BANDWIDTH_RATIO
     p = with_value(p, "controller.position_gain", kp)
@@ -173,6 +174,40 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
         target_bandwidth_Hz=bandwidth_Hz, target_phase_margin_deg=phase_margin_deg, params=p,
         analysis=analyze_loops(p, scenario),
     )
+
+
+#: trial crossovers between the search's ends when an end needs a negative gain (log-spaced)
+SCAN_POINTS = 17
+
+
+def _crossover(gap, lo, hi, target):
+    """The crossover in ``[lo, hi]`` where ``gap`` (closed-loop bandwidth minus the target) is 0.
+
+    Brent's method between the ends; where an end needs a negative gain (``gap`` raises :class:`InputError`: at a
+    low crossover the plant's own phase can leave a PI no way to the margin), the bracket is sought among
+    :data:`SCAN_POINTS` trial crossovers the PI can reach (a 0.2 Hz target at 60 deg on the paper rig was refused
+    for its 0.06 Hz end alone; its root is at 0.14 Hz).
+    """
+    def value(w):
+        try:
+            return gap(w)
+        except InputError as err:
+            return err
+
+    ends = [value(lo), value(hi)]
+    if all(isinstance(v, float) for v in ends) and ends[0] * ends[1] <= 0:
+        return brentq(gap, lo, hi, xtol=1e-6 * lo)
+    ws = np.geomspace(lo, hi, SCAN_POINTS)
+    vals = [ends[0]] + [value(w) for w in ws[1:-1]] + [ends[1]]
+    for a, b, fa, fb in zip(ws[:-1], ws[1:], vals[:-1], vals[1:]):
+        if isinstance(fa, float) and isinstance(fb, float) and fa * fb <= 0:
+            return brentq(gap, a, b, xtol=1e-6 * lo)
+    refused = [v for v in vals if isinstance(v, InputError)]
+    if len(refused) == len(vals):  # no crossover of the search has positive gains: the PI's own message
+        raise refused[0]
+    why = f"; a PI would need {refused[0].needs}" if refused and hasattr(refused[0], "needs") else ""
+    raise InputError("bandwidth", target, "a bandwidth and phase margin this PI can place together (no crossover in "
+                     f"0.3-1.2 x the target gives that bandwidth at that margin with positive gains{why})")
 
 
 def _unit_controller(params, scenario, op):

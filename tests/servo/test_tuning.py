@@ -35,3 +35,20 @@ def test_bad_targets(paper, bw, pm, field):
     with pytest.raises(InputError) as err:
         tune(paper, SC, bw, pm)
     assert err.value.field == field
+
+
+def test_a_low_bandwidth_is_placed_where_the_search_starts_out_of_reach(paper):
+    """At 0.2 Hz and 60 deg the search's low end (0.06 Hz) needs a negative kv, which refused the whole target
+    ('lower either', found by fuzzing); the crossovers the PI reaches hold the root (0.14 Hz)."""
+    low = tune(paper, SC, bandwidth_Hz=0.2, phase_margin_deg=60.0)
+    s = low.summary()
+    assert s["velocity"]["bandwidth_Hz"] == pytest.approx(0.2, rel=1e-4)
+    assert s["velocity"]["phase_margin_deg"] == pytest.approx(60.0, abs=1e-4)
+    assert low.velocity_gain > 0 and low.velocity_integral_gain >= 0
+
+
+def test_an_unreachable_low_target_says_which_way_to_go(paper):
+    # the plant's phase at 0.015-0.06 Hz leaves a PI no way down to 60 deg: a higher margin (or bandwidth)
+    with pytest.raises(InputError, match=r"kv = -[0-9.]+.*a higher margin or bandwidth") as err:
+        tune(paper, SC, bandwidth_Hz=0.05, phase_margin_deg=60.0)
+    assert err.value.field == "phase-margin"
