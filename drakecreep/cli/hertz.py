@@ -65,7 +65,12 @@ def run(args):
                        contact_angle=math.radians(args.contact_angle), lead=args.lead * 1e-3,
                        conformity=args.conformity, preload=args.preload, mass=args.mass,
                        screw=steel, ball=steel, nut=steel)
-    r = ballscrew_stiffness(nut)
+    try:
+        r = ballscrew_stiffness(nut)
+    except InputError as err:  # the option, not the model's field
+        if err.field != "conformity":
+            raise
+        raise InputError("--conformity", err.value, err.allowed) from None
     out = {
         "ball_load_N": r.ball_load,
         "helix_angle_deg": math.degrees(r.helix),

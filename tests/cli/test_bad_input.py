@@ -366,6 +366,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--conformity", "1"], "--conformity: got 1.0; allowed: a groove/ball radius ratio in (1, 10]"),
     (["hertz", "--conformity", "0.9"], "--conformity: got 0.9"),  # the model's 'conformity: got 0.9'
     (["hertz", "--conformity", "1e9"], "--conformity: got 1000000000.0"),
+    (["hertz", "--conformity", "1.0000000001"], "--conformity: got 1.0000000001; allowed: a groove that keeps the contact within the ball"),
     (["sweep", "{tmp}/token.txt"], "got 'a YAML str'"),
     # a missing file named by its option (the generic line said only 'No such file or directory')
     (["simulate", "--params", "{tmp}/nothere.yaml"], "--params: got"),
@@ -379,7 +380,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["margins", "--friction", "gms"], "--friction: got 'gms'; allowed: coulomb, stribeck or lugre"),  # 'friction.law'
     (["tune", "--friction", "gms"], "--friction: got 'gms'"),
     (["report", "--out", "{tmp}/r", "--friction", "gms"], "--friction: got 'gms'"),
-    (["tune", "--phase-margin", "89.999"], "at a phase margin of 89.999 deg"),  # a file that is no spec is not echoed (a token was)
+    (["tune", "--phase-margin", "89.999"], "--phase-margin: got 89.999; allowed: a target a PI can reach"),  # every crossover needs ki < 0
     (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
     (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0
     (["modal", "{tmp}/frf_1e300.csv"], "largest magnitude"),  # zeta = inf in the JSON, exit 0

@@ -74,3 +74,14 @@ def test_bad_geometry_raises_input_error():
         BallScrewNut(conformity=0.9)
     with pytest.raises(InputError):
         point_contact(-1.0, (1.0, 1.0, 0.0, 0.0))
+
+
+def test_a_contact_longer_than_the_ball_is_refused():
+    """Hertz theory needs a contact small against the ball: a groove a hair wider than the ball gave a 314 mm
+    ellipse on a 3.175 mm ball, and an axial stiffness 1900 times the paper's."""
+    import dataclasses
+
+    with pytest.raises(InputError, match=r"conformity: .*semi-major axis is [0-9.]+ mm .*beyond the ball's radius"):
+        ballscrew_stiffness(dataclasses.replace(TABLE3_NUT, conformity=1.0001))
+    near = ballscrew_stiffness(dataclasses.replace(TABLE3_NUT, conformity=1.001))  # a long contact, still inside
+    assert 0.5 * TABLE3_NUT.ball_diameter > float(near.screw_contact.a) > 0.3 * TABLE3_NUT.ball_diameter
