@@ -54,6 +54,13 @@ def _estimate_pulse_width(force, dt):
     return max((idx[-1] - idx[0] + 1) * dt, 2 * dt)
 
 
+def _span(header, data):
+    """The frequencies a file covers, as text: its FRF's f_Hz, or 0 to Nyquist of a time record."""
+    if header == FRF_COLUMNS:
+        return f"{data[0, 0]:g}-{data[-1, 0]:g} Hz"
+    return f"0-{0.5 / float(np.median(np.diff(data[:, 0]))):g} Hz"
+
+
 def _identify(args, header, data, band):
     """The identification of an FRF or a time record, and the kind of its FRF or response."""
     if header == FRF_COLUMNS:
@@ -101,9 +108,14 @@ def run(args):
     try:
         ident, kind = _identify(args, header, data, band)
     except InputError as err:  # the option, not the library's parameter
-        if err.field != "exp_tau":
-            raise
-        raise InputError("--exp-tau", err.value, err.allowed) from None
+        if err.field == "exp_tau":
+            raise InputError("--exp-tau", err.value, err.allowed) from None
+        if err.field in ("frequency band", "band") and band is not None:  # a band past the file's data
+            option, value = ("--fmin", args.fmin) if args.fmin is not None else ("--fmax", args.fmax)
+            top = "f_Hz" if header == FRF_COLUMNS else "frequencies"
+            raise InputError(option, value, f"{err.allowed} (the file's {top} run {_span(header, data)}; "
+                             "--fmin and --fmax select within them)") from None
+        raise
     fit = ident.fit
     out = {
         "input": {"file": str(args.file), "kind": kind, "modal_mass_kg": args.mass},

@@ -109,6 +109,10 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--fmin", "200", "--fmax", "100"], "--fmax: got 100.0; allowed: a frequency above --fmin (200 Hz)"),
     ("frf", ["--fmin", "100", "--fmax", "100"], "--fmax: got 100.0"),
     ("frf", ["--fmin", "-5"], "--fmin: got -5.0; allowed: a finite frequency >= 0 Hz"),
+    # a band past the file's data said 'frequency band: got (5000.0, None)'
+    ("frf", ["--fmin", "5000"], "--fmin: got 5000.0; allowed: a band with at least 3 FRF points (the file's f_Hz run "
+                                "10-500 Hz"),
+    ("frf", ["--fmax", "5"], "--fmax: got 5.0; allowed: a band with at least 3 FRF points (the file's f_Hz run 10-500"),
     # a window shorter than the data's decay: zeta = -0.82 (exit 0), at 1e-300 s an OverflowError (exit 1)
     ("frf", ["--exp-tau", "1e-3"], "--exp-tau: got 0.001; allowed: a longer window time constant: 1/tau = 1e+03 1/s"),
     ("frf", ["--exp-tau", "1e-300"], "--exp-tau: got 1e-300; allowed: a longer window time constant"),
