@@ -446,6 +446,16 @@ class MeasuredData:
 
 # --------------------------------------------------------------------------- metadata YAML
 
+def _named(prefix, build, *args, **kwargs):
+    """``build(*args, **kwargs)``, its :class:`InputError` naming the file the field is in (``prefix`` + field): a
+    diagnosis reads several files (runs, metadata, params, a scored file), so 'screw.lead: got -1.0' alone did not
+    say which."""
+    try:
+        return build(*args, **kwargs)
+    except InputError as err:
+        raise InputError(f"{prefix}{err.field}", err.value, err.allowed) from None
+
+
 def _meta_from_dict(data, meta_path):
     from drakecreep.files import resolve_reference
     from drakecreep.params import load_params, params_from_dict
@@ -462,9 +472,10 @@ def _meta_from_dict(data, meta_path):
     params = data.get("params")
     if isinstance(params, str):
         # relative to the metadata file; a regular file only; its content is never echoed
-        params = load_params(resolve_reference(params, meta_path, f"{where}: params"))
+        path = resolve_reference(params, meta_path, f"{where}: params")
+        params = _named(f"{path}: ", load_params, path)
     elif isinstance(params, dict):
-        params = params_from_dict(params)
+        params = _named(f"{where}: params.", params_from_dict, params)
     elif params is not None:
         raise InputError(f"{where}: params", params, "a parameter file path or a mapping")
     units = data["u_units"]
@@ -478,12 +489,12 @@ def _meta_from_dict(data, meta_path):
             allowed = "a number > 0 [N per A] (or params to derive it)" if units == "A" else "a number > 0 [N per V]"
             raise InputError(f"{where}: u_gain", None, allowed)
     ctrl = data.get("controller")
-    ctrl = ControllerMeta.from_dict(ctrl) if ctrl is not None else None
+    ctrl = _named(f"{where}: ", ControllerMeta.from_dict, ctrl) if ctrl is not None else None
     sensors = data.get("sensors") or {}
     if not isinstance(sensors, dict):
         raise InputError(f"{where}: sensors", sensors, "a mapping encoder_resolution, scale_resolution")
     try:
-        sensors = SensorMeta(**sensors)
+        sensors = _named(f"{where}: ", SensorMeta, **sensors)
     except TypeError:
         raise InputError(f"{where}: sensors", sensors, "keys encoder_resolution, scale_resolution") from None
     return MeasuredMeta(u_units=units, u_gain=gain, params=params, controller=ctrl, sensors=sensors,

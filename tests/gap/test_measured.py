@@ -532,3 +532,18 @@ def test_run_labels_are_read_as_written(tmp_path):
     data = load_measured(tmp_path / "runs.csv")
     assert data.labels == ("1", "1.0", "007")
     assert [r.n for r in data.runs] == [30, 30, 30]
+
+
+@pytest.mark.parametrize("change, field", [
+    ({"params": {"screw": {"lead": -1.0}}}, "run.yaml: params.screw.lead"),
+    ({"params": "rig.yaml"}, "rig.yaml: screw.lead"),  # the params file the metadata names
+    ({"controller": dict(META["controller"], sample_time=-1.0)}, "run.yaml: controller.sample_time"),
+    ({"sensors": {"encoder_resolution": -1.0}}, "run.yaml: sensors.encoder_resolution"),
+])
+def test_a_bad_field_of_the_metadata_names_its_file(tmp_path, change, field):
+    """A diagnosis reads runs, metadata, a params file and perhaps a scored file: 'screw.lead: got -1.0' alone did
+    not say which file holds it."""
+    (tmp_path / "rig.yaml").write_text("screw: {lead: -1.0}\n")
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=dict(META, **change)))
+    assert str(err.value.field).endswith(field) and err.value.value == -1.0
