@@ -29,8 +29,8 @@ from drakecreep.model.motor import motor_inertia
 from drakecreep.model.screw import screw_inertia
 from drakecreep.multibody.plant import BodyGroup
 
-__all__ = ["Mode", "ModalResult", "LABELS", "RIGID_BODY_HZ", "STEP_ROUNDOFF", "static_equilibrium", "linearize_mechanics",
-           "modal_analysis", "two_mass_axial_frequency"]
+__all__ = ["Mode", "ModalResult", "LABELS", "RIGID_BODY_HZ", "STEP_ROUNDOFF", "static_equilibrium",
+           "linearize_mechanics", "modal_analysis", "two_mass_axial_frequency"]
 
 #: (body group, motion) -> label; motion is "tx".."tz" (translation) or "rx".."rz" (rotation about an axis)
 LABELS = {
