@@ -60,6 +60,11 @@ class InputError(DrakecreepError, ValueError):
             value = short_repr(value)
         return type(self), (self.field, value, self.allowed)
 
+    def renamed(self, field):
+        """The same error naming ``field`` instead: a caller names the option or the file the value came from
+        (``--conformity`` for the model's ``conformity``, ``run.yaml: params.screw.lead`` for ``screw.lead``)."""
+        return type(self)(field, self.value, self.allowed)
+
     @classmethod
     def unknown_field(cls, field, known):
         """A key that names no field of a mapping whose fields are ``known`` (the value is not echoed)."""

@@ -643,7 +643,7 @@ def _from_dict(cls, data, path):
     try:
         return cls(**kwargs)
     except InputError as err:
-        raise InputError(f"{path}.{err.field}" if path else err.field, err.value, err.allowed) from None
+        raise err.renamed(f"{path}.{err.field}" if path else err.field) from None
 
 
 def params_from_dict(data):
@@ -774,7 +774,7 @@ def with_value(params, path, value):
         if not rest:
             raise
         # the error names a field relative to the child: prefix this level's name
-        raise InputError(f"{head}.{err.field}", err.value, err.allowed) from None
+        raise err.renamed(f"{head}.{err.field}") from None
 
 
 _PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[([0-9]{1,6})\])?$")

@@ -125,7 +125,7 @@ def run(args):
             try:
                 check_run(r, train[0].meta.params)
             except InputError as err:
-                raise InputError(f"--score {args.score}: {err.field}", err.value, err.allowed) from None
+                raise err.renamed(f"--score {args.score}: {err.field}") from None
     if own:
         if args.nominal_friction:
             raise InputError("--nominal-friction", args.nominal_friction, "only for runs of controller kind p_p_cascade (kind "
@@ -256,7 +256,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
     except BaseException as err:  # a failure or a stop (Ctrl-C): say what is kept, then the one-line error as always
         if isinstance(err, InputError) and err.field in ("uncertain", "effects"):  # checked before any work
-            raise InputError(f"--{err.field}", err.value, err.allowed) from None  # the option, not the parameter
+            raise err.renamed(f"--{err.field}") from None  # the option, not the parameter
         if outset is not None and outset.files:
             say(f"kept {' and '.join(sorted(outset.files))} in {outset.dir} (no manifest: the run did not finish)")
         raise

@@ -70,7 +70,7 @@ def run(args):
     except InputError as err:  # the option, not the model's field
         if err.field != "conformity":
             raise
-        raise InputError("--conformity", err.value, err.allowed) from None
+        raise err.renamed("--conformity") from None
     out = {
         "ball_load_N": r.ball_load,
         "helix_angle_deg": math.degrees(r.helix),

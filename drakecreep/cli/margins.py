@@ -56,13 +56,11 @@ def check_feed(params, scenario, option, mm_s):
     """Raise :class:`InputError` naming ``option`` (a feed of ``mm_s`` mm/s) when the drive cannot slide steadily at
     ``scenario``'s feed: the force it takes is beyond the drive's limit (the operating point said 'feed: got 0.001',
     the scenario's field in m/s, and blamed the feed for what is mostly the params' load and friction)."""
-    from drakecreep.model.controller import force_limit
-    from drakecreep.servo.linearize import sliding_force
+    from drakecreep.servo.linearize import sliding_overload
 
-    if params.friction.law == "gms":  # no steady sliding to linearize: the operating point says so
-        return
-    force, limit = sliding_force(params, scenario), force_limit(params)
-    if abs(force) >= limit:
+    overload = sliding_overload(params, scenario)
+    if overload is not None:
+        force, limit = overload
         raise InputError(option, mm_s, f"a feed in mm/s the drive can slide at: at load case {scenario.load_case} it "
                          f"takes {force:.4g} N, beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
                          "screw.lead; the load and the friction take most of it at a low feed)")

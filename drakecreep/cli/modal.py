@@ -109,7 +109,7 @@ def run(args):
         ident, kind = _identify(args, header, data, band)
     except InputError as err:  # the option, not the library's parameter
         if err.field == "exp_tau":
-            raise InputError("--exp-tau", err.value, err.allowed) from None
+            raise err.renamed("--exp-tau") from None
         if err.field in ("frequency band", "band") and band is not None:  # a band past the file's data
             option, value = ("--fmin", args.fmin) if args.fmin is not None else ("--fmax", args.fmax)
             top = "f_Hz" if header == FRF_COLUMNS else "frequencies"

@@ -104,7 +104,7 @@ def run(args):
         try:  # before the run, not after it
             check_study(params, args.uncertainty, [feed], [args.load_case], seed=args.seed, duration=args.duration)
         except InputError as err:
-            raise InputError("--uncertainty" if err.field == "--samples" else err.field, err.value, err.allowed) from None
+            raise err.renamed("--uncertainty" if err.field == "--samples" else err.field) from None
         spec = spec_from_args(args)
     elif args.spec is not None or args.seed is not None:
         raise InputError("--spec" if args.spec is not None else "--seed", args.spec or args.seed,

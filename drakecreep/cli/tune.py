@@ -50,7 +50,7 @@ def run(args):
         result = tune(params, scenario, args.bandwidth, args.phase_margin)
     except InputError as err:
         if err.field in ("bandwidth", "phase-margin"):
-            raise InputError("--" + err.field, err.value, err.allowed) from None
+            raise err.renamed("--" + err.field) from None
         raise
     summary = result.summary()
     if args.write:

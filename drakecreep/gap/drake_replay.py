@@ -885,7 +885,7 @@ def replay_params(run, params=None, quantize=True):
         try:
             sensors = dataclasses.replace(sensors, scale_resolution=declared.scale_resolution)
         except InputError as err:  # the metadata's key, not the params file's field the value goes to
-            raise InputError("sensors.scale_resolution", err.value, err.allowed) from None
+            raise err.renamed("sensors.scale_resolution") from None
     if not quantize:
         sensors = dataclasses.replace(sensors, encoder_counts_per_rev=0, scale_resolution=0.0)
     return dataclasses.replace(params, sensors=sensors)

@@ -453,7 +453,7 @@ def _named(prefix, build, *args, **kwargs):
     try:
         return build(*args, **kwargs)
     except InputError as err:
-        raise InputError(f"{prefix}{err.field}", err.value, err.allowed) from None
+        raise err.renamed(f"{prefix}{err.field}") from None
 
 
 def _meta_from_dict(data, meta_path):
@@ -638,7 +638,7 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
             runs.append(MeasuredRun(meta=meta, label=str(label), dt_rtol=dt_rtol, **kw))
             check_recorded(runs[-1])
         except InputError as err:
-            raise InputError(f"{csv_path}: {err.field}", err.value, err.allowed) from None
+            raise err.renamed(f"{csv_path}: {err.field}") from None
     return MeasuredData(runs=tuple(runs), meta=meta)
 
 

@@ -57,18 +57,16 @@ def check_sliding(params, load_case, feeds, source="the params"):
     [m/s], the loci's (:data:`LOCI`) and the crossings' (:data:`CROSSING_SPEEDS`), its force within the drive's
     limit. A params file whose drive cannot hold its load and friction was refused in the loci, after the loop
     analysis, as 'feed: got 2e-05' (a speed of the feed locus, in m/s)."""
-    from drakecreep.model.controller import force_limit
-    from drakecreep.servo.linearize import sliding_force
+    from drakecreep.servo.linearize import sliding_overload
 
-    if params.friction.law == "gms":  # no steady sliding to linearize: the loop analysis says so
-        return
     speeds = dict(LOCI)["feed"]
     cases = [(params, v, None) for v in (*feeds, *speeds, *CROSSING_SPEEDS)]
     cases += [(with_value(params, "table.mass", float(m)), feeds[0], float(m)) for m in dict(LOCI)["mass"]]
     lo, hi = 1e3 * min(*feeds, *speeds, *CROSSING_SPEEDS), 1e3 * max(*feeds, *speeds, *CROSSING_SPEEDS)
     for p, v, mass in cases:
-        force, limit = sliding_force(p, Scenario(feed=float(v), load_case=load_case)), force_limit(p)
-        if abs(force) >= limit:
+        overload = sliding_overload(p, Scenario(feed=float(v), load_case=load_case))
+        if overload is not None:
+            force, limit = overload
             where = f"{1e3 * v:.3g} mm/s" + (f" with a table mass of {mass:.3g} kg (the mass locus)" if mass else "")
             raise InputError("params", f"{source}, load case {load_case}: {force:.4g} N to slide at {where}",
                              f"a drive whose limit {limit:.4g} N (motor.peak_torque through screw.lead) holds it "

@@ -52,7 +52,7 @@ from drakecreep.model.nut_table import NutTable, friction_levels, moving_mass
 __all__ = [
     "OperatingPoint",
     "operating_point",
-    "sliding_force",
+    "sliding_overload",
     "linearize_plant",
     "linearize_controller",
     "linearize_closed_loop",
@@ -148,14 +148,19 @@ def _sliding(params, scenario):
     return (law, fc, fs), friction, spring, torque, torque / ratio
 
 
-def sliding_force(params, scenario):
-    """The force command [N] that holds the drive sliding steadily at ``scenario``'s feed and load case.
+def sliding_overload(params, scenario):
+    """``(force, limit)`` [N] when the drive cannot slide steadily at ``scenario``'s feed and load case, else None.
 
-    The load's axial force, the friction at that speed and the motor's viscous drag, at the table (the ball
-    nut's friction lumped on the table, :func:`nut_on_table`). :func:`operating_point` exists only while its
-    magnitude stays below :func:`drakecreep.model.controller.force_limit`.
+    ``force`` is the command that would hold it sliding: the load's axial force, the friction at that speed and
+    the motor's viscous drag, at the table (the ball nut's friction lumped on the table, :func:`nut_on_table`);
+    ``limit`` is :func:`drakecreep.model.controller.force_limit`. :func:`operating_point` exists only while
+    ``|force| < limit``. None for the GMS law too, which has no steady sliding to linearize (the operating point
+    says so).
     """
-    return _sliding(nut_on_table(params), scenario)[-1]
+    if params.friction.law == "gms":
+        return None
+    force, limit = _sliding(nut_on_table(params), scenario)[-1], force_limit(params)
+    return (force, limit) if abs(force) >= limit else None
 
 
 def operating_point(params, scenario):

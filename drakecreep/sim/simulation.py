@@ -307,7 +307,7 @@ def check_run(params, scenario, *, backend=None, model="two_mass", multibody=Non
     InputError
         An unknown model or backend, a fractional computation delay on the compiled backend, a metrics window
         that starts after the run ends, too many recorded samples or steps (:func:`check_log_period`,
-        :func:`check_step_budget`).
+        :func:`check_step_budget`), a load case the params do not have.
     """
     sim = params.simulation
     if model not in MODELS:
@@ -327,6 +327,7 @@ def check_run(params, scenario, *, backend=None, model="two_mass", multibody=Non
         raise InputError("simulation.steady_start", sim.steady_start, f"< duration ({scenario.duration} s)")
     check_log_period(sim.log_period, scenario.duration, sim.steady_start)
     check_step_budget(params, scenario.duration)
+    params.load_case(scenario.load_case)
     return backend
 
 

@@ -100,18 +100,16 @@ def _axis_values(path, values):
 
 def _check_distinct(path, values):
     """A grid axis with a value twice would run its cases twice (1 and 1.0 are the same value)."""
-    seen = []
-    hashed = set()
+    hashed, unhashable = set(), []
     for v in values:
         try:
-            if v in hashed:
-                raise InputError(f"axes.{path}", values, f"distinct values ({short_repr(v, 40)} is there twice)")
+            again = v in hashed
             hashed.add(v)
         except TypeError:  # an unhashable value (a list): compared one by one
-            if any(v == w for w in seen):
-                raise InputError(f"axes.{path}", values, f"distinct values ({short_repr(v, 40)} is there twice)") \
-                    from None
-            seen.append(v)
+            again = any(v == w for w in unhashable)
+            unhashable.append(v)
+        if again:
+            raise InputError(f"axes.{path}", values, f"distinct values ({short_repr(v, 40)} is there twice)")
 
 
 def grid(axes, max_cases=MAX_CASES):

@@ -87,7 +87,6 @@ def _run_one(job):
 def _map(jobs, workers):
     for params, _, feed_mm_s, load_case, duration in jobs:  # every run's one-line refusal before any runs
         check_run(params, Scenario(feed=feed_mm_s * 1e-3, load_case=load_case, duration=duration))
-        params.load_case(load_case)
     if workers <= 1:
         return [_run_one(j) for j in jobs]
     from drakecreep.processes import process_pool
