@@ -14,6 +14,10 @@ once). Left to itself such a pool does not stop well:
 :func:`process_pool` makes the workers ignore ``SIGINT`` (the parent alone decides to stop), watch their parent
 (they exit when it is gone), and, when the ``with`` block ends by an exception (``KeyboardInterrupt`` included),
 cancels the queued work and terminates the running workers before the exception goes on (:func:`stop_pool`).
+
+A pool never has more processes than the CPUs this process may run on (:func:`usable_cpus`): the work is
+CPU-bound, so more processes gain nothing, and each holds its own Drake (``--workers 256`` on two cores
+started 256 interpreters and ran the machine out of memory).
 """
 
 import concurrent.futures as cf
@@ -24,7 +28,20 @@ import signal
 import threading
 import time
 
-__all__ = ["new_pool", "process_pool", "stop_pool", "worker_init"]
+__all__ = ["new_pool", "pool_size", "process_pool", "stop_pool", "usable_cpus", "worker_init"]
+
+
+def usable_cpus():
+    """The CPUs this process may run on (its affinity mask where the OS has one: a container or ``taskset`` limits
+    it below ``os.cpu_count()``)."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return os.cpu_count() or 1
+
+
+def pool_size(workers):
+    """Processes of a pool asked for ``workers``: no more than :func:`usable_cpus`."""
+    return max(1, min(int(workers), usable_cpus()))
 
 
 def worker_init(parent_pid, initializer=None, initargs=(), period=1.0):
@@ -57,9 +74,10 @@ def stop_pool(pool, timeout=5.0):
 
 
 def new_pool(workers, initializer=None, initargs=()):
-    """A ``spawn`` :class:`concurrent.futures.ProcessPoolExecutor` of ``workers`` processes with :func:`worker_init`
-    (``initializer(*initargs)`` runs in each worker after it)."""
-    return cf.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+    """A ``spawn`` :class:`concurrent.futures.ProcessPoolExecutor` of ``workers`` processes, at most
+    :func:`usable_cpus` (:func:`pool_size`), with :func:`worker_init` (``initializer(*initargs)`` runs in each
+    worker after it)."""
+    return cf.ProcessPoolExecutor(max_workers=pool_size(workers), mp_context=multiprocessing.get_context("spawn"),
                                   initializer=worker_init, initargs=(os.getpid(), initializer, tuple(initargs)))
 
 
@@ -71,7 +89,7 @@ def process_pool(workers, initializer=None, initargs=()):
     Parameters
     ----------
     workers : int
-        Worker processes (>= 1).
+        Worker processes (>= 1; at most :func:`usable_cpus` are started).
     initializer : callable, optional
         Run in each worker once it starts (module level, picklable), with ``initargs``.
     """

@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from drakecreep.processes import process_pool
+from drakecreep.processes import pool_size, process_pool, usable_cpus
 
 
 def _ended(workers, timeout=10.0):
@@ -59,3 +59,18 @@ def test_an_error_in_the_block_stops_the_workers_and_goes_on():
             workers = list(pool._processes.values())
             raise ValueError("stop")
     assert _ended(workers)
+
+
+def test_a_pool_never_starts_more_processes_than_the_cpus_it_may_use():
+    """``--workers 256`` on two cores started 256 interpreters, each with its own Drake, and ran the machine out of
+    memory: the work is CPU-bound, so a pool is no larger than the CPUs this process may use."""
+    cpus = usable_cpus()
+    assert 1 <= cpus <= (os.cpu_count() or cpus)
+    assert pool_size(1) == 1
+    assert pool_size(cpus + 5) == cpus
+    with process_pool(cpus + 5) as pool:
+        futures = [pool.submit(time.sleep, 0.5) for _ in range(cpus + 5)]
+        for future in futures:
+            future.result()
+        pids = {proc.pid for proc in pool._processes.values()}
+    assert 1 <= len(pids) <= cpus

@@ -1,7 +1,7 @@
 """``drakecreep compensate``: friction compensation methods against none over feeds and loads."""
 
 from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, params_from_args,
-                                    positive_float, print_json)
+                                    positive_float, print_json, workers)
 from drakecreep.errors import InputError
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS
 
@@ -35,7 +35,8 @@ def add_parser(subparsers):
                         "like the command; ideal = continuously on the true motor speed")
     p.add_argument("--critical", action="store_true", help="also the lowest feed without creep (bisection)")
     p.add_argument("--robustness", action="store_true", help="also the model off by +-30 %% in each parameter")
-    p.add_argument("--workers", type=int, default=2, metavar="N", help="processes (default 2)")
+    p.add_argument("--workers", type=workers, default=2, metavar="N",
+                   help="processes (default 2; no more than the CPUs this process may use are started)")
     p.add_argument("--out", default="out/compensate", metavar="DIR", help="output folder")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
@@ -69,8 +70,6 @@ def run(args):
     check_duration(args.duration)
     n = len(params.loads.cases)
     loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
-    if not 1 <= args.workers <= 256:
-        raise InputError("--workers", args.workers, "an integer in [1, 256]")
     check_output_dir(args.out)  # before the study, not after it
     methods = ["none"] + list(dict.fromkeys(args.method or COMPENSATION_STUDY_METHODS[1:]))
     rows = evaluate(params, methods, feeds, loads, duration=args.duration, workers=args.workers)

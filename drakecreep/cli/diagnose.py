@@ -21,7 +21,6 @@ nominal_params.yaml when the nominal fit ends and ranking.json after each candid
 diagnosis.json, summary.txt and augmented_params.yaml (for simulate, margins and report --params).
 """
 
-import os
 import sys
 from pathlib import Path
 
@@ -29,6 +28,7 @@ from drakecreep.cli._common import existing_path, names, print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
+from drakecreep.processes import usable_cpus
 
 __all__ = ["add_parser", "run", "load_runs", "pick"]
 
@@ -63,10 +63,11 @@ def add_parser(subparsers):
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
                    "report --params, diagnosis.html, diagnosis.json, summary.txt)")
-    p.add_argument("--workers", type=workers, metavar="N", default=os.cpu_count() or 1,
+    p.add_argument("--workers", type=workers, metavar="N", default=usable_cpus(),
                    help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits, and as many "
                         f"threads in each for the runs of one evaluation; drakecreep: the runs and Jacobian columns; "
-                        f"default: all cores, {os.cpu_count()}; 1: all in this process, one at a time)")
+                        f"default, and the most processes started: the {usable_cpus()} CPUs this process may use; "
+                        f"1: all in this process, one at a time)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p

@@ -1,6 +1,6 @@
 """``drakecreep sweep SPEC.yaml``: run a parameter sweep (grid or random) and write its table (and map)."""
 
-import os
+from drakecreep.processes import usable_cpus
 
 from drakecreep.cli._common import print_json, workers
 from drakecreep.errors import InputError
@@ -21,7 +21,8 @@ def add_parser(subparsers):
     )
     p.add_argument("spec", metavar="SPEC.yaml", help="sweep spec (YAML)")
     p.add_argument("--workers", type=workers, metavar="N",
-                   help=f"local worker processes (default: all cores, {os.cpu_count()}); 1 runs in this process")
+                   help=f"local worker processes (default, and the most started: the {usable_cpus()} CPUs this process "
+                        f"may use); 1 runs in this process")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output folder (default out/sweep)")
     p.add_argument("--retries", type=int, default=2, metavar="N", help="extra attempts of a failed case (default 2, at most 10)")

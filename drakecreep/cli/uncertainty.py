@@ -5,6 +5,7 @@ import os
 from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, existing_path,
                                     feed_from_mm_s, params_from_args, positive_float, print_json, workers)
 from drakecreep.errors import InputError
+from drakecreep.processes import usable_cpus
 
 __all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
 
@@ -60,7 +61,8 @@ def add_parser(subparsers):
     p.add_argument("--duration", type=positive_float, default=3.0, metavar="S",
                    help="simulated time per case in s (default 3; metrics from simulation.steady_start)")
     p.add_argument("--workers", type=workers, metavar="N",
-                   help=f"local worker processes (default: all cores, {os.cpu_count()}); 1 runs in this process")
+                   help=f"local worker processes (default, and the most started: the {usable_cpus()} CPUs this process "
+                        f"may use); 1 runs in this process")
     p.add_argument("--scheduler", metavar="ADDRESS", help="Dask scheduler address, e.g. tcp://host:8786")
     p.add_argument("--out", default="out/uncertainty", metavar="DIR", help="output folder (default out/uncertainty)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")

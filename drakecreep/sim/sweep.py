@@ -7,7 +7,7 @@ points into validated :class:`Case` objects (full parameters + scenario + a hash
 :func:`run_sweep` runs a function of each simulation result on
 
 * ``"serial"``: in this process;
-* ``"processes"`` (default): a local process pool, all cores unless ``workers`` says otherwise;
+* ``"processes"`` (default): a local process pool, all usable CPUs unless ``workers`` says fewer (never more);
 * ``"dask"``: a ``dask.distributed`` cluster given its scheduler address (or a ``Client``).
 
 The same code runs on all three. With ``out_dir`` every finished case is cached as
@@ -28,7 +28,6 @@ import hashlib
 import itertools
 import json
 import math
-import os
 import sys
 import time
 from dataclasses import dataclass
@@ -40,7 +39,7 @@ from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.errors import InputError, short_repr
 from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
-from drakecreep.processes import new_pool, stop_pool
+from drakecreep.processes import new_pool, pool_size, stop_pool, usable_cpus
 from drakecreep.scenario import Scenario
 
 __all__ = [
@@ -563,7 +562,7 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     executor : {"serial", "processes", "dask"}
         ``"dask"`` needs ``scheduler``.
     workers : int, optional
-        Processes of the local pool (default: all cores).
+        Processes of the local pool (default, and the most started: the CPUs this process may use).
     scheduler : str or distributed.Client, optional
         Dask scheduler address (``"tcp://host:8786"``) or a connected client.
     out_dir : path, optional
@@ -611,7 +610,7 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
     metric = metric or feed_report
     cases = make_cases(base, points, scenario, metric)
     cache_dir = Path(out_dir) / "cache" if out_dir is not None else None
-    n_workers = 1 if executor == "serial" else (workers or os.cpu_count() or 1)
+    n_workers = 1 if executor == "serial" else pool_size(workers or usable_cpus())
     if executor == "dask" and hasattr(scheduler, "scheduler_info"):
         n_workers = max(1, len(scheduler.scheduler_info().get("workers", {})))
     if batch_size and cases:

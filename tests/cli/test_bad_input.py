@@ -411,6 +411,7 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["uncertainty", "--workers", "99999"], "--workers: '99999' must be <= 256"),
     (["sweep", "{tmp}/spec.yaml", "--workers", "100000"], "--workers: '100000' must be <= 256"),
     (["diagnose", "estimation", "--workers", "257"], "--workers: '257' must be <= 256"),
+    (["compensate", "--out", "{tmp}/c", "--workers", "2.5"], "--workers: '2.5' is not an integer"),
     # session 59's fuzzing: a retry count that repeats a deterministic failure for ever, a held-out run counted
     # twice (two held-out runs from one), blank or repeated candidates (',' ran none)
     (["sweep", "{tmp}/spec.yaml", "--retries", "99999999999"], "--retries: got 99999999999; allowed: an integer in"),
