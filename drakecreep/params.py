@@ -48,6 +48,8 @@ __all__ = [
     "params_to_dict",
     "with_value",
     "get_value",
+    "field_unit",
+    "field_range",
 ]
 
 #: most YAML aliases (``*name``) one file may use: parameter files need none; a few hundred is generous,
@@ -723,19 +725,31 @@ def get_value(params, path):
     return obj
 
 
-def field_unit(params, path):
-    """SI unit of the field at dotted ``path`` (``"N/m"``, ``"-"`` for dimensionless; ``""`` when unknown)."""
-    obj, unit = params, ""
+def _field(params, path):
+    """The :class:`dataclasses.Field` at dotted ``path`` of ``params``."""
+    obj, found = params, None
     for part in path.split("."):
         name, index = _split_index(part)
         fields = {f.name: f for f in dataclasses.fields(obj)} if dataclasses.is_dataclass(obj) else {}
         if name not in fields:
             raise InputError(path, part, "a dotted path of existing parameter fields")
-        unit = fields[name].metadata.get("unit", "") or ""
+        found = fields[name]
         obj = getattr(obj, name)
         if index is not None:
             obj = obj[index]
-    return unit
+    return found
+
+
+def field_unit(params, path):
+    """SI unit of the field at dotted ``path`` (``"N/m"``, ``"-"`` for dimensionless; ``""`` when unknown)."""
+    return _field(params, path).metadata.get("unit", "") or ""
+
+
+def field_range(params, path):
+    """Allowed range ``(lower, upper)`` of the number field at dotted ``path``, in its SI unit; ``None`` where a
+    side is open-ended (the validation's own range: a value outside it is refused by :func:`with_value`)."""
+    meta = _field(params, path).metadata
+    return meta.get("lo"), meta.get("hi")
 
 
 def with_value(params, path, value):

@@ -91,7 +91,7 @@ from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscil
                                       sustained_oscillation)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.model.controller import force_limit
-from drakecreep.params import DriveParams, field_unit, get_value, save_params, with_value
+from drakecreep.params import DriveParams, field_range, field_unit, get_value, save_params, with_value
 
 __all__ = [
     "FITTABLE",
@@ -125,11 +125,12 @@ FITTABLE = (
 DEFAULT_UNCERTAIN = ("table.seal_force", "nut.preload_torque", "friction.viscous")
 #: The asymmetric friction candidate's fields (signed fractions, FrictionParams' range [-0.9, 0.9]).
 _ASYMMETRY = ("friction.coulomb_asymmetry", "friction.viscous_asymmetry")
-#: Lower bound of each fitted field (the field's own range: ``static_ratio >= 1``, the asymmetries >= -0.9, the
-#: rest >= 0), and the upper bound of the fields that have one. A field is fitted as ``lower + (start - lower)
-#: exp(theta)``; an asymmetry of 0 sits 0.9 above its lower bound, so it moves about linearly near 0.
-_LOWER = {"friction.static_ratio": 1.0, **{p: -0.9 for p in _ASYMMETRY}}
-_UPPER = {p: 0.9 for p in _ASYMMETRY}
+#: The bounds of a fitted field are its own range in DriveParams (:func:`drakecreep.params.field_range`:
+#: ``static_ratio`` in [1, 10], the asymmetries in [-0.9, 0.9], the friction coefficients in [0, 1], the rest
+#: >= 0). A field is fitted as ``lower + (start - lower) exp(theta)``, theta bounded above where the range ends
+#: (a Stribeck fit that left it, static ratio 17.5, failed the whole diagnosis when its params were set); an
+#: asymmetry of 0 sits 0.9 above its lower bound, so it moves about linearly near 0.
+_RANGES = DriveParams()
 #: Signed fields without a range of their own, fitted in a linear coordinate: ``start + scale theta``, the scale
 #: the params file's Coulomb level on the unloaded axis (at least 1 N; :func:`_linear_scale`), so the fit's step
 #: is a tenth of it and its range four times it either way. A constant force beside the dry friction is told apart
@@ -139,8 +140,17 @@ _LINEAR = ("loads.constant_force",)
 
 
 def _lower(path):
-    """A fitted field's lower bound: its range's (:data:`_LOWER`, else 0), ``-inf`` for a :data:`_LINEAR` field."""
-    return -math.inf if path in _LINEAR else _LOWER.get(path, 0.0)
+    """A fitted field's lower bound: its range's (0 where it has none), ``-inf`` for a :data:`_LINEAR` field."""
+    if path in _LINEAR:
+        return -math.inf
+    lower = field_range(_RANGES, path)[0]
+    return 0.0 if lower is None else float(lower)
+
+
+def _upper(path):
+    """A fitted field's upper bound: its range's, ``inf`` where it has none or for a :data:`_LINEAR` field."""
+    upper = None if path in _LINEAR else field_range(_RANGES, path)[1]
+    return math.inf if upper is None else float(upper)
 
 
 #: Estimates whose correlation exceeds this are reported as not separable.
@@ -568,8 +578,8 @@ def _check_inputs(train, test, uncertain, effects, load_case):
     for path in uncertain:
         if get_value(prior, path) <= _lower(path):
             raise InputError("uncertain", path, f"a field whose params value is above {_lower(path):g}")
-        if path in _UPPER and get_value(prior, path) >= _UPPER[path]:
-            raise InputError("uncertain", path, f"a field whose params value is below {_UPPER[path]:g}")
+        if get_value(prior, path) >= _upper(path):
+            raise InputError("uncertain", path, f"a field whose params value is below {_upper(path):g}")
     names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else tuple(effects)
     for n in names:
         if n not in EFFECTS:
@@ -677,9 +687,10 @@ def _coordinates(prior, paths):
     as ``lower + (start - lower) exp(theta)``)."""
     v0 = np.array([get_value(prior, p) for p in paths], dtype=float)
     lo = np.array([_lower(p) for p in paths])
-    # theta's upper bound: the fitted range, or less where the field's range ends first
-    top = np.array([min(_BOUND, math.log((_UPPER[p] - lo[i]) / (v0[i] - lo[i]))) if p in _UPPER else _BOUND
-                    for i, p in enumerate(paths)])
+    # theta's upper bound: the fitted range, or less where the field's range ends first (1e-9 inside it, so the
+    # round-off of exp(log(x)) cannot step past a closed end)
+    top = np.array([min(_BOUND, math.log((_upper(p) - lo[i]) / (v0[i] - lo[i])) - 1e-9) if math.isfinite(_upper(p))
+                    else _BOUND for i, p in enumerate(paths)])
     scale = np.array([_linear_scale(prior) if p in _LINEAR else np.nan for p in paths])
     return lo, v0, top, scale
 

@@ -705,3 +705,23 @@ def test_ripple_frequencies_are_lines_of_most_runs():
     # and noise alone gives no line in most runs at once (a false line in one run is about as likely as ALPHA)
     noise, sims = _residual_runs([[]] * 4, seed=4)
     assert drive_fit._ripple_frequencies(noise, sims) == []
+
+
+@pytest.mark.parametrize("path", drive_fit.FITTABLE)
+def test_a_fitted_field_stays_in_its_own_range(path):
+    """The fit's coordinates end where the field's DriveParams range ends: a Stribeck fit that stepped to a static
+    ratio of 17.5 (range [1, 10]) failed a whole diagnosis when its params were set; the friction coefficients
+    (<= 1) and the Stribeck velocity (<= 1 m/s) had no upper end in the fit either. At the fit's largest and
+    smallest coordinates every field is a value with_value accepts."""
+    from drakecreep.params import field_range
+
+    prior = preset("paper")
+    lower, upper = field_range(prior, path)
+    lo, v0, top, scale = drive_fit._coordinates(prior, (path,))
+    for theta in (top, -np.full(1, drive_fit._BOUND)):
+        value = float(drive_fit._field_values(lo, v0, scale, theta)[0])
+        with_value(prior, path, value)  # raises outside the range
+        if upper is not None and path not in drive_fit._LINEAR and value > v0[0]:
+            assert value <= upper
+    if upper is not None and path not in drive_fit._LINEAR and upper < lo[0] + (v0[0] - lo[0]) * math.exp(4.0):
+        assert float(drive_fit._field_values(lo, v0, scale, top)[0]) == pytest.approx(upper, rel=1e-6)
