@@ -540,6 +540,8 @@ def check_run(run, params=None, load_case=0):
     it has at least :data:`MIN_SAMPLES` samples over :data:`MIN_DURATION` s, its declared sensor resolutions fit
     the lead of ``params`` (:func:`~drakecreep.gap.drake_replay.replay_params`), ``load_case`` is one of
     ``params``' and its external force stays within :data:`MAX_EXTERNAL_FORCE` times the drive's force limit.
+    Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
+    reference was constant ran five minutes of fits before a fitted value left its range).
     """
     ctrl = run.meta.controller
     if ctrl is None or ctrl.kind != "drakecreep":
@@ -550,6 +552,9 @@ def check_run(run, params=None, load_case=0):
     if run.n < MIN_SAMPLES or duration < MIN_DURATION:
         raise InputError("t", f"run {run.label}: {run.n} samples over {duration:.3g} s",
                          f">= {MIN_SAMPLES} samples and >= {MIN_DURATION:g} s per run")
+    if float(np.ptp(run.x_ref)) == 0.0:
+        raise InputError(f"x_ref (run {run.label})", f"constant at {float(run.x_ref[0]):.6g} m",
+                         "a reference that moves (the diagnosis compares the drive's motion and force)")
     params = run.meta.params if params is None else params
     replay_params(run, params)  # the declared sensor resolutions fit the params' lead
     params.load_case(load_case)

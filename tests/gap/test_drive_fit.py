@@ -591,6 +591,13 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
     with pytest.raises(InputError) as err:
         diagnose_drive([pushed], good[1:])
     assert err.value.field == "f_ext (run a)" and "x the drive's force limit" in err.value.allowed
+    # a reference that holds one position (found by fuzzing: five minutes of fits, then a fitted value out of its
+    # range), in training or held out
+    still = dataclasses.replace(good[2], x_ref=np.full(N, 0.01))
+    for train, test in (([still], good[1:]), (good[:1], [good[1], still])):
+        with pytest.raises(InputError) as err:
+            diagnose_drive(train, test)
+        assert err.value.field == "x_ref (run c)" and "constant at 0.01 m" in str(err.value)
 
 
 def test_leave_one_out_step_is_close_to_the_refit():
