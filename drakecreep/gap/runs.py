@@ -112,7 +112,8 @@ def train_test(runs, train_spec=None, test_spec=None, pairs=False):
 
 def pick(runs, spec, default_parity, option="--train", pairs=False):
     """Runs selected by a comma list of labels or indices, or by index parity (``default_parity`` 0 or 1);
-    errors name the CLI ``option`` the selection came from. ``pairs``: the default alternates pairs of runs
+    errors name the CLI ``option`` the selection came from. A label that holds a comma is named by its index
+    (the error says which). ``pairs``: the default alternates pairs of runs
     (indices 0, 1, 4, 5, ... and 2, 3, 6, 7, ...: out-and-back half cycles, so both sets move both ways)."""
     if not spec:
         if pairs:
@@ -127,7 +128,9 @@ def pick(runs, spec, default_parity, option="--train", pairs=False):
         elif item.isascii() and item.isdigit() and len(item) < 10 and int(item) < len(runs):
             out.append(runs[int(item)])
         else:
-            raise InputError(option, item, "a run label or index among " + ", ".join(labels))
+            commas = [f"{i} for {lab!r}" for i, lab in enumerate(labels) if "," in lab]
+            raise InputError(option, item, "a run label or index among " + ", ".join(labels)
+                             + (f" (a label with a comma by its index: {', '.join(commas)})" if commas else ""))
         if any(out[-1] is r for r in out[:-1]):  # a run twice would count as two (two held-out runs from one)
             raise InputError(option, spec, f"each run once ({item} names a run given before)")
     return out

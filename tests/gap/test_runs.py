@@ -58,3 +58,23 @@ def test_one_selection_leaves_the_other_runs_to_the_other_set():
     assert labels(train_test(runs[:3], test_spec="1")) == [["r0", "r2"], ["r1"]]
     assert labels(train_test(runs, train_spec="0,1")) == [["r0", "r1"], ["r2", "r3", "r4"]]
     assert labels(train_test(runs, test_spec="r4,r0", pairs=True)) == [["r1", "r2", "r3"], ["r4", "r0"]]
+
+
+def test_a_label_with_a_comma_is_named_by_its_index():
+    """``--train`` splits at commas, so a run labelled ``"a,b"`` cannot be named: the error says its index, and the
+    index selects it."""
+    from types import SimpleNamespace
+
+    import pytest
+
+    from drakecreep.errors import InputError
+    from drakecreep.gap.runs import pick
+
+    runs = [SimpleNamespace(label=lab) for lab in ("x", "a,b", "y")]
+    with pytest.raises(InputError) as err:
+        pick(runs, "a,b", 0, "--test")
+    assert err.value.field == "--test" and "by its index: 1 for 'a,b'" in str(err.value)
+    assert [r.label for r in pick(runs, "1,y", 0, "--test")] == ["a,b", "y"]
+    with pytest.raises(InputError) as err:
+        pick(runs[::2], "z", 0)
+    assert "comma" not in str(err.value)
