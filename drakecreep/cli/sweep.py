@@ -1,9 +1,8 @@
 """``drakecreep sweep SPEC.yaml``: run a parameter sweep (grid or random) and write its table (and map)."""
 
-from drakecreep.processes import usable_cpus
-
 from drakecreep.cli._common import print_json, workers
 from drakecreep.errors import InputError
+from drakecreep.processes import usable_cpus
 
 __all__ = ["add_parser", "run"]
 
