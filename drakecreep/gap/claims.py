@@ -15,10 +15,18 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
-__all__ = ["ALPHA", "replay_test", "mean_and_standard_error", "mean_log_ratio", "log_ratios", "sign_flip_p"]
+__all__ = ["ALPHA", "POOLED_FACTOR", "replay_test", "mean_and_standard_error", "mean_log_ratio", "log_ratios", "sign_flip_p"]
 
 #: One-sided level of the tests of a claim.
 ALPHA = 0.05
+#: ``diagnose_drive``'s other way past the Student bar on the per-run gains: a pooled held-out shrink above this
+#: many run-to-run nulls. A real effect's per-run gains can differ by two orders of magnitude (a lead error's force
+#: grows with the square of the speed), so their spread keeps the bar above a gain every run shares. 20 is the
+#: round number near the geometric middle of 6.0, the largest shrink / null of a candidate that is no effect of the
+#: truth on the development rows then written, and 80, the smallest of a true effect; declared before and decided on
+#: development rows written after it (docs/gap_benchmark.md, study 3bs: 4 of 6 right first claims at SNR >= 3
+#: against the bar's 2 of 6, no claim on 4 nulls, no wrong first claim).
+POOLED_FACTOR = 20.0
 
 
 def replay_test(e_nom, e_eff, threshold=0.0):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drakecreep.gap.claims import POOLED_FACTOR
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.drive_fit import NOT_BOUNDED, claims_withheld
 from drakecreep.report.gap_report import EDGE_UNITS, _fig_png, errors_by_run_figure, residual_figure, where_parts
@@ -25,6 +26,11 @@ def edge_value(value, unit):
         return value * 1e6, "um"
     factor, shown = EDGE_UNITS.get(unit, (1.0, unit))
     return value * factor, shown
+
+
+def _nulls(rt):
+    """``"85.7 nulls, "``: a replay test's pooled shrink in run-to-run nulls ("" without a null)."""
+    return f"{rt['shrink'] / rt['threshold']:.1f} nulls, " if rt.get("threshold") else ""
 
 
 def _with_unit(value, unit):
@@ -42,7 +48,7 @@ def _figures(result):
     if ranked:
         fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
         y = np.arange(len(ranked))[::-1]
-        ax.barh(y + 0.2, [c.gain for c in ranked], 0.4, label="held-out gain (green: passes)",
+        ax.barh(y + 0.2, [c.gain for c in ranked], 0.4, label=f"held-out gain (green: passes, over its bar or by a pooled shrink > {POOLED_FACTOR:g} nulls)",
                 color=["tab:green" if c.passes else "tab:gray" for c in ranked])
         ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
                 label="its bar (t quantile x standard error of the per-run gains)")
@@ -106,7 +112,9 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
                                   or line.strip().startswith("note:")) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when it lowers the training runs' force error, its "
                  "closed-loop replay of the held-out runs (parameters fixed from the training runs) beats the fitted "
-                 "params file by more than the t quantile times the standard error of the per-run gains, and the "
+                 "params file by more than the t quantile times the standard error of the per-run gains (or its pooled "
+                 f"shrink exceeds {POOLED_FACTOR:g} run-to-run nulls: a real effect's per-run gains can differ by "
+                 "orders of magnitude), and the "
                  "pooled held-out force-error energy shrinks by more than the run-to-run null (the largest change "
                  "when the uncertain fields are refitted with one training run left out"
                  + ("" if result.replay_null is None else f": {100 * result.replay_null:.2f} %")
@@ -125,14 +133,14 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
         rt = c.replay or {}
         rows.append([c.name, f"{100 * c.train_gain:+.2f}" if fitted else "-",
                      f"{c.gain:+.3f} (bar {c.threshold:.3f})" if fitted else "-",
-                     f"{100 * rt['shrink']:+.2f} ({rt['runs_better']} of {len(rt['log_ratios'])} runs better)"
-                     if fitted and rt.get("log_ratios") else "-",
+                     f"{100 * rt['shrink']:+.2f} ({_nulls(rt)}{rt['runs_better']} of {len(rt['log_ratios'])} runs "
+                     "better)" if fitted and rt.get("log_ratios") else "-",
                      "yes" if c.name in result.claimed else "passes, not claimed" if c.passes else "no",
                      c.reason,
                      "; ".join(f"{k} = {_with_unit(v, field_unit(prior, k))}" for k, v in c.values.items())])
     parts.append("<h2>Which effect: the candidates, best held-out gain first</h2>")
     parts.append(table(["effect", "training gain [% of SSE]", "held-out gain [points of %]",
-                        "pooled held-out shrink [%]", "claimed", "why", "fitted fields"], rows))
+                        "pooled held-out shrink [%] (in run-to-run nulls)", "claimed", "why", "fitted fields"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = [s for s in ("position", "velocity", "acceleration", "force", "table_position")
            if all(s in e for e in result.test_errors.values())]
