@@ -437,8 +437,7 @@ class DriveDiagnosis:
             if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
                 lines.append(f"  {c.name:18s} {c.reason}")
                 continue
-            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f})"
-                         f"{'  passes' if c.passes else ''}: {c.reason}")
+            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}")
             if c.passes:
                 lines.append("    fitted " + ", ".join(
                     f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"
