@@ -218,7 +218,9 @@ class DrakeReplay:
         n_delay = int(math.floor(self.delay))
         history = [float(run.u[0])] * (n_delay + 1)
         ctrl_state = pp_initial_state(ctrl.position_filter, self.delay, x0, v0, h, history)
-        self.compiled = bool(compiled)
+        # the compiled axis logs its state, and a rigid axis's table is x + e(x), not a state: fed back through it, a
+        # scale-fed run (feedback: table) was replayed on the motor position, without the lead error
+        self.compiled = bool(compiled) and not (ctrl.feedback == "table" and not self.flexible)
         leaf = PPCascade(ctrl.kp, ctrl.kv, ctrl.saturation, h, ctrl.position_filter, run.u_gain, res, self.delay,
                          ctrl_state)
         if self.compiled and leaf.frac == 0:
@@ -511,11 +513,13 @@ class SampledReplay:
         cctx = csym.CreateDefaultContext()
         cctx.SetDiscreteState(0, [Expression(v) for v in xc])
         it = 2 if self.flexible else 0  # the table's position in the axis state
-        fb = xa[0] if ctrl.feedback == "motor" else xa[it]
+        fb = Expression(xa[0] if ctrl.feedback == "motor" else xa[it])
         if ctrl.feedback != "motor" and not self.flexible:
-            fb = fb + lead_error(Expression(xa[0]), p_all)[0]  # the rigid table at x + e(x)
+            # the rigid table at x + e(x) (an Expression already: Expression(fb) of it was a TypeError, so every
+            # run of feedback: table ended in 'internal error')
+            fb = fb + lead_error(Expression(xa[0]), p_all)[0]
         csym.GetInputPort("x_ref").FixValue(cctx, [Expression(inp[0])])
-        csym.GetInputPort("position").FixValue(cctx, [Expression(fb)])
+        csym.GetInputPort("position").FixValue(cctx, [fb])
         c_update = csym.EvalUniquePeriodicDiscreteUpdate(cctx).get_vector(0).CopyToVector()
         first = j < 0.5
         c_next = [if_then_else(first, c_update[i], Expression(xc[i])) for i in range(nc)]
