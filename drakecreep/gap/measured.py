@@ -54,6 +54,8 @@ __all__ = [
     "MAX_U_GAIN",
     "MAX_SPEED",
     "MAX_FORCE",
+    "MAX_TAPS",
+    "MAX_TAP_GAIN",
     "COLUMNS",
     "CONTROLLER_KINDS",
     "ControllerMeta",
@@ -104,6 +106,15 @@ _FAST_SHARE = 0.01
 #: Share of a position column's non-zero steps that may be shorter than half a declared count: a counting
 #: sensor moves by whole counts, so more means the resolution is in the wrong unit or not the one recorded
 _SUBCOUNT_SHARE = 0.02
+#: Most taps of a declared ``position_filter``: drives average a few samples (EMPS: 2); each tap is a state of the
+#: replay, so 128 taps took twice the replay time of 2 and 10000 never finished
+MAX_TAPS = 256
+#: Largest sum of the taps' magnitudes (the filter's gain on encoder noise; an extrapolating filter of order 3,
+#: 4, -6, 4, -1, has 15): taps of 1e300 and -1e300 that sum to 1 replayed without end
+MAX_TAP_GAIN = 1000.0
+#: Largest recorded ``|u|`` of a P-P cascade's run, in its declared saturations: its output is clipped there,
+#: though a command added after the clip passes it (the EMPS validation pulses: 10.84 V at a 10 V saturation)
+_SATURATION_SLACK = 2.0
 #: Controller kinds of the metadata schema.
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
@@ -113,7 +124,7 @@ def _finite(name, value, lo=None, lo_open=False, hi=None):
         raise InputError(name, value, "a finite number (not quoted)")
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an integer of hundreds of digits
         raise InputError(name, value, "a finite number") from None
     if not math.isfinite(x):
         raise InputError(name, value, "a finite number")
@@ -178,19 +189,31 @@ class ControllerMeta:
                 raise InputError(f"controller.{name}", getattr(self, name),
                                  "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
         sat = self.saturation
-        if not (isinstance(sat, (int, float)) and not isinstance(sat, bool) and sat > 0 and not math.isnan(sat)):
+        try:  # an integer of hundreds of digits overflows a float ('internal error: OverflowError')
+            x = float(sat) if isinstance(sat, (int, float)) and not isinstance(sat, bool) else math.nan
+        except OverflowError:
+            x = math.nan
+        if not x > 0:
             raise InputError("controller.saturation", sat, "a number > 0 (inf for none)")
-        object.__setattr__(self, "saturation", float(sat))
+        object.__setattr__(self, "saturation", x)
         object.__setattr__(self, "sample_time", _finite("controller.sample_time", self.sample_time, 0.0, True))
         taps = self.position_filter
-        if isinstance(taps, (int, float)):
+        if isinstance(taps, (int, float)) and not isinstance(taps, bool):
             taps = (taps,)
         try:
+            if isinstance(taps, (str, bytes, bool)) or any(isinstance(x, (str, bytes, bool)) for x in taps):
+                raise TypeError  # a quoted '10' was read as the taps 1, 0 (its characters), true as 1
             taps = tuple(float(x) for x in taps)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputError("controller.position_filter", self.position_filter, "a list of numbers") from None
         if not taps or not all(math.isfinite(x) for x in taps) or abs(sum(taps) - 1.0) > 1e-9:
             raise InputError("controller.position_filter", self.position_filter, "a non-empty list summing to 1")
+        if len(taps) > MAX_TAPS or sum(abs(x) for x in taps) > MAX_TAP_GAIN:
+            # each tap is a state of the replay (10000 taps replayed for hours), and taps of 1e300 and -1e300
+            # summing to 1 passed and never finished replaying
+            raise InputError("controller.position_filter", f"{len(taps)} taps, sum of |taps| "
+                             f"{sum(abs(x) for x in taps):.3g}", f"at most {MAX_TAPS} taps whose magnitudes sum to "
+                             f"at most {MAX_TAP_GAIN:g} (a drive's position filter: EMPS 0.5, 0.5)")
         object.__setattr__(self, "position_filter", taps)
 
     @property
@@ -497,8 +520,8 @@ def _meta_from_dict(data, meta_path):
         sensors = _named(f"{where}: ", SensorMeta, **sensors)
     except TypeError:
         raise InputError(f"{where}: sensors", sensors, "keys encoder_resolution, scale_resolution") from None
-    return MeasuredMeta(u_units=units, u_gain=gain, params=params, controller=ctrl, sensors=sensors,
-                        source=str(data.get("source", "")), notes=str(data.get("notes", "")))
+    return _named(f"{where}: ", MeasuredMeta, u_units=units, u_gain=gain, params=params, controller=ctrl,
+                  sensors=sensors, source=str(data.get("source", "")), notes=str(data.get("notes", "")))
 
 
 def _meta_to_dict(meta):
@@ -650,6 +673,7 @@ def check_recorded(run):
       (``scale_resolution``), the resolution is in the wrong unit (5e-5 for a 50 nm count: millimetres written
       as metres), or not the one the positions were recorded at; the replay would count with it.
     * A drive command ``u`` that is zero throughout gives the fit nothing to match.
+    * A P-P cascade clips its output at ``controller.saturation``: a recorded ``|u|`` beyond twice it contradicts it.
 
     Only measured files are checked: simulated positions (replays, instruments) are not counted.
     """
@@ -670,6 +694,16 @@ def check_recorded(run):
                              f"{steps.min():.3g} m), so it moves by less than a count (a unit error?)")
     if not np.any(run.u):
         raise InputError(f"u (run {run.label})", "zero throughout", "the drive command the controller gave")
+    ctrl = run.meta.controller
+    if ctrl is not None and ctrl.kind == "p_p_cascade" and math.isfinite(ctrl.saturation):
+        # the P-P cascade clips its output at the saturation, so a recorded u far beyond it contradicts it: a
+        # saturation of 1e-300 replayed a drive that cannot push and ran a whole diagnosis on it (exit 0). Up to
+        # twice it is let be: a command added after the clip passes it (EMPS validation pulses: 10.84 V at 10 V)
+        i = int(np.argmax(np.abs(run.u)))
+        if abs(float(run.u[i])) > _SATURATION_SLACK * ctrl.saturation:
+            raise InputError(f"controller.saturation (run {run.label})", ctrl.saturation,
+                             f"at least half the largest recorded |u|, {abs(float(run.u[i])):g} {run.meta.u_units} at "
+                             f"data row {i + 1} of the run (the controller clips its output at its saturation)")
     if run.x_table is not None and np.ptp(run.x_table) == 0.0 and np.ptp(run.x_motor) > 0.0:
         # a scale that reads nothing while the motor moves (unplugged, or the wrong column): every replay error
         # relative to it was a division by zero ('y: got all zero')

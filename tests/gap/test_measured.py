@@ -165,7 +165,7 @@ def test_not_a_number(tmp_path):
 def test_unknown_unit_of_u(tmp_path):
     with pytest.raises(InputError, match="one of N, A, V") as err:
         load_measured(_write(tmp_path, meta={**META, "u_units": "mV"}))
-    assert err.value.field == "u_units"
+    assert err.value.field == f"{tmp_path / 'run.yaml'}: u_units"
 
 
 def test_an_unknown_metadata_key_is_named_with_the_known_ones(tmp_path):
@@ -547,3 +547,59 @@ def test_a_bad_field_of_the_metadata_names_its_file(tmp_path, change, field):
     with pytest.raises(InputError) as err:
         load_measured(_write(tmp_path, meta=dict(META, **change)))
     assert str(err.value.field).endswith(field) and err.value.value == -1.0
+
+
+@pytest.mark.parametrize("change, field, allowed", [
+    ({"u_gain": 10 ** 400}, "run.yaml: u_gain", "a finite number"),
+    ({"controller": dict(META["controller"], kp=10 ** 400)}, "run.yaml: controller.kp", "a finite number"),
+    ({"controller": dict(META["controller"], saturation=10 ** 400)}, "run.yaml: controller.saturation", "a number > 0"),
+    ({"sensors": {"encoder_resolution": 10 ** 400}}, "run.yaml: sensors.encoder_resolution", "a finite number"),
+])
+def test_an_integer_of_hundreds_of_digits_in_the_metadata_is_named(tmp_path, change, field, allowed):
+    """'u_gain: 999...9' (400 digits) ended in 'internal error: OverflowError: int too large to convert to float'."""
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=dict(META, **change)))
+    assert err.value.field == str(tmp_path / field) and err.value.allowed.startswith(allowed)
+
+
+@pytest.mark.parametrize("change, field", [({"u_gain": -35.0}, "u_gain"), ({"u_units": "W"}, "u_units")])
+def test_a_bad_unit_or_gain_of_u_names_the_metadata_file(tmp_path, change, field):
+    """The other fields of the metadata named their file since dda36be; u_gain and u_units did not."""
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=dict(META, **change)))
+    assert err.value.field == str(tmp_path / f"run.yaml: {field}")
+
+
+@pytest.mark.parametrize("taps, value", [
+    ("10", "10"),  # a quoted '10' was the taps 1, 0 (its characters)
+    (True, True),  # true was the tap 1
+    ([0.5, "0.5"], [0.5, "0.5"]),
+    ([1e300, -1e300, 1.0], "3 taps, sum of |taps| 2e+300"),  # summed to 1, replayed without end
+    ([1e-4] * 10000, "10000 taps, sum of |taps| 1"),  # each tap a state of the replay: never finished
+])
+def test_a_position_filter_that_is_text_or_cannot_be_replayed_is_refused(tmp_path, taps, value):
+    meta = dict(META, controller=dict(META["controller"], position_filter=taps))
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=meta))
+    assert err.value.field.endswith("run.yaml: controller.position_filter") and err.value.value == value
+
+
+def test_a_position_filter_of_few_taps_of_any_sign_is_kept():
+    for taps in ((0.5, 0.5), (2.0, -1.0), (4.0, -6.0, 4.0, -1.0), (1 / 256,) * 256):
+        assert ControllerMeta(kp=1.0, kv=1.0, position_filter=taps).position_filter == pytest.approx(taps)
+
+
+def test_a_recorded_u_beyond_the_declared_saturation_is_refused(tmp_path):
+    """A P-P cascade clips its output at its saturation: 'saturation: 1e-300' with u up to 4.3 V replayed a drive that
+    cannot push, through a whole diagnosis to exit 0. The EMPS validation set saved as a CSV still loads."""
+    for saturation in (1e-300, 0.0094):  # u = sin(t) reaches 0.0189989 at t = 19 ms
+        meta = dict(META, controller=dict(META["controller"], saturation=saturation))
+        with pytest.raises(InputError) as err:
+            load_measured(_write(tmp_path, meta=meta))
+        assert err.value.field.endswith("controller.saturation (run run)") and err.value.value == saturation
+        assert "at least half the largest recorded |u|, 0.0189989 V at data row 20 of the run" in err.value.allowed
+    for saturation in (0.0095, 0.019):  # a command added after the clip may pass it (EMPS validation pulses)
+        meta = dict(META, controller=dict(META["controller"], saturation=saturation))
+        assert load_measured(_write(tmp_path, meta=meta)).runs[0].n == 20
+    validation = load_emps("validation")  # u = vir - pulses_N reaches 10.84 V at the 10 V saturation
+    assert load_measured(save_measured(validation, tmp_path / "val.csv")[0]).runs[0].n == validation.runs[0].n
