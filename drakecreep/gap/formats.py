@@ -66,7 +66,37 @@ SEPARATORS = {",": ",", ";": ";", "tab": "\t", "\t": "\t"}
 DECIMALS = (".", ",")
 
 
-def _frame(path, fmt, key, separator=None, decimal=None, run_column="run"):
+def _mat_frame(path, mat, wanted):
+    """The vector variables of a loaded ``.mat`` as columns of one length. A variable that names a signal
+    (``wanted``) and is no real vector of that length is refused by name: dropped, it was reported as missing ('the
+    columns u as well' for a complex u, an x_ref one sample short or a matrix)."""
+    import pandas as pd
+
+    columns, refused = {}, {}
+    for name, value in mat.items():
+        if name.startswith("__"):
+            continue
+        a = np.asarray(value)
+        if a.dtype.kind == "c":
+            refused[name] = (f"complex numbers ({a.dtype})", "real numbers")
+        elif a.dtype.kind not in "fiu":
+            refused[name] = (f"a MATLAB {'struct' if a.dtype.names else 'cell or text'} array", "a numeric vector")
+        elif not (a.ndim <= 2 and 1 in (a.shape + (1,))[:2]):
+            refused[name] = (f"shape {a.shape}", "a vector (one row or one column)")
+        elif a.size > 1:
+            columns[name] = a.astype(float).ravel()
+    lengths = {a.size for a in columns.values()}
+    longest = max(lengths, default=0)
+    for name, a in columns.items():
+        if a.size != longest:
+            refused[name] = (f"length {a.size}", f"the length of the longest vector, {longest}")
+    for name, (got, allowed) in refused.items():
+        if name in wanted or parse_column(name)[0] in wanted:
+            raise InputError(f"{path}: {name}", got, allowed)
+    return pd.DataFrame({k: v for k, v in columns.items() if v.size == longest})
+
+
+def _frame(path, fmt, key, separator=None, decimal=None, run_column="run", wanted=()):
     import pandas as pd
 
     if fmt == "csv":
@@ -76,13 +106,19 @@ def _frame(path, fmt, key, separator=None, decimal=None, run_column="run"):
                               text_columns=(run_column,))  # run labels as written: 1 and 1.0 are two runs
     if fmt == "parquet":
         try:
-            return pd.read_parquet(path)
+            return _with_index(pd.read_parquet(path))
         except Exception as err:  # noqa: BLE001 - pyarrow raises many types for a corrupt file
             raise InputError(str(path), f"not a readable Parquet file ({type(err).__name__})",
                              "a Parquet table") from None
     if fmt == "hdf5":
         try:
-            return pd.read_hdf(path, key=key)
+            frame = pd.read_hdf(path, key=key)
+            if not isinstance(frame, pd.DataFrame):  # a Series ended in 'internal error: IndexError'
+                raise InputError(f"{path}: file.key", key, f"the key of a table (DataFrame.to_hdf); this one holds "
+                                 f"a {type(frame).__name__}")
+            return _with_index(frame)
+        except InputError:
+            raise
         except ImportError:
             raise InputError(str(path), "HDF5", "CSV, Parquet or .mat (HDF5 needs the 'tables' package: "
                              "pip install tables)") from None
@@ -98,18 +134,15 @@ def _frame(path, fmt, key, separator=None, decimal=None, run_column="run"):
     except Exception as err:  # noqa: BLE001 - empty, truncated, corrupt: OSError, IndexError, MatReadError, zlib.error
         raise InputError(str(path), f"not a readable MATLAB file ({type(err).__name__})",
                          "a MATLAB .mat file (v4-v7.2)") from None
-    columns = {}
-    for name, value in mat.items():
-        if name.startswith("__"):
-            continue
-        a = np.asarray(value)
-        if a.dtype.kind in "fiu" and a.ndim <= 2 and 1 in (a.shape + (1,))[:2] and a.size > 1:
-            columns[name] = a.astype(float).ravel()
-    lengths = {a.size for a in columns.values()}
-    if len(lengths) > 1:
-        longest = max(lengths)
-        columns = {k: v for k, v in columns.items() if v.size == longest}
-    return pd.DataFrame(columns)
+    return _mat_frame(path, mat, wanted)
+
+
+def _with_index(frame):
+    """A table with its named index as a column: a Parquet or HDF5 file written from a frame indexed by time
+    (``df.set_index('t[ms]').to_parquet(...)``) keeps t as the index, and t was then reported missing."""
+    if any(name is not None for name in frame.index.names) and not set(frame.index.names) & set(frame.columns):
+        frame = frame.reset_index()
+    return frame
 
 
 def read_signals(path, u_units, columns=None, units=None, key=None, separator=None, decimal=None):
@@ -140,7 +173,8 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise InputError(str(path), path.suffix or "(no suffix)", "a file ending in " + ", ".join(FORMATS))
-    frame = _frame(path, fmt, key, separator, decimal, run_column=str((columns or {}).get("run", "run")))
+    wanted = set(map(str, (columns or {}).values())) if columns else set(QUANTITY) | {"u", "run"}
+    frame = _frame(path, fmt, key, separator, decimal, run_column=str((columns or {}).get("run", "run")), wanted=wanted)
     if frame.shape[1] == 0 or frame.shape[0] == 0:
         raise InputError(str(path), "no data", "a header line and data rows")
     mapping = dict(columns or {})

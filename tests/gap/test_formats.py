@@ -35,3 +35,52 @@ def test_real_columns_of_any_width_are_read(tmp_path):
     frame.to_parquet(tmp_path / "run.parquet")
     signals = read_signals(tmp_path / "run.parquet", "N")
     assert signals["u"].dtype == float and np.allclose(signals["u"], np.sin(frame["t"]), atol=1e-6)
+
+
+def _mat(tmp_path, **variables):
+    import scipy.io
+
+    path = tmp_path / "run.mat"
+    scipy.io.savemat(path, variables)
+    return path
+
+
+@pytest.mark.parametrize("change, field, got", [
+    (lambda f: {"u": f["u"].to_numpy() + 1j}, "u", "complex numbers (complex128)"),
+    (lambda f: {"x_ref": f["x_ref"].to_numpy()[:-1]}, "x_ref", "length 49"),  # one sample short
+    (lambda f: {"x_ref": np.tile(f["x_ref"].to_numpy(), (2, 1))}, "x_ref", "shape (2, 50)"),
+    (lambda f: {"t": np.array([[1, 2], [3, 4]], dtype=object)}, "t", "a MATLAB cell or text array"),
+])
+def test_a_mat_variable_of_a_signal_that_is_no_real_vector_of_the_runs_length_is_named(tmp_path, change, field, got):
+    """Such a variable was dropped without a word, and the file then said 'header: got 't,x_ref,x_motor'; allowed:
+    the columns u as well' of a u that is there (complex), or of an x_ref one sample short or a matrix."""
+    frame = _frame()
+    variables = {k: frame[k].to_numpy() for k in frame} | change(frame)
+    with pytest.raises(InputError) as err:
+        read_signals(_mat(tmp_path, **variables), "N")
+    assert err.value.field == f"{tmp_path / 'run.mat'}: {field}" and err.value.value == got
+
+
+def test_a_mat_file_keeps_its_scalars_and_other_variables_out_of_the_columns(tmp_path):
+    frame = _frame()
+    variables = {k: frame[k].to_numpy() for k in frame} | {"gain": 3.0, "notes": "text", "m": np.ones((3, 3))}
+    assert sorted(read_signals(_mat(tmp_path, **variables), "N")) == ["t", "u", "x_motor", "x_ref"]
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".h5"])
+def test_a_table_indexed_by_time_reads_its_index_as_the_column(tmp_path, suffix):
+    """df.set_index('t').to_parquet(...) keeps t as the index: it was reported missing ('the columns t as well')."""
+    pytest.importorskip("pyarrow" if suffix == ".parquet" else "tables")
+    frame = _frame().set_index("t")
+    path = tmp_path / f"run{suffix}"
+    frame.to_parquet(path) if suffix == ".parquet" else frame.to_hdf(path, key="/run")
+    signals = read_signals(path, "N")
+    assert np.array_equal(signals["t"], frame.index.to_numpy()) and list(signals) == ["t", "x_ref", "x_motor", "u"]
+
+
+def test_an_hdf5_key_that_holds_a_series_is_named(tmp_path):
+    """'internal error: IndexError: tuple index out of range', exit 1."""
+    pytest.importorskip("tables")
+    _frame()["u"].to_hdf(tmp_path / "run.h5", key="/u")
+    with pytest.raises(InputError, match=r"run.h5: file.key: got None; allowed: the key of a table .* holds a Series"):
+        read_signals(tmp_path / "run.h5", "N")
