@@ -79,7 +79,15 @@ def load_runs(data, meta=None, split=True):
     from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
     if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):
-        md = load_emps(data)
+        try:
+            md = load_emps(data)
+        except InputError as err:
+            beside = [p for p in (Path(data).with_suffix(".yaml"), Path(data).with_suffix(".yml")) if p.is_file()]
+            if data in EMPS_FILES or not beside or not str(err.field).endswith(": variables"):
+                raise
+            # a measured run's .mat with its metadata beside it was told of the EMPS variables alone
+            raise InputError(err.field, err.value, f"{err.allowed}; or a measured run's signals, with its metadata "
+                             f"named (diagnose --meta {beside[0]}: without it a .mat is read as an EMPS file)") from None
     else:
         if not Path(data).exists():
             raise FileNotFoundError(2, "No such file or directory", str(data))

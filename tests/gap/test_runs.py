@@ -78,3 +78,24 @@ def test_a_label_with_a_comma_is_named_by_its_index():
     with pytest.raises(InputError) as err:
         pick(runs[::2], "z", 0)
     assert "comma" not in str(err.value)
+
+
+def test_a_measured_mat_with_its_metadata_beside_it_is_told_of_meta(tmp_path):
+    """A .mat without --meta is read as an EMPS file: a measured run's .mat with its metadata beside it was told
+    'the EMPS variables t, qm, qg, vir, gtau, kp, kv' alone."""
+    import pytest
+    import scipy.io
+
+    from drakecreep.errors import InputError
+    from drakecreep.gap.runs import load_runs
+
+    t = np.arange(50) * 1e-3
+    scipy.io.savemat(tmp_path / "run.mat", {"t": t, "x_ref": t, "x_motor": t, "u": np.sin(t)})
+    with pytest.raises(InputError, match="EMPS variables") as err:
+        load_runs(tmp_path / "run.mat")
+    assert "--meta" not in err.value.allowed  # no metadata: an EMPS file that lacks its variables
+    (tmp_path / "run.yaml").write_text("u_units: N\nu_gain: 1.0\n")
+    with pytest.raises(InputError, match=r"EMPS variables .*; or a measured run's signals, with its metadata named "
+                                         r"\(diagnose --meta .*run.yaml: without it a .mat is read as an EMPS file\)"):
+        load_runs(tmp_path / "run.mat")
+    assert len(load_runs(tmp_path / "run.mat", tmp_path / "run.yaml", split=False)) == 1
