@@ -306,6 +306,12 @@ class ScrewParams(_Params):
             raise InputError("root_diameter", self.root_diameter, f"<= nominal_diameter ({self.nominal_diameter} m)")
         if self.nut_start_distance >= self.length:
             raise InputError("nut_start_distance", self.nut_start_distance, f"< length ({self.length} m)")
+        ea = self.youngs_modulus * math.pi / 4.0 * self.root_diameter**2
+        if not (ea > 0.0 and math.isfinite(self.length / ea)):
+            # the shaft's section E pi d^2 / 4 underflowed to 0 (root_diameter 1e-300): its stiffness E A / a was 0
+            # and simulate, margins and report ended in 'internal error: ZeroDivisionError: float division by zero'
+            raise InputError("root_diameter", self.root_diameter, f"a diameter whose shaft section E pi d^2 / 4 is "
+                             f"a number > 0 (with youngs_modulus {self.youngs_modulus:g} Pa it underflows to {ea:g})")
 
 
 @dataclass(frozen=True)
