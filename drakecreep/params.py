@@ -186,6 +186,9 @@ def _allowed(meta):
 #: stay possible, while products and squares of fields stay far from float overflow (1e300 kg gave
 #: nonsense or runs that never end)
 ABSURD = 1e20
+#: smallest axial stiffness of the whole shaft, E A / length [N/m]: 8 decades below a real screw's (1.2e8 N/m on
+#: the paper's rig); a section or modulus that makes it smaller underflows the stiffness chain to a division by 0
+MIN_SHAFT_STIFFNESS = 1.0
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
@@ -306,12 +309,15 @@ class ScrewParams(_Params):
             raise InputError("root_diameter", self.root_diameter, f"<= nominal_diameter ({self.nominal_diameter} m)")
         if self.nut_start_distance >= self.length:
             raise InputError("nut_start_distance", self.nut_start_distance, f"< length ({self.length} m)")
-        ea = self.youngs_modulus * math.pi / 4.0 * self.root_diameter**2
-        if not (ea > 0.0 and math.isfinite(self.length / ea)):
-            # the shaft's section E pi d^2 / 4 underflowed to 0 (root_diameter 1e-300): its stiffness E A / a was 0
-            # and simulate, margins and report ended in 'internal error: ZeroDivisionError: float division by zero'
-            raise InputError("root_diameter", self.root_diameter, f"a diameter whose shaft section E pi d^2 / 4 is "
-                             f"a number > 0 (with youngs_modulus {self.youngs_modulus:g} Pa it underflows to {ea:g})")
+        k = self.youngs_modulus * math.pi / 4.0 * self.root_diameter**2 / self.length
+        if not k >= MIN_SHAFT_STIFFNESS:
+            # root_diameter 1e-300 made the section pi d^2 / 4 zero, youngs_modulus 1e-300 the stiffness E A / a
+            # near it: simulate, margins and report ended in 'internal error: ZeroDivisionError: float division by zero'
+            field, value = (("youngs_modulus", self.youngs_modulus) if self.youngs_modulus < 1e9
+                            else ("root_diameter", self.root_diameter))
+            raise InputError(field, value, f"a shaft whose axial stiffness E pi d^2 / 4 / length is at least "
+                             f"{MIN_SHAFT_STIFFNESS:g} N/m (youngs_modulus {self.youngs_modulus:g} Pa, root_diameter "
+                             f"{self.root_diameter:g} m and length {self.length:g} m make it {k:.3g} N/m)")
 
 
 @dataclass(frozen=True)

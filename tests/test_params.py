@@ -106,8 +106,9 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         ({"controller": {"position_period": 3e-4}}, "controller.position_period", "integer multiple"),
         ({"screw": {"root_diameter": 0.03}}, "screw.root_diameter", "nominal_diameter"),
         # the section pi d^2 / 4 underflowed to 0: 'internal error: ZeroDivisionError' in simulate, margins, report
-        ({"screw": {"root_diameter": 1e-300}}, "screw.root_diameter", "shaft section E pi d^2 / 4 is a number > 0"),
-        ({"screw": {"root_diameter": 1e-155, "youngs_modulus": 1e-10}}, "screw.root_diameter", "with youngs_modulus 1e-10 Pa"),
+        ({"screw": {"root_diameter": 1e-300}}, "screw.root_diameter", "a shaft whose axial stiffness E pi d^2 / 4 / "
+                                                                      "length is at least 1 N/m"),
+        ({"screw": {"youngs_modulus": 1e-300}}, "screw.youngs_modulus", "make it 6.22e-304 N/m"),
     ],
 )
 def test_invalid_values_name_field_value_and_range(data, field, fragment):
