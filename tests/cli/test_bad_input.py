@@ -170,6 +170,19 @@ SPECS = {
     "group_in_base": ("base: {set: {table: 1}}\naxes:\n  nut.mass: [0.3]\n", "not the whole group"),
     "cases_as_number": ("base: {set: {loads.cases: 1}}\naxes:\n  nut.mass: [0.3]\n", "loads.cases"),
     "max_step_tiny": ("axes:\n  simulation.max_step: [1.0e-3, 1.0e-9]\n", "simulation.max_step"),
+    # each error names the spec's key the value is under (it named the params field or the library's parameter alone:
+    # 'table.mass: got -1.0', 'preset: got 'nope'', 'seed: got -1', 'feed: got [0.001]'; found by the fourth pass)
+    "base_set_bad": ("base: {set: {table.mass: -1}}\naxes:\n  nut.mass: [0.3]\n", "error: base.set.table.mass: got -1.0"),
+    "base_set_unknown": ("base: {set: {table.mas: 1}}\naxes:\n  nut.mass: [0.3]\n", "error: base.set.table.mas: got 1"),
+    "base_preset_bad": ("base: {preset: nope}\naxes:\n  nut.mass: [0.3]\n", "error: base.preset: got 'nope'"),
+    "base_file_field": ("base: {file: rig.yaml}\naxes:\n  nut.mass: [0.3]\n", "error: base.file rig.yaml: table.mass: got"),
+    "base_file_text": ("base: {file: secret.txt}\naxes:\n  nut.mass: [0.3]\n", "error: base.file secret.txt: got 'invalid YAML"),
+    "sample_seed_named": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: -1}\n",
+                          "error: sample.seed: got -1"),
+    "sample_n_named": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random}\n", "error: sample.n: got None"),
+    "axis_value_named": ("axes:\n  feed: [[1.0e-3]]\n", "error: axes.feed: got [0.001]"),
+    "axis_choice_named": ("axes:\n  friction.law: [coulomb, nope]\n", "error: axes.friction.law: got 'nope'"),
+    "scenario_value_named": ("scenario: {load_case: 9}\naxes:\n  nut.mass: [0.3]\n", "error: scenario.load_case: got 9"),
 }
 
 
@@ -177,6 +190,7 @@ SPECS = {
 def test_bad_sweep_specs(name, tmp_path, capsys):
     text, fragment = SPECS[name]
     (tmp_path / "secret.txt").write_text(PASSWD_LIKE)
+    (tmp_path / "rig.yaml").write_text("table: {mass: -1.0}\n")
     spec = tmp_path / "spec.yaml"
     spec.write_text(text)
     code, _, err = _run(["sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "1", "--no-progress"],
