@@ -475,8 +475,8 @@ def _named(prefix, build, *args, **kwargs):
     say which."""
     try:
         return build(*args, **kwargs)
-    except InputError as err:
-        raise err.renamed(f"{prefix}{err.field}") from None
+    except InputError as err:  # an error that names the file already ('rig.yaml: got 'invalid YAML ...'') once
+        raise err.renamed(err.field if prefix == f"{err.field}: " else f"{prefix}{err.field}") from None
 
 
 def _meta_from_dict(data, meta_path):

@@ -603,3 +603,11 @@ def test_a_recorded_u_beyond_the_declared_saturation_is_refused(tmp_path):
         assert load_measured(_write(tmp_path, meta=meta)).runs[0].n == 20
     validation = load_emps("validation")  # u = vir - pulses_N reaches 10.84 V at the 10 V saturation
     assert load_measured(save_measured(validation, tmp_path / "val.csv")[0]).runs[0].n == validation.runs[0].n
+
+
+def test_a_params_file_that_is_no_yaml_is_named_once(tmp_path):
+    """'rig.yaml: rig.yaml: got 'invalid YAML (line 2, column 1) ...'' named the file twice."""
+    (tmp_path / "rig.yaml").write_text("not: [valid\n")
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=dict(META, params="rig.yaml")))
+    assert err.value.field == str(tmp_path / "rig.yaml") and "invalid YAML" in err.value.value
