@@ -766,3 +766,26 @@ def test_a_pooled_shrink_of_many_run_to_run_nulls_stands_for_the_student_bar():
     assert not _held_out(nominal, lead, None).passes
     # a gain above the bar passes as before
     assert _held_out([20.0, 21.0, 19.0], [10.0, 11.0, 9.5], 0.5).reason == "passes"
+
+
+def test_a_candidate_that_fails_is_recorded_and_the_others_go_on(monkeypatch):
+    """One candidate's failure (here a Drake integrator that gives up; in the field a fitted value its params
+    refused) ended the whole diagnosis after minutes of work. Now the candidate is recorded as failed, said in the
+    warnings, never claimed, and the lead error the runs carry is still found and claimed."""
+    truth = with_value(RIG, "disturbance.lead_error_amplitude", 2e-6)
+    runs = _runs(truth, seed=2)
+    fit_effect = drive_fit._fit_effect
+
+    def failing(name, *args, **kwargs):
+        if name == "force_ripple":
+            raise RuntimeError("Error control wants to select step smaller than minimum allowed (1e-14)\nmore")
+        return fit_effect(name, *args, **kwargs)
+
+    monkeypatch.setattr(drive_fit, "_fit_effect", failing)
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("force_ripple", "lead_error"))
+    (failed,) = [c for c in result.candidates if c.name == "force_ripple"]
+    assert not failed.passes and failed.reason == ("failed (RuntimeError: Error control wants to select step smaller "
+                                                   "than minimum allowed (1e-14))")
+    assert any(w.startswith("force_ripple failed (RuntimeError") for w in result.warnings)
+    assert result.claimed == ("lead_error",)
+    assert any("force_ripple" in line and "failed (RuntimeError" in line for line in result.summary())
