@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import stats
 
-__all__ = ["ALPHA", "POOLED_FACTOR", "replay_test", "mean_and_standard_error", "mean_log_ratio", "log_ratios", "sign_flip_p"]
+__all__ = ["ALPHA", "POOLED_FACTOR", "replay_test", "mean_and_standard_error", "mean_log_ratio", "log_ratios",
+           "sign_flip_p"]
 
 #: One-sided level of the tests of a claim.
 ALPHA = 0.05
