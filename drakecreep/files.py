@@ -331,8 +331,11 @@ def check_output_dir(path, field="--out"):
         written.
     """
     path = Path(path)
-    if path.exists() and not path.is_dir():
-        raise InputError(field, str(path), "a folder (this is an existing file)")
+    try:  # a name longer than the system allows raises here (ENAMETOOLONG: 'File name too long: ...', no option)
+        if path.exists() and not path.is_dir():
+            raise InputError(field, str(path), "a folder (this is an existing file)")
+    except OSError as err:
+        raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -359,8 +362,11 @@ def check_output_file(path, field="--out"):
         Naming ``field`` if ``path`` is an existing folder, or a file cannot be created in its folder.
     """
     path = Path(path)
-    if path.is_dir():
-        raise InputError(field, str(path), "a file name (this is an existing folder)")
+    try:
+        if path.is_dir():
+            raise InputError(field, str(path), "a file name (this is an existing folder)")
+    except OSError as err:  # ENAMETOOLONG
+        raise InputError(field, str(path), f"a file that can be written ({err.strerror})") from None
     folder = check_output_dir(path.parent, field)
     try:  # what write_atomic will do: a temporary file beside the target
         fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.stem}.", suffix=".check")

@@ -188,3 +188,12 @@ def test_a_folder_in_the_way_of_a_file_is_named(tmp_path):
         write_text(tmp_path / "params.yaml", "x")
     assert err.value.filename == str(tmp_path / "params.yaml")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["params.yaml"]
+
+
+def test_a_name_longer_than_the_system_allows_names_the_option(tmp_path):
+    """'report --out /tmp/aaa...' (300 characters in one name) said 'File name too long: /tmp/aaa...', no option."""
+    long = tmp_path / ("a" * 300)
+    with pytest.raises(InputError, match=r"^--out: got .*; allowed: a folder that can be created \(File name too long\)"):
+        check_output_dir(long)
+    with pytest.raises(InputError, match=r"^--write: got .*; allowed: a file that can be written \(File name too long\)"):
+        check_output_file(tmp_path / ("p" * 300 + ".yaml"), "--write")

@@ -79,11 +79,20 @@ def add_params_options(parser, friction=True):
 def existing_path(option, path):
     """``path`` unless it does not exist: then an :class:`~drakecreep.errors.InputError` naming ``option`` (the
     generic 'No such file or directory' line did not say which option the path came from)."""
-    from pathlib import Path
-
-    if path is not None and not Path(path).exists():
+    if path is not None and not path_exists(option, path):
         raise InputError(option, str(path), "an existing file (no such file or directory)")
     return path
+
+
+def path_exists(option, path):
+    """``Path(path).exists()``; a name the system refuses (longer than it allows) is an
+    :class:`~drakecreep.errors.InputError` naming ``option`` (it was 'File name too long: /tmp/aaa...', no option)."""
+    from pathlib import Path
+
+    try:
+        return Path(path).exists()
+    except OSError as err:
+        raise InputError(option, str(path), f"a path the system accepts ({err.strerror})") from None
 
 
 def params_from_args(args):

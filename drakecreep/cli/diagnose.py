@@ -24,7 +24,7 @@ diagnosis.json, summary.txt and augmented_params.yaml (for simulate, margins and
 import sys
 from pathlib import Path
 
-from drakecreep.cli._common import existing_path, names, print_json, workers
+from drakecreep.cli._common import existing_path, names, path_exists, print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
@@ -80,7 +80,7 @@ def run(args):
     from drakecreep.gap.measured import EMPS_FILES
 
     for option, path in (("DATA", args.data), ("--score", args.score)):
-        if path and path not in EMPS_FILES and not Path(path).exists():
+        if path and path not in EMPS_FILES and not path_exists(option, path):
             raise InputError(option, path, "an existing file: a measured run (CSV, Parquet, HDF5, .mat with its "
                              "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
     runs = load_runs(args.data, existing_path("--meta", args.meta), split=False)

@@ -439,6 +439,12 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1"], "--calibrate: got '1'; allowed: two rows"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'"),
+    # a name longer than the system allows: 'File name too long: /tmp/...', no option (found by the fourth pass)
+    (["simulate", "--params", "{tmp}/" + "a" * 300 + ".yaml"], "--params: got"),
+    (["diagnose", "{tmp}/" + "a" * 300 + ".csv"], "DATA: got"),
+    (["diagnose", "{tmp}/spec.yaml", "--meta", "{tmp}/" + "a" * 300 + ".yaml"], "--meta: got"),
+    (["uncertainty", "--spec", "{tmp}/" + "a" * 300 + ".yaml"], "--spec: got"),
+    (["modes", "--out", "{tmp}/" + "a" * 300], "--out: got"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))
