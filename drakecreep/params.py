@@ -186,9 +186,17 @@ def _allowed(meta):
 #: stay possible, while products and squares of fields stay far from float overflow (1e300 kg gave
 #: nonsense or runs that never end)
 ABSURD = 1e20
-#: smallest axial stiffness of the whole shaft, E A / length [N/m]: 8 decades below a real screw's (1.2e8 N/m on
-#: the paper's rig); a section or modulus that makes it smaller underflows the stiffness chain to a division by 0
-MIN_SHAFT_STIFFNESS = 1.0
+#: smallest stiffness of an element of the axial chain [N/m] (bearing, shaft E A / length, nut, a seat joint that is
+#: not rigid): 7-8 decades below a real one's (9.4e6 to 1.2e8 N/m on the paper's rig); a smaller one underflows the
+#: chain's series sums (1/k, k^2) to a division by 0 ('internal error: ZeroDivisionError' at 1e-300 N/m)
+MIN_STIFFNESS = 1.0
+
+
+def _check_stiffness(name, value, off=False):
+    """An element of the axial chain at least :data:`MIN_STIFFNESS` (or 0 where ``off`` says 0 means rigid)."""
+    if value < MIN_STIFFNESS and not (off and value == 0.0):
+        raise InputError(name, value, ("0 (rigid, off) or " if off else "") + f"a stiffness of at least "
+                         f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
@@ -309,14 +317,16 @@ class ScrewParams(_Params):
             raise InputError("root_diameter", self.root_diameter, f"<= nominal_diameter ({self.nominal_diameter} m)")
         if self.nut_start_distance >= self.length:
             raise InputError("nut_start_distance", self.nut_start_distance, f"< length ({self.length} m)")
+        _check_stiffness("bearing_stiffness", self.bearing_stiffness)
+        _check_stiffness("seat_joint_stiffness", self.seat_joint_stiffness, off=True)
         k = self.youngs_modulus * math.pi / 4.0 * self.root_diameter**2 / self.length
-        if not k >= MIN_SHAFT_STIFFNESS:
+        if not k >= MIN_STIFFNESS:
             # root_diameter 1e-300 made the section pi d^2 / 4 zero, youngs_modulus 1e-300 the stiffness E A / a
             # near it: simulate, margins and report ended in 'internal error: ZeroDivisionError: float division by zero'
             field, value = (("youngs_modulus", self.youngs_modulus) if self.youngs_modulus < 1e9
                             else ("root_diameter", self.root_diameter))
             raise InputError(field, value, f"a shaft whose axial stiffness E pi d^2 / 4 / length is at least "
-                             f"{MIN_SHAFT_STIFFNESS:g} N/m (youngs_modulus {self.youngs_modulus:g} Pa, root_diameter "
+                             f"{MIN_STIFFNESS:g} N/m (youngs_modulus {self.youngs_modulus:g} Pa, root_diameter "
                              f"{self.root_diameter:g} m and length {self.length:g} m make it {k:.3g} N/m)")
 
 
@@ -337,6 +347,10 @@ class NutParams(_Params):
         0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
     )
     seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the nut seat joints")
+
+    def _check(self):
+        _check_stiffness("axial_stiffness", self.axial_stiffness)
+        _check_stiffness("seat_joint_stiffness", self.seat_joint_stiffness, off=True)
 
 
 @dataclass(frozen=True)

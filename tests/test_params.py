@@ -109,6 +109,11 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         ({"screw": {"root_diameter": 1e-300}}, "screw.root_diameter", "a shaft whose axial stiffness E pi d^2 / 4 / "
                                                                       "length is at least 1 N/m"),
         ({"screw": {"youngs_modulus": 1e-300}}, "screw.youngs_modulus", "make it 6.22e-304 N/m"),
+        # every element of the axial chain (1e-300 N/m: 'internal error: ZeroDivisionError' in simulate and margins)
+        ({"screw": {"bearing_stiffness": 1e-300}}, "screw.bearing_stiffness", "a stiffness of at least 1 N/m"),
+        ({"nut": {"axial_stiffness": 1e-300}}, "nut.axial_stiffness", "a stiffness of at least 1 N/m"),
+        ({"nut": {"seat_joint_stiffness": 1e-300}}, "nut.seat_joint_stiffness", "0 (rigid, off) or a stiffness of"),
+        ({"screw": {"seat_joint_stiffness": 0.5}}, "screw.seat_joint_stiffness", "0 (rigid, off) or a stiffness of"),
     ],
 )
 def test_invalid_values_name_field_value_and_range(data, field, fragment):
