@@ -197,6 +197,9 @@ def _check_stiffness(name, value, off=False):
     if value < MIN_STIFFNESS and not (off and value == 0.0):
         raise InputError(name, value, ("0 (rigid, off) or " if off else "") + f"a stiffness of at least "
                          f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
+#: smallest Stribeck velocity [m/s]: measured ones are 1e-5 to 1e-2 m/s; below 1 pm/s the curve's (v / vs)^delta
+#: overflows a float at a feed axis's speeds
+MIN_STRIBECK_VELOCITY = 1e-12
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
@@ -421,6 +424,13 @@ class FrictionParams(_Params):
     gms_attraction: float = _q(
         1.0e4, "N/s", 0.0, lo_open=True, doc="GMS: attraction C of a sliding element to its Stribeck share",
     )
+
+    def _check(self):
+        if self.stribeck_velocity < MIN_STRIBECK_VELOCITY:
+            # (v / vs)^delta overflowed: margins ended in 'internal error: OverflowError: (34, 'Numerical result out
+            # of range')' at 1e-300 m/s, and its loop's slope was NaN
+            raise InputError("stribeck_velocity", self.stribeck_velocity, f"a finite number in "
+                             f"[{MIN_STRIBECK_VELOCITY:g}, 1.0] m/s (a smaller one overflows (v / vs)^delta)")
 
 
 @dataclass(frozen=True)

@@ -114,6 +114,8 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         ({"nut": {"axial_stiffness": 1e-300}}, "nut.axial_stiffness", "a stiffness of at least 1 N/m"),
         ({"nut": {"seat_joint_stiffness": 1e-300}}, "nut.seat_joint_stiffness", "0 (rigid, off) or a stiffness of"),
         ({"screw": {"seat_joint_stiffness": 0.5}}, "screw.seat_joint_stiffness", "0 (rigid, off) or a stiffness of"),
+        # (v / vs)^2 overflowed: 'margins' ended in 'internal error: OverflowError: (34, 'Numerical result out of range')'
+        ({"friction": {"stribeck_velocity": 1e-300}}, "friction.stribeck_velocity", "[1e-12, 1.0] m/s"),
     ],
 )
 def test_invalid_values_name_field_value_and_range(data, field, fragment):
