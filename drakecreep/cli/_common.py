@@ -81,6 +81,17 @@ def existing_path(option, path):
     generic 'No such file or directory' line did not say which option the path came from)."""
     if path is not None and not path_exists(option, path):
         raise InputError(option, str(path), "an existing file (no such file or directory)")
+    return regular_file(option, path)
+
+
+def regular_file(option, path):
+    """``path`` (``None`` passes) unless it names a folder or a device: then an :class:`~drakecreep.errors.InputError`
+    naming ``option`` (the file readers said 'adir: got 'adir (a directory)'', no option)."""
+    from pathlib import Path
+
+    if path is not None and Path(path).exists() and not Path(path).is_file():
+        raise InputError(option, str(path), "a regular file (this is " + ("a folder)" if Path(path).is_dir()
+                                                                          else "a device or other special file)"))
     return path
 
 

@@ -24,7 +24,7 @@ diagnosis.json, summary.txt and augmented_params.yaml (for simulate, margins and
 import sys
 from pathlib import Path
 
-from drakecreep.cli._common import existing_path, names, path_exists, print_json, workers
+from drakecreep.cli._common import existing_path, names, path_exists, print_json, regular_file, workers
 from drakecreep.errors import InputError
 from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
@@ -83,6 +83,8 @@ def run(args):
         if path and path not in EMPS_FILES and not path_exists(option, path):
             raise InputError(option, path, "an existing file: a measured run (CSV, Parquet, HDF5, .mat with its "
                              "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
+        if path and path not in EMPS_FILES:
+            regular_file(option, path)  # a folder was told 'metadata: got 'adir.yaml''
     runs = load_runs(args.data, existing_path("--meta", args.meta), split=False)
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so

@@ -127,6 +127,26 @@ def test_non_regular_files_are_refused_without_reading(target, tmp_path, capsys)
         os.mkfifo(target)
     code, _, err = _run(["params", "--check", target], capsys, timeout=10)
     _one_line_exit_2(code, err, "a regular file")
+    assert "error: --check: got" in err  # the option (it was 'dir: got 'dir (a directory)'')
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["simulate", "--params", "{dir}"], "--params"),
+    (["diagram", "--params", "/dev/zero"], "--params"),
+    (["uncertainty", "--spec", "{dir}"], "--spec"),
+    (["diagnose", "{dir}"], "DATA"),  # it was 'metadata: got 'dir.yaml'', a file it never named
+    (["diagnose", "{csv}", "--meta", "{dir}"], "--meta"),
+    (["diagnose", "{csv}", "--score", "{dir}"], "--score"),
+])
+def test_a_folder_or_device_given_for_a_file_names_the_option(argv, option, tmp_path, capsys):
+    """'simulate --params adir' said 'adir: got 'adir (a directory)'; allowed: a regular file', no option (found by
+    the fourth fuzzing pass)."""
+    from drakecreep.data import example_path
+
+    (tmp_path / "d").mkdir()
+    argv = [a.format(dir=tmp_path / "d", csv=example_path("emps_segment.csv")) for a in argv]
+    code, _, err = _run(argv, capsys, timeout=30)
+    _one_line_exit_2(code, err, f"error: {option}: got", "allowed: a regular file (this is a")
 
 
 # --------------------------------------------------------------------------- sweep specs
