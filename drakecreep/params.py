@@ -200,6 +200,9 @@ def _check_stiffness(name, value, off=False):
 #: smallest Stribeck velocity [m/s]: measured ones are 1e-5 to 1e-2 m/s; below 1 pm/s the curve's (v / vs)^delta
 #: overflows a float at a feed axis's speeds
 MIN_STRIBECK_VELOCITY = 1e-12
+#: shortest velocity-loop sample time [s]: digital drives sample at 5-100 kHz (1e-5 s and up); below about 1e-16 s
+#: the sampled loop's model rounds exp(p T) to 1
+MIN_SAMPLE_PERIOD = 1e-9
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
@@ -458,6 +461,12 @@ class ControllerParams(_Params):
     )
 
     def _check(self):
+        if self.velocity_period < MIN_SAMPLE_PERIOD:
+            # the sampled loop's model rounds exp(p T) to 1: margins printed a velocity-loop phase margin of -2.5 deg
+            # (75.2 at any period from 1e-15 s up) at 1e-20 s, exit 0, and ended in 'internal error: ValueError: The
+            # function value at x=0.01 is NaN' at 1e-300 s
+            raise InputError("velocity_period", self.velocity_period, f"a finite number in [{MIN_SAMPLE_PERIOD:g}, "
+                             f"0.1] s (the sampled loop's model loses a faster one to round-off)")
         ratio = self.position_period / self.velocity_period
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise InputError(

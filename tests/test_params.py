@@ -116,6 +116,9 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         ({"screw": {"seat_joint_stiffness": 0.5}}, "screw.seat_joint_stiffness", "0 (rigid, off) or a stiffness of"),
         # (v / vs)^2 overflowed: 'margins' ended in 'internal error: OverflowError: (34, 'Numerical result out of range')'
         ({"friction": {"stribeck_velocity": 1e-300}}, "friction.stribeck_velocity", "[1e-12, 1.0] m/s"),
+        # the sampled loop's model rounds exp(p T) to 1: 'margins' printed a phase margin of -2.5 deg for 75.2 at 1e-20 s
+        ({"controller": {"velocity_period": 1e-20, "position_period": 4e-20}}, "controller.velocity_period",
+         "[1e-09, 0.1] s"),
     ],
 )
 def test_invalid_values_name_field_value_and_range(data, field, fragment):
