@@ -173,6 +173,11 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
     fmt = FORMATS.get(path.suffix.lower())
     if fmt is None:
         raise InputError(str(path), path.suffix or "(no suffix)", "a file ending in " + ", ".join(FORMATS))
+    # an option of another format was ignored without a word ('file: {key: /x}' beside a CSV)
+    for name, value, only in (("key", key, "hdf5"), ("separator", separator, "csv"), ("decimal", decimal, "csv")):
+        if value is not None and fmt != only:
+            raise InputError(f"{path}: file.{name}", value, f"only for {'an HDF5' if only == 'hdf5' else 'a CSV'} file "
+                             f"(this one is read as {fmt}: leave file.{name} out)")
     wanted = set(map(str, (columns or {}).values())) if columns else set(QUANTITY) | {"u", "run"}
     frame = _frame(path, fmt, key, separator, decimal, run_column=str((columns or {}).get("run", "run")), wanted=wanted)
     if frame.shape[1] == 0 or frame.shape[0] == 0:

@@ -84,3 +84,14 @@ def test_an_hdf5_key_that_holds_a_series_is_named(tmp_path):
     _frame()["u"].to_hdf(tmp_path / "run.h5", key="/u")
     with pytest.raises(InputError, match=r"run.h5: file.key: got None; allowed: the key of a table .* holds a Series"):
         read_signals(tmp_path / "run.h5", "N")
+
+
+@pytest.mark.parametrize("option, value, suffix", [("key", "/run", ".csv"), ("separator", ";", ".mat"),
+                                                   ("decimal", ",", ".h5")])
+def test_an_option_of_another_format_is_refused(tmp_path, option, value, suffix):
+    """The metadata's file.key beside a CSV (or a separator beside a .mat) was ignored without a word, though every
+    other unknown or misplaced key of the metadata is refused."""
+    path = tmp_path / f"run{suffix}"
+    path.write_text("t,x_ref,x_motor,u\n")
+    with pytest.raises(InputError, match=rf"run{suffix}: file.{option}: got '{value}'; allowed: only for an? "):
+        read_signals(path, "N", **{option: value})
