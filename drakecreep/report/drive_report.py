@@ -56,7 +56,10 @@ def _figures(result):
         ax.axvline(0, color="k", lw=0.8)
         ax.set_yticks(y, [c.name for c in ranked])
         ax.set_xlabel("held-out force error decrease [points of %]")
-        ax.legend(fontsize=8, loc="lower right")
+        # under the figure, whose axes and labels the layout fits first (its tight bounding box grows to hold the
+        # legend): inside the axes it hid the last candidates' bars
+        fig.tight_layout()
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=fig.transFigure)
         figs.append((_fig_png(fig), "Which effect: each fitted candidate's held-out gain against its bar"))
     if result.nominal_test_errors:
         figs.append(errors_by_run_figure([
