@@ -88,28 +88,36 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
 
 
 def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, tmp_path, capsys, monkeypatch):
-    """A candidate that fails after another was replayed (here the delay search, made to raise): the run
-    exits 1 with one line, no manifest claims a complete run, and the folder keeps the fitted params file and
-    the ranking of the candidates done (the issue: a failure late in the pipeline keeps what was computed)."""
+    """A step after the candidates that fails (here the location of what is left, made to raise): the run exits 1
+    with one line, no manifest claims a complete run, and the folder keeps the fitted params file and the ranking
+    of the candidates (the issue: a failure late in the pipeline keeps what was computed). A candidate that fails
+    (here the delay search) no longer ends the run: it is listed as failed, the others are ranked."""
     from drakecreep.gap import drive_fit
 
     def broken(*args, **kwargs):
         raise RuntimeError("the delay search broke")
 
+    def lost(*args, **kwargs):
+        raise RuntimeError("the location broke")
+
     monkeypatch.setattr(drive_fit, "_delay_effect", broken)
+    monkeypatch.setattr(drive_fit, "locate", lost)
     path, _ = own_csv
     out = tmp_path / "diag"
     code = cli.main(["diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3", "--uncertain",
                      "table.seal_force", "--effects", "nut_friction_side,control_delay", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 1 and "the delay search broke" in err[-1] and "Traceback" not in "\n".join(err)
+    assert code == 1 and "the location broke" in err[-1] and "Traceback" not in "\n".join(err)
     assert any("nominal_params.yaml" in line for line in err)  # the progress says where it is kept
     assert "kept nominal_params.yaml and ranking.json in" in err[-2]
     assert not (out / "manifest.json").exists()
     assert load_params(out / "nominal_params.yaml").table.seal_force > 0
     ranking = json.loads((out / "ranking.json").read_text())
-    assert ranking["stage"] == "candidate" and ranking["complete"] is False and ranking["claimed"] == []
-    assert [c["name"] for c in ranking["candidates"]] == ["nut_friction_side"]
+    assert ranking["stage"] == "claims" and ranking["complete"] is False and ranking["claimed"] == []
+    assert sorted(c["name"] for c in ranking["candidates"]) == ["control_delay", "nut_friction_side"]
+    (delay,) = [c for c in ranking["candidates"] if c["name"] == "control_delay"]
+    assert delay["reason"] == "failed (RuntimeError: the delay search broke)"
+    assert any("control_delay failed (RuntimeError: the delay search broke)" in w for w in ranking["warnings"])
     assert ranking["replay_null"] is not None and ranking["train_runs"] == ["r0", "r1"]
 
 
