@@ -197,11 +197,13 @@ def _check_stiffness(name, value, off=False):
     if value < MIN_STIFFNESS and not (off and value == 0.0):
         raise InputError(name, value, ("0 (rigid, off) or " if off else "") + f"a stiffness of at least "
                          f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
-#: smallest Stribeck velocity [m/s]: measured ones are 1e-5 to 1e-2 m/s; below 1 pm/s the curve's (v / vs)^delta
-#: overflows a float at a feed axis's speeds
+#: smallest Stribeck velocity [m/s], the lower end of its range: measured ones are 1e-5 to 1e-2 m/s; below 1 pm/s
+#: the curve's (v / vs)^delta overflows a float at a feed axis's speeds (margins ended in 'internal error:
+#: OverflowError' at 1e-300 m/s)
 MIN_STRIBECK_VELOCITY = 1e-12
-#: shortest velocity-loop sample time [s]: digital drives sample at 5-100 kHz (1e-5 s and up); below about 1e-16 s
-#: the sampled loop's model rounds exp(p T) to 1
+#: shortest velocity-loop sample time [s], the lower end of its range: digital drives sample at 5-100 kHz (1e-5 s
+#: and up); below about 1e-16 s the sampled loop's model rounds exp(p T) to 1 (margins printed a phase margin of
+#: -2.5 deg for 75.2 at 1e-20 s, and ended in 'internal error: ValueError' at 1e-300 s)
 MIN_SAMPLE_PERIOD = 1e-9
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
@@ -402,7 +404,7 @@ class FrictionParams(_Params):
 
     law: str = _q("lugre", "-", choices=("coulomb", "stribeck", "lugre", "gms"), doc="friction law")
     static_ratio: float = _q(1.5, "-", 1.0, 10.0, doc="breakaway / Coulomb force Fs/Fc")
-    stribeck_velocity: float = _q(1.0e-4, "m/s", 0.0, 1.0, lo_open=True, doc="vs")
+    stribeck_velocity: float = _q(1.0e-4, "m/s", MIN_STRIBECK_VELOCITY, 1.0, doc="vs")
     stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
     viscous: float = _q(200.0, "N s/m", 0.0, doc="viscous coefficient Fv")
     coulomb_asymmetry: float = _q(
@@ -428,13 +430,6 @@ class FrictionParams(_Params):
         1.0e4, "N/s", 0.0, lo_open=True, doc="GMS: attraction C of a sliding element to its Stribeck share",
     )
 
-    def _check(self):
-        if self.stribeck_velocity < MIN_STRIBECK_VELOCITY:
-            # (v / vs)^delta overflowed: margins ended in 'internal error: OverflowError: (34, 'Numerical result out
-            # of range')' at 1e-300 m/s, and its loop's slope was NaN
-            raise InputError("stribeck_velocity", self.stribeck_velocity, f"a finite number in "
-                             f"[{MIN_STRIBECK_VELOCITY:g}, 1.0] m/s (a smaller one overflows (v / vs)^delta)")
-
 
 @dataclass(frozen=True)
 class ControllerParams(_Params):
@@ -453,7 +448,7 @@ class ControllerParams(_Params):
         "motor", "-", choices=("motor", "table"), doc="semi-closed (encoder) or closed loop (scale)"
     )
     sampled: bool = field(default=True, metadata=dict(unit="-", doc="discrete controller; false = continuous"))
-    velocity_period: float = _q(2.5e-4, "s", 0.0, 0.1, lo_open=True, doc="velocity loop sample time")
+    velocity_period: float = _q(2.5e-4, "s", MIN_SAMPLE_PERIOD, 0.1, doc="velocity loop sample time")
     position_period: float = _q(1.0e-3, "s", 0.0, 1.0, lo_open=True, doc="position loop sample time")
     computation_delay: float = _q(
         1.0, "samples", 0.0, 100.0,
@@ -461,12 +456,6 @@ class ControllerParams(_Params):
     )
 
     def _check(self):
-        if self.velocity_period < MIN_SAMPLE_PERIOD:
-            # the sampled loop's model rounds exp(p T) to 1: margins printed a velocity-loop phase margin of -2.5 deg
-            # (75.2 at any period from 1e-15 s up) at 1e-20 s, exit 0, and ended in 'internal error: ValueError: The
-            # function value at x=0.01 is NaN' at 1e-300 s
-            raise InputError("velocity_period", self.velocity_period, f"a finite number in [{MIN_SAMPLE_PERIOD:g}, "
-                             f"0.1] s (the sampled loop's model loses a faster one to round-off)")
         ratio = self.position_period / self.velocity_period
         if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
             raise InputError(
