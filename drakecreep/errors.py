@@ -2,7 +2,7 @@
 
 import reprlib
 
-__all__ = ["DrakecreepError", "InputError", "short_repr"]
+__all__ = ["DrakecreepError", "InputError", "renaming", "short_repr"]
 
 #: longest value shown in a message: a value from a file may be huge (a YAML alias bomb expands to
 #: billions of items) and its whole ``repr()`` would hang the program before it could print one line
@@ -69,3 +69,12 @@ class InputError(DrakecreepError, ValueError):
     def unknown_field(cls, field, known):
         """A key that names no field of a mapping whose fields are ``known`` (the value is not echoed)."""
         return cls(field, "an unknown field", "one of the known fields " + ", ".join(sorted(known)))
+
+
+def renaming(field, build, *args, **kwargs):
+    """``build(*args, **kwargs)``; an :class:`InputError` it raises goes on as ``err.renamed(field(err.field))``, so the
+    caller names where the value came from (a file, a sweep spec's key) around a builder that knows only the field."""
+    try:
+        return build(*args, **kwargs)
+    except InputError as err:
+        raise err.renamed(field(err.field)) from None

@@ -44,7 +44,7 @@ import numpy as np
 import yaml
 
 from drakecreep.data import emps_data_dir
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, renaming
 from drakecreep.files import write_atomic, write_text
 from drakecreep.gap.formats import read_signals
 
@@ -208,12 +208,13 @@ class ControllerMeta:
             raise InputError("controller.position_filter", self.position_filter, "a list of numbers") from None
         if not taps or not all(math.isfinite(x) for x in taps) or abs(sum(taps) - 1.0) > 1e-9:
             raise InputError("controller.position_filter", self.position_filter, "a non-empty list summing to 1")
-        if len(taps) > MAX_TAPS or sum(abs(x) for x in taps) > MAX_TAP_GAIN:
+        gain = sum(abs(x) for x in taps)
+        if len(taps) > MAX_TAPS or gain > MAX_TAP_GAIN:
             # each tap is a state of the replay (10000 taps replayed for hours), and taps of 1e300 and -1e300
             # summing to 1 passed and never finished replaying
-            raise InputError("controller.position_filter", f"{len(taps)} taps, sum of |taps| "
-                             f"{sum(abs(x) for x in taps):.3g}", f"at most {MAX_TAPS} taps whose magnitudes sum to "
-                             f"at most {MAX_TAP_GAIN:g} (a drive's position filter: EMPS 0.5, 0.5)")
+            raise InputError("controller.position_filter", f"{len(taps)} taps, sum of |taps| {gain:.3g}",
+                             f"at most {MAX_TAPS} taps whose magnitudes sum to at most {MAX_TAP_GAIN:g} (a drive's "
+                             "position filter: EMPS 0.5, 0.5)")
         object.__setattr__(self, "position_filter", taps)
 
     @property
@@ -473,10 +474,8 @@ def _named(prefix, build, *args, **kwargs):
     """``build(*args, **kwargs)``, its :class:`InputError` naming the file the field is in (``prefix`` + field): a
     diagnosis reads several files (runs, metadata, params, a scored file), so 'screw.lead: got -1.0' alone did not
     say which."""
-    try:
-        return build(*args, **kwargs)
-    except InputError as err:  # an error that names the file already ('rig.yaml: got 'invalid YAML ...'') once
-        raise err.renamed(err.field if prefix == f"{err.field}: " else f"{prefix}{err.field}") from None
+    # an error that names the file already ('rig.yaml: got 'invalid YAML ...'') names it once
+    return renaming(lambda field: field if prefix == f"{field}: " else f"{prefix}{field}", build, *args, **kwargs)
 
 
 def _meta_from_dict(data, meta_path):

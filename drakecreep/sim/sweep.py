@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from drakecreep.model.drive_source import scenario_with_drive
-from drakecreep.errors import InputError, short_repr
+from drakecreep.errors import InputError, renaming, short_repr
 from drakecreep.files import write_json
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.processes import new_pool, pool_size, stop_pool, usable_cpus
@@ -769,14 +769,6 @@ def _range(path, spec, max_cases=MAX_CASES):
     raise InputError(f"axes.{path}", spec, "a list of values or {start, stop, num[, scale: linear|log]}")
 
 
-def _spec_named(field, build, *args, **kwargs):
-    """``build(*args, **kwargs)``, its :class:`InputError` naming the spec's key: ``field(err.field)``."""
-    try:
-        return build(*args, **kwargs)
-    except InputError as err:
-        raise err.renamed(field(err.field)) from None
-
-
 def load_spec(path, max_cases=MAX_CASES):
     """Read a sweep spec (YAML).
 
@@ -818,17 +810,17 @@ def load_spec(path, max_cases=MAX_CASES):
     # every error names the spec's key the value came from ('base.set.table.mass', not the params field alone)
     if "file" in base_spec:
         ref = resolve_reference(base_spec["file"], path, "base.file")
-        base = _spec_named(lambda f: f"base.file {base_spec['file']}" + ("" if f == str(ref) else f": {f}"),
+        base = renaming(lambda f: f"base.file {base_spec['file']}" + ("" if f == str(ref) else f": {f}"),
                            load_params, ref)
     else:
-        base = _spec_named(lambda f: f"base.{f}", preset, base_spec.get("preset", "paper"))
+        base = renaming(lambda f: f"base.{f}", preset, base_spec.get("preset", "paper"))
     overrides = base_spec.get("set") or {}
     if not isinstance(overrides, dict):
         raise InputError("base.set", overrides, "a mapping path -> value")
     for key, value in overrides.items():
         if not isinstance(key, str):
             raise InputError("base.set", key, "parameter paths (text such as table.mass)")
-        base = _spec_named(lambda f: f"base.set.{f}", with_value, base, key, value)
+        base = renaming(lambda f: f"base.set.{f}", with_value, base, key, value)
     scenario = data.get("scenario") or {}
     if not isinstance(scenario, dict):
         raise InputError("scenario", scenario, "a mapping of " + ", ".join(SCENARIO_FIELDS))
@@ -844,10 +836,10 @@ def load_spec(path, max_cases=MAX_CASES):
         expanded = {p: (_range(p, v, max_cases) if isinstance(v, dict) else v) for p, v in axes.items()}
         points = grid(expanded, max_cases)
     else:
-        points = _spec_named(lambda f: f"sample.{f}" if f in ("n", "seed") else f, random_sample, axes,
+        points = renaming(lambda f: f"sample.{f}" if f in ("n", "seed") else f, random_sample, axes,
                              sample.get("n"), seed=sample.get("seed", 0), max_cases=max_cases)
     # every path and value before anything runs, and before the plot names them (a misspelt axis is named as such)
-    _spec_named(lambda f: f"axes.{f}" if f in axes else f"scenario.{f}" if f in scenario else f,
+    renaming(lambda f: f"axes.{f}" if f in axes else f"scenario.{f}" if f in scenario else f,
                 make_cases, base, points, scenario)
     metrics = data.get("metrics")
     known_metrics = metric_columns()
