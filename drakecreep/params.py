@@ -197,6 +197,13 @@ def _check_stiffness(name, value, off=False):
     if value < MIN_STIFFNESS and not (off and value == 0.0):
         raise InputError(name, value, ("0 (rigid, off) or " if off else "") + f"a stiffness of at least "
                          f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
+#: largest gains of the PI cascade, the upper ends of their ranges: 3-4 decades above any feed drive's (kp 40 1/s,
+#: kv 1.2e5 N s/m, ki 7.5e6 N/m on the paper's rig; a kv of 1e9 N s/m puts the velocity loop's crossover on a 300 kg
+#: axis near 0.5 MHz, far beyond any sampled loop). Gains of 1e20 were accepted and ran as an unstable loop chattering
+#: in saturation at every sample, minutes per simulated second on the leaf backend
+MAX_POSITION_GAIN = 1e4
+MAX_VELOCITY_GAIN = 1e9
+MAX_VELOCITY_INTEGRAL_GAIN = 1e12
 #: smallest Stribeck velocity [m/s], the lower end of its range: measured ones are 1e-5 to 1e-2 m/s; below 1 pm/s
 #: the curve's (v / vs)^delta overflows a float at a feed axis's speeds (margins ended in 'internal error:
 #: OverflowError' at 1e-300 m/s)
@@ -439,10 +446,10 @@ class ControllerParams(_Params):
     maps m/s to an axial force (N) which the drive turns into torque through the lead.
     """
 
-    position_gain: float = _q(40.0, "1/s", 0.0, doc="kp")
+    position_gain: float = _q(40.0, "1/s", 0.0, MAX_POSITION_GAIN, doc="kp")
     velocity_feedforward: float = _q(1.0, "-", 0.0, 2.0, doc="share of the reference speed fed forward")
-    velocity_gain: float = _q(1.2e5, "N s/m", 0.0, lo_open=True, doc="kv (proportional)")
-    velocity_integral_gain: float = _q(7.5e6, "N/m", 0.0, doc="ki (integral)")
+    velocity_gain: float = _q(1.2e5, "N s/m", 0.0, MAX_VELOCITY_GAIN, lo_open=True, doc="kv (proportional)")
+    velocity_integral_gain: float = _q(7.5e6, "N/m", 0.0, MAX_VELOCITY_INTEGRAL_GAIN, doc="ki (integral)")
     anti_windup: bool = field(default=True, metadata=dict(unit="-", doc="stop integrating in saturation"))
     position_feedback: str = _q(
         "motor", "-", choices=("motor", "table"), doc="semi-closed (encoder) or closed loop (scale)"

@@ -119,6 +119,10 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         # the sampled loop's model rounds exp(p T) to 1: 'margins' printed a phase margin of -2.5 deg for 75.2 at 1e-20 s
         ({"controller": {"velocity_period": 1e-20, "position_period": 4e-20}}, "controller.velocity_period",
          "[1e-09, 0.1] s"),
+        # gains of 1e20 ran as a loop chattering in saturation every sample: minutes per simulated second (leaf)
+        ({"controller": {"velocity_gain": 1e20}}, "controller.velocity_gain", "(0.0, 1000000000.0] N s/m"),
+        ({"controller": {"velocity_integral_gain": 1e13}}, "controller.velocity_integral_gain", "1000000000000.0] N/m"),
+        ({"controller": {"position_gain": 2e4}}, "controller.position_gain", "[0.0, 10000.0] 1/s"),
     ],
 )
 def test_invalid_values_name_field_value_and_range(data, field, fragment):
