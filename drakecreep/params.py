@@ -642,10 +642,18 @@ class DriveParams(_Params):
     disturbance: DisturbanceParams = field(default_factory=DisturbanceParams)
     compensation: CompensationParams = field(default_factory=CompensationParams)
 
+    @property
+    def load_cases_allowed(self):
+        """What a load case number may be, as an error message says it."""
+        n = len(self.loads.cases)
+        if n == 0:
+            return "0 (unloaded): these parameters define no load cases (loads.cases adds them)"
+        return f"an integer in 0..{n} (0 = unloaded)"
+
     def load_case(self, number):
         """The :class:`LoadCase` numbered ``number`` (1-based); 0 means no external load. Its ``fx`` includes
         ``loads.constant_force``, so every model of the drive sees that force through this one method."""
-        allowed = f"an integer in 0..{len(self.loads.cases)} (0 = unloaded)"
+        allowed = self.load_cases_allowed
         if isinstance(number, bool) or not isinstance(number, numbers.Integral):  # True was case 1
             raise InputError("load_case", number, allowed)
         number = int(number)  # np.int64 too

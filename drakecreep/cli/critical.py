@@ -58,7 +58,7 @@ def _drive(args):
     params = params_from_args(args)
     n = len(params.loads.cases)
     if not 0 <= args.load_case <= n:
-        raise InputError("--load-case", args.load_case, f"an integer in 0..{n} (0 = unloaded)")
+        raise InputError("--load-case", args.load_case, params.load_cases_allowed)
     drive = lumped(params, args.load_case)
     changes = {}
     for option, (field, unit, zero_ok) in OVERRIDES.items():

@@ -65,7 +65,7 @@ def run(args):
         params = with_value(params, "controller.sampled", args.controller == "sampled")
     feed = feed_from_mm_s(args.feed)
     if not 0 <= args.load_case <= len(params.loads.cases):
-        raise InputError("--load-case", args.load_case, f"an integer in 0..{len(params.loads.cases)} (0 = unloaded)")
+        raise InputError("--load-case", args.load_case, params.load_cases_allowed)
     check_duration(args.duration)
     if params.simulation.steady_start >= args.duration:
         raise InputError(

@@ -105,3 +105,13 @@ def test_params_check_and_preset_are_one_or_the_other(tmp_path, capsys):
     assert stop.value.code == 2 and "not allowed with argument" in err[-1]
     assert main(["params", "--check", str(tmp_path / "p.yaml")]) == 0 and main(["params", "--json"]) == 0
     capsys.readouterr()
+
+
+@pytest.mark.parametrize("command", [["simulate", "--out", "{tmp}/o"], ["critical"]])
+def test_a_params_file_without_load_cases_says_so_for_the_default_load_case(command, tmp_path, capsys):
+    """A params file of only a controller section said 'allowed: an integer in 0..0' for the default case 3."""
+    path = tmp_path / "gains.yaml"
+    path.write_text("controller: {velocity_gain: 1.0e5}\n")
+    assert main([a.format(tmp=tmp_path) for a in command] + ["--params", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--load-case: got 3; allowed: 0 (unloaded): these parameters define no load cases" in err[0]
