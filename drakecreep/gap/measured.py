@@ -65,6 +65,7 @@ __all__ = [
     "MeasuredData",
     "load_measured",
     "check_recorded",
+    "controller_gains",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -115,6 +116,19 @@ MAX_TAP_GAIN = 1000.0
 #: Largest recorded ``|u|`` of a P-P cascade's run, in its declared saturations: its output is clipped there,
 #: though a command added after the clip passes it (the EMPS validation pulses: 10.84 V at a 10 V saturation)
 _SATURATION_SLACK = 2.0
+#: Largest factor between the travels of two position columns of a run (``x_motor`` against ``x_ref``,
+#: ``x_table`` against ``x_motor``): a closed loop follows its reference, and the table its motor, within a few per
+#: cent of the travel; a unit written wrong on one column puts a thousand between them
+_TRAVEL_FACTOR = 10.0
+#: Largest factor between a declared P-P gain and the one the recorded ``u`` follows (:func:`controller_gains`):
+#: a gain in the wrong unit (per mm/s for per m/s, a mistyped exponent) is off by decades; noise, quantization
+#: and a computation delay move the fitted gains by per cent (EMPS: 0.02 % and 0.03 %)
+_GAIN_FACTOR = 10.0
+#: The fitted law must reproduce the unsaturated ``u`` within this share of its RMS for its gains to be read (a
+#: command far from the P-P form says nothing about the declared gains)
+_LAW_FIT = 0.5
+#: Largest computation delay [samples] the gain check tries: the fitted gains are those of the best lag
+_MAX_LAG = 10
 #: Controller kinds of the metadata schema.
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 
@@ -673,6 +687,10 @@ def check_recorded(run):
       as metres), or not the one the positions were recorded at; the replay would count with it.
     * A drive command ``u`` that is zero throughout gives the fit nothing to match.
     * A P-P cascade clips its output at ``controller.saturation``: a recorded ``|u|`` beyond twice it contradicts it.
+    * A closed loop follows its reference and the table its motor: a travel of ``x_motor`` (``x_table``) more than
+      ten times ``x_ref``'s (``x_motor``'s) or less than a tenth of it has a unit wrong on one of them.
+    * A P-P cascade's declared ``kp`` or ``kv`` more than ten times off the gain the recorded ``u`` follows
+      (:func:`controller_gains`) is in the wrong unit, or not the controller that ran.
 
     Only measured files are checked: simulated positions (replays, instruments) are not counted.
     """
@@ -703,12 +721,78 @@ def check_recorded(run):
             raise InputError(f"controller.saturation (run {run.label})", ctrl.saturation,
                              f"at least half the largest recorded |u|, {abs(float(run.u[i])):g} {run.meta.u_units} at "
                              f"data row {i + 1} of the run (the controller clips its output at its saturation)")
+    for column, against, what in (("x_motor", "x_ref", "the motor follows its reference"),
+                                  ("x_table", "x_motor", "the table follows its motor")):
+        a, b = getattr(run, column), getattr(run, against)
+        if a is None or b is None or not np.ptp(a) > 0.0 or not np.ptp(b) > 0.0:
+            continue
+        ratio = float(np.ptp(a) / np.ptp(b))
+        if not 1.0 / _TRAVEL_FACTOR <= ratio <= _TRAVEL_FACTOR:
+            raise InputError(f"{column} (run {run.label})", f"a travel of {np.ptp(a):.4g} m against {against}'s "
+                             f"{np.ptp(b):.4g} m", f"a travel within a factor of {_TRAVEL_FACTOR:g} of {against}'s "
+                             f"({what}; is the unit of one of them wrong?)")
+    if ctrl is not None and ctrl.kind == "p_p_cascade":
+        fitted = controller_gains(run)
+        if fitted is not None:
+            kp, kv, lag, misfit = fitted
+            for name, got, follows in (("kv", ctrl.kv, kv), ("kp", ctrl.kp, kp)):
+                if not 1.0 / _GAIN_FACTOR <= follows / got <= _GAIN_FACTOR:
+                    raise InputError(
+                        f"controller.{name} (run {run.label})", got,
+                        f"the gain the recorded u follows, within a factor of {_GAIN_FACTOR:g}: the P-P law fitted to "
+                        f"its unsaturated samples has kp = {kp:.4g} 1/s, kv = {kv:.4g} {run.meta.u_units} per m/s "
+                        f"(delay {lag} samples; it reproduces u within {100 * misfit:.1f} % RMS); is a unit wrong?")
     if run.x_table is not None and np.ptp(run.x_table) == 0.0 and np.ptp(run.x_motor) > 0.0:
         # a scale that reads nothing while the motor moves (unplugged, or the wrong column): every replay error
         # relative to it was a division by zero ('y: got all zero')
         raise InputError(f"x_table (run {run.label})", "constant while x_motor moves",
                          "the linear scale's reading of the table, or no x_table column (a motion within one count "
                          "of the scale cannot be scored against it)")
+
+
+def controller_gains(run):
+    """The P-P cascade's gains that the recorded ``u`` of ``run`` follows: a least-squares fit of the declared law
+    (its position filter and feedback, :class:`ControllerMeta`) to the unsaturated samples.
+
+    ``u[k] = kp kv (x_ref - x)[k - d] - kv dx[k - d]`` is fitted for each delay ``d`` of 0 to :data:`_MAX_LAG`
+    samples, and the best delay's gains are returned. An independent reading of the controller from the data, for
+    :func:`check_recorded` to hold the declared gains against (a unit error puts decades between them).
+
+    Parameters
+    ----------
+    run : MeasuredRun
+        A run whose metadata declares a ``p_p_cascade`` controller.
+
+    Returns
+    -------
+    tuple or None
+        ``(kp [1/s], kv [unit of u per m/s], delay [samples], misfit)``, ``misfit`` the fit's RMS residual over the
+        RMS of ``u``; None when the run says nothing about them: fewer than 50 unsaturated samples, a fit that
+        leaves more than :data:`_LAW_FIT` of ``u`` (not the P-P form), or gains that are not both positive.
+    """
+    ctrl = run.meta.controller
+    x = run.x_motor if ctrl.feedback == "motor" or run.x_table is None else run.x_table
+    taps = np.asarray(ctrl.position_filter, float)
+    xf = np.convolve(x, taps)[: x.size] if abs(run.dt - ctrl.sample_time) <= 1e-3 * ctrl.sample_time else x
+    dx = np.diff(xf) / run.dt
+    e = (run.x_ref - x)[1:]
+    u = np.asarray(run.u[1:], float)
+    valid = np.abs(u) < 0.9 * ctrl.saturation
+    valid[: taps.size] = False
+    best = None
+    for lag in range(_MAX_LAG + 1):
+        rows = np.flatnonzero(valid[lag:]) + lag
+        if rows.size < 50:
+            continue
+        a = np.c_[e[rows - lag], -dx[rows - lag]]
+        sol, *_ = np.linalg.lstsq(a, u[rows], rcond=None)
+        misfit = float(np.sqrt(np.mean((u[rows] - a @ sol) ** 2) / np.mean(u[rows] ** 2)))
+        if best is None or misfit < best[3]:
+            best = (sol[0], sol[1], lag, misfit)
+    if best is None or not best[3] <= _LAW_FIT or not (best[0] > 0 and best[1] > 0):
+        return None
+    gain, kv, lag, misfit = best
+    return float(gain / kv), float(kv), lag, misfit
 
 
 def save_measured(data, csv_path, meta_path=None):

@@ -11,6 +11,7 @@ from drakecreep.gap.measured import (
     MeasuredData,
     MeasuredMeta,
     MeasuredRun,
+    controller_gains,
     emps_data_dir,
     emps_path,
     load_emps,
@@ -30,6 +31,14 @@ META = {"u_units": "V", "u_gain": 35.0,
 def _rows(n=20, dt=1e-3):
     t = np.arange(n) * dt
     return {"t": t, "x_ref": 1e-3 * t, "x_motor": 1e-3 * t - 1e-7, "u": np.sin(t), "f_ext": 0 * t + 2.0}
+
+
+def _law(x_ref, x, controller=META["controller"]):
+    """The P-P law's command of positions ``x`` (clipped): a synthetic run its declared controller could have made."""
+    taps = controller["position_filter"]
+    dx = np.diff(np.convolve(x, taps)[: x.size], prepend=x[0]) / controller["sample_time"]
+    u = controller["kp"] * controller["kv"] * (x_ref - x) - controller["kv"] * dx
+    return np.clip(u, -controller["saturation"], controller["saturation"])
 
 
 def _write(tmp_path, cols=None, header=None, meta=META, name="run.csv"):
@@ -111,7 +120,8 @@ def test_positions_in_the_wrong_unit_are_refused_by_their_speed(tmp_path):
     n, dt = 400, 1e-3
     t = np.arange(n) * dt
     x = 0.05 * np.sin(2 * np.pi * t)  # 0.31 m/s peak: a feed axis
-    cols = {"t": t, "x_ref": x, "x_motor": x - 1e-6, "u": np.sin(t)}
+    x_motor = x - 1e-6 * np.cos(2 * np.pi * t)
+    cols = {"t": t, "x_ref": x, "x_motor": x_motor, "u": _law(x, x_motor)}
     assert load_measured(_write(tmp_path, cols)).run().n == n
     # the same run in millimetres, labelled m: 314 m/s
     with pytest.raises(InputError, match="m/s") as err:
@@ -611,3 +621,61 @@ def test_a_params_file_that_is_no_yaml_is_named_once(tmp_path):
     with pytest.raises(InputError) as err:
         load_measured(_write(tmp_path, meta=dict(META, params="rig.yaml")))
     assert err.value.field == str(tmp_path / "rig.yaml") and "invalid YAML" in err.value.value
+
+
+def test_position_columns_whose_travels_disagree_by_a_unit_are_refused(tmp_path):
+    """A loop follows its reference and the table its motor: a thousand between two travels is a unit error."""
+    n, dt = 2000, 1e-3
+    t = np.arange(n) * dt
+    x = 0.01 * (1 - np.cos(np.pi * t))
+    x_motor = x - 1e-6 * np.sin(np.pi * t)
+    cols = {"t": t, "x_ref": x, "x_motor": x_motor, "x_table": x_motor - 2e-6, "u": _law(x, x_motor)}
+    assert load_measured(_write(tmp_path, cols)).run().n == n
+    # x_ref in millimetres labelled m would move too fast: the slip the speed check cannot see is the other way,
+    # a column in metres beside one written in millimetres and labelled mm (so read as a thousandth)
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, {**cols, "x_ref": 1e-3 * x}, name="ref.csv"))
+    assert err.value.field.endswith("ref.csv: x_motor (run ref)") and "x_ref" in err.value.allowed
+    assert "factor of 10" in err.value.allowed and "unit" in err.value.allowed
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, {**cols, "x_table": 1e-3 * x}, name="table.csv"))
+    assert err.value.field.endswith("x_table (run table)") and "x_motor" in err.value.allowed
+
+
+def _segment(tmp_path, **controller):
+    """The shipped EMPS segment with its controller metadata changed."""
+    from drakecreep.data import example_path
+
+    meta = yaml.safe_load(example_path("emps_segment.yaml").read_text())
+    meta["controller"].update(controller)
+    (tmp_path / "seg.yaml").write_text(yaml.safe_dump(meta))
+    (tmp_path / "seg.csv").write_bytes(example_path("emps_segment.csv").read_bytes())
+    return tmp_path / "seg.csv"
+
+
+def test_declared_p_p_gains_the_recorded_command_contradicts_are_refused(tmp_path):
+    run = load_measured(_segment(tmp_path)).run()  # as shipped: kp 160.18 1/s, kv 243.45 V per m/s
+    kp, kv, lag, misfit = controller_gains(run)
+    assert kp == pytest.approx(160.18, rel=0.05) and kv == pytest.approx(243.45, rel=0.1)
+    assert lag == 0 and misfit < 0.05
+    # a position gain of 1e-300 1/s ran a whole diagnosis of a loop without its position feedback
+    with pytest.raises(InputError) as err:
+        load_measured(_segment(tmp_path, kp=1e-300))
+    assert err.value.field.endswith("controller.kp (run seg)") and err.value.value == 1e-300
+    assert f"kp = {kp:.4g} 1/s" in err.value.allowed and "factor of 10" in err.value.allowed
+    # kv per mm/s written for per m/s
+    with pytest.raises(InputError) as err:
+        load_measured(_segment(tmp_path, kv=0.24345))
+    assert err.value.field.endswith("controller.kv (run seg)") and f"kv = {kv:.4g} V per m/s" in err.value.allowed
+    # within the factor (a gain 3x off, or a delay of a few samples) the data are let be: the replay shows the rest
+    assert load_measured(_segment(tmp_path, kp=3 * 160.18)).run().n == run.n
+    late = MeasuredRun(t=run.t, x_ref=run.x_ref, x_motor=run.x_motor, u=np.r_[np.zeros(3), run.u[:-3]], meta=run.meta)
+    assert controller_gains(late)[2] == 3 and controller_gains(late)[1] == pytest.approx(kv, rel=1e-3)
+
+
+def test_a_command_that_is_not_the_p_p_form_says_nothing_about_the_gains():
+    t = np.arange(400) * 1e-3
+    x = 0.01 * t
+    run = MeasuredRun(t=t, x_ref=x, x_motor=x - 1e-6 * np.cos(3 * t), u=np.random.default_rng(0).normal(size=t.size),
+                      meta=MeasuredMeta(u_units="V", u_gain=35.0, controller=ControllerMeta(kp=100.0, kv=200.0)))
+    assert controller_gains(run) is None
