@@ -2,7 +2,7 @@
 
 import reprlib
 
-__all__ = ["DrakecreepError", "InputError", "renaming", "short_repr"]
+__all__ = ["DrakecreepError", "InputError", "Terminated", "renaming", "short_repr"]
 
 #: longest value shown in a message: a value from a file may be huge (a YAML alias bomb expands to
 #: billions of items) and its whole ``repr()`` would hang the program before it could print one line
@@ -20,6 +20,12 @@ def short_repr(value, limit=MAX_VALUE_CHARS):
     except Exception:  # noqa: BLE001 - a value whose repr fails still gets a message
         text = f"<{type(value).__name__}>"
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+class Terminated(KeyboardInterrupt):
+    """A ``SIGTERM`` (``kill``, ``timeout``, a job scheduler, ``docker stop``) handled as a Ctrl-C: what runs stops
+    and keeps what was computed, and the command line exits 143 (128 + 15). Without it Python ended at once:
+    no partial results, the pool's workers left to notice, a ``resource_tracker`` warning of leaked semaphores."""
 
 
 class DrakecreepError(Exception):

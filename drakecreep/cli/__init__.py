@@ -7,13 +7,15 @@ Each subcommand lives in its own module of this package and exposes
 
 User errors (:class:`drakecreep.errors.DrakecreepError`, bad files, bad options) print one line on stderr
 and exit with code 2, never a traceback. Anything unexpected (a bug, a full disk) prints one line naming
-the error and pointing to ``--debug`` (which shows the traceback) and exits with code 1; Ctrl-C exits 130.
+the error and pointing to ``--debug`` (which shows the traceback) and exits with code 1; Ctrl-C exits 130. A
+SIGTERM (``kill``, ``timeout``, a job scheduler) stops as a Ctrl-C does, keeping what was computed, and exits 143.
 """
 
 import argparse
 import errno
 import importlib
 import re
+import signal
 import textwrap
 import os
 import sys
@@ -22,7 +24,7 @@ import time
 import traceback
 
 from drakecreep import __version__
-from drakecreep.errors import DrakecreepError
+from drakecreep.errors import DrakecreepError, Terminated
 
 __all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "plain"]
 
@@ -117,6 +119,18 @@ def _heartbeat(command):
     return done
 
 
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+def _on_sigterm():
+    """Handle ``SIGTERM`` as a Ctrl-C while a command runs (:class:`~drakecreep.errors.Terminated`); returns the
+    handler it replaced (None where signals cannot be set: not the main thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _terminate)
+
+
 def build_parser():
     """Build the top-level parser with every registered subcommand."""
     parser = _Parser(
@@ -158,6 +172,7 @@ def main(argv=None):
     stop = _heartbeat(args.command) if args.command in HEARTBEAT and show and not args.quiet else None
     debug = getattr(args, "debug", False) or args.verbose > 1
     prefix = f"drakecreep {args.command}"
+    previous = _on_sigterm()
     try:
         _check_no_empty_values(parser, args)
         return int(args.func(args) or 0)
@@ -180,7 +195,10 @@ def main(argv=None):
         print(f"{prefix}: internal error: {type(err).__name__}: {_one_line(err.strerror or err)}"
               f"{': ' + _one_line(err.filename) if err.filename else ''}{hint}", file=sys.stderr)
         return 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
+        if isinstance(err, Terminated):
+            print(f"{prefix}: terminated (SIGTERM)", file=sys.stderr)
+            return 143
         print(f"{prefix}: interrupted", file=sys.stderr)
         return 130
     except Exception as err:  # noqa: BLE001 - the one top-level guard: one line, the traceback on --debug
@@ -190,6 +208,8 @@ def main(argv=None):
         print(f"{prefix}: internal error: {type(err).__name__}: {what}{hint}", file=sys.stderr)
         return 1
     finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
         if stop is not None:
             stop()
         if args.quiet:

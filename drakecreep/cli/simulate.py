@@ -146,7 +146,9 @@ def run(args):
                   f"fluctuation p50/p95 {row['fluctuation_p50_mm_s']:.3g}/{row['fluctuation_p95_mm_s']:.3g} mm/s")
     if not result.ok:
         print(f"drakecreep simulate: error: {result.status} (results up to then saved in {args.out})", file=sys.stderr)
-        return 130 if result.status.startswith("interrupted") else 1
+        if result.status.startswith("interrupted"):
+            return 143 if "SIGTERM" in result.status else 130
+        return 1
     return 0
 
 

@@ -43,7 +43,7 @@ from pydrake.systems.primitives import VectorLogSink
 
 from drakecreep.sim.compiled import compile_diagram
 from drakecreep.model.diagram import build_diagram
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, Terminated
 from drakecreep.sim.metrics import feed_metrics
 from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
@@ -538,8 +538,9 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None):
         if "minimum" in first.lower() and "step" in first.lower():
             first = f"diverged: the integrator needed a step below {MIN_STEP:g} s ({first[:120]})"
         status = f"integration stopped at t = {context.get_time():.6g} s: {first}"
-    except KeyboardInterrupt:
-        status = f"interrupted (Ctrl-C) at t = {context.get_time():.6g} s"
+    except KeyboardInterrupt as err:
+        why = "SIGTERM" if isinstance(err, Terminated) else "Ctrl-C"
+        status = f"interrupted ({why}) at t = {context.get_time():.6g} s"
     if guard["reason"] is not None:
         status = guard["reason"]
     wall = time.perf_counter() - start

@@ -672,8 +672,8 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
                 retried = _run_processes(units, metric, retries, done, n_workers)
             else:
                 retried = _run_dask(units, metric, retries, done, scheduler)
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as err:
+        interrupted, stop = True, err  # raised again once the table is written: a SIGTERM stays one (exit 143)
         for key, entry in unwritten.items():  # the finished case whose cache write the Ctrl-C cut short
             write_json(cache_dir / f"{key}.json", entry)
     finally:
@@ -701,7 +701,7 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
             paths["manifest"] = out.commit(dict(cases=len(cases), interrupted=interrupted,
                                                 computed=computed, cached=n_cached, failed=failed))
     if interrupted:
-        raise KeyboardInterrupt
+        raise stop
     return SweepResult(table=table, computed=computed, cached=n_cached, failed=failed, retried=retried,
                        paths=paths, wall_time=time.perf_counter() - start)
 

@@ -57,19 +57,23 @@ def test_wall_clock_limit(short_paper):
     assert r.time[-1] < 60.0
 
 
-def test_ctrl_c_keeps_what_was_computed(short_paper, tmp_path, capsys, monkeypatch, ctrl_c_as_at_a_terminal):
-    # a real SIGINT, sent from inside the run once it is under way (as a user's Ctrl-C would arrive)
+@pytest.mark.parametrize("sent, code, said", [(signal.SIGINT, 130, "interrupted (Ctrl-C)"),
+                                               # a SIGTERM (kill, timeout, a job scheduler) ended Python at once
+                                               (signal.SIGTERM, 143, "interrupted (SIGTERM)")])
+def test_ctrl_c_or_sigterm_keeps_what_was_computed(sent, code, said, short_paper, tmp_path, capsys, monkeypatch,
+                                                   ctrl_c_as_at_a_terminal):
+    # a real signal, sent from inside the run once it is under way (as a user's Ctrl-C would arrive)
     real = simulation._guard
 
     def guard(simulator, root, read_speeds, bounds, wall_limit):
         report = real(simulator, root, read_speeds, bounds, wall_limit)
         inner = simulator.get_monitor() if hasattr(simulator, "get_monitor") else None
-        sent = []
+        done = []
 
         def monitor(context):
-            if context.get_time() > 0.4 and not sent:
-                sent.append(1)
-                os.kill(os.getpid(), signal.SIGINT)
+            if context.get_time() > 0.4 and not done:
+                done.append(1)
+                os.kill(os.getpid(), sent)
             return inner(context) if inner else None
 
         if inner is not None:
@@ -81,9 +85,9 @@ def test_ctrl_c_keeps_what_was_computed(short_paper, tmp_path, capsys, monkeypat
 
     path = tmp_path / "p.yaml"
     save_params(short_paper, path)
-    code = main(["simulate", "--params", str(path), "--duration", "30", "--no-plot", "--out", str(tmp_path / "o")])
+    main_code = main(["simulate", "--params", str(path), "--duration", "30", "--no-plot", "--out", str(tmp_path / "o")])
     err = capsys.readouterr().err
-    assert code == 130 and "interrupted" in err
+    assert main_code == code and said in err
     body = json.loads((tmp_path / "o" / "metrics.json").read_text())
-    assert body["summary"]["status"].startswith("interrupted")
+    assert body["summary"]["status"].startswith(said)
     assert 0.4 < body["summary"]["sim_time_s"] < 30
