@@ -248,8 +248,11 @@ def read_csv_frame(source, field, allowed, separator=None, decimal=None, text_co
 
 def first_non_number(values):
     """The first of ``values`` (cells of a table read as text) that ``float`` cannot read, for a message naming
-    it; None when all can."""
+    it; None when all can. A text with an underscore is not a number here, though ``float`` reads Python's digit
+    grouping (``'1_000'`` as 1000): no table writes it, and ``'1_5'`` is likelier a typo than 15."""
     for value in values:
+        if isinstance(value, str) and "_" in value:
+            return value
         try:
             float(value)
         except (TypeError, ValueError):

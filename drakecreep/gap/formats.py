@@ -220,14 +220,19 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
             raise InputError(f"{path}: column {signal}", f"{kind[values.dtype.kind]} ({values.dtype})",
                              "real numbers" + (" (seconds from the run's start, or a unit in the header: t[ms])"
                                                if signal == "t" else ""))
-        try:
-            data = values.to_numpy(dtype=float)
-        except (TypeError, ValueError):
-            from drakecreep.files import first_non_number
+        from pandas.api.types import is_numeric_dtype
 
+        from drakecreep.files import first_non_number
+
+        data = None
+        try:
+            bad = None if is_numeric_dtype(values) else first_non_number(values)  # text cells: each one read
+            data = values.to_numpy(dtype=float) if bad is None else None
+        except (TypeError, ValueError):
             bad = first_non_number(values)
             bad = values.iloc[0] if bad is None else bad
-            raise InputError(f"{path}: column {signal}", str(bad)[:40], "numbers") from None
+        if data is None:
+            raise InputError(f"{path}: column {signal}", str(bad)[:40], "numbers")
         signals[signal] = data * unit_factor(signal, unit, u_units, str(path))
     return signals
 

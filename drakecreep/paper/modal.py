@@ -797,6 +797,12 @@ def read_hammer_csv(path):
     header = tuple(str(c).strip() for c in frame.columns)
     if header not in (FRF_COLUMNS, TIME_COLUMNS):
         raise InputError(f"{path}: header", separator.join(header), allowed)
+    from pandas.api.types import is_numeric_dtype
+
+    text_columns = [c for c in frame.columns if not is_numeric_dtype(frame[c])]
+    bad = first_non_number(frame[text_columns].to_numpy().ravel()) if text_columns else None
+    if bad is not None:  # '1_5', which float() reads as 15, included
+        raise InputError(f"{path}: data", str(bad)[:40], "numbers")
     try:
         data = frame.to_numpy(dtype=float)
     except (TypeError, ValueError):

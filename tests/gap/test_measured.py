@@ -170,6 +170,10 @@ def test_not_a_number(tmp_path):
     cols["u"][2] = "abc"
     with pytest.raises(InputError, match="abc"):
         load_measured(_write(tmp_path, cols))
+    # float() reads Python's digit grouping: '1_5' was read as 15, silently
+    cols["u"][2] = "1_5"
+    with pytest.raises(InputError, match="got '1_5'; allowed: numbers"):
+        load_measured(_write(tmp_path, cols, name="grouped.csv"))
 
 
 def test_unknown_unit_of_u(tmp_path):

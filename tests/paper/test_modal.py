@@ -128,6 +128,8 @@ def test_a_hammer_test_file_is_read_with_any_common_separator_and_decimal_mark(t
 
 @pytest.mark.parametrize("body, message", [("f_Hz,re,im\n" + "1,2,3\n" * 7 + "1,2,x\n", "data: got 'x'"),
                                            ("f_Hz,re,im\n" + "1,2,3\n" * 7 + "1,2,\n", "empty cell at data row 8"),
+                                           # float() reads Python's digit grouping: '1_5' was 15
+                                           ("f_Hz,re,im\n" + "1,2,3\n" * 7 + "1,2,1_5\n", "data: got '1_5'"),
                                            ("f,re,im\n" + "1,2,3\n" * 8, "header: got 'f,re,im'"),
                                            ("f_Hz,re,im\n" + "1,2,3\n" * 3, "rows: got 3")])
 def test_a_bad_hammer_test_file_is_named(tmp_path, body, message):
