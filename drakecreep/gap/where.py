@@ -163,7 +163,7 @@ def where_lines(where):
     if where.get("bands") is None:
         return [f"unexplained: not located ({gone})"]
     reg = sorted(where["regimes"].items(), key=lambda kv: -kv[1]["energy_share"])
-    lines = [f"unexplained: held-out force residual {where['force_rms_N']:.3g} N rms; by regime "
+    lines = [f"unexplained: held-out force residual {where['force_rms_N']:.3g} N rms; by regime: "
              + ", ".join(f"{k.replace('_', ' ')} {100 * v['energy_share']:.0f} % of the energy in "
                          f"{100 * v['time_share']:.0f} % of the time" for k, v in reg if v["time_share"] >= 0.005)
              + (f" ({gone}: left out)" if gone else "")]
