@@ -640,7 +640,9 @@ def test_position_columns_whose_travels_disagree_by_a_unit_are_refused(tmp_path)
     with pytest.raises(InputError) as err:
         load_measured(_write(tmp_path, {**cols, "x_ref": 1e-3 * x}, name="ref.csv"))
     assert err.value.field.endswith("ref.csv: x_motor (run ref)") and "x_ref" in err.value.allowed
-    assert "factor of 10" in err.value.allowed and "unit" in err.value.allowed
+    assert "factor of 100 " in err.value.allowed and "unit" in err.value.allowed
+    # a stick test of micrometres: the motor winds the screw up, the table hardly moves (30 times less) - let be
+    assert load_measured(_write(tmp_path, {**cols, "x_table": x_motor / 30}, name="stick.csv")).run().n == n
     with pytest.raises(InputError) as err:
         load_measured(_write(tmp_path, {**cols, "x_table": 1e-3 * x}, name="table.csv"))
     assert err.value.field.endswith("x_table (run table)") and "x_motor" in err.value.allowed
