@@ -197,6 +197,8 @@ def _check_stiffness(name, value, off=False):
     if value < MIN_STIFFNESS and not (off and value == 0.0):
         raise InputError(name, value, ("0 (rigid, off) or " if off else "") + f"a stiffness of at least "
                          f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
+
+
 #: largest gains of the PI cascade, the upper ends of their ranges: 3-4 decades above any feed drive's (kp 40 1/s,
 #: kv 1.2e5 N s/m, ki 7.5e6 N/m on the paper's rig; a kv of 1e9 N s/m puts the velocity loop's crossover on a 300 kg
 #: axis near 0.5 MHz, far beyond any sampled loop). Gains of 1e20 were accepted and ran as an unstable loop chattering
