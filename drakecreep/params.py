@@ -13,6 +13,7 @@ import dataclasses
 import math
 import numbers
 import re
+import sys
 import typing
 from dataclasses import dataclass, field
 from importlib import resources
@@ -72,6 +73,19 @@ class _Loader(yaml.SafeLoader):
                 raise yaml.composer.ComposerError(
                     None, None, f"more than {MAX_YAML_ALIASES} aliases (*name)", event.start_mark)
         return super().compose_node(parent, index)
+
+    def construct_object(self, node, deep=False):
+        # a scalar its constructor refuses ('rotor_inertia: 2001-13-45', '!!float abc', an integer of 5000 digits)
+        # raised a bare ValueError: 'internal error: ValueError: month must be in 1..12', exit 1
+        try:
+            return super().construct_object(node, deep=deep)
+        except (ValueError, OverflowError) as err:
+            digits = sys.get_int_max_str_digits()
+            if node.tag == "tag:yaml.org,2002:int" and len(str(node.value)) > digits:
+                problem = f"an integer of more than {digits} digits"
+            else:
+                problem = f"a value it cannot read ({err})"
+            raise yaml.constructor.ConstructorError(None, None, problem, node.start_mark) from None
 
     def construct_mapping(self, node, deep=False):
         if isinstance(node, yaml.MappingNode):

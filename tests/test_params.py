@@ -133,6 +133,22 @@ def test_invalid_values_name_field_value_and_range(data, field, fragment):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("text, fragment", [
+    ("2001-13-45", "(line 1, column 24): a value it cannot read (month must be in 1..12)"),
+    ("!!float abc", "(line 1, column 24): a value it cannot read (could not convert string to float: 'abc')"),
+    ("!!int 1.5", "a value it cannot read (invalid literal for int()"),
+    ("1" + "0" * 5000, "(line 1, column 24): an integer of more than 4300 digits"),
+])
+def test_a_scalar_yaml_cannot_construct_is_bad_input(tmp_path, text, fragment):
+    # the constructor's bare ValueError was 'internal error: ValueError: month must be in 1..12' (or 'Exceeds the
+    # limit (4300 digits) for integer string conversion'), exit 1 (found by the fifth fuzzing pass)
+    path = tmp_path / "p.yaml"
+    path.write_text(f"motor: {{rotor_inertia: {text}}}\n")
+    with pytest.raises(InputError) as info:
+        load_params(path)
+    assert info.value.field == str(path) and fragment in str(info.value) and "\n" not in str(info.value)
+
+
 def test_invalid_yaml_is_one_clear_error(tmp_path):
     path = tmp_path / "bad.yaml"
     path.write_text("table: [\n")
