@@ -94,6 +94,8 @@ def write_atomic(path, write):
     path = Path(path)
     if path.is_dir():  # named before any work on the file (os.replace's error named the temporary file)
         raise IsADirectoryError(errno.EISDIR, "a folder is in the way of the file", str(path))
+    if _special(path):  # os.replace put a regular file in its place: 'tune --write /dev/null' as root replaced the device
+        raise FileExistsError(errno.EEXIST, "a device or other special file is in the way of the file", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}")
     os.close(fd)
@@ -108,6 +110,11 @@ def write_atomic(path, write):
             os.unlink(tmp)
         raise
     return path
+
+
+def _special(path):
+    """Whether ``path`` names an existing device, FIFO or socket (or a link to one): no file to replace."""
+    return path.exists() and not path.is_file() and not path.is_dir()
 
 
 def write_text(path, text):
@@ -368,6 +375,9 @@ def check_output_file(path, field="--out"):
     try:
         if path.is_dir():
             raise InputError(field, str(path), "a file name (this is an existing folder)")
+        if _special(path):
+            raise InputError(field, str(path), "a file name (this is a device or other special file, which writing "
+                             "the file would replace)")
     except OSError as err:  # ENAMETOOLONG
         raise InputError(field, str(path), f"a file that can be written ({err.strerror})") from None
     folder = check_output_dir(path.parent, field)

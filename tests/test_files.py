@@ -190,6 +190,24 @@ def test_a_folder_in_the_way_of_a_file_is_named(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["params.yaml"]
 
 
+def test_a_device_or_fifo_in_the_way_of_a_file_is_refused_not_replaced(tmp_path):
+    """'tune --write /dev/null' (as root) wrote the tuned parameters and replaced the device /dev/null with a regular
+    file (os.replace onto it), exit 0; the check and the write now refuse a target that is no regular file."""
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    link = tmp_path / "link.yaml"
+    link.symlink_to(fifo)
+    for target in (fifo, link):
+        with pytest.raises(InputError, match=r"^--write: got .*; allowed: a file name \(this is a device or other "
+                                             r"special file, which writing the file would replace\)"):
+            check_output_file(target, "--write")
+        with pytest.raises(FileExistsError) as err:
+            write_text(target, "x")
+        assert err.value.filename == str(target)
+    assert fifo.is_fifo() and link.is_symlink() and sorted(p.name for p in tmp_path.iterdir()) == ["link.yaml",
+                                                                                                   "pipe.yaml"]
+
+
 def test_a_name_longer_than_the_system_allows_names_the_option(tmp_path):
     """'report --out /tmp/aaa...' (300 characters in one name) said 'File name too long: /tmp/aaa...', no option."""
     long = tmp_path / ("a" * 300)
