@@ -180,6 +180,9 @@ def random_sample(axes, n, seed=0, max_cases=MAX_CASES):
                 columns[path] = [float(v) for v in np.exp(rng.uniform(math.log(low), math.log(high), n))]
             elif scale == "linear":
                 if isinstance(low, int) and isinstance(high, int):
+                    if not -2**63 <= low <= high < 2**63:  # 'internal error: ValueError: high is out of bounds for int64'
+                        raise InputError(f"axes.{path}", spec, "integer bounds low <= high in [-2^63, 2^63) (drawn as "
+                                         "64-bit integers; write a bound with a decimal point for real values)")
                     columns[path] = [int(v) for v in rng.integers(low, high + 1, n)]
                 else:
                     columns[path] = [float(v) for v in rng.uniform(low, high, n)]

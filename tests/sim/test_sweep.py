@@ -62,6 +62,15 @@ def test_random_sample_is_seeded_and_within_bounds():
         random_sample({"x": {"low": 0.0, "high": 1.0, "scale": "log"}}, 3)
 
 
+@pytest.mark.parametrize("low, high", [(0, 10**23), (-10**23, 3), (0, 2**63), (-2**63 - 1, 0)])
+def test_random_integer_bounds_beyond_64_bits_are_named(low, high):
+    # 'internal error: ValueError: high is out of bounds for int64', exit 1 (found by the fifth fuzzing pass)
+    with pytest.raises(InputError, match=r"^axes\.friction\.gms_elements: got .*; allowed: integer bounds low <= high "
+                                         r"in \[-2\^63, 2\^63\)"):
+        random_sample({"friction.gms_elements": {"low": low, "high": high}}, 2)
+    assert {p["x"] for p in random_sample({"x": {"low": 2**63 - 2, "high": 2**63 - 1}}, 20)} == {2**63 - 2, 2**63 - 1}
+
+
 def test_cases_validate_and_keys_follow_the_full_parameters(base):
     cases = make_cases(base, [{"feed": 1e-3}, {"feed": 2e-3}, {"feed": 1e-3}], SHORT)
     assert cases[0].key == cases[2].key != cases[1].key
