@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, renaming
 from drakecreep.params import PRESETS, get_value, load_yaml_file, preset, with_value
 
 __all__ = [
@@ -72,9 +72,13 @@ class Distribution:
             raise InputError(f"{where}.dist", self.dist, "one of " + ", ".join(DISTRIBUTIONS))
         for name in ("low", "high"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            try:  # an integer of hundreds of digits: math.isfinite raised 'internal error: OverflowError'
+                number = float(value) if isinstance(value, (int, float)) and not isinstance(value, bool) else None
+            except OverflowError:
+                number = None
+            if number is None or not math.isfinite(number):
                 raise InputError(f"{where}.{name}", value, "a finite number")
-            object.__setattr__(self, name, float(value))
+            object.__setattr__(self, name, number)
         if not self.low < self.high:
             raise InputError(f"{where}.high", self.high, f"> low ({self.low})")
         if self.dist == "log-uniform" and self.low <= 0:
@@ -165,7 +169,8 @@ def _spec_from_data(data, where, name=None):
         if not isinstance(spec, dict) or set(spec) != {"dist", "low", "high", "source"}:
             raise InputError(f"sample.{path}", spec, "a mapping with dist, low, high, source")
         dist = Distribution(path=str(path), **spec)
-        current = get_value(base, dist.path)  # raises for an unknown path
+        # raises for an unknown path, naming the spec's key (it said '1: got '1'', no 'sample')
+        current = renaming(lambda f: f"sample.{path}", get_value, base, dist.path)
         if isinstance(current, (bool, str)):
             raise InputError(f"sample.{path}", current, "a numeric parameter")
         if isinstance(current, int):  # its draws were refused one by one: 'got 1363.0383126785457; allowed: an integer'
@@ -180,8 +185,8 @@ def _spec_from_data(data, where, name=None):
     fixed = data.get("fixed") or {}
     if not isinstance(fixed, dict):
         raise InputError("fixed", fixed, "a mapping path -> reason")
-    for path in fixed:
-        get_value(base, path)
+    for path in fixed:  # 'fixed: {1: x}' said 'path: got 1', no 'fixed'
+        renaming(lambda f: f"fixed.{path}", get_value, base, path)
     both = sorted(set(fixed) & set(sample))
     if both:
         raise InputError(f"fixed.{both[0]}", fixed[both[0]], "a path not also sampled")

@@ -70,6 +70,9 @@ def test_distribution_validates_and_maps_quantiles():
         Distribution("x", "normal", 1.0, 2.0, "s")
     with pytest.raises(InputError, match="sample.x.source"):
         Distribution("x", "uniform", 1.0, 2.0, "")
+    # an integer of hundreds of digits: 'internal error: OverflowError: int too large to convert to float', exit 1
+    with pytest.raises(InputError, match=r"^sample\.x\.high: got 1000.*; allowed: a finite number$"):
+        Distribution("x", "uniform", 1.0, 10**400, "s")
 
 
 def test_spec_file_errors_name_the_key(tmp_path):
@@ -83,6 +86,14 @@ def test_spec_file_errors_name_the_key(tmp_path):
     assert err.value.field == "sample.friction.static_ratio.low" and "a value of friction.static_ratio" in err.value.allowed
     with pytest.raises(InputError, match="preset"):
         uncertainty_spec("rigid_axis")
+    # a path that is no parameter names the spec's key: it said '1: got '1'' and, under fixed, 'path: got 1'
+    bad.write_text("preset: paper\nsample:\n  1: {dist: uniform, low: 1, high: 2, source: s}\n")
+    with pytest.raises(InputError, match=r"^sample\.1: got '1'; allowed: a dotted path of field names"):
+        load_uncertainty(bad)
+    bad.write_text("preset: paper\nsample:\n  motor.peak_torque: {dist: uniform, low: 6, high: 10, source: s}\n"
+                   "fixed: {1: why}\n")
+    with pytest.raises(InputError, match=r"^fixed\.1: got 1; allowed: a dotted path of parameter fields"):
+        load_uncertainty(bad)
     # an integer field: its first draw was refused as 'sensors.encoder_counts_per_rev: got 1363.04...'
     bad.write_text("preset: paper\nsample:\n  sensors.encoder_counts_per_rev: {dist: uniform, low: 1000, high: 2000, "
                    "source: s}\n")
