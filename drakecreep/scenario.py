@@ -6,10 +6,14 @@ from dataclasses import dataclass
 
 from drakecreep.errors import InputError
 
-__all__ = ["Scenario", "MAX_FEED", "MAX_DURATION"]
+__all__ = ["Scenario", "MIN_FEED", "MAX_FEED", "MAX_DURATION"]
 
 #: largest feed accepted (m/s); feed drives of this class reach 0.5-1 m/s rapid traverse
 MAX_FEED = 1.0
+#: smallest feed magnitude accepted (m/s), the CLI's 1e-4 mm/s: a run of seconds moves a few scale counts, nothing
+#: left to measure, and the analyses' 1/v terms overflow (a sweep at 1e-300 m/s reported a fluctuation of 60130 %
+#: and creep, exit 0)
+MIN_FEED = 1e-7
 #: longest simulated time of one run (s)
 MAX_DURATION = 3600.0
 
@@ -34,8 +38,9 @@ class Scenario:
 
     def __post_init__(self):
         feed, duration = _finite_real(self.feed), _finite_real(self.duration)
-        if feed is None or feed == 0 or abs(feed) > MAX_FEED:
-            raise InputError("feed", self.feed, f"a non-zero speed within +-{MAX_FEED} m/s")
+        if feed is None or not MIN_FEED <= abs(feed) <= MAX_FEED:
+            raise InputError("feed", self.feed, f"a non-zero speed within +-{MAX_FEED} m/s, of magnitude at least "
+                             f"{MIN_FEED:g} m/s")
         if isinstance(self.load_case, bool) or not isinstance(self.load_case, numbers.Integral) or self.load_case < 0:
             raise InputError("load_case", self.load_case, "an integer >= 0 (0 = unloaded)")
         if duration is None or not 0 < duration <= MAX_DURATION:

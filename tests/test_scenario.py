@@ -25,3 +25,13 @@ def test_numpy_scalars_are_numbers_and_stored_as_python_numbers():
 def test_bools_text_and_non_finite_values_are_refused(kwargs):
     with pytest.raises(InputError, match=f"^{next(iter(kwargs))}: "):
         Scenario(**kwargs)
+
+
+@pytest.mark.parametrize("feed", [1e-300, -1e-300, 5e-324, 9.9e-8, -9.9e-8])
+def test_a_feed_below_a_tenth_of_a_micrometre_per_second_is_refused(feed):
+    # a sweep's 'axes: {feed: [1.0e-300]}' ran and reported a fluctuation of 60130 % and creep, exit 0 (simulate's
+    # --feed refused it; the library did not); found by the fifth fuzzing pass
+    with pytest.raises(InputError, match=r"^feed: got .*; allowed: a non-zero speed within \+-1.0 m/s, of magnitude "
+                                         r"at least 1e-07 m/s$"):
+        Scenario(feed=feed)
+    assert Scenario(feed=1e-7).feed == 1e-7 and Scenario(feed=-1e-4 * 1e-3).feed == -1e-4 * 1e-3  # the CLI's 1e-4 mm/s

@@ -953,7 +953,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     from pydrake.systems.primitives import ConstantVectorSource, Multiplexer
 
     from drakecreep.model.diagram import build_diagram, initial_conditions
-    from drakecreep.scenario import Scenario
+    from drakecreep.scenario import MIN_FEED, Scenario
     from drakecreep.sim.compiled import compile_diagram
     from drakecreep.sim.simulation import make_simulator, target_accuracy
 
@@ -981,7 +981,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
     ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
     feed = float(np.max(np.abs(vr))) or 1e-6
-    scenario = Scenario(feed=min(feed, 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
+    scenario = Scenario(feed=min(max(feed, MIN_FEED), 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
     # u[k] is the force command the controller computes at t_k from the measurement at t_k (what the truth and a
     # drive's own trace record). A log published at t_k holds the command before the speed loop's update at t_k
     # (the last tick of the previous sample): with the position loop at 1 kHz and the speed loop at 4 kHz that
