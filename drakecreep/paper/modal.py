@@ -61,6 +61,10 @@ FRF_COLUMNS = ("f_Hz", "re", "im")
 #: Range of the largest magnitude of a hammer-test file's signal columns (SI units): outside it the SDOF fit's
 #: stiffness, mass and damping under- or overflow
 MIN_MAGNITUDE, MAX_MAGNITUDE = 1e-20, 1e20
+#: Range of the highest frequency of a hammer-test file (an FRF's last f_Hz, a time record's Nyquist frequency) [Hz]:
+#: hammer tests reach a few kHz; far outside it the fit's w^2 terms overflow (f_Hz up to 5e302 Hz, or a time step of
+#: 1e-304 s, ended in 'internal error: LinAlgError: SVD did not converge')
+MIN_FREQUENCY, MAX_FREQUENCY = 1e-3, 1e6
 TIME_COLUMNS = ("t", "force", "response")
 
 _FRF_POWERS = {"receptance": 0, "displacement": 0, "mobility": 1, "velocity": 1,
@@ -822,6 +826,13 @@ def read_hammer_csv(path):
         row = int(np.flatnonzero(np.diff(axis) <= 0)[0]) + 1
         raise InputError(f"{path}: {name}", f"{axis[row]:g} {unit} at data row {row + 1} after {axis[row - 1]:g}",
                          "values increasing row by row")
+    top = float(axis[-1]) if header == FRF_COLUMNS else 0.5 / float(np.min(np.diff(axis)))
+    if not MIN_FREQUENCY <= top <= MAX_FREQUENCY:
+        got = (f"a highest frequency of {top:.3g} Hz" if header == FRF_COLUMNS
+               else f"a sample interval of {0.5 / top:.3g} s (Nyquist frequency {top:.3g} Hz)")
+        allowed = (f"a highest frequency in [{MIN_FREQUENCY:g}, {MAX_FREQUENCY:g}] Hz" if header == FRF_COLUMNS
+                   else f"a sample interval in [{0.5 / MAX_FREQUENCY:g}, {0.5 / MIN_FREQUENCY:g}] s")
+        raise InputError(f"{path}: {name}", got, allowed + " (a hammer test's band in SI units; is a unit wrong?)")
     # magnitudes no hammer test gives in SI units (a receptance of 1e-9 m/N, an accelerance of 1e2 m/s^2/N, forces of
     # 1e3 N): beyond these the fit's k, m and c under- or overflow (an FRF scaled by 1e300 gave zeta = inf)
     values = np.abs(data[:, 1:])

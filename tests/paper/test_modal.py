@@ -139,3 +139,29 @@ def test_a_bad_hammer_test_file_is_named(tmp_path, body, message):
     path.write_text(body)
     with pytest.raises(InputError, match=message):
         read_hammer_csv(path)
+
+
+
+@pytest.mark.parametrize("columns, axis, message", [
+    ("f_Hz,re,im", 1e300, r"f_Hz: got 'a highest frequency of 8e\+300 Hz'; allowed: a highest frequency in "
+                          r"\[0.001, 1e\+06\] Hz"),
+    ("f_Hz,re,im", 1e-300, "f_Hz: got 'a highest frequency of 8e-300 Hz'"),
+    ("t,force,response", 1e-300, r"t: got 'a sample interval of 1e-300 s \(Nyquist frequency 5e\+299 Hz\)'; "
+                                 r"allowed: a sample interval in \[5e-07, 500\] s"),
+    ("t,force,response", 1e300, "t: got 'a sample interval of 1e[+]300 s"),
+])
+def test_a_hammer_test_file_beyond_any_band_is_named(tmp_path, columns, axis, message):
+    # f_Hz up to 5e302 Hz (or a time step of 1e-304 s) ended 'modal' in 'internal error: LinAlgError: SVD did not
+    # converge in Linear Least Squares' after overflow warnings, exit 1 (found by the fifth fuzzing pass)
+    from drakecreep.paper.modal import read_hammer_csv
+
+    def write(step):
+        path.write_text(columns + "\n" + "".join(f"{float(k * step)!r},{1e-6 * (1 + k % 2)},1e-06\n"
+                                                 for k in range(1, 9)))
+
+    path = tmp_path / "frf.csv"
+    write(axis)
+    with pytest.raises(InputError, match=message):
+        read_hammer_csv(path)
+    write(1e-3)  # 1 ms steps (Nyquist 500 Hz), or 1-8 mHz: inside
+    assert read_hammer_csv(path)[1].shape == (8, 3)
