@@ -860,6 +860,8 @@ def load_spec(path, max_cases=MAX_CASES):
     for key in ("x", "y"):
         if key in plot and plot[key] not in swept:
             raise InputError(f"plot.{key}", plot[key], "a swept path or scenario field: " + ", ".join(map(str, swept)))
+    if "y" in plot and plot["y"] == plot["x"]:  # a map of an axis against itself: 'plot: {x: feed, y: feed}' drew one
+        raise InputError("plot.y", plot["y"], f"a swept path or scenario field other than plot.x ({plot['x']})")
     if "color" in plot and plot["color"] not in known_metrics:
         raise InputError("plot.color", plot["color"], "one of " + ", ".join(known_metrics))
     return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))

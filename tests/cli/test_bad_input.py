@@ -172,6 +172,9 @@ SPECS = {
     "absurd_value": ("axes:\n  table.mass: [1.0e300]\n", "table.mass"),
     "bad_plot_x": ("axes:\n  table.mass: [30, 40]\nplot: {x: nut.mass}\n", "plot.x"),
     "bad_plot_y": ("axes:\n  table.mass: [30, 40]\nplot: {x: table.mass, y: nope}\n", "plot.y"),
+    # a map of an axis against itself: the sweep ran and drew feed against feed, exit 0 (found by the fifth pass)
+    "plot_y_is_x": ("axes:\n  feed: [1.0e-3, 2.0e-3]\nplot: {x: feed, y: feed}\n",
+                    "error: plot.y: got 'feed'; allowed: a swept path or scenario field other than plot.x (feed)"),
     "bad_plot_color": ("axes:\n  table.mass: [30, 40]\nplot: {x: table.mass, color: nope}\n", "plot.color"),
     "duplicate_axis": ("axes:\n  table.mass: [30]\n  table.mass: [40]\n", "duplicate key"),
     "empty": ("", "empty"),
