@@ -25,6 +25,7 @@ unit in the name (``fluctuation_rate_percent``), as :meth:`drakecreep.sim.metric
 import concurrent.futures as cf
 import dataclasses
 import hashlib
+import importlib.util
 import itertools
 import json
 import math
@@ -692,11 +693,7 @@ def run_sweep(base, points, *, scenario=None, metric=None, executor="processes",
 
         with OutputSet(out_dir, "manifest.json") as out:
             paths["results_csv"] = out.write("results.csv", lambda tmp: table.to_csv(tmp, index=False))
-            try:
-                import pyarrow  # noqa: F401
-            except ImportError:  # pragma: no cover - pyarrow is a dependency; CSV is still written
-                pass
-            else:
+            if importlib.util.find_spec("pyarrow") is not None:  # a dependency; without it the CSV is still written
                 paths["results_parquet"] = out.write("results.parquet", lambda tmp: table.to_parquet(tmp, index=False))
             if not interrupted:
                 for name, write in (extra_outputs or {}).items():

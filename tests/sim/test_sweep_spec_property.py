@@ -1,11 +1,18 @@
 """Property-based: the sweep-spec loader answers any file with a SweepSpec or an InputError, nothing else."""
 
+import importlib
+
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drakecreep.errors import InputError
 from drakecreep.sim.sweep import SweepSpec, load_spec
+
+# load_spec imports pydrake (drakecreep.sim.simulation) on the first spec it accepts; imported here so that the
+# one-off import, several seconds on a loaded CI machine, is not timed against the deadline of one example (it was:
+# a deadline failure under a fuzzing helper's load, session 63); the deadline still catches a loader that hangs
+importlib.import_module("drakecreep.sim.simulation")
 
 SETTINGS = settings(max_examples=40, deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture], database=None)
 
