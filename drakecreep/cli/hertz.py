@@ -6,7 +6,8 @@ Defaults are the paper's Table 3 inputs; lengths at this edge are in mm, angles 
 import json
 import math
 
-from drakecreep.paper.hertz import BallScrewNut, Material, ballscrew_stiffness
+from drakecreep.paper.hertz import (CONTACT_ANGLE_DEG, CONTACT_ANGLE_REASON, BallScrewNut, Material,
+                                    ballscrew_stiffness)
 
 __all__ = ["add_parser", "run"]
 
@@ -50,8 +51,9 @@ def run(args):
         if not (math.isfinite(value) and lo <= value <= hi):
             raise InputError(option, value, f"a finite number in [{lo:g}, {hi:g}]")
     # in the options' own units (the model's checks named its fields, in rad and m)
-    if not (math.isfinite(args.contact_angle) and 0.0 < args.contact_angle < 90.0):
-        raise InputError("--contact-angle", args.contact_angle, "an angle in (0, 90) deg")
+    lo, hi = CONTACT_ANGLE_DEG  # the model's bounds, in degrees
+    if not (math.isfinite(args.contact_angle) and lo <= args.contact_angle <= hi):
+        raise InputError("--contact-angle", args.contact_angle, f"an angle in [{lo:g}, {hi:g}] deg ({CONTACT_ANGLE_REASON})")
     if not args.ball_diameter < args.diameter:
         raise InputError("--ball-diameter", args.ball_diameter, f"a diameter below --diameter ({args.diameter:g} mm)")
     if not (math.isfinite(args.conformity) and 1.0 < args.conformity <= 10.0):  # the model said 'conformity: got 1.0'

@@ -45,6 +45,8 @@ __all__ = [
     "point_contact",
     "brewe_hamrock_contact",
     "BallScrewNut",
+    "CONTACT_ANGLE_DEG",
+    "CONTACT_ANGLE_REASON",
     "TABLE3_NUT",
     "helix_angle",
     "ball_load",
@@ -248,6 +250,15 @@ def brewe_hamrock_contact(P, Rx, Ry, E_prime):
     return {"kappa": k, "a": a, "b": b, "approach": delta}
 
 
+#: Contact angles a ball nut may have, deg: a ball screw's are 30-60 deg (45 typical); the bounds are generous. Below
+#: them the ball load ``Fa/(z sin β cos λ)`` grows without bound (1e-300 deg: 7e302 N a ball, and the contact that
+#: left the ball was blamed on the conformity).
+CONTACT_ANGLE_DEG = (5.0, 85.0)
+#: why: stated in every message that refuses a contact angle
+CONTACT_ANGLE_REASON = ("a ball screw's contact angle is 30-60 deg, 45 typical, and the bounds are generous; a flatter one loads each ball with "
+                        "Fa/(z sin(beta) cos(lambda)) beyond any contact")
+
+
 @dataclass(frozen=True)
 class BallScrewNut:
     """Geometry, material and preload of a single ball nut (defaults: paper Table 3).
@@ -292,8 +303,10 @@ class BallScrewNut:
             "ball_diameter": (self.ball_diameter, 0.0 < self.ball_diameter < self.nominal_diameter,
                               "> 0 m and < nominal_diameter"),
             "nominal_diameter": (self.nominal_diameter, self.nominal_diameter > 0.0, "> 0 m"),
-            "contact_angle": (self.contact_angle, 0.0 < self.contact_angle < np.pi / 2,
-                              "in (0, pi/2) rad"),
+            "contact_angle": (self.contact_angle,
+                              np.radians(CONTACT_ANGLE_DEG[0]) <= self.contact_angle <= np.radians(CONTACT_ANGLE_DEG[1]),
+                              f"in [{np.radians(CONTACT_ANGLE_DEG[0]):.4g}, {np.radians(CONTACT_ANGLE_DEG[1]):.4g}] rad "
+                              f"({CONTACT_ANGLE_DEG[0]:g} to {CONTACT_ANGLE_DEG[1]:g} deg: {CONTACT_ANGLE_REASON})"),
             "lead": (self.lead, self.lead > 0.0, "> 0 m"),
             "conformity": (self.conformity, self.conformity > 1.0, "> 1 (groove wider than ball)"),
             "preload": (self.preload, self.preload > 0.0, "> 0 N"),

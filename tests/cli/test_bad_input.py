@@ -398,7 +398,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--preload", "inf"], "--preload"),
     (["hertz", "--lead", "-1"], "--lead"),
     (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
-    (["hertz", "--contact-angle", "90"], "--contact-angle: got 90.0; allowed: an angle in (0, 90) deg"),
+    (["hertz", "--contact-angle", "90"], "--contact-angle: got 90.0; allowed: an angle in [5, 85] deg"),
+    # a ball load of 7e302 N: the contact left the ball and the message blamed '--conformity: got 1.04'
+    (["hertz", "--contact-angle", "1e-300"], "--contact-angle: got 1e-300; allowed: an angle in [5, 85] deg (a ball"),
+    (["hertz", "--contact-angle", "0.1"], "--contact-angle: got 0.1; allowed: an angle in [5, 85] deg"),
     (["hertz", "--diameter", "1"], "--ball-diameter: got 3.175; allowed: a diameter below --diameter (1 mm)"),
     (["hertz", "--conformity", "1"], "--conformity: got 1.0; allowed: a groove/ball radius ratio in (1, 10]"),
     (["hertz", "--conformity", "0.9"], "--conformity: got 0.9"),  # the model's 'conformity: got 0.9'

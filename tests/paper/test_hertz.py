@@ -76,6 +76,18 @@ def test_bad_geometry_raises_input_error():
         point_contact(-1.0, (1.0, 1.0, 0.0, 0.0))
 
 
+@pytest.mark.parametrize("degrees", [1e-300, 0.1, 4.9, 85.1])
+def test_a_contact_angle_outside_a_ball_screws_is_refused_by_name(degrees):
+    """A contact angle of 1e-300 deg loaded each ball with 7e302 N; the contact that then left the ball was
+    refused as 'conformity: got 1.04', a field nobody had set."""
+    import dataclasses
+
+    with pytest.raises(InputError, match=r"^contact_angle: got .*; allowed: in \[0.08727, 1.484\] rad \(5 to 85 deg"):
+        dataclasses.replace(TABLE3_NUT, contact_angle=float(np.radians(degrees)))
+    for edge in (5.0, 85.0):
+        assert ballscrew_stiffness(dataclasses.replace(TABLE3_NUT, contact_angle=float(np.radians(edge)))).fa > 0
+
+
 def test_a_contact_longer_than_the_ball_is_refused():
     """Hertz theory needs a contact small against the ball: a groove a hair wider than the ball gave a 314 mm
     ellipse on a 3.175 mm ball, and an axial stiffness 1900 times the paper's."""
