@@ -110,8 +110,10 @@ def run(args):
         raise InputError("--spec" if args.spec is not None else "--seed", args.spec or args.seed,
                          "only with --uncertainty N (the rig sample it describes)")
     check_output_dir(args.out)  # before the run, not after it
+    notice = None if args.quiet else (lambda line: print(f"drakecreep simulate: note: {line}", file=sys.stderr,
+                                                        flush=True))
     result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall, model=args.model,
-                      multibody=multibody)
+                      multibody=multibody, notice=notice)
     extra = {}
     if not args.no_plot and len(result.time) > 1:
         from drakecreep.report.plots import plot_feed

@@ -50,7 +50,7 @@ from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "check_run", "check_log_period", "check_step_budget",
            "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS",
-           "MAX_TABLE_SPEED", "MIN_STEP"]
+           "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE", "slow_run_notice"]
 
 #: integrators without error control: they step at ``max_step``
 FIXED_STEP = ("runge_kutta2",)
@@ -75,6 +75,14 @@ MAX_TABLE_SPEED = 10.0 * MAX_FEED
 MIN_STEP = 1e-9
 #: the guard looks at the signals every this many integrator steps (a Python call per step costs ~1 us)
 GUARD_EVERY = 64
+#: a run whose pace, measured after :data:`SLOW_NOTICE_AFTER` s of computing, projects more than this many seconds
+#: in all gets one notice (``simulate(notice=...)``): the projection, the mean step and what to change. A feed of
+#: 1 m/s on the paper preset (LuGre bristles relaxing at ~2e7 1/s, under Runge-Kutta 3's stable step) projected
+#: tens of minutes for 5 s and showed nothing until it ended
+SLOW_NOTICE = 120.0
+SLOW_NOTICE_AFTER = 15.0
+#: implicit integrators: stable on stiff friction, so a slow run on them is not helped by switching
+_IMPLICIT = ("radau3", "implicit_euler")
 
 #: default integrator target accuracy per friction law (``simulation.accuracy: 0``); see the module notes
 ACCURACY_BY_LAW = {"lugre": 1e-4, "stribeck": 1e-5, "coulomb": 1e-5, "gms": 1e-5}
@@ -253,13 +261,44 @@ def make_simulator(system, context, sim, accuracy=None, integrator=None):
     return simulator
 
 
-def _guard(simulator, root, read_speeds, bounds, wall_limit):
-    """Install the divergence guard as the simulator's monitor; returns the dict it reports into."""
+def slow_run_notice(t, until, elapsed, steps, integrator):
+    """The one-line notice of a run whose pace projects more than :data:`SLOW_NOTICE` s of computing, or None.
+
+    Parameters
+    ----------
+    t, until : float
+        Simulated time reached and to reach (s).
+    elapsed : float
+        Seconds of computing so far.
+    steps : int
+        Integrator steps taken so far.
+    integrator : str
+        The integrator's name (:data:`drakecreep.params.INTEGRATORS`).
+    """
+    if not t > 0 or steps <= 0:
+        return None
+    projected = elapsed * until / t
+    if projected <= SLOW_NOTICE:
+        return None
+    line = (f"slow run: {t:.3g} of {until:g} s simulated in {elapsed:.0f} s of computing, about "
+            f"{projected / 60.0:.0f} min in all at this pace (mean step {t / steps:.2g} s, {integrator})")
+    if integrator not in _IMPLICIT:
+        line += ("; an explicit integrator on stiff friction (LuGre bristles at a high speed) steps far below the "
+                 "controller's period: simulation.integrator: radau3 in a --params file steps over it")
+    return line + "; --max-wall S stops the run and keeps what was computed"
+
+
+def _guard(simulator, root, read_speeds, bounds, wall_limit, until=None, notice=None, integrator=""):
+    """Install the divergence guard as the simulator's monitor; returns the dict it reports into.
+
+    With ``notice`` (a callable taking one line) and ``until``, a run whose pace projects more than
+    :data:`SLOW_NOTICE` s gets one :func:`slow_run_notice` once :data:`SLOW_NOTICE_AFTER` s have passed."""
     from pydrake.systems.framework import EventStatus
 
     report = dict(reason=None)
     start = time.perf_counter()
     calls = [0]
+    pending = [notice is not None and until is not None]
     v_max, w_max = bounds
 
     def monitor(context):
@@ -279,6 +318,12 @@ def _guard(simulator, root, read_speeds, bounds, wall_limit):
                       f"(the table speed limit {v_max:g} m/s through the lead)")
         elif wall_limit is not None and time.perf_counter() - start > wall_limit:
             reason = f"stopped at t = {t:.6g} s: wall-clock limit of {wall_limit:g} s reached"
+        if pending[0] and time.perf_counter() - start > SLOW_NOTICE_AFTER:
+            pending[0] = False
+            line = slow_run_notice(t, until, time.perf_counter() - start,
+                                   simulator.get_integrator().get_num_steps_taken(), integrator)
+            if line is not None:
+                notice(line)
         if reason is None:
             return EventStatus.Succeeded()
         report["reason"] = reason
@@ -331,7 +376,7 @@ def check_run(params, scenario, *, backend=None, model="two_mass", multibody=Non
     return backend
 
 
-def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass", multibody=None):
+def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass", multibody=None, notice=None):
     """Simulate ``scenario`` on the drive described by ``params``, with a convergence check.
 
     Parameters
@@ -351,6 +396,9 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     multibody : drakecreep.multibody.diagram.MultibodyOptions, optional
         Segments, rigid joints, friction on/off and the integrator of the multibody model (its
         defaults when None).
+    notice : callable, optional
+        Called with one line when a run's pace projects more than :data:`SLOW_NOTICE` s of computing
+        (:func:`slow_run_notice`; once per run, after :data:`SLOW_NOTICE_AFTER` s).
 
     Returns
     -------
@@ -371,7 +419,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))
-    result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit)
+    result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice)
     check = sim.convergence_check and built[5]["integrator"] not in FIXED_STEP and result.ok \
         and result.metrics is not None
     if not check:
@@ -382,7 +430,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     attempts = 0
     while True:
         tight = max(accuracy / 10.0, _ACCURACY_FLOOR)
-        probe = _run(params, scenario, built, tight, end, wall_limit)
+        probe = _run(params, scenario, built, tight, end, wall_limit, notice)
         wall += probe.wall_time
         agree, change = _agree(result, probe, end, sim.convergence_tolerance)
         attempts += 1
@@ -390,7 +438,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
             break
         # the verdict moved: the whole run again at the tighter accuracy, then check that one
         accuracy = tight
-        result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit)
+        result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice)
         wall += result.wall_time
         if result.metrics is None:
             break
@@ -514,7 +562,7 @@ def _build_multibody(params, scenario, options, backend="compiled"):
     return feed_drive, root, loggers, init, read_speeds, info
 
 
-def _run(params, scenario, built, accuracy, until, wall_limit=None):
+def _run(params, scenario, built, accuracy, until, wall_limit=None, notice=None):
     """One simulation from t = 0 to ``until`` at target ``accuracy`` on a diagram from :func:`_build`, watched
     by the divergence guard."""
     sim = params.simulation
@@ -529,7 +577,7 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None):
     start = time.perf_counter()
     other = {} if info["integrator"] == sim.integrator else dict(integrator=info["integrator"])
     simulator = make_simulator(root, context, sim, accuracy, **other)
-    guard = _guard(simulator, root, read_speeds, bounds, wall_limit)
+    guard = _guard(simulator, root, read_speeds, bounds, wall_limit, until, notice, info["integrator"])
     status = "ok"
     try:
         simulator.AdvanceTo(until)  # the log's periodic publish lands on `until` too

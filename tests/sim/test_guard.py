@@ -65,8 +65,8 @@ def test_ctrl_c_or_sigterm_keeps_what_was_computed(sent, code, said, short_paper
     # a real signal, sent from inside the run once it is under way (as a user's Ctrl-C would arrive)
     real = simulation._guard
 
-    def guard(simulator, root, read_speeds, bounds, wall_limit):
-        report = real(simulator, root, read_speeds, bounds, wall_limit)
+    def guard(simulator, root, read_speeds, bounds, wall_limit, *args):
+        report = real(simulator, root, read_speeds, bounds, wall_limit, *args)
         inner = simulator.get_monitor() if hasattr(simulator, "get_monitor") else None
         done = []
 
@@ -91,3 +91,22 @@ def test_ctrl_c_or_sigterm_keeps_what_was_computed(sent, code, said, short_paper
     body = json.loads((tmp_path / "o" / "metrics.json").read_text())
     assert body["summary"]["status"].startswith(said)
     assert 0.4 < body["summary"]["sim_time_s"] < 30
+
+
+def test_slow_run_notice_projects_and_names_the_fix():
+    # 0.21 of 5 s in 15 s: 6 min at this pace (the paper preset at 1 m/s on Runge-Kutta 3)
+    line = simulation.slow_run_notice(0.21, 5.0, 15.0, 780_000, "runge_kutta3")
+    assert "6 min" in line and "mean step 2.7e-07 s" in line and "radau3" in line and "\n" not in line
+    assert "radau3 in a" not in simulation.slow_run_notice(0.21, 5.0, 15.0, 100, "radau3")  # already implicit
+    assert simulation.slow_run_notice(4.0, 5.0, 15.0, 1000, "runge_kutta3") is None  # 19 s in all: no notice
+
+
+def test_a_slow_run_gets_one_notice_and_a_quick_one_none(short_paper, monkeypatch):
+    lines = []
+    simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6), notice=lines.append)
+    assert lines == []  # the default threshold: 0.6 s of this run project a few seconds
+    monkeypatch.setattr(simulation, "SLOW_NOTICE", 0.0)
+    monkeypatch.setattr(simulation, "SLOW_NOTICE_AFTER", 0.0)
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6), notice=lines.append)
+    assert r.ok and len(lines) == 2  # once per run: the run and its convergence probe
+    assert all(line.startswith("slow run: ") and "of 0.6 s simulated" in line for line in lines)
