@@ -33,12 +33,12 @@ def add_parser(subparsers):
 
 def run(args):
     """Tune and print."""
-    if not args.bandwidth > 0:  # refused before any import or linearization
-        raise InputError("--bandwidth", args.bandwidth, "a bandwidth > 0 Hz")
-    if not 0 < args.phase_margin < 90:
-        raise InputError("--phase-margin", args.phase_margin, "a phase margin in (0, 90) deg")
     from drakecreep.cli.margins import print_margins, scenario_from_args
-    from drakecreep.servo.tuning import tune
+    from drakecreep.errors import renaming
+    from drakecreep.servo.tuning import check_targets, tune
+
+    # the library's bounds, refused before the parameters are read and anything is linearized
+    renaming(lambda field: "--" + field, check_targets, args.bandwidth, args.phase_margin)
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)

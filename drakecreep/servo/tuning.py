@@ -31,10 +31,16 @@ from drakecreep.servo.linearize import linearize_plant, operating_point
 from drakecreep.servo.loops import analyze_loops, loop_margins, loop_transfer
 from drakecreep.params import with_value
 
-__all__ = ["TuningResult", "tune", "POSITION_BANDWIDTH_RATIO", "RULE", "SCAN_POINTS"]
+__all__ = ["TuningResult", "tune", "check_targets", "POSITION_BANDWIDTH_RATIO", "RULE", "SCAN_POINTS",
+           "MIN_BANDWIDTH_HZ", "PHASE_MARGIN_DEG"]
 
 #: velocity-loop bandwidth / position-loop gain (rad/s per 1/s)
 POSITION_BANDWIDTH_RATIO = 4.0
+#: lowest velocity-loop bandwidth target, Hz: a feed drive's velocity loop closes at tens to hundreds of Hz; at
+#: 1e-300 Hz the search placed a crossover at 3e-301 Hz and blamed the phase margin
+MIN_BANDWIDTH_HZ = 0.01
+#: phase margin targets, deg: [low, high); below 10 deg the loop is all but unstable (1e-300 deg was tuned, exit 0)
+PHASE_MARGIN_DEG = (10.0, 90.0)
 RULE = ("loop shaping at the crossover on the linearized sampled loop: PI (kv, ki) solved for |L| = 1 and "
         "the target phase margin at wc, wc set for the target closed-loop bandwidth; kp = w_bw / 4")
 
@@ -102,6 +108,22 @@ def _gains_at(params, scenario, wc, pm_deg, q_loop, sampled):
     return kv, ki
 
 
+def check_targets(bandwidth_Hz, phase_margin_deg):
+    """Refuse targets no feed drive is tuned for, before any linearization (:class:`InputError` naming
+    ``bandwidth`` or ``phase-margin``; the upper end of the bandwidth, a quarter of the Nyquist frequency, depends
+    on the controller's period and is checked by :func:`tune`)."""
+    if not (math.isfinite(bandwidth_Hz) and bandwidth_Hz >= MIN_BANDWIDTH_HZ):
+        raise InputError("bandwidth", bandwidth_Hz,
+                         f"a bandwidth of at least {MIN_BANDWIDTH_HZ:g} Hz (a feed drive's velocity loop closes at tens "
+                         f"to hundreds of Hz; one of {MIN_BANDWIDTH_HZ:g} Hz already takes some 16 s to settle)")
+    lo, hi = PHASE_MARGIN_DEG
+    if not (math.isfinite(phase_margin_deg) and lo <= phase_margin_deg < hi):
+        raise InputError("phase-margin", phase_margin_deg,
+                         f"an angle in [{lo:g}, {hi:g}) deg (below {lo:g} deg the closed loop rings with a damping ratio "
+                         f"under about 0.1 and the model's errors can make it unstable; {hi:g} deg needs more phase lead "
+                         "than a PI has)")
+
+
 def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
     """PI gains for a velocity-loop bandwidth and phase margin, P gain for the position loop.
 
@@ -111,9 +133,9 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
     scenario : drakecreep.scenario.Scenario
         Operating point (feed, load case) of the linearization.
     bandwidth_Hz : float
-        Target -3 dB bandwidth of the closed velocity loop.
+        Target -3 dB bandwidth of the closed velocity loop, at least :data:`MIN_BANDWIDTH_HZ`.
     phase_margin_deg : float
-        Target phase margin of the velocity loop at its crossover, in (0, 90).
+        Target phase margin of the velocity loop at its crossover, in [10, 90) (:data:`PHASE_MARGIN_DEG`).
 
     Returns
     -------
@@ -124,14 +146,11 @@ def tune(params, scenario, bandwidth_Hz=40.0, phase_margin_deg=60.0):
     InputError
         Targets out of range, or not reachable with a PI (negative gains would be needed).
     """
-    if not (math.isfinite(bandwidth_Hz) and bandwidth_Hz > 0):
-        raise InputError("bandwidth", bandwidth_Hz, "a bandwidth > 0 Hz")
+    check_targets(bandwidth_Hz, phase_margin_deg)
     sampled = params.controller.sampled
     nyquist = 0.5 / params.controller.velocity_period
     if sampled and bandwidth_Hz >= 0.25 * nyquist:
         raise InputError("bandwidth", bandwidth_Hz, f"< {0.25 * nyquist:g} Hz (a quarter of the Nyquist frequency)")
-    if not (math.isfinite(phase_margin_deg) and 0 < phase_margin_deg < 90):
-        raise InputError("phase-margin", phase_margin_deg, "an angle in (0, 90) deg")
     op = operating_point(params, scenario)
     P = linearize_plant(params, scenario, op)
     unit = with_value(with_value(params, "controller.velocity_gain", 1.0), "controller.velocity_integral_gain", 0.0)

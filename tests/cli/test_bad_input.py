@@ -420,6 +420,11 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["margins", "--friction", "gms"], "--friction: got 'gms'; allowed: coulomb, stribeck or lugre"),  # 'friction.law'
     (["tune", "--friction", "gms"], "--friction: got 'gms'"),
     (["report", "--out", "{tmp}/r", "--friction", "gms"], "--friction: got 'gms'"),
+    # targets no drive is tuned for: 1e-300 Hz blamed '--phase-margin: got 60.0', 1e-300 deg was tuned, exit 0
+    (["tune", "--bandwidth", "1e-300"], "--bandwidth: got 1e-300; allowed: a bandwidth of at least 0.01 Hz (a feed"),
+    (["tune", "--bandwidth", "0"], "--bandwidth: got 0.0; allowed: a bandwidth of at least 0.01 Hz"),
+    (["tune", "--phase-margin", "1e-300"], "--phase-margin: got 1e-300; allowed: an angle in [10, 90) deg (below"),
+    (["tune", "--phase-margin", "-1"], "--phase-margin: got -1.0; allowed: an angle in [10, 90) deg"),
     (["tune", "--phase-margin", "89.999"], "--phase-margin: got 89.999; allowed: a target a PI can reach"),  # every crossover needs ki < 0
     (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
     (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0

@@ -37,6 +37,31 @@ def test_bad_targets(paper, bw, pm, field):
     assert err.value.field == field
 
 
+@pytest.mark.parametrize("bw, pm, field, fragment", [
+    (1e-300, 60.0, "bandwidth", "a bandwidth of at least 0.01 Hz"),  # said 'phase-margin: ... at 3e-301 Hz'
+    (1e-3, 60.0, "bandwidth", "a bandwidth of at least 0.01 Hz"),  # said 'phase-margin: ... kv = -178'
+    (0.0, 60.0, "bandwidth", "a bandwidth of at least 0.01 Hz"),
+    (40.0, 1e-300, "phase-margin", "an angle in [10, 90) deg (below 10 deg"),  # was tuned: a loop on the edge, exit 0
+    (40.0, 9.99, "phase-margin", "an angle in [10, 90) deg"),
+    (40.0, -5.0, "phase-margin", "an angle in [10, 90) deg"),
+])
+def test_targets_have_physical_lower_ends(paper, monkeypatch, bw, pm, field, fragment):
+    import drakecreep.servo.tuning as tuning
+
+    def started(*args, **kwargs):
+        raise AssertionError("the plant was linearized before the targets were checked")
+
+    monkeypatch.setattr(tuning, "operating_point", started)
+    with pytest.raises(InputError) as err:
+        tune(paper, SC, bw, pm)
+    assert err.value.field == field and fragment in str(err.value)
+
+
+def test_the_lowest_phase_margin_is_tuned(paper):
+    low = tune(paper, SC, bandwidth_Hz=30.0, phase_margin_deg=10.0)
+    assert low.summary()["velocity"]["phase_margin_deg"] == pytest.approx(10.0, abs=1e-4)
+
+
 def test_a_low_bandwidth_is_placed_where_the_search_starts_out_of_reach(paper):
     """At 0.2 Hz and 60 deg the search's low end (0.06 Hz) needs a negative kv, which refused the whole target
     ('lower either', found by fuzzing); the crossovers the PI reaches hold the root (0.14 Hz)."""
