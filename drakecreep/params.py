@@ -228,6 +228,10 @@ MIN_STRIBECK_VELOCITY = 1e-12
 #: and up); below about 1e-16 s the sampled loop's model rounds exp(p T) to 1 (margins printed a phase margin of
 #: -2.5 deg for 75.2 at 1e-20 s, and ended in 'internal error: ValueError' at 1e-300 s)
 MIN_SAMPLE_PERIOD = 1e-9
+#: shortest screw lead [m], the lower end of its range: a ball screw's lead is 1 to 50 mm; 0.1 mm is a decade below
+#: the finest. At 1e-300 m the force limit 2 pi peak_torque / lead and the motor's speed feed 2 pi / lead left every
+#: float: simulate reported a still table and creep, exit 0, and margins, tune and report blamed '--feed: got 1.0'
+MIN_LEAD = 1e-4
 #: largest integer field (encoder counts per revolution: 2^40 is beyond any encoder; float-exact)
 MAX_INT = 2**40
 
@@ -316,7 +320,7 @@ class MotorParams(_Params):
 class ScrewParams(_Params):
     """Ball screw shaft and its thrust bearing: the axial stiffness chain up to the nut."""
 
-    lead: float = _q(5.0e-3, "m", 0.0, 0.1, lo_open=True, doc="lead Ph (Table 3)")
+    lead: float = _q(5.0e-3, "m", MIN_LEAD, 0.1, doc="lead Ph (Table 3)")
     nominal_diameter: float = _q(25.0e-3, "m", 0.0, 0.5, lo_open=True, doc="nominal diameter d0 (Table 3)")
     root_diameter: float = _q(21.8e-3, "m", 0.0, 0.5, lo_open=True, doc="root diameter (shaft section)")
     length: float = _q(0.6, "m", 0.0, 20.0, lo_open=True, doc="shaft length (rotating inertia)")

@@ -96,7 +96,10 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
     "data, field, fragment",
     [
         ({"table": {"mass": -1.0}}, "table.mass", "(0.0, 100000.0] kg"),
-        ({"screw": {"lead": 0.0}}, "screw.lead", "(0.0, 0.1]"),
+        ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
+        # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
+        ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),
+        ({"screw": {"lead": 9.9e-5}}, "screw.lead", "[0.0001, 0.1] m"),
         ({"friction": {"viscous": float("nan")}}, "friction.viscous", "finite"),
         ({"motor": {"rotor_inertia": "big"}}, "motor.rotor_inertia", "finite number"),
         ({"table": {"mas": 3}}, "table.mas", "an unknown field"),
