@@ -67,6 +67,13 @@ class _Formatter(argparse.HelpFormatter):
         return plain(super()._expand_help(action))
 
 
+_NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|inf(?:inity)?|nan"
+#: what argparse takes for a negative number (an option's value, not an option): argparse's own matcher knows no
+#: exponent (in Python 3.11), so 'modes --table-position -1e-3' ended in 'expected one argument' while -0.001 ran;
+#: also -inf and -nan (the option's type names them) and comma lists starting with one ('--feeds -1,2')
+_NEGATIVE_NUMBER = re.compile(rf"^-(?:{_NUMBER})(?:,\s*[-+]?(?:{_NUMBER})?)*$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose errors are one line and exit code 2; help without reStructuredText markup.
 
@@ -79,6 +86,7 @@ class _Parser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", _Formatter)
         kwargs.setdefault("allow_abbrev", False)
         super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER  # before any option is added (argparse checks them with it)
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")

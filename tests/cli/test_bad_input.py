@@ -479,6 +479,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["diagnose", "{tmp}/spec.yaml", "--meta", "{tmp}/" + "a" * 300 + ".yaml"], "--meta: got"),
     (["uncertainty", "--spec", "{tmp}/" + "a" * 300 + ".yaml"], "--spec: got"),
     (["modes", "--out", "{tmp}/" + "a" * 300], "--out: got"),
+    # a negative number in exponent form was taken for an option: 'argument --table-position: expected one argument'
+    (["modes", "--table-position", "-1e3"], "--table-position: got -1000.0; allowed: in (-100, 500) mm"),
+    (["hertz", "--preload", "-1e-3"], "--preload: got -0.001; allowed: a finite number in [1e-06, 1e+07]"),
+    (["tune", "--feed", "-inf"], "--feed: '-inf' must be finite"),
 ])
 def test_bad_options(argv, fragment, tmp_path, capsys):
     (tmp_path / "u16.csv").write_bytes("f_Hz,re,im\n1,2,3\n".encode("utf-16"))

@@ -83,3 +83,29 @@ def test_tune_refuses_bad_targets_before_any_work(args, option, capsys, monkeypa
     assert cli.main(["tune", *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"error: {option}: got" in err[0]
+
+
+def _valued_options():
+    _, commands = _subparsers()
+    return [(name, a.option_strings[-1]) for name, sub in commands.items() for a in sub._actions
+            if a.option_strings and a.nargs is None and a.type is not None and a.choices is None]
+
+
+@pytest.mark.parametrize("value", ["-1e-3", "-1E+3", "-2.5e1", "-inf", "-1e-3,2", "-1,,2"])
+def test_a_negative_number_in_exponent_form_is_a_value_not_an_option(value, capsys):
+    """argparse (3.11) takes '-1e-3' for an option: 'modes --table-position -1e-3' ended in 'argument
+    --table-position: expected one argument' while -0.001 ran; every option with a value reads it now."""
+    parser = cli.build_parser()
+    assert parser.parse_args(["modes", "--table-position", "-1e-3"]).table_position == -1e-3
+    options = _valued_options()
+    assert len(options) > 40
+    for name, option in options:
+        extra = ["x"] if name in ("sweep", "modal", "diagnose") else []
+        try:
+            parser.parse_args([name, option, value, *extra])
+        except SystemExit:
+            pass
+        err = capsys.readouterr().err
+        assert "expected one argument" not in err, (name, option, err)
+    with pytest.raises(SystemExit):  # options are still options
+        parser.parse_args(["modes", "--table-position", "-q"])
