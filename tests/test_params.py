@@ -136,6 +136,23 @@ def test_invalid_values_name_field_value_and_range(data, field, fragment):
     assert "\n" not in str(info.value)
 
 
+def test_load_cases_are_capped_before_they_are_built():
+    """100 000 load cases in a params file were read, built and checked for 49 s before a command said anything."""
+    import time
+
+    from drakecreep.params import MAX_LOAD_CASES, LoadCase, LoadParams
+
+    start = time.perf_counter()
+    with pytest.raises(InputError) as info:
+        params_from_dict({"loads": {"cases": [{"fx": 1.0}] * 100_000}})
+    assert time.perf_counter() - start < 1.0  # building the 100 000 cases alone took 4 s
+    assert info.value.field == "loads.cases"
+    assert str(info.value).startswith("loads.cases: got '100000 load cases'; allowed: at most 1000 load cases (")
+    assert len(params_from_dict({"loads": {"cases": [{"fx": 1.0}] * MAX_LOAD_CASES}}).loads.cases) == MAX_LOAD_CASES
+    with pytest.raises(InputError, match=r"^cases: got '1001 load cases'"):
+        LoadParams(cases=(LoadCase(),) * (MAX_LOAD_CASES + 1))
+
+
 @pytest.mark.parametrize("text, fragment", [
     ("2001-13-45", "(line 1, column 24): a value it cannot read (month must be in 1..12)"),
     ("!!float abc", "(line 1, column 24): a value it cannot read (could not convert string to float: 'abc')"),

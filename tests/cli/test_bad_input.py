@@ -79,6 +79,8 @@ PARAM_TEXTS = {
     # the drive's force limit 2 pi peak_torque / lead overflowed: a still table reported as creep, exit 0 (margins,
     # tune and report said '--feed: got 1.0; allowed: a feed in mm/s the drive can slide at')
     "lead_tiny": ("screw: {lead: 1.0e-300}\n", "screw.lead: got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),
+    "too_many_load_cases": ("loads:\n  cases:\n" + "  - {fx: 1.0}\n" * 1001,
+                            "loads.cases: got '1001 load cases'; allowed: at most 1000 load cases"),
     "log_period_tiny": ("simulation: {log_period: 1.0e-8}\n", "simulation.log_period"),
     # 19 samples in the 19 s metrics window: the run used to end "ok" with no metrics at all
     "log_period_coarse": ("simulation: {log_period: 1.0}\n", "at least 20 recorded samples in the metrics window"),
