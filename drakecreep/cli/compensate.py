@@ -1,8 +1,8 @@
 """``drakecreep compensate``: friction compensation methods against none over feeds and loads."""
 
-from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, params_from_args,
-                                    positive_float, print_json, workers)
-from drakecreep.errors import InputError
+from drakecreep.cli._common import (add_params_options, comma_items, distinct, params_from_args, positive_float,
+                                    print_json, workers)
+from drakecreep.errors import InputError, renaming
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS
 
 __all__ = ["add_parser", "run"]
@@ -55,7 +55,7 @@ def _list(text, option, kind, check, allowed):
 
 
 def run(args):
-    from drakecreep.studies.compensation import creep_boundaries, evaluate, robustness, write_report
+    from drakecreep.studies.compensation import check_duration, creep_boundaries, evaluate, robustness, write_report
     from drakecreep.scenario import MAX_FEED
 
     params = params_from_args(args)
@@ -67,7 +67,7 @@ def run(args):
 
     feeds = _list(args.feeds, "--feeds", float, lambda v: 1e-4 <= v <= MAX_FEED * 1e3,
                   f"comma-separated feeds in [1e-4, {MAX_FEED * 1e3:g}] mm/s")
-    check_duration(args.duration)
+    renaming(lambda field: "--duration", check_duration, params, args.duration)  # the study's bounds, in s
     n = len(params.loads.cases)
     loads = _list(args.load_cases, "--load-cases", int, lambda v: 0 <= v <= n, f"comma-separated integers in 0..{n}")
     check_output_dir(args.out)  # before the study, not after it

@@ -7,8 +7,8 @@ with a Markdown/CSV/PNG report (:func:`write_report`).
 from drakecreep.errors import InputError
 from drakecreep.files import write_atomic, write_text
 from drakecreep.params import COMPENSATION_METHODS, COMPENSATION_STUDY_METHODS, COMPENSATION_VARIANTS, with_value
-from drakecreep.scenario import Scenario
-from drakecreep.sim.simulation import check_run, simulate
+from drakecreep.scenario import MAX_DURATION, Scenario
+from drakecreep.sim.simulation import MIN_WINDOW_SAMPLES, check_run, simulate
 from drakecreep.studies.paper_reproduction import simulated_creep_boundary
 
 __all__ = [
@@ -19,6 +19,7 @@ __all__ = [
     "DEFAULT_FEEDS_MM_S",
     "DEFAULT_METHODS",
     "EVAL_KEYS",
+    "check_duration",
     "evaluate",
     "creep_boundary",
     "creep_boundaries",
@@ -100,6 +101,27 @@ def _check_method(method):
         raise InputError("method", method, "one of " + ", ".join(method_names()))
 
 
+def _steady(params, duration):
+    """``params`` with the metrics window starting no later than half the run."""
+    return with_value(params, "simulation.steady_start", min(params.simulation.steady_start, 0.5 * duration))
+
+
+def check_duration(params, duration):
+    """Refuse a run time the study cannot measure (:class:`InputError` naming ``duration``): its metrics window,
+    ``simulation.steady_start`` to the end and at least the run's last half, must hold :data:`MIN_WINDOW_SAMPLES`
+    recorded samples (1e-300 s was refused as 'simulation.log_period: got 0.00025', a field nobody had set)."""
+    sim = params.simulation
+    least = min(sim.steady_start, MIN_WINDOW_SAMPLES * sim.log_period) + MIN_WINDOW_SAMPLES * sim.log_period
+    if isinstance(duration, bool) or not (isinstance(duration, (int, float)) and 0 < duration <= MAX_DURATION and (
+            # as simulate's check of the window (check_log_period), on the window this study gives the run
+            (duration - min(sim.steady_start, 0.5 * duration)) / sim.log_period >= MIN_WINDOW_SAMPLES)):
+        raise InputError("duration", duration,
+                         f"a time in [{least:.3g}, {MAX_DURATION:g}] s (the metrics window, from "
+                         f"simulation.steady_start or the run's last half, needs {MIN_WINDOW_SAMPLES} recorded samples, "
+                         f"one every simulation.log_period = {sim.log_period:g} s)")
+    return duration
+
+
 def evaluate(params, methods=DEFAULT_METHODS, feeds_mm_s=DEFAULT_FEEDS_MM_S, load_cases=(1, 2, 3), duration=2.0,
              workers=1):
     """Each method at each feed and load case: speed fluctuation, stick fraction, following error.
@@ -116,7 +138,7 @@ def evaluate(params, methods=DEFAULT_METHODS, feeds_mm_s=DEFAULT_FEEDS_MM_S, loa
     """
     for m in methods:
         _check_method(m)
-    base = with_value(params, "simulation.steady_start", min(params.simulation.steady_start, 0.5 * duration))
+    base = _steady(params, check_duration(params, duration))
     jobs = [(with_method(base, m), m, float(f), lc, duration) for m in methods for lc in load_cases for f in feeds_mm_s]
     rows = _map(jobs, workers)
     _add_ratios(rows)
@@ -152,7 +174,7 @@ def robustness(params, methods=DEFAULT_METHODS[1:], feeds_mm_s=(0.1, 0.2), load_
     """
     for m in methods:
         _check_method(m)
-    base = with_value(params, "simulation.steady_start", min(params.simulation.steady_start, 0.5 * duration))
+    base = _steady(params, check_duration(params, duration))
     configs = [("none", with_method(base, "none"))]
     for m in methods:
         configs.append((f"{m} nominal", with_method(base, m)))

@@ -183,6 +183,25 @@ def test_every_run_is_checked_before_any_runs(short_paper, monkeypatch):
         evaluate(short_paper, ("none",), feeds_mm_s=(1.0,), load_cases=(9,), duration=2.0, workers=2)
 
 
+@pytest.mark.parametrize("duration", [1e-300, 0.0099, 1e9, float("nan")])
+def test_a_run_too_short_to_measure_names_the_duration(paper, monkeypatch, duration):
+    """1e-300 s was refused as 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody set:
+    the window (steady_start, or the run's last half) needs 20 samples of the 0.25 ms log, so 10 ms at least."""
+    import drakecreep.studies.compensation as compensation
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("a run was checked or started")
+
+    monkeypatch.setattr(compensation, "check_run", no_work)
+    for study in (lambda: evaluate(paper, ("none",), feeds_mm_s=(1.0,), load_cases=(1,), duration=duration),
+                  lambda: robustness(paper, ("dob",), feeds_mm_s=(1.0,), duration=duration)):
+        with pytest.raises(InputError) as err:
+            study()
+        assert err.value.field == "duration"
+        assert "allowed: a time in [0.01, 3600] s (the metrics window" in str(err.value)
+    assert compensation.check_duration(paper, 0.01) == 0.01
+
+
 def test_write_report_is_atomic(tmp_path, monkeypatch):
     import drakecreep.files
     from drakecreep.studies.compensation import write_report
