@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drakecreep.errors import InputError, renaming
+from drakecreep.errors import InputError, renaming, short_repr
 from drakecreep.params import PRESETS, get_value, load_yaml_file, preset, with_value
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "load_uncertainty",
     "uncertainty_spec",
     "sample_rigs",
+    "check_rigs",
     "run_uncertainty",
     "summarize",
     "sensitivity",
@@ -251,6 +252,26 @@ class UncertaintyResult:
     failed: int
 
 
+def check_rigs(base, rigs):
+    """Refuse a sample with a rig that is no valid parameter set, naming the spec's key (``sample.PATH``) whose draw
+    made it invalid, before anything runs (the sweep named the field a cross-check refused: a velocity period drawn
+    between 0.2 and 0.25 ms said 'controller.position_period: got 0.001', a key the spec does not have).
+
+    ``rigs`` are :func:`sample_rigs`' draws, applied to ``base`` in the spec's order as the sweep applies them
+    (:func:`run_uncertainty` calls it when the sweep refuses a case: 1.6 ms a rig of the paper's spec, no cost when
+    every rig is valid)."""
+    for i, rig in enumerate(rigs):
+        params = base
+        for path, value in rig.items():
+            try:
+                params = with_value(params, path, value)
+            except InputError as err:
+                why = (err.allowed if err.field == path else
+                       f"then {err.field} = {short_repr(err.value)} is refused, allowed: {err.allowed}")
+                raise InputError(f"sample.{path}", value, f"a range whose every draw makes a valid rig (rig {i} drew "
+                                 f"this value; {why})") from None
+
+
 def run_uncertainty(base, spec, samples, feeds, load_cases=(3,), *, seed=0, duration=3.0, executor="processes",
                     workers=None, scheduler=None, batch_size=200, out_dir=None, progress=True):
     """Run every plausible rig at every feed and load case; summarize creep and fluctuation.
@@ -289,8 +310,12 @@ def run_uncertainty(base, spec, samples, feeds, load_cases=(3,), *, seed=0, dura
         base.load_case(case)
     rigs = sample_rigs(spec, samples, seed)
     points = [dict(rig, feed=f, load_case=c) for rig in rigs for c in load_cases for f in feeds]
-    result = run_sweep(base, points, scenario=dict(duration=duration), executor=executor, workers=workers,
-                       scheduler=scheduler, out_dir=out_dir, progress=progress, batch_size=batch_size)
+    try:
+        result = run_sweep(base, points, scenario=dict(duration=duration), executor=executor, workers=workers,
+                           scheduler=scheduler, out_dir=out_dir, progress=progress, batch_size=batch_size)
+    except InputError:  # the sweep checks every case before it runs one; a rig it refused is named by its key
+        check_rigs(base, rigs)
+        raise
     table = result.table
     per_rig = len(load_cases) * len(feeds)
     table.insert(1, "rig", table["case"] // per_rig)

@@ -121,6 +121,37 @@ def test_a_spec_of_another_preset_is_refused(tmp_path, capsys, monkeypatch):
     assert len(err) == 1 and "preset: got ['rigid_axis']; allowed: a spec of the preset it is used with, paper" in err[0]
 
 
+def test_a_draw_that_makes_an_invalid_rig_names_the_specs_key(tmp_path, capsys, monkeypatch):
+    """Bounds valid one by one, draws between them not: a velocity period of 0.2-0.25 ms (the 1 ms position period
+    is no integer multiple of most of them) said 'controller.position_period: got 0.001', no key of the spec; a
+    root diameter drawn above a nominal diameter drawn below it said 'screw.root_diameter: got ...'."""
+    import drakecreep.sim.sweep as sweep
+
+    def started(*args, **kwargs):
+        raise AssertionError("a rig ran")
+
+    monkeypatch.setattr(sweep, "run_case", started)
+    spec = tmp_path / "u.yaml"
+    spec.write_text("preset: paper\nsample:\n  controller.velocity_period: {dist: uniform, low: 2.0e-4, high: 2.5e-4, "
+                    "source: s}\n")
+    with pytest.raises(InputError) as err:
+        run_uncertainty(preset("paper"), load_uncertainty(spec), 4, [1e-3], [3], duration=1.5, executor="serial",
+                        progress=False)
+    assert err.value.field == "sample.controller.velocity_period"
+    assert err.value.allowed.startswith("a range whose every draw makes a valid rig (rig 0 drew this value; then "
+                                        "controller.position_period = 0.001 is refused, allowed: an integer multiple")
+    spec.write_text("preset: paper\nsample:\n"
+                    "  screw.root_diameter: {dist: uniform, low: 0.020, high: 0.0249, source: s}\n"
+                    "  screw.nominal_diameter: {dist: uniform, low: 0.0245, high: 0.030, source: s}\n")
+    code = main(["uncertainty", "--spec", str(spec), "--samples", "500", "--feeds", "1", "--out", str(tmp_path / "o"),
+                 "--no-progress"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert re.match(r"drakecreep uncertainty: error: sample\.screw\.nominal_diameter: got 0\.0245[0-9]*; allowed: a "
+                    r"range whose every draw makes a valid rig \(rig [0-9]+ drew this value; then screw\.root_diameter",
+                    err[0]), err[0]
+
+
 def test_summary_shares_and_percentiles_from_a_known_table():
     table = pd.DataFrame(dict(
         feed=[1e-4] * 4 + [2e-4] * 4, load_case=[3] * 8, status=["ok"] * 7 + ["failed: x"],
