@@ -648,6 +648,20 @@ def test_position_columns_whose_travels_disagree_by_a_unit_are_refused(tmp_path)
     assert err.value.field.endswith("x_table (run table)") and "x_motor" in err.value.allowed
 
 
+def test_a_motor_encoder_that_reads_one_value_while_the_reference_travels_is_refused(tmp_path):
+    """An unplugged encoder (or the wrong column): a zero travel is no travel to compare, and a whole diagnosis ran
+    on a motor that never moved (found by the fuzzing pass)."""
+    n, dt = 2000, 1e-3
+    t = np.arange(n) * dt
+    x = 0.01 * (1 - np.cos(np.pi * t))
+    cols = {"t": t, "x_ref": x, "x_motor": 0 * t + 0.002, "u": np.sin(7 * t)}
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, cols))
+    assert err.value.field.endswith("run.csv: x_motor (run run)")
+    assert err.value.value == "constant while x_ref travels 0.02 m" and "unplugged" in err.value.allowed
+    # a standstill (reference and motor both still) is not this error
+    assert load_measured(_write(tmp_path, {**cols, "x_ref": 0 * t}, name="still.csv")).run().n == n
+
 def _segment(tmp_path, **controller):
     """The shipped EMPS segment with its controller metadata changed."""
     from drakecreep.data import example_path
