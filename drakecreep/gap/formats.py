@@ -47,16 +47,23 @@ def parse_column(cell):
     return m.group(1), (m.group(2) or None)
 
 
+#: the micro prefix as it is typed: the micro sign U+00B5 (the tables' spelling) and the Greek small mu U+03BC, which
+#: Unicode normalization makes of it and many programs write; they look alike, so 'μs' was refused with 'allowed:
+#: one of s, ms, us, µs'
+_MICRO = str.maketrans({"\u03bc": "\u00b5"})
+
+
 def unit_factor(signal, unit, u_units, where):
     """Factor from ``unit`` to SI for ``signal`` (``u``: to ``u_units``), or an InputError naming the column."""
     quantity = u_units if signal == "u" else QUANTITY.get(signal)
     if quantity is None or unit is None:
         return 1.0
     table = UNITS[quantity]
-    if unit not in table:
+    key = unit.translate(_MICRO) if isinstance(unit, str) else unit
+    if key not in table:
         raise InputError(f"{where}: column {signal} unit", unit,
                          "one of " + ", ".join(table) + (" (u is in the metadata's u_units)" if signal == "u" else ""))
-    return table[unit]
+    return table[key]
 
 
 #: CSV field separators a file may use (``file.separator``; without it, the header line decides)

@@ -95,3 +95,18 @@ def test_an_option_of_another_format_is_refused(tmp_path, option, value, suffix)
     path.write_text("t,x_ref,x_motor,u\n")
     with pytest.raises(InputError, match=rf"run{suffix}: file.{option}: got '{value}'; allowed: only for an? "):
         read_signals(path, "N", **{option: value})
+
+
+@pytest.mark.parametrize("mu", ["\u00b5", "\u03bc"])  # the micro sign, and the Greek mu many programs write
+def test_the_micro_prefix_is_read_as_either_mu(tmp_path, mu):
+    """'t[μs]' (Greek mu) was refused with 'allowed: one of s, ms, us, µs', a list that looks to hold it (found by the
+    fuzzing pass)."""
+    path = tmp_path / "run.csv"
+    _frame().rename(columns={"t": f"t[{mu}s]", "x_motor": f"x_motor ({mu}m)"}).to_csv(path, index=False)
+    signals = read_signals(path, "N", units={"x_ref": f"{mu}m"})
+    frame = _frame()
+    assert np.allclose(signals["t"], 1e-6 * frame["t"]) and np.allclose(signals["x_motor"], 1e-6 * frame["x_motor"])
+    assert np.allclose(signals["x_ref"], 1e-6 * frame["x_ref"])
+    _frame().rename(columns={"t": f"t[{mu}ss]"}).to_csv(path, index=False)
+    with pytest.raises(InputError, match=f"column t unit: got '{mu}ss'; allowed: one of s, ms, us, µs"):
+        read_signals(path, "N")
