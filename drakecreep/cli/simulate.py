@@ -188,5 +188,14 @@ def _converged_text(summary):
         return "not checked"
     acc = summary.get("accuracy")
     where = f" at accuracy {acc:g}" if acc else ""
-    return (f"yes{where}, checked at 10x tighter" if c else
-            f"NO{where}: a 10x tighter run differs (verdict or fluctuation); read the figures as indicative")
+    if c:
+        return f"yes{where}, checked at 10x tighter"
+    same, change = summary.get("convergence_verdict_agrees"), summary.get("convergence_fluctuation_change_mm_s")
+    if same and change is not None:  # the verdict holds; the amplitude moved beyond the tolerance
+        verdict = "creeps" if summary.get("creep") else "no creep"
+        return (f"NO{where}: a 10x tighter run gives the same verdict ({verdict}) but a fluctuation "
+                f"{change:.2g} mm/s apart (tolerance {summary.get('convergence_tolerance_mm_s', float('nan')):.2g} "
+                f"mm/s); read the amplitudes as indicative")
+    if same is False:
+        return f"NO{where}: a 10x tighter run gives the other verdict; the creep verdict is not converged"
+    return f"NO{where}: the 10x tighter run failed; read the figures as indicative"
