@@ -152,6 +152,16 @@ def _with_index(frame):
     return frame
 
 
+def _unit_of(path, signal, header_unit, units):
+    """The unit of ``signal``'s column: the header's, or the metadata's ``file.units`` for a name without one. Both,
+    and different, are refused: ``t[ms]`` with ``file.units: {t: s}`` was read in seconds without a word."""
+    unit = units.get(signal, header_unit)
+    if header_unit is not None and signal in units and str(unit).translate(_MICRO) != header_unit.translate(_MICRO):
+        raise InputError(f"{path}: file.units.{signal}", unit, f"the unit the file's header gives the column, "
+                         f"{header_unit} (file.units is for names without a unit: leave {signal} out)")
+    return unit
+
+
 def read_signals(path, u_units, columns=None, units=None, key=None, separator=None, decimal=None):
     """Read a measured file into SI arrays of the project's signal names.
 
@@ -203,7 +213,7 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
                 raise InputError(f"{path}: file.columns.{signal}", column,
                                  "a column of the file: " + ", ".join(list(by_file)[:20]))
             _, unit = parse_column(column)
-            out[signal] = (by_file[str(column)], units.get(signal, unit))
+            out[signal] = (by_file[str(column)], _unit_of(path, signal, unit, units))
     else:
         for name, column in by_file.items():
             signal, unit = parse_column(name)
@@ -212,7 +222,7 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
                 signal = parse_column(first.group(1))[0]
             if signal in out:
                 raise InputError(f"{path}: header", signal, "each column once")
-            out[signal] = (column, units.get(signal, unit))
+            out[signal] = (column, _unit_of(path, signal, unit, units))
     signals = {}
     for signal, (column, unit) in out.items():
         values = frame[column]

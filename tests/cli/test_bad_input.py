@@ -281,6 +281,9 @@ MEASURED = {
     # an encoder that reads nothing while the reference moves: a whole diagnosis ran on it (found by the fuzzing pass)
     "x_motor_constant": (("t,x_ref,x_motor,u\n" + "".join(f"{i * 0.001},{i * 1e-6},0,0.5\n" for i in range(50))).encode(),
                          GOOD_META, "x_motor (run run): got 'constant while x_ref travels 4.9e-05 m'"),
+    # read in seconds without a word (found by the fuzzing pass)
+    "file_units_against_header": (GOOD_CSV.replace("t,", "t[ms],", 1).encode(), GOOD_META + "file: {units: {t: s}}\n",
+                                  "run.csv: file.units.t: got 's'; allowed: the unit the file's header gives the column, ms"),
     "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),

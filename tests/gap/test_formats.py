@@ -110,3 +110,19 @@ def test_the_micro_prefix_is_read_as_either_mu(tmp_path, mu):
     _frame().rename(columns={"t": f"t[{mu}ss]"}).to_csv(path, index=False)
     with pytest.raises(InputError, match=f"column t unit: got '{mu}ss'; allowed: one of s, ms, us, µs"):
         read_signals(path, "N")
+
+
+def test_a_unit_of_file_units_that_contradicts_the_header_is_refused(tmp_path):
+    """'t[ms]' with 'file: {units: {t: s}}' was read in seconds without a word (a P-P run was then refused for its
+    gains, a drakecreep one not at all; found by the fuzzing pass). The same unit twice is let be."""
+    path = tmp_path / "run.csv"
+    _frame().rename(columns={"t": "t[ms]", "x_motor": "x_motor[µm]"}).to_csv(path, index=False)
+    with pytest.raises(InputError) as err:
+        read_signals(path, "N", units={"t": "s"})
+    assert str(err.value) == (f"{path}: file.units.t: got 's'; allowed: the unit the file's header gives the column, "
+                              "ms (file.units is for names without a unit: leave t out)")
+    with pytest.raises(InputError, match="file.units.x_motor: got 'mm'"):
+        read_signals(path, "N", columns={"t": "t[ms]", "x_ref": "x_ref", "x_motor": "x_motor[µm]", "u": "u"},
+                     units={"x_motor": "mm"})
+    signals = read_signals(path, "N", units={"t": "ms", "x_motor": "μm", "x_ref": "mm"})
+    assert np.allclose(signals["t"], 1e-3 * _frame()["t"]) and np.allclose(signals["x_ref"], 1e-3 * _frame()["x_ref"])
