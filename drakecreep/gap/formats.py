@@ -40,11 +40,12 @@ _HEADER = re.compile(r"^\s*([^\[\]()]*?)\s*(?:[\[(]\s*([^\])]*?)\s*[\])])?\s*$")
 
 
 def parse_column(cell):
-    """``"x_motor [mm]"`` -> ``("x_motor", "mm")``; ``"t"`` -> ``("t", None)``."""
+    """``"x_motor [mm]"`` -> ``("x_motor", "mm")``; ``"t"`` -> ``("t", None)``; ``"t[]"`` -> ``("t", "")`` (brackets
+    without a unit are no unit, which :func:`unit_factor` refuses: they were read as SI)."""
     m = _HEADER.match(str(cell))
     if not m or not m.group(1):
         return str(cell).strip(), None
-    return m.group(1), (m.group(2) or None)
+    return m.group(1), m.group(2)
 
 
 #: the micro prefix as it is typed: the micro sign U+00B5 (the tables' spelling) and the Greek small mu U+03BC, which
@@ -62,7 +63,9 @@ def unit_factor(signal, unit, u_units, where):
     key = unit.translate(_MICRO) if isinstance(unit, str) else unit
     if key not in table:
         raise InputError(f"{where}: column {signal} unit", unit,
-                         "one of " + ", ".join(table) + (" (u is in the metadata's u_units)" if signal == "u" else ""))
+                         "one of " + ", ".join(table) + (" (u is in the metadata's u_units)" if signal == "u" else "")
+                         + (f" in the brackets (or no brackets: {signal} in {'u_units' if signal == 'u' else 'SI'})"
+                            if not unit.strip() else ""))
     return table[key]
 
 

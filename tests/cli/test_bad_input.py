@@ -284,6 +284,8 @@ MEASURED = {
     # read in seconds without a word (found by the fuzzing pass)
     "file_units_against_header": (GOOD_CSV.replace("t,", "t[ms],", 1).encode(), GOOD_META + "file: {units: {t: s}}\n",
                                   "run.csv: file.units.t: got 's'; allowed: the unit the file's header gives the column, ms"),
+    "empty_unit_brackets": (GOOD_CSV.replace("t,", "t[],", 1).encode(), GOOD_META,  # read as SI (fuzzing pass)
+                            "run.csv: column t unit: got ''; allowed: one of s, ms, us, µs in the brackets"),
     "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),

@@ -126,3 +126,14 @@ def test_a_unit_of_file_units_that_contradicts_the_header_is_refused(tmp_path):
                      units={"x_motor": "mm"})
     signals = read_signals(path, "N", units={"t": "ms", "x_motor": "μm", "x_ref": "mm"})
     assert np.allclose(signals["t"], 1e-3 * _frame()["t"]) and np.allclose(signals["x_ref"], 1e-3 * _frame()["x_ref"])
+
+
+@pytest.mark.parametrize("header, field", [("t[]", "t"), ("x_motor [ ]", "x_motor"), ("u()", "u")])
+def test_brackets_without_a_unit_are_refused(tmp_path, header, field):
+    """'t[]' was read as SI, a unit nobody wrote (a spreadsheet's empty unit cell; found by the fuzzing pass)."""
+    path = tmp_path / "run.csv"
+    _frame().rename(columns={field: header}).to_csv(path, index=False)
+    with pytest.raises(InputError) as err:
+        read_signals(path, "N")
+    assert err.value.field == f"{path}: column {field} unit" and err.value.value == ""
+    assert err.value.allowed.endswith(f"in the brackets (or no brackets: {field} in {'u_units' if field == 'u' else 'SI'})")
