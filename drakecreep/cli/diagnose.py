@@ -108,7 +108,7 @@ def run(args):
     if args.out:
         check_output_dir(args.out)
     for r in train + test:  # a controller it cannot replay, a missing params file
-        check_replayable(r)
+        _in_file(f"{args.data}: ", check_replayable, r)
     if not train:
         raise InputError("--train", args.train, "at least one training run")
     if len(test) < 2:  # both kinds (the drakecreep kind's library said 'test: got 1')
@@ -119,16 +119,13 @@ def run(args):
     score_runs = load_runs(args.score, None, split=own) if args.score else None
     kind = "drakecreep" if own else "p_p_cascade"
     for r in score_runs or ():
-        check_replayable(r)
+        _in_file(f"--score {args.score}: ", check_replayable, r)  # which of the two files (both had 'run: got ...')
         if r.meta.controller.kind != kind:  # a p_p_cascade file scored through a params file: exit 0, 1e4 % errors
             raise InputError("--score", args.score, f"runs of controller kind {kind}, like the diagnosed ones")
         if own:  # what the replay at the end would refuse (a sensor resolution off the lead), before the diagnosis
             from drakecreep.gap.drive_fit import check_run
 
-            try:
-                check_run(r, train[0].meta.params)
-            except InputError as err:
-                raise err.renamed(f"--score {args.score}: {err.field}") from None
+            _in_file(f"--score {args.score}: ", lambda run: check_run(run, train[0].meta.params), r)
     if own:
         if args.nominal_friction:
             raise InputError("--nominal-friction", args.nominal_friction, "only for runs of controller kind p_p_cascade (kind "
@@ -147,6 +144,14 @@ def run(args):
                 raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
                     tuple(DRAKE_EFFECTS) + ("control_delay",))))
     return _run_drake(args, train, test, score_runs, effects)
+
+
+def _in_file(prefix, check, run):
+    """``check(run)``, its :class:`InputError` naming the file the run is from (``prefix``)."""
+    try:
+        check(run)
+    except InputError as err:
+        raise err.renamed(prefix + str(err.field)) from None
 
 
 def _say(args):

@@ -88,10 +88,12 @@ def check_replayable(run):
 
         # a params file's max_step or velocity_period of 1e-9 s replayed for days
         check_step_budget(run.meta.params, float(run.t[-1] - run.t[0]))
+    # named by the run: a file holds several, and their sample times may differ
     if ctrl.kind == "p_p_cascade" and abs(ctrl.sample_time - run.dt) > 1e-6 * run.dt:
-        raise InputError("controller.sample_time", ctrl.sample_time, f"the run's sample time {run.dt:g} s")
+        raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
+                         f"the run's sample time {run.dt:g} s")
     if run.n < 20:
-        raise InputError("run", f"{run.n} samples", "at least 20 samples")
+        raise InputError(f"run {run.label}", f"{run.n} samples", "at least 20 samples")
 
 
 def axis_from_idim(params, **extra):

@@ -363,6 +363,29 @@ def test_missing_score_file_is_found_before_the_diagnosis(tmp_path, capsys):
     _one_line_exit_2(code, err, "nothere.mat")
 
 
+def test_a_score_file_that_cannot_be_replayed_is_named(tmp_path, capsys):
+    """Errors of the replay's checks said 'run: got '10 samples'' or 'controller.sample_time: got 0.01', of the
+    diagnosed file or of the scored one, unsaid (found by the fuzzing pass)."""
+    from drakecreep.data import data_dir
+
+    example = data_dir() / "examples" / "emps_segment.csv"
+    meta = (example.with_suffix(".yaml")).read_text()
+    rows = (example.read_text().splitlines()[3:])
+    (tmp_path / "sc.csv").write_text("t[ms],x_ref[mm],x_motor[mm],u[V],f_ext[N],run\n" + "".join(
+        f"{row},{'a' if i < 100 else 'b'}\n" for i, row in enumerate(rows[:110])))
+    (tmp_path / "sc.yaml").write_text(meta)
+    (tmp_path / "ts.csv").write_text(example.read_text())
+    (tmp_path / "ts.yaml").write_text(meta.replace("sample_time: 0.001", "sample_time: 0.002"))
+    for argv, fragment in (
+            (["--score", str(tmp_path / "sc.csv")], f"--score {tmp_path / 'sc.csv'}: run b: got '10 samples'; allowed: "
+                                                    "at least 20 samples"),
+            (["--score", str(tmp_path / "ts.csv")], f"--score {tmp_path / 'ts.csv'}: controller.sample_time (run ts): "
+                                                    "got 0.002; allowed: the run's sample time 0.001 s"),
+            ([], None)):
+        data = str(tmp_path / "ts.csv") if not argv else str(example)
+        code, _, err = _run(["diagnose", data, "--train", "0", "--test", "1,2"] + argv, capsys, timeout=20)
+        _one_line_exit_2(code, err, fragment or f"{data}: controller.sample_time (run ts@0): got 0.002")
+
 @pytest.mark.parametrize("address", ["garbage", "tcp://127.0.0.1:1", "tcp://[::1", ""])
 def test_bad_or_unreachable_scheduler(address, tmp_path, capsys, monkeypatch):
     import drakecreep.sim.sweep as sweep

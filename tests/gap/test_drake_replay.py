@@ -413,6 +413,21 @@ def test_a_drakecreep_run_whose_params_force_billions_of_steps_is_refused_before
     check_replayable(dataclasses.replace(run, meta=dataclasses.replace(meta, params=preset("rigid_axis"))))
 
 
+def test_a_run_that_cannot_be_replayed_is_named_by_its_label():
+    """A file holds several runs, and a diagnosis reads two files: 'controller.sample_time: got 0.001' and 'run: got
+    '10 samples'' did not say which run (found by the fuzzing pass)."""
+    from drakecreep.gap.drake_replay import check_replayable
+
+    t = np.arange(40) * 2e-3
+    meta = MeasuredMeta(u_units="V", u_gain=35.0, controller=ControllerMeta(kp=100.0, kv=200.0, sample_time=1e-3))
+    run = MeasuredRun(t=t, x_ref=1e-3 * t, x_motor=1e-3 * t, u=np.cos(t), meta=meta, label="b")
+    with pytest.raises(InputError, match=r"^controller.sample_time \(run b\): got 0.001; allowed: the run's sample "
+                                         r"time 0.002 s$"):
+        check_replayable(run)
+    with pytest.raises(InputError, match="^run b: got '10 samples'; allowed: at least 20 samples$"):
+        check_replayable(dataclasses.replace(run.slice(0, 10), meta=dataclasses.replace(
+            meta, controller=ControllerMeta(kp=100.0, kv=200.0, sample_time=2e-3))))
+
 def test_a_runs_time_origin_does_not_change_its_replay(run, nominal):
     """A run starts at its first sample, whatever its clock reads (a negative start included): both controller
     kinds replay the same run shifted in time to the same outputs, a time-fixed force ripple included."""
