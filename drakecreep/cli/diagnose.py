@@ -85,7 +85,8 @@ def run(args):
                              "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
         if path and path not in EMPS_FILES:
             regular_file(option, path)  # a folder was told 'metadata: got 'adir.yaml''
-    runs = load_runs(args.data, existing_path("--meta", args.meta), split=False)
+    runs = _in_file("", lambda data: load_runs(data, existing_path("--meta", args.meta), split=False), args.data,
+                    {"meta": "--meta"})
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
     # both sets move both ways), into out-and-back cycles for the kind drakecreep branch
@@ -146,12 +147,14 @@ def run(args):
     return _run_drake(args, train, test, score_runs, effects)
 
 
-def _in_file(prefix, check, run):
-    """``check(run)``, its :class:`InputError` naming the file the run is from (``prefix``)."""
+def _in_file(prefix, check, run, options=None):
+    """``check(run)``, its :class:`InputError` naming the file the run is from (``prefix``), or the CLI option of a
+    library parameter (``options``, e.g. ``{"meta": "--meta"}``)."""
     try:
-        check(run)
+        return check(run)
     except InputError as err:
-        raise err.renamed(prefix + str(err.field)) from None
+        field = (options or {}).get(err.field)
+        raise err.renamed(field or prefix + str(err.field)) from None
 
 
 def _say(args):

@@ -67,7 +67,7 @@ def load_runs(data, meta=None, split=True):
         ``estimation`` / ``validation`` (the EMPS files), an EMPS ``.mat`` file, or a measured run
         (CSV, Parquet, HDF5, or ``.mat`` with ``meta``; see ``docs/measured_format.md``).
     meta : str or path, optional
-        Metadata YAML of a measured run (default: beside it).
+        Metadata YAML of a measured run (default: beside it); none with ``estimation`` / ``validation``.
     split : bool or str
         Split a single-run file into out-and-back cycles (True), into the parts between reversals of the
         reference (``"half"``, :func:`split_half_cycles`), or not at all (False).
@@ -78,6 +78,9 @@ def load_runs(data, meta=None, split=True):
     """
     from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
 
+    if data in EMPS_FILES and meta is not None:  # the benchmark's own metadata: a meta file was ignored unsaid
+        raise InputError("meta", str(meta), f"no metadata with the EMPS benchmark's {data} file (its controller, "
+                         "gains and units are the benchmark's; a measured run's metadata goes with its data file)")
     if data in EMPS_FILES or (str(data).endswith(".mat") and meta is None):
         try:
             md = load_emps(data)

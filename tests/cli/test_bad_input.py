@@ -501,6 +501,8 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["diagnose", "{example}", "--effects", ","], "--effects: got ','; allowed: comma-separated names, none blank"),
     (["diagnose", "{example}", "--effects", "position_ripple,position_ripple"], "given twice"),
     (["gap-benchmark", "--effects", "stribeck,", "--n-per-effect", "1"], "--effects"),
+    # the benchmark's own metadata: a --meta beside 'estimation' was ignored without a word (found by the fuzzing pass)
+    (["diagnose", "estimation", "--meta", "{tmp}/spec.yaml"], "--meta: got '"),
     # the options, not the library's names ('duration: got 1000000000.0', 'calibration_rows: got (1,)')
     (["simulate", "--out", "{tmp}/s", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
     # a window of 5e-301 s: 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody had set

@@ -1,9 +1,11 @@
 """drakecreep.gap.runs: cutting a measured run at the reversals of its reference."""
 
 import numpy as np
+import pytest
 
+from drakecreep.errors import InputError
 from drakecreep.gap.measured import EMPS_CONTROLLER, MeasuredMeta, MeasuredRun
-from drakecreep.gap.runs import split_cycles, split_half_cycles
+from drakecreep.gap.runs import load_runs, split_cycles, split_half_cycles
 from drakecreep.gap.truth import out_and_back
 
 META = MeasuredMeta(u_units="V", u_gain=35.15, controller=EMPS_CONTROLLER)
@@ -99,3 +101,14 @@ def test_a_measured_mat_with_its_metadata_beside_it_is_told_of_meta(tmp_path):
                                          r"\(diagnose --meta .*run.yaml: without it a .mat is read as an EMPS file\)"):
         load_runs(tmp_path / "run.mat")
     assert len(load_runs(tmp_path / "run.mat", tmp_path / "run.yaml", split=False)) == 1
+
+
+@pytest.mark.parametrize("data", ["estimation", "validation"])
+def test_a_metadata_file_beside_an_emps_benchmark_name_is_refused(data, tmp_path):
+    """The benchmark's files carry their own controller and units: a meta file given with them was ignored without a
+    word (found by the fuzzing pass)."""
+    (tmp_path / "m.yaml").write_text("u_units: N\n")
+    with pytest.raises(InputError) as err:
+        load_runs(data, tmp_path / "m.yaml")
+    assert err.value.field == "meta" and err.value.value == str(tmp_path / "m.yaml")
+    assert err.value.allowed.startswith(f"no metadata with the EMPS benchmark's {data} file")
