@@ -359,6 +359,14 @@ def check_run(params, scenario, *, backend=None, model="two_mass", multibody=Non
         that starts after the run ends, too many recorded samples or steps (:func:`check_log_period`,
         :func:`check_step_budget`), a load case the params do not have.
     """
+    from drakecreep.params import DriveParams
+    from drakecreep.scenario import Scenario
+
+    # a script's preset name, mapping or feed where the objects go ended in 'internal error: AttributeError'
+    if not isinstance(params, DriveParams):
+        raise InputError("params", params, "a DriveParams (drakecreep.preset(name) or drakecreep.load_params(path))")
+    if not isinstance(scenario, Scenario):
+        raise InputError("scenario", scenario, "a Scenario (drakecreep.Scenario(feed=m/s, load_case=n, duration=s))")
     sim = params.simulation
     if model not in MODELS:
         raise InputError("model", model, " or ".join(MODELS))
@@ -419,8 +427,8 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     if wall_limit is not None and (isinstance(wall_limit, bool) or not isinstance(wall_limit, (int, float))
                                    or not wall_limit > 0):
         raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
-    sim = params.simulation
     backend = check_run(params, scenario, backend=backend, model=model, multibody=multibody)
+    sim = params.simulation
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))

@@ -89,6 +89,20 @@ def test_bad_scenarios():
         Scenario(load_case=-1)
 
 
+@pytest.mark.parametrize("params, scenario, field", [
+    ("paper", Scenario(), "params"), ({"table": {"mass": 40.0}}, Scenario(), "params"), (None, Scenario(), "params"),
+    (None, 1e-3, "params"), ("rig", {"feed": 1e-3}, "params"), ("paper_params", 1e-3, "scenario"),
+    ("paper_params", None, "scenario"), ("paper_params", {"feed": 1e-3}, "scenario")])
+def test_a_preset_name_mapping_or_number_for_the_objects_is_named(paper, params, scenario, field):
+    """A script's preset name, mapping or feed where the objects go ended in 'AttributeError: 'str' object has no
+    attribute 'simulation'' (found by the fuzzing pass)."""
+    params = paper if params == "paper_params" else params
+    with pytest.raises(InputError, match=f"^{field}: got .*; allowed: a {'DriveParams' if field == 'params' else 'Scenario'}"):
+        simulate(params, scenario)
+    with pytest.raises(InputError, match=f"^{field}: "):
+        simulation.check_run(params, scenario)
+
+
 def test_steady_window_must_fit(paper):
     with pytest.raises(InputError, match="steady_start"):
         simulate(paper, Scenario(duration=0.5))
