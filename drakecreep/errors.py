@@ -2,7 +2,7 @@
 
 import reprlib
 
-__all__ = ["DrakecreepError", "InputError", "Terminated", "renaming", "short_repr"]
+__all__ = ["DrakecreepError", "InputError", "Terminated", "name_list", "renaming", "short_repr"]
 
 #: longest value shown in a message: a value from a file may be huge (a YAML alias bomb expands to
 #: billions of items) and its whole ``repr()`` would hang the program before it could print one line
@@ -84,3 +84,18 @@ def renaming(field, build, *args, **kwargs):
         return build(*args, **kwargs)
     except InputError as err:
         raise err.renamed(field(err.field)) from None
+
+
+def name_list(value, field):
+    """``value``, a sequence of names (effects, parameter paths), as a tuple; an :class:`InputError` naming ``field``
+    for one string (its letters were taken for the names: 'effects: got 's'') or a name given twice (fitted twice)."""
+    if isinstance(value, (str, bytes)):
+        raise InputError(field, value, f"a list of names (one name goes in a list: [{value!r}])")
+    try:
+        names = tuple(value)
+    except TypeError:
+        raise InputError(field, value, "a list of names") from None
+    twice = sorted({str(n) for n in names if names.count(n) > 1})
+    if twice:
+        raise InputError(field, value, f"each name once ({', '.join(twice)} given twice)")
+    return names

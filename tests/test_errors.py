@@ -2,7 +2,9 @@
 
 import pickle
 
-from drakecreep.errors import InputError
+import pytest
+
+from drakecreep.errors import InputError, name_list
 
 
 def test_input_error_survives_pickling_whole():
@@ -18,3 +20,14 @@ def test_input_error_with_an_unpicklable_value_pickles_its_repr():
     err = pickle.loads(pickle.dumps(InputError("callback", lambda: None, "a number")))
     assert err.field == "callback" and err.allowed == "a number"
     assert str(err).startswith("callback: got '<function")
+
+
+@pytest.mark.parametrize("value, allowed", [
+    ("stribeck", "a list of names (one name goes in a list: ['stribeck'])"),  # its letters were the names
+    (("stribeck", "lead_error", "stribeck"), "each name once (stribeck given twice)"),
+    (3, "a list of names")])
+def test_name_list_refuses_one_string_and_a_name_twice(value, allowed):
+    with pytest.raises(InputError) as err:
+        name_list(value, "effects")
+    assert err.value.field == "effects" and err.value.allowed == allowed
+    assert name_list(["a", "b"], "effects") == ("a", "b") and name_list((), "effects") == ()

@@ -134,7 +134,7 @@ import numpy as np
 import yaml
 from scipy import stats
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, name_list
 from drakecreep.gap.claims import ALPHA, log_ratios, mean_and_standard_error, sign_flip_p
 from drakecreep.files import write_text
 from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, axial_mode_frequency,
@@ -832,7 +832,7 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     train, test = list(train), list(test)
     if not train or len(test) < 2:
         raise InputError("runs", f"{len(train)} training, {len(test)} held-out", ">= 1 training and >= 2 held-out runs")
-    names = tuple(effects) if effects is not None else tuple(DRAKE_EFFECTS) + ("control_delay",)
+    names = name_list(effects, "effects") if effects is not None else tuple(DRAKE_EFFECTS) + ("control_delay",)
     for n in names:
         if n != "control_delay" and n not in DRAKE_EFFECTS:
             why = NOT_RANKED.get(n, "one of " + ", ".join(tuple(DRAKE_EFFECTS) + ("control_delay",)))

@@ -87,7 +87,7 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import least_squares
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, name_list
 from drakecreep.gap.claims import ALPHA, POOLED_FACTOR, mean_and_standard_error, replay_test
 from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
@@ -582,14 +582,14 @@ def _check_inputs(train, test, uncertain, effects, load_case):
             prior = r.meta.params
         elif r.meta.params != prior:
             raise InputError("params", f"run {r.label}", "the same params file for every run")
-    uncertain = tuple(uncertain)
+    uncertain = name_list(uncertain, "uncertain")
     check_fields(uncertain)
     for path in uncertain:
         if get_value(prior, path) <= _lower(path):
             raise InputError("uncertain", path, f"a field whose params value is above {_lower(path):g}")
         if get_value(prior, path) >= _upper(path):
             raise InputError("uncertain", path, f"a field whose params value is below {_upper(path):g}")
-    names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else tuple(effects)
+    names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else name_list(effects, "effects")
     for n in names:
         if n not in EFFECTS:
             raise InputError("effects", n, NOT_IN_MODEL.get(n, "one of " + ", ".join(EFFECTS)))

@@ -601,3 +601,17 @@ def test_a_passing_candidate_below_a_fitted_one_that_fails_is_not_claimed():
     out = {r.name: r.outranked_by for r in _outranked(ranking)}
     assert out == {"axial_mode": "", "position_friction": "axial_mode", "stribeck": "", "lead_error": ""}
     assert [r.outranked_by for r in _outranked(ranking[1:3])] == ["", ""]
+
+
+@pytest.mark.parametrize("effects, allowed", [("stribeck", "a list of names (one name goes in a list: ['stribeck'])"),
+                                              (["axial_mode", "axial_mode"], "each name once (axial_mode given twice)")])
+def test_one_string_or_an_effect_twice_is_refused_before_any_fit(effects, allowed):
+    """'stribeck' was read as its letters ('effects: got 's''), an effect twice was fitted and ranked twice (found by
+    the fuzzing pass)."""
+    from drakecreep.data import example_path
+    from drakecreep.gap.runs import load_runs
+
+    runs = load_runs(example_path("emps_segment.csv"), split="half")
+    with pytest.raises(InputError) as err:
+        diagnose_drake(runs[:1], runs[1:3], effects)
+    assert err.value.field == "effects" and err.value.allowed == allowed

@@ -789,3 +789,19 @@ def test_a_candidate_that_fails_is_recorded_and_the_others_go_on(monkeypatch):
     assert any(w.startswith("force_ripple failed (RuntimeError") for w in result.warnings)
     assert result.claimed == ("lead_error",)
     assert any("force_ripple" in line and "failed (RuntimeError" in line for line in result.summary())
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"effects": "stribeck"}, "effects: got 'stribeck'; allowed: a list of names (one name goes in a list"),
+    ({"effects": ("stribeck", "stribeck")}, "effects: got ('stribeck', 'stribeck'); allowed: each name once"),
+    ({"uncertain": "friction.viscous"}, "uncertain: got 'friction.viscous'; allowed: a list of names"),
+    ({"uncertain": ["friction.viscous"] * 2}, "uncertain: got ['friction.viscous', 'friction.viscous']; allowed: each")])
+def test_one_string_or_a_name_twice_is_refused_before_any_replay(kwargs, message):
+    """A string's letters were taken for the names ('uncertain: got 'f''), and a name twice was fitted twice (the
+    CLI refused both, a script not; found by the fuzzing pass)."""
+    from drakecreep.data import example_path
+    from drakecreep.gap.runs import load_runs
+
+    runs = load_runs(example_path("drive_lead_error.csv"), split=False)
+    with pytest.raises(InputError, match="^" + re.escape(message)):
+        diagnose_drive(runs[:1], runs[1:3], **kwargs)
