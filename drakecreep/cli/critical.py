@@ -90,27 +90,23 @@ def run(args):
     # the lumped mass carries the friction the model applies to the table (drakecreep.model.lumped)
     friction_on_mass = ("guides only (the ball nut's drag acts on the screw, motor side of the spring)"
                         if nut_on == "screw" else "guides and ball nut")
-    v = args.feed * 1e-3
     K, M, C, Fs, Fd = d.stiffness, d.mass, d.damping, d.breakaway, d.coulomb
-    c1 = float(creep.friction_slope(d.steady_friction, v))
-    zeta = float(creep.damping_ratio(K, M, C, c1))
-    D = float(creep.friction_drop_ratio(Fs, Fd, v, K, M))
-    D0 = float(creep.critical_D0(zeta))
-    v0 = float(creep.critical_speed(Fs, Fd, K, M, C, c1))
-    v0_sc = creep.critical_speed_of(d)
+    cond = creep.creep_condition(d, args.feed * 1e-3)
+    c1, zeta, D, D0 = cond.friction_slope, cond.zeta, cond.D, cond.D0
+    v0, v0_sc = cond.critical_speed, cond.critical_speed_self_consistent
     result = {
         "inputs": {"source": source, "load_case": d.load_case, "friction_law": law_name,
                    "friction_on_mass": friction_on_mass,
                    "stiffness_N_per_um": K * 1e-6, "mass_kg": M, "damping_Ns_per_m": C,
                    "Fs_N": Fs, "Fd_N": Fd, "feed_mm_per_s": args.feed},
         "C1_Ns_per_m": c1,
-        "natural_frequency_Hz": float(creep.natural_frequency(K, M)) / (2 * math.pi),
+        "natural_frequency_Hz": cond.natural_frequency / (2 * math.pi),
         "zeta": zeta,
         "D": D,
         "D0": None if math.isnan(D0) else D0,
         "v0_mm_per_s": None if math.isnan(v0) else v0 * 1e3,
         "v0_self_consistent_mm_per_s": None if math.isnan(v0_sc) else v0_sc * 1e3,
-        "creep_predicted": bool(creep.creep_predicted(v, Fs, Fd, K, M, C, c1)),
+        "creep_predicted": cond.creep,
     }
     if args.json:
         print_json(result)

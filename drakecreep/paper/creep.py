@@ -22,6 +22,7 @@ from :mod:`drakecreep.model.friction`.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -39,6 +40,8 @@ __all__ = [
     "friction_slope",
     "critical_speed_self_consistent",
     "critical_speed_of",
+    "CreepCondition",
+    "creep_condition",
 ]
 
 FrictionLaw = Callable[[np.ndarray], np.ndarray]
@@ -281,3 +284,62 @@ def critical_speed_of(drive):
     """
     return float(critical_speed_self_consistent(drive.steady_friction, drive.breakaway, drive.coulomb,
                                                 drive.stiffness, drive.mass, drive.damping))
+
+
+@dataclass(frozen=True)
+class CreepCondition:
+    """The paper's creep condition of a lumped drive at one feed (SI units; ``nan`` where undefined).
+
+    Attributes
+    ----------
+    feed : float
+        Sliding speed ``v`` (m/s).
+    friction_slope : float
+        ``C1 = dF/dv`` of the drive's steady friction curve at ``v`` (N s/m).
+    natural_frequency : float
+        ``sqrt(K / M)`` (rad/s).
+    zeta, D, D0 : float
+        Eq. 4's damping ratio with ``C1``, eq. 6's friction-drop ratio and eq. 10's ``sqrt(4 pi zeta)``.
+    critical_speed : float
+        Eq. 11's ``v0`` with ``C1`` taken at ``v`` (m/s).
+    critical_speed_self_consistent : float
+        ``v0`` with ``C1`` taken at ``v0`` itself (:func:`critical_speed_of`, m/s).
+    creep : bool
+        ``v < v0`` (``D > D0``), eq. 11 at ``v``.
+    """
+
+    feed: float
+    friction_slope: float
+    natural_frequency: float
+    zeta: float
+    D: float
+    D0: float
+    critical_speed: float
+    critical_speed_self_consistent: float
+    creep: bool
+
+
+def creep_condition(drive, v):
+    """Eqs. 3-11 for a lumped drive at feed ``v``: what ``drakecreep critical`` prints and the loop report shows.
+
+    Parameters
+    ----------
+    drive : drakecreep.model.lumped.LumpedDrive
+        ``lumped(params, load_case)``: the friction the model applies to the moving mass (with the ball nut's
+        drag on the screw, the guides' alone), K, C and M of the chain.
+    v : float
+        Feed (m/s, > 0).
+
+    Returns
+    -------
+    CreepCondition
+    """
+    K, M, C, Fs, Fd = drive.stiffness, drive.mass, drive.damping, drive.breakaway, drive.coulomb
+    c1 = float(friction_slope(drive.steady_friction, v))
+    zeta = float(damping_ratio(K, M, C, c1))
+    return CreepCondition(
+        feed=float(v), friction_slope=c1, natural_frequency=float(natural_frequency(K, M)), zeta=zeta,
+        D=float(friction_drop_ratio(Fs, Fd, v, K, M)), D0=float(critical_D0(zeta)),
+        critical_speed=float(critical_speed(Fs, Fd, K, M, C, c1)),
+        critical_speed_self_consistent=critical_speed_of(drive),
+        creep=bool(creep_predicted(v, Fs, Fd, K, M, C, c1)))

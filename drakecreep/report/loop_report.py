@@ -159,16 +159,15 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
     low_run = simulate(p_low, Scenario(feed=low_feed, load_case=load_case, duration=1.5))
     t = lap("simulations", t)
 
-    # critical speed (paper eq. 11) with the chain's K, C, the moving mass and the friction law
-    from drakecreep.model.friction import make_friction_law
+    # critical speed (paper eq. 11) as 'drakecreep critical' gives it: the lumped drive with the friction the model
+    # applies to the moving mass (with the nut's drag on the screw the guides' alone; the loop analysis above lumps
+    # the nut on the table instead, an approximation of the linearization, which gave 8.7 mm/s here against
+    # critical's 0.52 mm/s on the paper preset)
+    from drakecreep.model.lumped import lumped
 
-    law = make_friction_law(params.friction)
-
-    def steady(v):
-        return law.steady_state_force(v, op.Fc, op.Fs)
-
-    v0 = float(creep.critical_speed(op.Fs, op.Fc, op.stiffness, op.mass, op.damping, op.friction_slope))
-    v0_sc = creep.critical_speed_self_consistent(steady, op.Fs, op.Fc, op.stiffness, op.mass, op.damping)
+    drive = lumped(params, load_case)
+    condition = creep.creep_condition(drive, feed)
+    v0, v0_sc = condition.critical_speed, condition.critical_speed_self_consistent
     t = lap("creep", t)
 
     fmt_cross = ", ".join(f"{v * 1e3:.3g}" for v in crossings["closed_loop"]["pole"]) or "none"
@@ -199,7 +198,7 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
     ))
     json_path = outset.write_text("margins.json", json.dumps(payload, indent=2) + "\n")
 
-    html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v0, v0_sc, png, low_feed,
+    html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, drive, condition, png, low_feed,
                       timings)
     timings["total"] = time.perf_counter() - t_start
     html_text = html_text.replace("@@TOTAL@@", f"{timings['total']:.1f}")
@@ -221,7 +220,9 @@ def _param_rows(params, op):
         ("motor-side inertia J, reflected J/r^2", f"{J:.3g} kg m^2, {J / r**2:.4g} kg"),
         ("current loop time constant", f"{params.motor.current_loop_time_constant * 1e3:g} ms"),
         ("friction law", f.law),
-        ("Coulomb / breakaway friction Fc / Fs (load case)", f"{op.Fc:.4g} N / {op.Fs:.4g} N"),
+        ("Coulomb / breakaway friction Fc / Fs (load case" + (
+            "; the ball nut's, on the screw, lumped with the guides' on the table for the linear analysis)"
+            if f.nut_friction_on == "screw" else ")"), f"{op.Fc:.4g} N / {op.Fs:.4g} N"),
         ("Stribeck velocity vs, viscous Fv", f"{f.stribeck_velocity * 1e3:g} mm/s, {f.viscous:g} N s/m"),
         ("kv, ki (velocity PI)", f"{g.velocity_gain:.4g} N s/m, {g.velocity_integral_gain:.4g} N/m "
                                  f"(corner {g.velocity_integral_gain / g.velocity_gain / 2 / math.pi:.3g} Hz)"),
@@ -232,7 +233,8 @@ def _param_rows(params, op):
     ]
 
 
-def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v0, v0_sc, png, low_feed, timings):
+def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, drive, condition, png, low_feed,
+          timings):
     import yaml
 
     main = summary["controller"]
@@ -315,6 +317,9 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v
         f"<p>Plane at the low-speed feed {low_feed * 1e3:g} mm/s (on the falling Stribeck branch, so negative "
         "effective damping is reachable). K is varied by scaling every stiffness of the screw chain; C + C1 through "
         "the viscous friction coefficient. Colour: real part of the rightmost pole of the whole loop. "
+        + (f"Like the loop analysis, the map and its simulations lump the ball nut's friction on the table, so its "
+           f"paper condition uses their whole friction drop (Fs - Fc = {pm.friction_drop:.3g} N), not the guides' "
+           "of the critical speed below. " if params.friction.nut_friction_on == "screw" else "")
         + (f"Markers: {len(pm.sim_creep)} nonlinear simulations (sampled controller, 1 s each), {n_creep} of them "
            f"creep; simulated creep agrees with the whole-loop linear boundary at {agree['linear']} of "
            f"{agree['points']} points and with the paper's condition at {agree['paper']} of {agree['points']}. "
@@ -332,10 +337,20 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, v
             [f"low-speed feed {low_run.scenario.feed * 1e3:g} mm/s"] + _metric_cells(lm),
         ]),
         "<h2>Critical speed (paper eq. 11)</h2>",
+        f"<p>As <code>drakecreep critical</code> gives it: the friction on the moving mass is the one the model "
+        f"applies to the table, {'the guides alone (the ball nut&#39;s drag acts on the screw, on the motor side of the spring)' if params.friction.nut_friction_on == 'screw' else 'the guides and the ball nut'}: "
+        f"Fs {drive.breakaway:.4g} N, Fd {drive.coulomb:.4g} N; K {drive.stiffness * 1e-6:.4g} N/um, "
+        f"C {drive.damping:.4g} N s/m, M {drive.mass:.4g} kg.</p>",
         _table(["quantity", "value"], [
-            ("v0 with C1 taken at the operating feed", "n/a (C + C1 <= 0)" if not math.isfinite(v0) else f"{v0 * 1e3:.4g} mm/s"),
-            ("v0 with C1 taken at v0 (self-consistent)", "n/a" if not math.isfinite(v0_sc) else f"{v0_sc * 1e3:.4g} mm/s"),
-            ("simulated creep at the low-speed feed", "yes" if (lm is not None and lm.stick_fraction > 0) else "no"),
+            ("C1 = dF/dv at the operating feed", f"{condition.friction_slope:.4g} N s/m"),
+            ("zeta, D, D0 = sqrt(4 pi zeta) at the operating feed",
+             f"{condition.zeta:.4g}, {condition.D:.4g}, " + ("n/a" if math.isnan(condition.D0) else f"{condition.D0:.4g}")),
+            ("v0 with C1 taken at the operating feed", "n/a (C + C1 <= 0)" if not math.isfinite(condition.critical_speed)
+             else f"{condition.critical_speed * 1e3:.4g} mm/s"),
+            ("v0 with C1 taken at v0 (self-consistent)", "n/a" if not math.isfinite(condition.critical_speed_self_consistent)
+             else f"{condition.critical_speed_self_consistent * 1e3:.4g} mm/s"),
+            (f"simulated creep at the low-speed feed ({low_run.scenario.feed * 1e3:g} mm/s)",
+             "n/a" if lm is None else "yes" if lm.creep else "no"),
             ("linearized whole loop unstable between (mm/s)", mm(whole["pole"])),
         ]),
         "<p>Equation 11 puts the onset of creep where the paper's large-signal condition is met; the linearized "

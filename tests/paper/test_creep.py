@@ -62,3 +62,19 @@ def test_self_consistent_critical_speed_is_fixed_point():
     assert v > 0.0
     assert creep.critical_speed(Fs, Fc, K, M, C, creep.friction_slope(F, v)) == pytest.approx(v,
                                                                                              rel=1e-8)
+
+
+def test_creep_condition_of_a_lumped_drive_is_the_equations_at_its_feed():
+    from drakecreep.model.lumped import lumped
+    from drakecreep.params import preset
+
+    drive = lumped(preset("paper"), 3)
+    for v in (0.1e-3, 1e-3):
+        c = creep.creep_condition(drive, v)
+        c1 = creep.friction_slope(drive.steady_friction, v)
+        args = (drive.breakaway, drive.coulomb, drive.stiffness, drive.mass, drive.damping)
+        assert c.friction_slope == pytest.approx(c1)
+        assert c.critical_speed == pytest.approx(creep.critical_speed(*args, c1), nan_ok=True)  # nan: C + C1 <= 0
+        assert c.critical_speed_self_consistent == pytest.approx(creep.critical_speed_of(drive))
+        assert c.D0 == pytest.approx(np.sqrt(4 * np.pi * c.zeta) if c.zeta > 0 else np.nan, nan_ok=True)
+        assert c.creep == (not v >= c.critical_speed)  # eq. 11: creep below v0 (and where C + C1 <= 0)

@@ -28,6 +28,19 @@ def test_report_json(report):
     for loop in ("velocity", "position"):
         assert data["margins"][loop]["closed_loop_stable"] is True
     assert data["critical_speed_mm_s"] > 0
+
+
+def test_report_critical_speed_is_the_critical_commands(report, capsys):
+    """One eq. 11 in the product: the report's v0 is 'drakecreep critical''s (the friction on the moving mass as
+    the model applies it), not the linearization's, which lumps the nut's drag on the table (8.7 mm/s against
+    0.52 mm/s on the paper preset before they were one)."""
+    data = json.loads(report["json"].read_text())
+    assert main(["critical", "--load-case", "3", "--feed", "1", "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    assert data["critical_speed_mm_s"] == pytest.approx(cli["v0_mm_per_s"], rel=1e-12)
+    assert data["critical_speed_self_consistent_mm_s"] == pytest.approx(cli["v0_self_consistent_mm_per_s"], rel=1e-12)
+    text = report["html"].read_text()
+    assert f"Fs {cli['inputs']['Fs_N']:.4g} N, Fd {cli['inputs']['Fd_N']:.4g} N" in text
     assert data["low_feed"]["stick_fraction"] > 0  # the preset creeps at 0.1 mm/s
     # its time is reported (analysis/bench_report.py measures it against a baseline; no timed test here)
     assert report["timings"]["total"] > 0
