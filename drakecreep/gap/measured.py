@@ -65,6 +65,7 @@ __all__ = [
     "MeasuredData",
     "load_measured",
     "check_recorded",
+    "check_disjoint",
     "controller_gains",
     "save_measured",
     "load_emps",
@@ -950,3 +951,24 @@ def load_emps(path=None):
     run = MeasuredRun(t=array("t"), x_ref=array("qg"), x_motor=array("qm"), u=u, f_ext=f_ext, meta=meta,
                       label=path.stem)
     return MeasuredData(runs=(run,), meta=meta)
+
+
+def check_disjoint(train, test):
+    """Refuse a run given twice, or both to fit and to hold out (:class:`InputError` naming ``test`` or
+    ``train``): a held-out run that is also a training run scores the fit on its own data, and one held out twice
+    counts twice in the claim threshold's spread. Runs are the same when they are the same object, or carry the
+    same label and the same samples (``t``, ``x_ref``, ``x_motor``, ``u``).
+    """
+    def same(a, b):
+        return a is b or (a.label == b.label and all(np.array_equal(getattr(a, k), getattr(b, k))
+                                                     for k in ("t", "x_ref", "x_motor", "u")))
+
+    for group, runs in (("train", train), ("test", test)):
+        for i, r in enumerate(runs):
+            if any(same(r, q) for q in runs[:i]):
+                raise InputError(group, f"run {r.label} twice", "each run once")
+    for r in test:
+        if any(same(r, q) for q in train):
+            raise InputError("test", f"run {r.label}, a training run too",
+                             "held-out runs that are not training runs (a held-out run scores the fit on data it "
+                             "was not fitted on)")

@@ -615,3 +615,16 @@ def test_one_string_or_an_effect_twice_is_refused_before_any_fit(effects, allowe
     with pytest.raises(InputError) as err:
         diagnose_drake(runs[:1], runs[1:3], effects)
     assert err.value.field == "effects" and err.value.allowed == allowed
+
+
+def test_a_run_both_fitted_and_held_out_or_held_out_twice_is_refused_before_any_fit():
+    """A script's diagnose_drake(runs[:2], runs[1:]) scored the fit on a run it was fitted on, exit-free (the CLI's
+    --train/--test refuse it; found by the fuzzing pass)."""
+    from drakecreep.data import example_path
+    from drakecreep.gap.runs import load_runs
+
+    runs = load_runs(example_path("emps_segment.csv"), split="half")
+    for train, test, said in ((runs[:2], runs[1:], "a training run too"), (runs[:1], [runs[1], runs[1]], "twice")):
+        with pytest.raises(InputError) as err:
+            diagnose_drake(train, test, ("stribeck",))
+        assert err.value.field == "test" and said in str(err.value.value)

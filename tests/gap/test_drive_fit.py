@@ -572,6 +572,12 @@ def test_bad_input_is_refused_before_any_replay(no_replay):
     with pytest.raises(InputError) as err:
         diagnose_drive(good[:1], good[1:2])
     assert err.value.field == "test"
+    # a run both fitted and held out, or held out twice (a script could; the CLI's --train/--test refuse it)
+    for train, test, said in ((good[:2], good[1:], "run b, a training run too"), (good[:1], [good[1], good[1]], "run b twice"),
+                              ([good[0], dataclasses.replace(good[0])], good[1:], "run a twice")):
+        with pytest.raises(InputError) as err:
+            diagnose_drive(train, test)
+        assert str(err.value).startswith(("test: got", "train: got")) and said in str(err.value)
     with pytest.raises(InputError) as err:
         diagnose_drive(good[:1], good[1:], uncertain=("screw.lead",))
     assert err.value.field == "uncertain"
