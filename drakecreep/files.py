@@ -42,6 +42,7 @@ __all__ = [
     "read_csv_frame",
     "first_non_number",
     "check_input_file",
+    "check_path_argument",
     "resolve_reference",
     "check_output_dir",
     "check_output_file",
@@ -134,6 +135,22 @@ def write_json(path, obj, indent=None):
 
 # --------------------------------------------------------------------------- inputs
 
+def check_path_argument(path, field="path"):
+    """Refuse what is no file path (None, a number, a mapping, an empty or blank string) by ``field``, before
+    :class:`~pathlib.Path` says ``TypeError`` or the empty path is read as the current folder.
+
+    Raises
+    ------
+    InputError
+        Naming ``field``.
+    """
+    if isinstance(path, (str, bytes, os.PathLike)):
+        name = os.fspath(path)
+        if (name.strip() if isinstance(name, str) else name.strip(b" \t\n")) and "\0" not in str(name):
+            return
+    raise InputError(field, path, "a file path (a non-empty str or path-like naming a file)")
+
+
 def check_input_file(path, field, max_bytes=MAX_INPUT_BYTES):
     """``path`` as a :class:`~pathlib.Path` if it is a regular file of at most ``max_bytes``.
 
@@ -144,6 +161,7 @@ def check_input_file(path, field, max_bytes=MAX_INPUT_BYTES):
     InputError
         Naming ``field`` if it is not a regular file (a directory, ``/dev/zero``, a FIFO) or too large.
     """
+    check_path_argument(path, field or "path")
     path = Path(path)
     try:
         info = os.stat(path)

@@ -21,7 +21,7 @@ from importlib import resources
 import yaml
 
 from drakecreep.errors import InputError, short_repr
-from drakecreep.files import MAX_INPUT_BYTES, read_input_text, write_text
+from drakecreep.files import MAX_INPUT_BYTES, check_path_argument, read_input_text, write_text
 
 __all__ = [
     "MEASURED_AXIS_KIND",
@@ -757,6 +757,7 @@ def load_params(path):
     FileNotFoundError
         If ``path`` does not exist.
     """
+    check_path_argument(path)  # None, a number or '' named as the path, not str(path)
     data = load_yaml_file(path, str(path), "a YAML mapping of parameter groups")
     if isinstance(data, dict) and data.get("kind") == MEASURED_AXIS_KIND:
         raise InputError(f"{path}: kind", data["kind"],

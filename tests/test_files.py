@@ -215,3 +215,11 @@ def test_a_name_longer_than_the_system_allows_names_the_option(tmp_path):
         check_output_dir(long)
     with pytest.raises(InputError, match=r"^--write: got .*; allowed: a file that can be written \(File name too long\)"):
         check_output_file(tmp_path / ("p" * 300 + ".yaml"), "--write")
+
+
+@pytest.mark.parametrize("path", [None, 3.5, b"", "", "\t", "x\0y"])
+def test_an_input_file_that_is_no_path_is_named_by_its_field(path):
+    from drakecreep.files import check_input_file
+
+    with pytest.raises(InputError, match=r"^meta: got .*; allowed: a file path"):
+        check_input_file(path, "meta")

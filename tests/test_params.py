@@ -245,3 +245,12 @@ def test_numpy_scalars_are_numbers():
 def test_true_is_no_load_case(paper):
     with pytest.raises(InputError, match="^load_case: got True"):
         paper.load_case(True)  # it was case 1
+
+
+@pytest.mark.parametrize("path", [None, 1, {}, [], "", "   ", "a\0b"])
+def test_load_params_names_a_path_that_is_no_path(path):
+    """A script's load_params(None) ended in pathlib's TypeError, load_params('') said ': got '. (a directory)''."""
+    from drakecreep.params import load_params
+
+    with pytest.raises(InputError, match=r"^path: got .*; allowed: a file path"):
+        load_params(path)

@@ -37,6 +37,7 @@ reference the fast path is tested against).
 """
 
 import math
+import numbers
 import time
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -424,9 +425,11 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         the convergence check ran (see the module notes), None when it was off or not possible; ``stats``
         holds the accuracy used and the check's numbers.
     """
-    if wall_limit is not None and (isinstance(wall_limit, bool) or not isinstance(wall_limit, (int, float))
-                                   or not wall_limit > 0):
-        raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
+    if wall_limit is not None:  # NumPy's numbers too (numbers.Real), as a float
+        if isinstance(wall_limit, (bool, np.bool_)) or not isinstance(wall_limit, numbers.Real) \
+                or not float(wall_limit) > 0:
+            raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
+        wall_limit = float(wall_limit)
     backend = check_run(params, scenario, backend=backend, model=model, multibody=multibody)
     sim = params.simulation
     accuracy = target_accuracy(params)

@@ -5,10 +5,12 @@ import os
 import signal
 import time
 
+import numpy as np
 import pytest
 
 import drakecreep.sim.simulation as simulation
 from drakecreep.cli import main
+from drakecreep.errors import InputError
 from drakecreep.params import with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import MAX_TABLE_SPEED, simulate
@@ -51,10 +53,17 @@ def test_cli_diverging_run_one_line_exit_1_results_saved(diverging, tmp_path, ca
     assert body["summary"]["status"].startswith("diverged") and "timeseries.csv" in body["files"]
 
 
-def test_wall_clock_limit(short_paper):
-    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=60.0), wall_limit=0.3)
+@pytest.mark.parametrize("limit", [0.3, np.float32(0.3), np.int64(1)])  # NumPy's numbers too (were refused)
+def test_wall_clock_limit(short_paper, limit):
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=60.0), wall_limit=limit)
     assert r.status.startswith("stopped at t = ") and "wall-clock" in r.status
     assert r.time[-1] < 60.0
+
+
+@pytest.mark.parametrize("limit", [0, -1.0, np.float64("nan"), True, np.bool_(True), "5", 1j])
+def test_a_wall_clock_limit_that_is_no_positive_number_is_refused(short_paper, limit):
+    with pytest.raises(InputError, match="wall_limit"):
+        simulate(short_paper, Scenario(feed=1e-3, duration=0.1), wall_limit=limit)
 
 
 @pytest.mark.parametrize("sent, code, said", [(signal.SIGINT, 130, "interrupted (Ctrl-C)"),
