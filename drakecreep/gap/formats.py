@@ -65,7 +65,7 @@ def unit_factor(signal, unit, u_units, where):
         raise InputError(f"{where}: column {signal} unit", unit,
                          "one of " + ", ".join(table) + (" (u is in the metadata's u_units)" if signal == "u" else "")
                          + (f" in the brackets (or no brackets: {signal} in {'u_units' if signal == 'u' else 'SI'})"
-                            if not unit.strip() else ""))
+                            if not str(unit).strip() else ""))
     return table[key]
 
 

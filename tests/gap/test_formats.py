@@ -137,3 +137,11 @@ def test_brackets_without_a_unit_are_refused(tmp_path, header, field):
         read_signals(path, "N")
     assert err.value.field == f"{path}: column {field} unit" and err.value.value == ""
     assert err.value.allowed.endswith(f"in the brackets (or no brackets: {field} in {'u_units' if field == 'u' else 'SI'})")
+
+
+def test_a_unit_that_is_no_string_is_refused_by_its_column():
+    """read_signals(units={'t': 5}) from a script ended in AttributeError ('int' has no 'strip')."""
+    from drakecreep.gap.formats import unit_factor
+
+    with pytest.raises(InputError, match=r"^f.csv: column t unit: got 5; allowed: one of s, ms"):
+        unit_factor("t", 5, "N", "f.csv")
