@@ -724,9 +724,10 @@ def check_recorded(run):
             raise InputError(f"controller.saturation (run {run.label})", ctrl.saturation,
                              f"at least half the largest recorded |u|, {abs(float(run.u[i])):g} {run.meta.u_units} at "
                              f"data row {i + 1} of the run (the controller clips its output at its saturation)")
-    if np.ptp(run.x_motor) == 0.0 and np.ptp(run.x_ref) > 0.0:
+    if np.ptp(run.x_motor) == 0.0 and np.ptp(run.x_ref) > 10.0 * run.meta.sensors.encoder_resolution:
         # an encoder that reads nothing while the reference travels (unplugged, or the wrong column): the travel
-        # check below compares travels that are not zero, and a whole diagnosis ran on a motor that never moved
+        # check below compares travels that are not zero, and a whole diagnosis ran on a motor that never moved;
+        # a reference of a few counts (a stick test) may leave a counting encoder where it was
         raise InputError(f"x_motor (run {run.label})", f"constant while x_ref travels {np.ptp(run.x_ref):.4g} m",
                          "the motor encoder's reading at the load (a closed loop follows its reference: an encoder "
                          "that reads one value throughout is unplugged, or the wrong column)")

@@ -661,6 +661,13 @@ def test_a_motor_encoder_that_reads_one_value_while_the_reference_travels_is_ref
     assert err.value.value == "constant while x_ref travels 0.02 m" and "unplugged" in err.value.allowed
     # a standstill (reference and motor both still) is not this error
     assert load_measured(_write(tmp_path, {**cols, "x_ref": 0 * t}, name="still.csv")).run().n == n
+    # nor a stick test whose reference moves a few counts of a counting encoder that stays where it was
+    counting = {**META, "sensors": {"encoder_resolution": 1e-6, "scale_resolution": 0.0}}
+    small = {**cols, "x_ref": 0.002 + 5e-6 * (1 - np.cos(np.pi * t)) / 2}
+    assert load_measured(_write(tmp_path, small, meta=counting, name="stick.csv")).run().n == n
+    with pytest.raises(InputError, match="constant while x_ref travels"):  # 20 counts: it would have moved
+        load_measured(_write(tmp_path, {**small, "x_ref": 0.002 + 2e-5 * (1 - np.cos(np.pi * t)) / 2},
+                             meta=counting, name="moved.csv"))
 
 def _segment(tmp_path, **controller):
     """The shipped EMPS segment with its controller metadata changed."""
