@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 from drakecreep.cli._common import existing_path, names, path_exists, print_json, regular_file, workers
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, renaming
 from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
 from drakecreep.processes import usable_cpus
@@ -150,11 +150,7 @@ def run(args):
 def _in_file(prefix, check, run, options=None):
     """``check(run)``, its :class:`InputError` naming the file the run is from (``prefix``), or the CLI option of a
     library parameter (``options``, e.g. ``{"meta": "--meta"}``)."""
-    try:
-        return check(run)
-    except InputError as err:
-        field = (options or {}).get(err.field)
-        raise err.renamed(field or prefix + str(err.field)) from None
+    return renaming(lambda field: (options or {}).get(field) or prefix + str(field), check, run)
 
 
 def _say(args):
