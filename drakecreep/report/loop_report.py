@@ -198,8 +198,8 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
     ))
     json_path = outset.write_text("margins.json", json.dumps(payload, indent=2) + "\n")
 
-    html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, drive, condition, png, low_feed,
-                      timings)
+    html_text = _html(params, source, analysis, summary, op, crossings, pm, step, low_run, drive, condition, png,
+                      low_feed, timings)
     timings["total"] = time.perf_counter() - t_start
     html_text = html_text.replace("@@TOTAL@@", f"{timings['total']:.1f}")
     html_path = outset.write_text("index.html", html_text)
@@ -233,11 +233,18 @@ def _param_rows(params, op):
     ]
 
 
+def _speed(v, missing):
+    """A speed in mm/s for the report's tables, ``missing`` where it is not finite."""
+    return f"{v * 1e3:.4g} mm/s" if math.isfinite(v) else missing
+
+
 def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, drive, condition, png, low_feed,
           timings):
     import yaml
 
     main = summary["controller"]
+    on_mass = ("the guides alone (the ball nut&#39;s drag acts on the screw, on the motor side of the spring)"
+               if params.friction.nut_friction_on == "screw" else "the guides and the ball nut")
     variants = [main] + [v for v in analysis.margins if v != main]
     header = ["measure"] + [f"{loop} loop, {v}" for loop in LOOPS for v in variants]
     rows = []
@@ -338,17 +345,15 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, d
         ]),
         "<h2>Critical speed (paper eq. 11)</h2>",
         f"<p>As <code>drakecreep critical</code> gives it: the friction on the moving mass is the one the model "
-        f"applies to the table, {'the guides alone (the ball nut&#39;s drag acts on the screw, on the motor side of the spring)' if params.friction.nut_friction_on == 'screw' else 'the guides and the ball nut'}: "
+        f"applies to the table, {on_mass}: "
         f"Fs {drive.breakaway:.4g} N, Fd {drive.coulomb:.4g} N; K {drive.stiffness * 1e-6:.4g} N/um, "
         f"C {drive.damping:.4g} N s/m, M {drive.mass:.4g} kg.</p>",
         _table(["quantity", "value"], [
             ("C1 = dF/dv at the operating feed", f"{condition.friction_slope:.4g} N s/m"),
-            ("zeta, D, D0 = sqrt(4 pi zeta) at the operating feed",
-             f"{condition.zeta:.4g}, {condition.D:.4g}, " + ("n/a" if math.isnan(condition.D0) else f"{condition.D0:.4g}")),
-            ("v0 with C1 taken at the operating feed", "n/a (C + C1 <= 0)" if not math.isfinite(condition.critical_speed)
-             else f"{condition.critical_speed * 1e3:.4g} mm/s"),
-            ("v0 with C1 taken at v0 (self-consistent)", "n/a" if not math.isfinite(condition.critical_speed_self_consistent)
-             else f"{condition.critical_speed_self_consistent * 1e3:.4g} mm/s"),
+            ("zeta, D, D0 = sqrt(4 pi zeta) at the operating feed", f"{condition.zeta:.4g}, {condition.D:.4g}, "
+             + ("n/a" if math.isnan(condition.D0) else f"{condition.D0:.4g}")),
+            ("v0 with C1 taken at the operating feed", _speed(condition.critical_speed, "n/a (C + C1 <= 0)")),
+            ("v0 with C1 taken at v0 (self-consistent)", _speed(condition.critical_speed_self_consistent, "n/a")),
             (f"simulated creep at the low-speed feed ({low_run.scenario.feed * 1e3:g} mm/s)",
              "n/a" if lm is None else "yes" if lm.creep else "no"),
             ("linearized whole loop unstable between (mm/s)", mm(whole["pole"])),
