@@ -580,6 +580,8 @@ def _file_options(opts, meta_path):
         value = opts.get(name)
         if value is not None and not (isinstance(value, dict) and all(isinstance(v, str) for v in value.values())):
             raise InputError(f"{where}.{name}", value, "a mapping of signal names to strings")
+    if "run" in (opts.get("units") or {}):  # was ignored without a word
+        raise InputError(f"{where}.units.run", opts["units"]["run"], "no unit: the run column holds labels")
     key = opts.get("key")
     if key is not None and not isinstance(key, str):
         raise InputError(f"{where}.key", key, "a string (the HDF5 table's key)")

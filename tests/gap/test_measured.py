@@ -342,7 +342,11 @@ def test_the_metadata_may_name_the_separator_and_the_decimal_mark(tmp_path):
 
 @pytest.mark.parametrize("file, field", [({"separator": "|"}, "file.separator"), ({"decimal": ";"}, "file.decimal"),
                                          ({"separator": [";"]}, "file.separator"),
-                                         ({"separator": ",", "decimal": ","}, "file.decimal")])
+                                         ({"separator": ",", "decimal": ","}, "file.decimal"),
+                                         # a decimal comma on a file whose header separates by commas (was ignored)
+                                         ({"decimal": ","}, "file.decimal: got ','; allowed: a mark other than the "
+                                                            "file's separator ','"),
+                                         ({"units": {"run": "s"}}, "file.units.run: got 's'; allowed: no unit")])
 def test_a_bad_separator_or_decimal_mark_is_named(tmp_path, file, field):
     with pytest.raises(InputError, match=field):
         load_measured(_write(tmp_path, meta=dict(META, file=file)))
