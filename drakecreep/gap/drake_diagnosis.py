@@ -141,7 +141,7 @@ from drakecreep.gap.drake_effects import (DRAKE_EFFECTS, NOT_RANKED, EffectFit, 
                                          best_start_index, effect_regime, fit_delay, fit_effect, score_parameters)
 from drakecreep.gap.drake_replay import piece_keys, rms_force_error, set_replay_threads
 from drakecreep.gap.identify import identify
-from drakecreep.gap.measured import check_disjoint
+from drakecreep.gap.measured import check_split
 from drakecreep.gap.screen import NOT_SCREENED, ScreenResult, screen_delay, screen_effect
 from drakecreep.gap.where import where_gap, where_lines
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS
@@ -830,10 +830,9 @@ def diagnose_drake(train, test, effects=None, *, max_nfev=6, k_se=None, progress
     DrakeDiagnosis
     """
     t0 = _time.perf_counter()
-    train, test = list(train), list(test)
+    train, test = check_split(train, test)
     if not train or len(test) < 2:
         raise InputError("runs", f"{len(train)} training, {len(test)} held-out", ">= 1 training and >= 2 held-out runs")
-    check_disjoint(train, test)
     names = name_list(effects, "effects") if effects is not None else tuple(DRAKE_EFFECTS) + ("control_delay",)
     for n in names:
         if n != "control_delay" and n not in DRAKE_EFFECTS:

@@ -92,7 +92,7 @@ from drakecreep.gap.claims import ALPHA, POOLED_FACTOR, mean_and_standard_error,
 from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
                                          rms_force_error)
-from drakecreep.gap.measured import check_disjoint
+from drakecreep.gap.measured import check_split
 from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscillation_log_errors,
                                       sustained_oscillation)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
@@ -571,12 +571,11 @@ def check_run(run, params=None, load_case=0):
 
 
 def _check_inputs(train, test, uncertain, effects, load_case):
-    train, test = list(train), list(test)
+    train, test = check_split(train, test)
     if not train:
         raise InputError("train", 0, ">= 1 training run")
     if len(test) < 2:
         raise InputError("test", len(test), ">= 2 held-out runs (the claim threshold is their spread)")
-    check_disjoint(train, test)
     prior = None
     for r in train + test:
         check_run(r, load_case=load_case)

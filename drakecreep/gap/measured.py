@@ -65,7 +65,7 @@ __all__ = [
     "MeasuredData",
     "load_measured",
     "check_recorded",
-    "check_disjoint",
+    "check_split",
     "controller_gains",
     "save_measured",
     "load_emps",
@@ -956,16 +956,29 @@ def load_emps(path=None):
     return MeasuredData(runs=(run,), meta=meta)
 
 
-def check_disjoint(train, test):
-    """Refuse a run given twice, or both to fit and to hold out (:class:`InputError` naming ``test`` or
-    ``train``): a held-out run that is also a training run scores the fit on its own data, and one held out twice
-    counts twice in the claim threshold's spread. Runs are the same when they are the same object, or carry the
-    same label and the same samples (``t``, ``x_ref``, ``x_motor``, ``u``).
+def check_split(train, test):
+    """``(train, test)`` as lists of :class:`MeasuredRun`, each run in one of them once (:class:`InputError` naming
+    ``train`` or ``test``).
+
+    A run held out that is also a training run scores the fit on its own data, and one held out twice counts twice
+    in the claim threshold's spread. Runs are the same when they are the same object, or carry the same label and
+    the same samples (``t``, ``x_ref``, ``x_motor``, ``u``). A string, a number or None where a list of runs goes
+    ended in ``AttributeError`` or ``TypeError``.
     """
+    def runs_of(value, group):
+        if isinstance(value, (str, bytes, MeasuredRun)) or not hasattr(value, "__iter__"):
+            raise InputError(group, value, "a list of MeasuredRun (drakecreep.gap.measured.load_measured(...).runs)")
+        runs = list(value)
+        for r in runs:
+            if not isinstance(r, MeasuredRun):
+                raise InputError(group, r, "MeasuredRun items (drakecreep.gap.measured.load_measured(...).runs)")
+        return runs
+
     def same(a, b):
         return a is b or (a.label == b.label and all(np.array_equal(getattr(a, k), getattr(b, k))
                                                      for k in ("t", "x_ref", "x_motor", "u")))
 
+    train, test = runs_of(train, "train"), runs_of(test, "test")
     for group, runs in (("train", train), ("test", test)):
         for i, r in enumerate(runs):
             if any(same(r, q) for q in runs[:i]):
@@ -975,3 +988,4 @@ def check_disjoint(train, test):
             raise InputError("test", f"run {r.label}, a training run too",
                              "held-out runs that are not training runs (a held-out run scores the fit on data it "
                              "was not fitted on)")
+    return train, test

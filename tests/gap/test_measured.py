@@ -710,3 +710,16 @@ def test_a_command_that_is_not_the_p_p_form_says_nothing_about_the_gains():
     run = MeasuredRun(t=t, x_ref=x, x_motor=x - 1e-6 * np.cos(3 * t), u=np.random.default_rng(0).normal(size=t.size),
                       meta=MeasuredMeta(u_units="V", u_gain=35.0, controller=ControllerMeta(kp=100.0, kv=200.0)))
     assert controller_gains(run) is None
+
+
+@pytest.mark.parametrize("train, test, said", [("abc", [], "train: got 'abc'; allowed: a list of MeasuredRun"),
+                                               (None, [], "train: got None; allowed: a list of MeasuredRun"),
+                                               ([], 5, "test: got 5; allowed: a list of MeasuredRun"),
+                                               (["a"], [], "train: got 'a'; allowed: MeasuredRun items")])
+def test_a_split_that_is_no_list_of_runs_is_named(train, test, said):
+    """A script's diagnose_drive('abc', ...) ended in AttributeError: 'str' object has no attribute 'label'."""
+    from drakecreep.gap.measured import check_split
+
+    with pytest.raises(InputError) as err:
+        check_split(train, test)
+    assert str(err.value).startswith(said)
