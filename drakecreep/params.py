@@ -25,6 +25,7 @@ from drakecreep.files import MAX_INPUT_BYTES, check_path_argument, read_input_te
 
 __all__ = [
     "MEASURED_AXIS_KIND",
+    "check_params",
     "MotorParams",
     "ScrewParams",
     "NutParams",
@@ -769,6 +770,8 @@ def load_params(path):
 
 def save_params(params, path):
     """Write ``params`` to ``path`` as YAML (SI units); :func:`load_params` reads it back identically."""
+    check_params(params)
+    check_path_argument(path)
     write_text(path, yaml.safe_dump(params_to_dict(params), sort_keys=False))  # atomically: all or the old file
 
 
@@ -836,11 +839,21 @@ def field_range(params, path):
     return meta.get("lo"), meta.get("hi")
 
 
+def check_params(params, field="params"):
+    """Refuse what is no :class:`DriveParams` (a preset's name, a mapping, None) by ``field``, before an attribute
+    of it is read (``AttributeError: 'str' object has no attribute 'controller'`` from a script)."""
+    if not isinstance(params, DriveParams):
+        raise InputError(field, params, "a DriveParams (drakecreep.preset(name) or drakecreep.load_params(path))")
+    return params
+
+
 def with_value(params, path, value):
     """A copy of ``params`` with the field at dotted ``path`` set to ``value`` (validated).
 
     ``path`` may index load cases: ``"loads.cases[2].fx"``. Errors name the full dotted field.
     """
+    if not dataclasses.is_dataclass(params) or isinstance(params, type):  # 'a: got 1' for with_value('paper', 'a', 1)
+        check_params(params)
     _check_path(path)
     head, _, rest = path.partition(".")
     name, index = _split_index(head, path)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from drakecreep.errors import InputError
 
-__all__ = ["Scenario", "MIN_FEED", "MAX_FEED", "MAX_DURATION"]
+__all__ = ["Scenario", "check_scenario", "MIN_FEED", "MAX_FEED", "MAX_DURATION"]
 
 #: largest feed accepted (m/s); feed drives of this class reach 0.5-1 m/s rapid traverse
 MAX_FEED = 1.0
@@ -62,3 +62,10 @@ def _finite_real(value):
     except OverflowError:
         return None
     return x if math.isfinite(x) else None
+
+
+def check_scenario(scenario, field="scenario"):
+    """Refuse what is no :class:`Scenario` (a feed, None) by ``field``, before an attribute of it is read."""
+    if not isinstance(scenario, Scenario):
+        raise InputError(field, scenario, "a Scenario (drakecreep.Scenario(feed=m/s, load_case=n, duration=s))")
+    return scenario

@@ -618,6 +618,11 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
     FileNotFoundError
         If the CSV does not exist.
     """
+    from drakecreep.files import check_path_argument
+
+    check_path_argument(csv_path, "csv_path")  # None ended in pathlib's TypeError
+    if meta_path is not None:
+        check_path_argument(meta_path, "meta_path")
     csv_path = Path(csv_path)
     if meta_path is None:
         candidates = [csv_path.with_suffix(".yaml"), csv_path.with_suffix(".yml")]

@@ -135,7 +135,11 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     import dataclasses
 
     from drakecreep.model.drive_source import DRIVES, ConstantSpeedDrive, motor_speed_for
+    from drakecreep.params import check_params
+    from drakecreep.scenario import check_scenario
 
+    check_params(params)
+    check_scenario(scenario)
     drive = drive or getattr(scenario, "drive", "cascade")
     if drive not in DRIVES:
         from drakecreep.errors import InputError

@@ -67,6 +67,9 @@ def lumped(params, load_case=0, x=0.0):
     x : float
         Table position (m); the shaft's stiffness depends on it.
     """
+    from drakecreep.params import check_params
+
+    check_params(params)
     fc, fs = table_friction_levels(params, params.load_case(load_case))
     law = make_friction_law(params.friction)
     return LumpedDrive(

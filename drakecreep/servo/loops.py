@@ -422,8 +422,12 @@ def analyze_loops(params, scenario):
     -------
     LoopAnalysis
     """
+    from drakecreep.params import check_params
+    from drakecreep.scenario import check_scenario
     from drakecreep.servo.linearize import closed_loop_from_parts
 
+    check_params(params)
+    check_scenario(scenario)
     op = operating_point(params, scenario)
     P = linearize_plant(params, scenario, op)
     K = linearize_controller(params, scenario, op)

@@ -360,14 +360,12 @@ def check_run(params, scenario, *, backend=None, model="two_mass", multibody=Non
         that starts after the run ends, too many recorded samples or steps (:func:`check_log_period`,
         :func:`check_step_budget`), a load case the params do not have.
     """
-    from drakecreep.params import DriveParams
-    from drakecreep.scenario import Scenario
+    from drakecreep.params import check_params
+    from drakecreep.scenario import check_scenario
 
     # a script's preset name, mapping or feed where the objects go ended in 'internal error: AttributeError'
-    if not isinstance(params, DriveParams):
-        raise InputError("params", params, "a DriveParams (drakecreep.preset(name) or drakecreep.load_params(path))")
-    if not isinstance(scenario, Scenario):
-        raise InputError("scenario", scenario, "a Scenario (drakecreep.Scenario(feed=m/s, load_case=n, duration=s))")
+    check_params(params)
+    check_scenario(scenario)
     sim = params.simulation
     if model not in MODELS:
         raise InputError("model", model, " or ".join(MODELS))

@@ -242,6 +242,19 @@ def make_cases(base, points, scenario=None, metric=None):
     """
     from drakecreep.sim.simulation import check_log_period, check_step_budget  # pydrake, as simulate: not at import
 
+    from collections.abc import Mapping
+
+    from drakecreep.params import check_params
+
+    check_params(base, "base")
+    if isinstance(points, (str, bytes, Mapping)) or not hasattr(points, "__iter__"):  # 'str' has no attribute 'items'
+        raise InputError("points", points, "a list of {path: value} mappings, one a case")
+    points = list(points)
+    for index, point in enumerate(points):
+        if not isinstance(point, Mapping):
+            raise InputError(f"points[{index}]", point, "a {path: value} mapping")
+    if scenario is not None and not isinstance(scenario, (Scenario, Mapping)):
+        raise InputError("scenario", scenario, "a Scenario or a mapping of its fields")
     metric = metric or feed_report
     defaults = dataclasses.asdict(scenario) if isinstance(scenario, Scenario) else dict(scenario or {})
     unknown = set(defaults) - set(SCENARIO_FIELDS)
