@@ -16,6 +16,9 @@ def test_gap_benchmark_json_on_one_short_null(capsys):
     assert row["category"] == "null" and row["kind"] == "p_p_cascade" and row["claimed"] == []
     assert [r["effect"] for r in row["ranking"]] == ["position_ripple"]
     assert row["audit"]["nominal"]["force_rms"] > 0
+    # no claim: no shrink, and the audit of the claimed model is the nominal's (tests/gap/test_benchmark.py ran a
+    # second null for these until session 64)
+    assert row["audit_shrink"] == 0.0 and row["audit"]["claimed"] == row["audit"]["nominal"]
     assert "[gap-benchmark] 1/1 seed" in captured.err
 
 

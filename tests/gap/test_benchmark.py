@@ -223,13 +223,14 @@ def _dataset(seed, withheld, effects, n=1000):
     return ds
 
 
-def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
+def test_diagnose_drake_end_to_end_on_a_strong_effect():
     """Through the product diagnosis with one candidate (position_ripple) on 1 s runs: a 10 N cogging force
     (motor order 1) is claimed as position_ripple and shrinks the audit replay (runs the diagnosis never saw) as
-    much as the true effect's fit (it is that fit); a null claims nothing. The rates over all candidates are
-    the benchmark's business (docs/gap_benchmark.md); this checks the mechanism. Measured: SNR 4.0, audit force
-    error 20.4 -> 12.1 %; 86 s for both on an idle core (session 57; the suite's slowest test, most of it the
-    nominal identification's least-squares replays)."""
+    much as the true effect's fit (it is that fit). The rates over all candidates are the benchmark's business
+    (docs/gap_benchmark.md); this checks the mechanism. Measured: SNR 4.0, audit force error 20.4 -> 12.1 %; 86 s
+    with a null beside it on an idle core (session 57; the suite's slowest test, most of it the nominal
+    identification's least-squares replays). The null, which claims nothing and leaves the audit as the nominal's,
+    is tests/cli/test_gap_benchmark.py's, through the command (it was run twice, here and there)."""
     from drakecreep.gap.benchmark import evaluate
 
     ds = _dataset(DEV_SEEDS + 2200, ("cogging",), {"cogging": {"amplitude_N": 10.0, "order": 1, "phase": 0.5, "h2": 0.0}})
@@ -250,9 +251,6 @@ def test_diagnose_drake_end_to_end_on_a_strong_effect_and_a_null():
     # and the candidate's own model's moves (its fit's jackknife), for a null of its own counted on the rows
     assert len(ranked["own_training_run_moves"]) == len(ds.train)
     assert all(len(m) == 2 and all(np.isfinite(m)) for m in ranked["own_training_run_moves"])
-    null = evaluate(_dataset(DEV_SEEDS + 2100, (), {}), effects=("position_ripple",))
-    assert null["category"] == "null" and null["claimed"] == [] and null["audit_shrink"] == 0.0
-    assert null["audit"]["claimed"] == null["audit"]["nominal"]
 
 
 def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkeypatch):
