@@ -539,6 +539,10 @@ def _peak_frequencies(sig, base, band, count=3):
     return tuple(float(fi[i]) for i in order)
 
 
+#: frequencies per call of :func:`scipy.signal.lombscargle` in :func:`_peak_periods`
+_LOMB_BLOCK = 512
+
+
 def _peak_periods(sig, base, band, count=3):
     """The ``count`` periods [m] of the largest peaks of the Lomb-Scargle periodogram of the inverse-dynamics
     residual against the motor position (``band``: shortest and longest period).
@@ -557,7 +561,12 @@ def _peak_periods(sig, base, band, count=3):
     w_lo, w_hi = 2.0 * math.pi / band[1], 2.0 * math.pi / band[0]
     step = 0.25 * math.pi / travel  # 1/8 cycle over the travel
     w = np.arange(w_lo, w_hi + step, step) if (w_hi - w_lo) / step < 2e5 else np.linspace(w_lo, w_hi, 200_000)
-    power = lombscargle(q - q.mean(), r - r.mean(), w)
+    # in blocks of frequencies: each frequency's power is computed alone (normalize and floating_mean off), so the
+    # blocks give the same values to rounding (1e-15), at under half the time (scipy 1.17 forms samples x
+    # frequencies arrays: 180 MB for an EMPS screen's 5901 x 3783, 3.5 s against 1.4 s in blocks of 512)
+    x, y = q - q.mean(), r - r.mean()
+    power = np.concatenate([np.atleast_1d(lombscargle(x, y, w[i:i + _LOMB_BLOCK]))  # (one frequency: a 0-d array)
+                            for i in range(0, w.size, _LOMB_BLOCK)])
     peaks, _ = find_peaks(power)
     if peaks.size == 0:
         peaks = np.array([int(np.argmax(power))])
