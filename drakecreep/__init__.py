@@ -19,7 +19,8 @@ The front door (each name is imported from its subpackage on first use, so ``imp
 ``simulate``                  one run -> ``SimulationResult`` (:mod:`drakecreep.sim.simulation`)
 ``run_sweep``                 parameter sweeps, serial / processes / Dask (:mod:`drakecreep.sim.sweep`)
 ``analyze_loops``             linearized velocity and position loops, margins (:mod:`drakecreep.servo.loops`)
-``critical_speed``            the paper's eq. 11 (:mod:`drakecreep.paper.creep`)
+``critical_speed``,           the paper's eq. 11 (:mod:`drakecreep.paper.creep`); ``creep_condition(lumped(params,
+``creep_condition``           load_case), feed)`` gives C1, zeta, D, D0 and v0 of a drive, as ``drakecreep critical``
 ``load_measured``             measured runs in any units with their metadata (:mod:`drakecreep.gap.measured`)
 ``diagnose``                  the sim-to-real gap diagnosis on the Drake replay model, what ``drakecreep
                               diagnose`` runs (:func:`drakecreep.gap.drake_diagnosis.diagnose_drake`)
@@ -46,6 +47,7 @@ _API = {
     "run_sweep": "drakecreep.sim.sweep",
     "analyze_loops": "drakecreep.servo.loops",
     "critical_speed": "drakecreep.paper.creep",
+    "creep_condition": "drakecreep.paper.creep",
     "load_measured": "drakecreep.gap.measured",
     "diagnose": ("drakecreep.gap.drake_diagnosis", "diagnose_drake"),
 }
