@@ -114,10 +114,11 @@ def _frame(path, fmt, key, separator=None, decimal=None, run_column="run", wante
 
         if decimal is not None and separator is None:  # the metadata's decimal against the header's separator
             with open(path, encoding="utf-8", errors="replace") as fh:
-                found = csv_dialect(fh)[0]
-            if found == decimal:
-                raise InputError(f"{path}: file.decimal", decimal, f"a mark other than the file's separator {found!r} "
-                                 "(a decimal comma goes with ';' or tab separators; file.separator names another)")
+                separator = csv_dialect(fh)[0]  # (given on to the reader, which would detect it again)
+            if separator == decimal:
+                raise InputError(f"{path}: file.decimal", decimal, f"a mark other than the file's separator "
+                                 f"{separator!r} (a decimal comma goes with ';' or tab separators; file.separator "
+                                 "names another)")
         return read_csv_frame(path, str(path), "a CSV with a header line and data rows", separator, decimal,
                               text_columns=(run_column,))  # run labels as written: 1 and 1.0 are two runs
     if fmt == "parquet":

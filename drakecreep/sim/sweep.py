@@ -31,6 +31,7 @@ import json
 import math
 import sys
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,7 +40,7 @@ import numpy as np
 from drakecreep.model.drive_source import scenario_with_drive
 from drakecreep.errors import InputError, renaming, short_repr
 from drakecreep.files import write_json
-from drakecreep.params import params_to_dict, with_value
+from drakecreep.params import check_params, params_to_dict, with_value
 from drakecreep.processes import new_pool, pool_size, stop_pool, usable_cpus
 from drakecreep.scenario import Scenario
 
@@ -241,10 +242,6 @@ def make_cases(base, points, scenario=None, metric=None):
         Naming the path and value of the first invalid point.
     """
     from drakecreep.sim.simulation import check_log_period, check_step_budget  # pydrake, as simulate: not at import
-
-    from collections.abc import Mapping
-
-    from drakecreep.params import check_params
 
     check_params(base, "base")
     if isinstance(points, (str, bytes, Mapping)) or not hasattr(points, "__iter__"):  # 'str' has no attribute 'items'
