@@ -79,7 +79,7 @@ DECIMALS = (".", ",")
 def _mat_frame(path, mat, wanted):
     """The vector variables of a loaded ``.mat`` as columns of one length. A variable that names a signal
     (``wanted``) and is no real vector of that length is refused by name: dropped, it was reported as missing ('the
-    columns u as well' for a complex u, an x_ref one sample short or a matrix)."""
+    columns u as well' for a complex u, an x_ref one sample short, a matrix or a single value)."""
     import pandas as pd
 
     columns, refused = {}, {}
@@ -95,6 +95,8 @@ def _mat_frame(path, mat, wanted):
             refused[name] = (f"shape {a.shape}", "a vector (one row or one column)")
         elif a.size > 1:
             columns[name] = a.astype(float).ravel()
+        else:  # a scalar (a gain, a setting) stays out of the columns; named only if it is a signal's name
+            refused[name] = (f"{a.size} value{'s' if a.size != 1 else ''}", "a vector of the run's samples")
     lengths = {a.size for a in columns.values()}
     longest = max(lengths, default=0)
     for name, a in columns.items():

@@ -50,6 +50,8 @@ def _mat(tmp_path, **variables):
     (lambda f: {"x_ref": f["x_ref"].to_numpy()[:-1]}, "x_ref", "length 49"),  # one sample short
     (lambda f: {"x_ref": np.tile(f["x_ref"].to_numpy(), (2, 1))}, "x_ref", "shape (2, 50)"),
     (lambda f: {"t": np.array([[1, 2], [3, 4]], dtype=object)}, "t", "a MATLAB cell or text array"),
+    (lambda f: {"u": 2.5}, "u", "1 value"),  # a scalar where a signal is named
+    (lambda f: {"x_motor": np.zeros((0, 1))}, "x_motor", "0 values"),
 ])
 def test_a_mat_variable_of_a_signal_that_is_no_real_vector_of_the_runs_length_is_named(tmp_path, change, field, got):
     """Such a variable was dropped without a word, and the file then said 'header: got 't,x_ref,x_motor'; allowed:
