@@ -14,9 +14,7 @@ import math
 
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, print_json
 from drakecreep.errors import InputError
-from drakecreep.model.lumped import lumped
 from drakecreep.params import ABSURD
-from drakecreep.paper import creep
 
 __all__ = ["add_parser", "run"]
 
@@ -55,6 +53,8 @@ def add_parser(subparsers):
 
 def _drive(args):
     """The lumped drive of the parameters with the what-if overrides applied (validated)."""
+    from drakecreep.model.lumped import lumped
+
     params = params_from_args(args)
     n = len(params.loads.cases)
     if not 0 <= args.load_case <= n:
@@ -83,6 +83,8 @@ def _drive(args):
 
 def run(args):
     """Compute and print the creep boundary."""
+    from drakecreep.paper import creep
+
     if not (math.isfinite(args.feed) and args.feed > 0):
         raise InputError("--feed", args.feed, "a finite speed > 0 in mm/s")
     feed_from_mm_s(args.feed)  # the range of every command (1e300 mm/s overflowed the friction law)

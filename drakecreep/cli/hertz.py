@@ -6,9 +6,6 @@ Defaults are the paper's Table 3 inputs; lengths at this edge are in mm, angles 
 import json
 import math
 
-from drakecreep.paper.hertz import (CONTACT_ANGLE_DEG, CONTACT_ANGLE_REASON, BallScrewNut, Material,
-                                    ballscrew_stiffness)
-
 __all__ = ["add_parser", "run"]
 
 PAPER = {"ka_N_per_m": 48.6e6, "fa_Hz": 1917.0, "kr_N_per_m": 1.83e5, "fr_Hz": 117.63}
@@ -38,6 +35,8 @@ def add_parser(subparsers):
 def run(args):
     """Compute and print the Hertz stiffness."""
     from drakecreep.errors import InputError
+    from drakecreep.paper.hertz import (CONTACT_ANGLE_DEG, CONTACT_ANGLE_REASON, BallScrewNut, Material,
+                                        ballscrew_stiffness)
 
     # sanity bounds (no ball screw is outside them; beyond them the contact arithmetic under- or overflows)
     if not (math.isfinite(args.youngs_modulus) and 1.0 <= args.youngs_modulus <= 2000.0):

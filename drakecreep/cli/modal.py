@@ -13,7 +13,6 @@ import numpy as np
 
 from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
-from drakecreep.paper.modal import FRF_COLUMNS, HammerTest, identify_frf, identify_hammer_test, read_hammer_csv
 
 __all__ = ["add_parser", "run"]
 
@@ -56,6 +55,8 @@ def _estimate_pulse_width(force, dt):
 
 def _span(header, data):
     """The frequencies a file covers, as text: its FRF's f_Hz, or 0 to Nyquist of a time record."""
+    from drakecreep.paper.modal import FRF_COLUMNS
+
     if header == FRF_COLUMNS:
         return f"{data[0, 0]:g}-{data[-1, 0]:g} Hz"
     return f"0-{0.5 / float(np.median(np.diff(data[:, 0]))):g} Hz"
@@ -63,6 +64,8 @@ def _span(header, data):
 
 def _identify(args, header, data, band):
     """The identification of an FRF or a time record, and the kind of its FRF or response."""
+    from drakecreep.paper.modal import FRF_COLUMNS, HammerTest, identify_frf, identify_hammer_test
+
     if header == FRF_COLUMNS:
         f = data[:, 0]
         _uniform_step(f, "f_Hz")
@@ -82,6 +85,8 @@ def _identify(args, header, data, band):
 
 def run(args):
     """Read the file, identify, print."""
+    from drakecreep.paper.modal import FRF_COLUMNS, read_hammer_csv
+
     # bounded as hertz --mass: 1e300 kg printed k = 4.852e+305 N/m, exit 0
     if args.mass is not None and not (math.isfinite(args.mass) and 1e-6 <= args.mass <= 1e5):
         raise InputError("--mass", args.mass, "a modal mass in [1e-06, 100000] kg")

@@ -8,7 +8,6 @@ frequency is printed beside it). See ``docs/multibody.md``.
 
 from drakecreep.cli._common import add_params_options, number, params_from_args, print_json
 from drakecreep.errors import InputError
-from drakecreep.multibody import build_multibody, modal_analysis, two_mass_axial_frequency
 
 __all__ = ["add_parser", "run"]
 
@@ -36,6 +35,8 @@ def add_parser(subparsers):
 
 def run(args):
     """Build, analyse, print."""
+    from drakecreep.multibody import build_multibody, modal_analysis, two_mass_axial_frequency
+
     if not 2 <= args.segments <= 400:
         raise InputError("--segments", args.segments, "an integer in [2, 400]")
     if not 1 <= args.modes <= 100:
