@@ -9,7 +9,7 @@ from drakecreep.errors import InputError
 def test_gap_benchmark_json_on_one_short_null(capsys):
     """One short null through the product diagnosis (one candidate, to stay fast)."""
     assert cli.main(["gap-benchmark", "--seeds", "dev", "--n-per-effect", "0", "--effects", "position_ripple",
-                     "--n-null", "1", "--n-ool", "0", "--samples", "900", "--json"]) == 0
+                     "--n-null", "1", "--n-ool", "0", "--samples", "600", "--json"]) == 0
     captured = capsys.readouterr()
     data = json.loads(captured.out)
     assert data["scores"]["n_datasets"] == 1
