@@ -536,8 +536,15 @@ def _meta_from_dict(data, meta_path):
         sensors = _named(f"{where}: ", SensorMeta, **sensors)
     except TypeError:
         raise InputError(f"{where}: sensors", sensors, "keys encoder_resolution, scale_resolution") from None
+    text = {}
+    for key in ("source", "notes"):
+        value = data.get(key)
+        if isinstance(value, (dict, list)):  # it was kept as its Python repr ("{'rig': 'A'}") and saved so
+            raise InputError(f"{where}: {key}", f"a YAML {'mapping' if isinstance(value, dict) else 'list'}",
+                             "free text (a string; a YAML block scalar, '|', keeps several lines)")
+        text[key] = "" if value is None else str(value)  # an empty 'notes:' was the text 'None'
     return _named(f"{where}: ", MeasuredMeta, u_units=units, u_gain=gain, params=params, controller=ctrl,
-                  sensors=sensors, source=str(data.get("source", "")), notes=str(data.get("notes", "")))
+                  sensors=sensors, **text)
 
 
 def _meta_to_dict(meta):

@@ -723,3 +723,16 @@ def test_a_split_that_is_no_list_of_runs_is_named(train, test, said):
     with pytest.raises(InputError) as err:
         check_split(train, test)
     assert str(err.value).startswith(said)
+
+
+@pytest.mark.parametrize("key", ["source", "notes"])
+def test_free_text_of_the_metadata_is_text(tmp_path, key):
+    """A mapping or list under source/notes was kept as its Python repr ("{'rig': 'A'}") and saved so; an empty
+    'notes:' was the text 'None'."""
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=dict(META, **{key: {"rig": "A"}})))
+    assert err.value.field == str(tmp_path / f"run.yaml: {key}") and err.value.value == "a YAML mapping"
+    with pytest.raises(InputError, match=f"{key}: got 'a YAML list'; allowed: free text"):
+        load_measured(_write(tmp_path, meta=dict(META, **{key: ["a", "b"]})))
+    assert getattr(load_measured(_write(tmp_path, meta=dict(META, **{key: None}))).meta, key) == ""
+    assert getattr(load_measured(_write(tmp_path, meta=dict(META, **{key: 2024}))).meta, key) == "2024"
