@@ -79,6 +79,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import threading
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -610,11 +611,25 @@ class _Replayer:
     Over a pool the replays are handed out longest first, by each run's last replay time (unknown runs by their
     length): one evaluation of a fit is often three runs on two workers, and a fast run (3 mm/s on the paper rig:
     1.2 s against 0.4 s for 0.5 mm/s) handed out last sets the wall time. The results keep the order asked for.
+    Over a pool every replay runs in a worker, so the candidates' threads (:func:`_fit_candidates`) never replay
+    in this process beside the workers.
     """
 
-    def __init__(self, load_case, pool=None):
+    def __init__(self, load_case, pool=None, parent=None):
         self.load_case, self.count, self.pool = load_case, 0, pool
-        self._seconds = {}  # id of a run -> its last replay's wall time [s]
+        self._parent = parent
+        self._seconds = {} if parent is None else parent._seconds  # id of a run -> its last replay's wall time [s]
+        self._lock = threading.Lock()
+
+    def view(self):
+        """A replayer over the same pool that also counts its own replays (one candidate's, in its thread)."""
+        return _Replayer(self.load_case, self.pool, parent=self)
+
+    def _add(self, n):
+        with self._lock:
+            self.count += n
+        if self._parent is not None:
+            self._parent._add(n)
 
     def __call__(self, runs, params):
         return self.many([(runs, params)])[0]
@@ -622,8 +637,8 @@ class _Replayer:
     def many(self, jobs):
         """Replays of several ``(runs, params)`` at once (in parallel over a pool): a list of lists of results."""
         tasks = [(r, params) for runs, params in jobs for r in runs]
-        self.count += len(tasks)
-        if self.pool is None or len(tasks) < 2:
+        self._add(len(tasks))
+        if self.pool is None or not tasks:
             flat = [replay_drakecreep(r, params, load_case=self.load_case) for r, params in tasks]
         else:
             order = sorted(range(len(tasks)), key=lambda i: -self._seconds.get(id(tasks[i][0]), 1e-6 * tasks[i][0].n))
@@ -1418,40 +1433,41 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                 f"{', '.join(uncertain)} fitted on runs that oscillate where the model does not: the values fit the "
                 "oscillation's samples as well as they can, not the friction; fit them on runs of a stable loop",)
     candidates, failures = [], []
+    fit_now = []
     for name in names:
         if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):
             continue  # already fitted as uncertain
         if withheld and name != _OSCILLATION_EFFECT:
-            candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False,
-                                           "not fitted: the measured runs oscillate, the model does not"))
             continue
-        before = replay.count
-        try:
-            values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
-                                             uncertain)
-            if values is None:
-                continue
-            if not values:
-                candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, "nothing to fit"))
-                continue
-            c = _held_out(name, values, train_gain, test, params, nominal_errors, replay, null)
-        except Exception as err:  # noqa: BLE001 - one candidate's failure must not end the diagnosis
-            # (an integrator that gives up on a fitted value, a value the params refuse: a Stribeck fit that left
-            # its range failed the whole diagnosis after five minutes); recorded, said, never claimed
-            why = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"[:300]
-            candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, f"failed ({why})"))
+        fit_now.append(name)
+    done, before_candidates = {}, tuple(warnings)
+
+    def finished(name, result, why, used):  # in this thread, as each candidate ends: say it, keep what is known
+        nonlocal warnings
+        done[name] = (result, why)
+        if why is not None:
             failures.append(f"{name} failed ({why}): it is not ranked; the other candidates are")
             warnings = tuple(warnings) + tuple(failures[-1:])
             say(f"{name}: failed ({why})")
-            continue
-        if withheld and c.passes:
-            c = dataclasses.replace(c, passes=False, reason="withheld: the measured runs oscillate, the model "
-                                                            "does not; " + c.reason)
-        candidates.append(c)
-        say(f"{name}: training gain {100 * train_gain:.1f} %, held-out gain {c.gain:+.3f} (bar {c.threshold:.3f}; "
-            f"{replay.count - before} replays)")
-        stage("candidate", candidates=tuple(sorted(candidates, key=lambda c: -c.gain)), oscillation=oscillation,
-              warnings=warnings)
+        elif result is not None and result.reason != "nothing to fit":
+            say(f"{name}: training gain {100 * result.train_gain:.1f} %, held-out gain {result.gain:+.3f} (bar "
+                f"{result.threshold:.3f}; {used} replays)")
+            so_far = [r for r, _ in done.values() if r is not None]
+            stage("candidate", candidates=tuple(sorted(so_far, key=lambda c: -c.gain)), oscillation=oscillation,
+                  warnings=warnings)
+
+    args = (train, test, params, base_sims, sse0, max_nfev, oscillation, uncertain, nominal_errors, null, withheld)
+    _fit_candidates(fit_now, replay, args, finished)
+    # in the order asked for, whatever order they ended in (ties of the gain keep it; so do the failures' warnings)
+    failures = [f"{name} failed ({done[name][1]}): it is not ranked; the other candidates are"
+                for name in names if name in done and done[name][1] is not None]
+    warnings = before_candidates + tuple(failures)
+    for name in names:
+        if withheld and name != _OSCILLATION_EFFECT:
+            candidates.append(EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False,
+                                           "not fitted: the measured runs oscillate, the model does not"))
+        elif name in done and done[name][0] is not None:
+            candidates.append(done[name][0])
     candidates.sort(key=lambda c: -c.gain)
     claimed, current, current_errors = [], params, nominal_errors
     if withheld:
@@ -1491,6 +1507,61 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                           seconds=_time.perf_counter() - t0, oscillation=oscillation,
                           where=locate(test, final_sims, lead=prior.screw.lead),
                           residuals=_residual_traces(test[0], nominal_sims[0], final_sims[0]))
+
+
+def _fit_candidate(name, replay, args):
+    """One candidate fitted on the training runs and replayed on the held-out ones: ``(EffectResult or None, why it
+    failed or None)``. A failure (an integrator that gives up on a fitted value, a value the params refuse: a
+    Stribeck fit that left its range failed the whole diagnosis after five minutes) is recorded, never claimed."""
+    train, test, params, base_sims, sse0, max_nfev, oscillation, uncertain, nominal_errors, null, withheld = args
+    try:
+        values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
+                                         uncertain)
+        if values is None:
+            return None, None
+        if not values:
+            return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, "nothing to fit"), None
+        c = _held_out(name, values, train_gain, test, params, nominal_errors, replay, null)
+    except Exception as err:  # noqa: BLE001 - one candidate's failure must not end the diagnosis
+        why = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"[:300]
+        return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, f"failed ({why})"), why
+    if withheld and c.passes:
+        c = dataclasses.replace(c, passes=False, reason="withheld: the measured runs oscillate, the model "
+                                                        "does not; " + c.reason)
+    return c, None
+
+
+def _fit_candidates(names, replay, args, finished):
+    """Fit the candidates ``names`` (:func:`_fit_candidate`), calling ``finished(name, result, why, replays)`` in
+    this thread as each ends.
+
+    Over a process pool each candidate is fitted in a thread of its own, all of them at once: one candidate's
+    least-squares evaluation is a few replays (three training runs on two workers), so candidates fitted one
+    after the other left workers idle at the end of each evaluation (the paper rig's candidates: 1.2 times the
+    speed of one worker on two). The threads only wait for the pool and do the fits' arithmetic; each result
+    depends on its candidate alone, so it is the one a serial diagnosis gives. Without a pool, one after the
+    other in this process.
+    """
+    if replay.pool is None or len(names) < 2:
+        for name in names:
+            view = replay.view()
+            finished(name, *_fit_candidate(name, view, args), view.count)
+        return
+    from concurrent.futures import ThreadPoolExecutor, as_completed
+
+    threads = ThreadPoolExecutor(max_workers=len(names), thread_name_prefix="candidate")
+    try:
+        views = {name: replay.view() for name in names}
+        futures = {threads.submit(_fit_candidate, name, views[name], args): name for name in names}
+        for future in as_completed(futures):
+            name = futures[future]
+            finished(name, *future.result(), views[name].count)
+    except BaseException:
+        # a Ctrl-C or an error here: no new candidate starts; the pool's owner stops the workers, which ends the
+        # running ones' replays at once (their threads then end with the pool's error, not waited for)
+        threads.shutdown(wait=False, cancel_futures=True)
+        raise
+    threads.shutdown(wait=True)
 
 
 def _residual_traces(run, nominal, augmented):

@@ -456,13 +456,21 @@ def test_switch_candidates_find_the_nut_drag_on_the_screw():
 
 
 def test_replays_in_worker_processes_give_the_same_diagnosis():
+    """Over a pool the candidates are fitted at once, each in a thread (their replays interleave in the pool): the
+    same fits, gains, candidate order and replay count as one after the other in this process."""
     runs = _runs(RIG, seed=3)
-    kwargs = dict(uncertain=("table.seal_force",), effects=("law_coulomb",), max_nfev=2)
+    kwargs = dict(uncertain=("table.seal_force",), effects=("law_coulomb", "nut_friction_side", "law_gms"), max_nfev=2)
+    lines = []
     serial = diagnose_drive(runs[:2], runs[2:], **kwargs)
-    pooled = diagnose_drive(runs[:2], runs[2:], workers=2, **kwargs)
+    pooled = diagnose_drive(runs[:2], runs[2:], workers=2, progress=lines.append, **kwargs)
     assert pooled.fitted == serial.fitted and pooled.claimed == serial.claimed
     assert pooled.simulations == serial.simulations
-    assert [c.gain for c in pooled.candidates] == [c.gain for c in serial.candidates]
+    assert [(c.name, c.gain, c.values) for c in pooled.candidates] == [(c.name, c.gain, c.values)
+                                                                      for c in serial.candidates]
+    assert pooled.warnings == serial.warnings
+    # each candidate's progress line counts its own replays (a switch: its two training and two held-out runs)
+    said = [line for line in lines if "held-out gain" in line]
+    assert len(said) == 3 and all(line.endswith("; 4 replays)") for line in said), said
     with pytest.raises(InputError, match="workers"):
         diagnose_drive(runs[:2], runs[2:], workers=0, **kwargs)
 
@@ -477,7 +485,10 @@ def test_pooled_replays_are_handed_out_longest_first_and_returned_in_order(monke
         return SimpleNamespace(label=run.label, wall_time=seconds[run.label])
 
     class Pool:
+        maps = 0
+
         def map(self, fn, *columns):
+            Pool.maps += 1
             return [fn(*args) for args in zip(*columns)]  # in the order handed out, as one worker would
 
     monkeypatch.setattr(drive_fit, "replay_drakecreep", fake_replay)
@@ -488,6 +499,12 @@ def test_pooled_replays_are_handed_out_longest_first_and_returned_in_order(monke
     handed.clear()
     assert [s.label for s in replayer(runs, None)] == ["fast", "slow", "mid"]
     assert handed == ["slow", "mid", "fast"] and replayer.count == 6
+    # a view (one candidate's, in its thread) shares the pool and the timings, counts its own and the whole's
+    view = replayer.view()
+    handed.clear()
+    assert [s.label for s in view(runs[:1], None)] == ["fast"] and handed == ["fast"]
+    assert Pool.maps == 3  # one replay goes to the pool too: none runs in this process beside the workers
+    assert view.count == 1 and replayer.count == 7
 
 
 def test_a_constant_force_is_fitted_from_runs_both_ways_and_not_separable_from_runs_one_way(tmp_path):
