@@ -1362,8 +1362,9 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         ``True`` prints a line per step to stderr; a callable receives the lines.
     workers : int
         Processes for the replays (the runs of one evaluation, and every column of a Jacobian, are independent;
-        ``spawn`` processes, each imports Drake once, a few seconds). 1 replays in this process. The result
-        does not depend on it.
+        ``spawn`` processes, each imports Drake once, a few seconds); over them the candidates are fitted at once,
+        each in a thread of this process that waits for its replays. 1 replays in this process, one candidate after
+        the other. The result does not depend on it.
     on_stage : callable, optional
         ``on_stage(stage, partial)`` with a :class:`DriveDiagnosis` of what is known so far, so that a caller
         keeps it if a later step fails or is stopped: ``"nominal"`` after the nominal fit and its run-to-run
