@@ -65,9 +65,9 @@ def add_parser(subparsers):
                    "report --params, diagnosis.html, diagnosis.json, summary.txt)")
     p.add_argument("--workers", type=workers, metavar="N", default=usable_cpus(),
                    help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits, and as many "
-                        f"threads in each for the runs of one evaluation; drakecreep: the runs, Jacobian columns and candidates; "
-                        f"default, and the most processes started: the {usable_cpus()} CPUs this process may use; "
-                        f"1: all in this process, one at a time)")
+                        f"threads in each for the runs of one evaluation; drakecreep: the runs, Jacobian columns and "
+                        f"candidates; default, and the most processes started: the {usable_cpus()} CPUs this process "
+                        f"may use; 1: all in this process, one at a time)")
     p.add_argument("--json", action="store_true", help="print the JSON result on stdout")
     p.set_defaults(func=run)
     return p

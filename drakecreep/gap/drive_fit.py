@@ -78,6 +78,7 @@ Not identifiable here, and why: see ``docs/gap_drakecreep_kind.md``.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import threading
 import time as _time
@@ -1438,8 +1439,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
             warnings = tuple(warnings) + (
                 f"{', '.join(uncertain)} fitted on runs that oscillate where the model does not: the values fit the "
                 "oscillation's samples as well as they can, not the friction; fit them on runs of a stable loop",)
-    candidates, failures = [], []
-    fit_now = []
+    candidates, fit_now = [], []
     for name in names:
         if name == "stribeck" and {"friction.static_ratio", "friction.stribeck_velocity"} & set(uncertain):
             continue  # already fitted as uncertain
@@ -1452,21 +1452,22 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         nonlocal warnings
         done[name] = (result, why)
         if why is not None:
-            failures.append(f"{name} failed ({why}): it is not ranked; the other candidates are")
-            warnings = tuple(warnings) + tuple(failures[-1:])
+            warnings = tuple(warnings) + (_failure_warning(name, why),)
             say(f"{name}: failed ({why})")
-        elif result is not None and result.reason != "nothing to fit":
+        elif result is not None and result.reason != _NOTHING_TO_FIT:
             say(f"{name}: training gain {100 * result.train_gain:.1f} %, held-out gain {result.gain:+.3f} (bar "
                 f"{result.threshold:.3f}; {used} replays)")
             so_far = [r for r, _ in done.values() if r is not None]
             stage("candidate", candidates=tuple(sorted(so_far, key=lambda c: -c.gain)), oscillation=oscillation,
                   warnings=warnings)
 
-    args = (train, test, params, base_sims, sse0, max_nfev, oscillation, uncertain, nominal_errors, null, withheld)
-    _fit_candidates(fit_now, replay, args, finished)
+    fit = functools.partial(_fit_candidate, train=train, test=test, params=params, base_sims=base_sims, sse0=sse0,
+                            max_nfev=max_nfev, oscillation=oscillation, uncertain=uncertain,
+                            nominal_errors=nominal_errors, null=null, withheld=withheld)
+    _fit_candidates(fit_now, replay, fit, finished)
     # in the order asked for, whatever order they ended in (ties of the gain keep it; so do the failures' warnings)
-    failures = [f"{name} failed ({done[name][1]}): it is not ranked; the other candidates are"
-                for name in names if name in done and done[name][1] is not None]
+    failures = [_failure_warning(name, done[name][1]) for name in names
+                if name in done and done[name][1] is not None]
     warnings = before_candidates + tuple(failures)
     for name in names:
         if withheld and name != _OSCILLATION_EFFECT:
@@ -1515,18 +1516,26 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                           residuals=_residual_traces(test[0], nominal_sims[0], final_sims[0]))
 
 
-def _fit_candidate(name, replay, args):
+#: the reason of a candidate that found nothing to fit (listed, neither said nor staged on its own)
+_NOTHING_TO_FIT = "nothing to fit"
+
+
+def _failure_warning(name, why):
+    return f"{name} failed ({why}): it is not ranked; the other candidates are"
+
+
+def _fit_candidate(name, replay, *, train, test, params, base_sims, sse0, max_nfev, oscillation, uncertain,
+                   nominal_errors, null, withheld):
     """One candidate fitted on the training runs and replayed on the held-out ones: ``(EffectResult or None, why it
     failed or None)``. A failure (an integrator that gives up on a fitted value, a value the params refuse: a
     Stribeck fit that left its range failed the whole diagnosis after five minutes) is recorded, never claimed."""
-    train, test, params, base_sims, sse0, max_nfev, oscillation, uncertain, nominal_errors, null, withheld = args
     try:
         values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
                                          uncertain)
         if values is None:
             return None, None
         if not values:
-            return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, "nothing to fit"), None
+            return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, _NOTHING_TO_FIT), None
         c = _held_out(name, values, train_gain, test, params, nominal_errors, replay, null)
     except Exception as err:  # noqa: BLE001 - one candidate's failure must not end the diagnosis
         why = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"[:300]
@@ -1537,9 +1546,9 @@ def _fit_candidate(name, replay, args):
     return c, None
 
 
-def _fit_candidates(names, replay, args, finished):
-    """Fit the candidates ``names`` (:func:`_fit_candidate`), calling ``finished(name, result, why, replays)`` in
-    this thread as each ends.
+def _fit_candidates(names, replay, fit, finished):
+    """Fit the candidates ``names`` (``fit(name, replayer)``: :func:`_fit_candidate`), calling
+    ``finished(name, result, why, replays)`` in this thread as each ends.
 
     Over a process pool each candidate is fitted in a thread of its own, all of them at once: one candidate's
     least-squares evaluation is a few replays (three training runs on two workers), so candidates fitted one
@@ -1551,14 +1560,14 @@ def _fit_candidates(names, replay, args, finished):
     if replay.pool is None or len(names) < 2:
         for name in names:
             view = replay.view()
-            finished(name, *_fit_candidate(name, view, args), view.count)
+            finished(name, *fit(name, view), view.count)
         return
     from concurrent.futures import ThreadPoolExecutor, as_completed
 
     threads = ThreadPoolExecutor(max_workers=len(names), thread_name_prefix="candidate")
     try:
         views = {name: replay.view() for name in names}
-        futures = {threads.submit(_fit_candidate, name, views[name], args): name for name in names}
+        futures = {threads.submit(fit, name, views[name]): name for name in names}
         for future in as_completed(futures):
             name = futures[future]
             finished(name, *future.result(), views[name].count)
