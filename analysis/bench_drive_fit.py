@@ -4,7 +4,8 @@
    ``backend="leaf"`` on the same measured run (an out-and-back reference with an external force), for the
    presets ``paper`` and ``rigid_axis`` and the test rig of ``tests/gap/test_drive_fit.py``. Both are
    timed in this process, CPU time (``time.process_time``: the machine is shared, wall time is not
-   comparable between runs) and wall time; the agreement of the two is printed beside.
+   comparable between runs) and wall time; the agreement of the two is printed beside. Then the compiled
+   diagram with every recorded signal in its output against the three a replay reads.
 2. Recovery: runs simulated by the test rig with a known change (Coulomb level +30 %, a 2 um lead error,
    nothing), two training and two held-out runs, noise 2 N on ``u``: what ``diagnose_drive`` finds.
 
@@ -16,6 +17,7 @@ Run: ``python analysis/bench_drive_fit.py [--duration S] [--skip-speed] [--skip-
 """
 
 import argparse
+import itertools
 import time
 
 import numpy as np
@@ -72,6 +74,42 @@ def speed(duration):
               f"{ix:11.2e} {iu:11.3g}", flush=True)
 
 
+def signals(duration):
+    """The compiled diagram outputting every recorded signal against the three a replay reads (session 66):
+    the plant's output is evaluated at every sample tick and every log, so the signals it carries cost time."""
+    from pydrake.systems.framework import DiagramBuilder
+    from pydrake.systems.primitives import LogVectorOutput
+
+    from drakecreep.model.diagram import build_diagram
+    from drakecreep.scenario import Scenario
+    from drakecreep.sim.compiled import compile_diagram
+    from drakecreep.sim.simulation import make_simulator, target_accuracy
+
+    three = ("motor_angle", "table_position", "force_command")
+    print(f"\ncompiled diagram, a {duration:g} s ramp, least CPU s of four with every signal in its output / with the "
+          "three a replay reads (the same integrator and accuracy; the three agree to the bit):")
+    for (name, params), feed in itertools.product(
+            (("test rig", test_rig()), ("paper", preset("paper")), ("rigid_axis", preset("rigid_axis"))), (0.5e-3, 3e-3)):
+        drive = build_diagram(params, Scenario(feed=feed, duration=duration))
+        cpu, logged = {}, {}
+        for names in (None, three) * 4:  # alternately, four times each: the least CPU time of each
+            compiled = compile_diagram(drive, signals=names)
+            b = DiagramBuilder()
+            system = b.AddSystem(compiled.diagram)
+            log = LogVectorOutput(system.GetOutputPort("signals"), b, params.controller.velocity_period)
+            root = b.Build()
+            context = root.CreateDefaultContext()
+            compiled.set_initial_state(root.GetMutableSubsystemContext(system, context))
+            simulator = make_simulator(root, context, params.simulation, target_accuracy(params))
+            _, took, _ = timed(lambda: simulator.AdvanceTo(duration))
+            cpu[names] = min(took, cpu.get(names, took))
+            data = log.FindLog(context).data()
+            logged[names] = np.array([data[compiled.signal_names.index(n)] for n in three])
+        same = np.array_equal(logged[None], logged[three])
+        print(f"{name:12s} {1e3 * feed:3.1f} mm/s {len(drive.signal_names):2d} signals {cpu[None]:6.2f} / 3 signals {cpu[three]:6.2f}: "
+              f"{cpu[None] / cpu[three]:.2f} x; {'to the bit' if same else 'DIFFERENT'}", flush=True)
+
+
 def coulomb_truth(rig):
     """``rig`` with the guides' Coulomb level raised by 30 % of the rig's whole Coulomb force."""
     return with_value(rig, "table.seal_force", rig.table.seal_force + 0.3 * friction_levels(rig, LoadCase())[0])
@@ -124,6 +162,7 @@ def main():
         return
     if not args.skip_speed:
         speed(args.duration)
+        signals(1.5)
     if not args.skip_recovery:
         recovery()
 

@@ -37,3 +37,34 @@ def test_continuous_controller_compiles_without_discrete_state(paper):
     drive = build_diagram(with_value(paper, "controller.sampled", False), Scenario())
     compiled = compile_diagram(drive)
     assert compiled.sampler is None and len(compiled.equations.xc) == 8  # + the nut's LuGre state
+
+
+def test_a_compiled_diagram_of_some_signals_simulates_them_to_the_same_bits(paper):
+    from pydrake.systems.analysis import Simulator
+    from pydrake.systems.primitives import LogVectorOutput
+    from pydrake.systems.framework import DiagramBuilder
+    import pytest
+
+    drive = build_diagram(paper, Scenario(feed=1e-3, duration=0.05))
+    some = ("force_command", "motor_angle", "nut_friction_force")
+    logged = {}
+    for names in (None, some):
+        compiled = compile_diagram(drive, signals=names)
+        b = DiagramBuilder()
+        system = b.AddSystem(compiled.diagram)
+        log = LogVectorOutput(system.GetOutputPort("signals"), b, paper.controller.velocity_period)
+        root = b.Build()
+        context = root.CreateDefaultContext()
+        compiled.set_initial_state(root.GetMutableSubsystemContext(system, context))
+        Simulator(root, context).AdvanceTo(0.05)
+        data = log.FindLog(context).data()
+        logged[names] = {n: data[i] for i, n in enumerate(compiled.signal_names)}
+        assert data.shape[0] == len(compiled.signal_names) + len(compiled.equations.xc)
+    assert list(logged[some]) == list(some)
+    for n in some:
+        np.testing.assert_array_equal(logged[some][n], logged[None][n])
+    assert np.ptp(logged[some]["motor_angle"]) > 0  # the axis moved: the comparison is of a motion
+    with pytest.raises(ValueError, match="signals: got .*'speed'.*; allowed: distinct names among x_ref"):
+        compile_diagram(drive, signals=("motor_angle", "speed"))
+    with pytest.raises(ValueError, match="signals: got"):
+        compile_diagram(drive, signals=("motor_angle", "motor_angle"))
