@@ -629,3 +629,17 @@ def test_a_drive_that_cannot_slide_names_the_feed_option_or_the_params(tmp_path,
     code, _, err = _run(["report", "--params", str(stribeck), "--out", str(tmp_path / "r"), "--low-feed", "1"], capsys)
     _one_line_exit_2(code, err, "params: got '", "stribeck.yaml, load case 3: ", "N to slide at 0.02 mm/s'",
                      "the report's feeds, 0.005 to 3 mm/s")
+
+
+def test_a_parameter_file_of_more_than_one_mebibyte_is_refused_before_it_is_parsed(tmp_path, capsys):
+    from drakecreep.files import MAX_INPUT_BYTES
+
+    path = tmp_path / "big.yaml"
+    # valid YAML all through (a comment block after one field): only its size is wrong
+    path.write_text("table: {mass: 3}\n" + "# padding\n" * (MAX_INPUT_BYTES // 10 + 1))
+    code, _, err = _run(["params", "--check", str(path)], capsys)
+    _one_line_exit_2(code, err, f"allowed: a file of at most {MAX_INPUT_BYTES} bytes")
+    assert MAX_INPUT_BYTES == 1024 * 1024
+    path.write_text("table: {mass: 3}\n" + "# padding\n" * (MAX_INPUT_BYTES // 10 - 10))  # just under: read
+    code, _, err = _run(["params", "--check", str(path)], capsys)
+    assert "at most" not in err
