@@ -59,6 +59,7 @@ rebuild.
 """
 
 import math
+import sys
 
 import numpy as np
 from pydrake.systems.framework import BasicVector_, LeafSystem_
@@ -363,7 +364,7 @@ def set_axis_parameters(axis, context, **values):
         vec.SetAtIndex(_NAMES.index(name), float(value))
 
 
-@TemplateSystem.define("MeasuredAxis_")
+@TemplateSystem.define("MeasuredAxis_", scope=sys.modules[__name__])
 def MeasuredAxis_(T):
     class Impl(LeafSystem_[T]):
         """Rigid or two-mass axis with parameterised friction, optionally with LuGre bristles.

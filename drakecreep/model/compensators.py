@@ -48,6 +48,7 @@ The study that compares them is :mod:`drakecreep.studies.compensation`.
 
 import dataclasses
 import math
+import sys
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.primitives import Adder
@@ -212,7 +213,7 @@ def _measured_speed(system, context):
     return system._u_motor_measured.Eval(context)[1] * system.ratio
 
 
-@TemplateSystem.define("StaticCompensator_")
+@TemplateSystem.define("StaticCompensator_", scope=sys.modules[__name__])
 def StaticCompensator_(T):
     class Impl(_SampledMixin, LeafSystem_[T]):
         """Stribeck + viscous friction feedforward.
@@ -261,7 +262,7 @@ def StaticCompensator_(T):
     return Impl
 
 
-@TemplateSystem.define("LuGreCompensator_")
+@TemplateSystem.define("LuGreCompensator_", scope=sys.modules[__name__])
 def LuGreCompensator_(T):
     class Impl(_SampledMixin, LeafSystem_[T]):
         """LuGre friction compensation with a friction-state observer; state ``w = sigma0 z / Fc``.
@@ -331,7 +332,7 @@ def LuGreCompensator_(T):
     return Impl
 
 
-@TemplateSystem.define("DisturbanceObserver_")
+@TemplateSystem.define("DisturbanceObserver_", scope=sys.modules[__name__])
 def DisturbanceObserver_(T):
     class Impl(_SampledMixin, LeafSystem_[T]):
         """First-order disturbance observer on the motor; state ``p`` with ``d = p - L J_n omega``.
@@ -392,7 +393,7 @@ def DisturbanceObserver_(T):
     return Impl
 
 
-@TemplateSystem.define("DitherCompensator_")
+@TemplateSystem.define("DitherCompensator_", scope=sys.modules[__name__])
 def DitherCompensator_(T):
     class Impl(LeafSystem_[T]):
         """Sinusoidal dither force ``A sin(2 pi f t)`` through the lead; output ``torque`` (1, N m)."""

@@ -22,6 +22,7 @@ Position feedback: ``motor`` (semi-closed loop, encoder angle times lead over 2 
 """
 
 import math
+import sys
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -37,7 +38,7 @@ def force_limit(params):
     return params.motor.peak_torque * 2.0 * math.pi / params.screw.lead
 
 
-@TemplateSystem.define("CascadeController_")
+@TemplateSystem.define("CascadeController_", scope=sys.modules[__name__])
 def CascadeController_(T):
     class Impl(LeafSystem_[T]):
         """PI cascade controller.

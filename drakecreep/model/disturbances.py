@@ -27,6 +27,7 @@ Cogging
 """
 
 import math
+import sys
 
 import numpy as np
 import pydrake.math as dmath
@@ -50,7 +51,7 @@ def cos(x):
     return np.cos(x) if isinstance(x, (float, int, np.floating, np.ndarray)) else dmath.cos(x)
 
 
-@TemplateSystem.define("LeadError_")
+@TemplateSystem.define("LeadError_", scope=sys.modules[__name__])
 def LeadError_(T):
     class Impl(LeafSystem_[T]):
         """Kinematic lead error between the motor rotation and the nut.
@@ -121,7 +122,7 @@ def LeadError_(T):
     return Impl
 
 
-@TemplateSystem.define("LoadRipple_")
+@TemplateSystem.define("LoadRipple_", scope=sys.modules[__name__])
 def LoadRipple_(T):
     class Impl(LeafSystem_[T]):
         """Force ripple on the table: output ``force`` (1, N) ``= -amplitude sin(2 pi f t + phase)``, added to the
@@ -156,7 +157,7 @@ def cogging_force(disturbance, x):
     return force
 
 
-@TemplateSystem.define("Cogging_")
+@TemplateSystem.define("Cogging_", scope=sys.modules[__name__])
 def Cogging_(T):
     class Impl(LeafSystem_[T]):
         """Cogging load torque on the motor: input ``motor_state`` (2, ``[theta (rad), omega (rad/s)]``), output

@@ -11,6 +11,7 @@ equations 1-11. Its ``motor_torque`` is the torque the ideal drive has to supply
 """
 
 import math
+import sys
 from dataclasses import dataclass
 
 from pydrake.systems.framework import LeafSystem_
@@ -26,7 +27,7 @@ __all__ = ["DRIVES", "ConstantSpeedDrive", "ConstantSpeedDrive_", "DriveScenario
 DRIVES = ("cascade", "constant_speed")
 
 
-@TemplateSystem.define("ConstantSpeedDrive_")
+@TemplateSystem.define("ConstantSpeedDrive_", scope=sys.modules[__name__])
 def ConstantSpeedDrive_(T):
     class Impl(LeafSystem_[T]):
         """Ideal speed source on the motor shaft (no state).

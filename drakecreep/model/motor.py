@@ -5,6 +5,8 @@ so the motor side of the two-mass model lives here; the screw's elastic coupling
 in :mod:`drakecreep.model.screw`.
 """
 
+import sys
+
 import numpy as np
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -19,7 +21,7 @@ def motor_inertia(motor, load_inertia=0.0):
     return motor.rotor_inertia + motor.coupling_inertia + load_inertia
 
 
-@TemplateSystem.define("Motor_")
+@TemplateSystem.define("Motor_", scope=sys.modules[__name__])
 def Motor_(T):
     class Impl(LeafSystem_[T]):
         """Motor with rotor state ``[theta, omega]`` (+ ``tau`` when the current loop has a lag).

@@ -11,6 +11,7 @@ level is the nut's. The viscous term is not: ``friction.viscous`` is the axis's 
 
 import dataclasses
 import math
+import sys
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -39,7 +40,7 @@ def nut_friction_params(friction):
     return dataclasses.replace(friction, viscous=0.0)
 
 
-@TemplateSystem.define("NutFriction_")
+@TemplateSystem.define("NutFriction_", scope=sys.modules[__name__])
 def NutFriction_(T):
     class Impl(LeafSystem_[T]):
         """Drag torque of the nut on the screw.

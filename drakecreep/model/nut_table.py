@@ -23,6 +23,7 @@ The lateral load ``Fy`` loads the guides' side raceways either way: ``|Fy|``.
 """
 
 import math
+import sys
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -68,7 +69,7 @@ def table_friction_levels(params, load):
     return friction_levels(params, load)
 
 
-@TemplateSystem.define("NutTable_")
+@TemplateSystem.define("NutTable_", scope=sys.modules[__name__])
 def NutTable_(T):
     class Impl(LeafSystem_[T]):
         """Table mass with friction; state ``[x, v, z...]`` (``z``: the friction law's internal states).

@@ -17,6 +17,7 @@ Discrete state: ``[q[k-1] .. q[k-N] (N = len(taps)), u[k] .. u[k-n], applied]``.
 """
 
 import math
+import sys
 
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -51,7 +52,7 @@ def pp_initial_state(taps, delay, q0, v0, h, u_history=()):
     return hist + queue + [applied]
 
 
-@TemplateSystem.define("PPCascade_")
+@TemplateSystem.define("PPCascade_", scope=sys.modules[__name__])
 def PPCascade_(T):
     class Impl(LeafSystem_[T]):
         """Sampled position-P / velocity-P cascade (EMPS).

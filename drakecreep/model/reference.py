@@ -1,5 +1,7 @@
 """Feed reference: a position ramp at the feed speed, reached with a constant acceleration."""
 
+import sys
+
 from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
@@ -8,7 +10,7 @@ from drakecreep.model._scalar import vector, where
 __all__ = ["FeedReference", "FeedReference_"]
 
 
-@TemplateSystem.define("FeedReference_")
+@TemplateSystem.define("FeedReference_", scope=sys.modules[__name__])
 def FeedReference_(T):
     class Impl(LeafSystem_[T]):
         """Output ``reference`` ``[x_ref (m), v_ref (m/s)]`` as a function of time.

@@ -28,6 +28,7 @@ The fixed joints' coefficients are used as given.
 """
 
 import math
+import sys
 
 from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
@@ -114,7 +115,7 @@ def screw_inertia(screw):
     return math.pi / 32.0 * screw.density * screw.length * screw.nominal_diameter**4
 
 
-@TemplateSystem.define("ScrewDrive_")
+@TemplateSystem.define("ScrewDrive_", scope=sys.modules[__name__])
 def ScrewDrive_(T):
     class Impl(LeafSystem_[T]):
         """Spring-damper of the screw between the motor rotation and the table (no state).

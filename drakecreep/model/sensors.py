@@ -17,6 +17,7 @@ amplitude ``a`` puts a ripple ``2 pi a v / p`` on it, proportional to the feed `
 """
 
 import math
+import sys
 
 import numpy as np
 
@@ -97,7 +98,7 @@ def encoder_resolution(counts_per_rev):
     return 0.0 if counts_per_rev == 0 else 2.0 * math.pi / counts_per_rev
 
 
-@TemplateSystem.define("MotorEncoder_")
+@TemplateSystem.define("MotorEncoder_", scope=sys.modules[__name__])
 def MotorEncoder_(T):
     class Impl(LeafSystem_[T]):
         """Incremental/absolute motor encoder.
@@ -125,7 +126,7 @@ def MotorEncoder_(T):
     return Impl
 
 
-@TemplateSystem.define("LinearScale_")
+@TemplateSystem.define("LinearScale_", scope=sys.modules[__name__])
 def LinearScale_(T):
     class Impl(LeafSystem_[T]):
         """Linear scale on the table: input ``table_state`` ``[x, v]``, output ``table_position_measured``.
