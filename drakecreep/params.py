@@ -169,6 +169,8 @@ def load_yaml_file(path, field=None, what="a YAML mapping", max_bytes=MAX_INPUT_
         raise InputError(field, "YAML nested too deeply", what) from None
     if data is None:
         raise InputError(field, "empty (no values, only comments or blank lines)", what)
+    if data == {}:  # as empty as no file: a parameter file '{}' silently meant "all defaults"
+        raise InputError(field, "an empty mapping ({})", what)
     return data
 
 
@@ -760,6 +762,10 @@ def load_params(path):
     """
     check_path_argument(path)  # None, a number or '' named as the path, not str(path)
     data = load_yaml_file(path, str(path), "a YAML mapping of parameter groups")
+    if isinstance(data, dict) and "u_units" in data:
+        # a measured run's metadata named as the params file (its own 'params:' pointing at itself, a --params slip)
+        raise InputError(str(path), "a measured run's metadata file (it has u_units)",
+                         "a drakecreep params file (parameter groups motor, screw, nut, table, friction, ...)")
     if isinstance(data, dict) and data.get("kind") == MEASURED_AXIS_KIND:
         raise InputError(f"{path}: kind", data["kind"],
                          "a drakecreep params file (parameter groups motor, screw, nut, table, friction, ...); this "

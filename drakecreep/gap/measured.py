@@ -514,6 +514,9 @@ def _meta_from_dict(data, meta_path):
         path = resolve_reference(params, meta_path, f"{where}: params")
         params = _named(f"{path}: ", load_params, path)
     elif isinstance(params, dict):
+        if not params:  # 'params: {}' silently meant the default rig, not the user's
+            raise InputError(f"{where}: params", "an empty mapping ({})",
+                             "a parameter file path or a mapping of parameter groups")
         params = _named(f"{where}: params.", params_from_dict, params)
     elif params is not None:
         raise InputError(f"{where}: params", params, "a parameter file path or a mapping")

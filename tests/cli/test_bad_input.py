@@ -643,3 +643,11 @@ def test_a_parameter_file_of_more_than_one_mebibyte_is_refused_before_it_is_pars
     path.write_text("table: {mass: 3}\n" + "# padding\n" * (MAX_INPUT_BYTES // 10 - 10))  # just under: read
     code, _, err = _run(["params", "--check", str(path)], capsys)
     assert "at most" not in err
+
+
+def test_an_empty_mapping_as_parameter_file_is_refused_not_read_as_all_defaults(tmp_path, capsys):
+    path = tmp_path / "p.yaml"
+    path.write_text("{}  # nothing\n")
+    code, _, err = _run(["simulate", "--params", str(path), "--load-case", "0", "--out", str(tmp_path / "o")], capsys)
+    _one_line_exit_2(code, err, "got 'an empty mapping ({})'; allowed: a YAML mapping of parameter groups")
+    assert not (tmp_path / "o").exists()

@@ -77,7 +77,7 @@ def test_params_prints_loadable_yaml(tmp_path, capsys):
 
 def test_diagram_of_a_params_file_without_load_cases(tmp_path, capsys):
     """'load_case: got 3' named an option diagram does not have; the drawing does not depend on the load case."""
-    (tmp_path / "p.yaml").write_text("{}\n")
+    (tmp_path / "p.yaml").write_text("screw: {lead: 0.005}\n")  # defaults but the lead: no load cases
     assert main(["diagram", "--params", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "d.dot")]) == 0
     assert "CascadeController" in (tmp_path / "d.dot").read_text()
     capsys.readouterr()

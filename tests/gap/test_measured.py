@@ -281,6 +281,21 @@ def test_params_file_relative_to_metadata(tmp_path):
     assert data.meta.params.screw.lead == 4e-3
 
 
+def test_an_empty_params_mapping_or_file_is_refused_not_read_as_the_default_rig(tmp_path):
+    with pytest.raises(InputError, match=r"run.yaml: params: got 'an empty mapping \(\{\}\)'"):
+        load_measured(_write(tmp_path, meta={**META, "params": {}}))
+    (tmp_path / "rig.yaml").write_text("{}\n")
+    with pytest.raises(InputError, match=r"rig.yaml: got 'an empty mapping \(\{\}\)'; allowed: a YAML mapping of "
+                                         "parameter groups"):
+        load_measured(_write(tmp_path, meta={**META, "params": "rig.yaml"}))
+
+
+def test_the_metadata_named_as_its_own_params_file_is_said_to_be_metadata(tmp_path):
+    with pytest.raises(InputError, match="run.yaml: got \"a measured run's metadata file \\(it has u_units\\)\"; "
+                                         "allowed: a drakecreep params file"):
+        load_measured(_write(tmp_path, meta={**META, "params": "run.yaml"}))
+
+
 def test_row_length_mismatch(tmp_path):
     path = _write(tmp_path)
     lines = path.read_text().splitlines()
