@@ -152,6 +152,10 @@ def _finite(name, value, lo=None, lo_open=False, hi=None):
     return x
 
 
+#: :class:`ControllerMeta`'s fields of the P-P law alone (refused for kind ``drakecreep`` unless at their defaults)
+_P_P_FIELDS = ("kp", "kv", "saturation", "position_filter")
+
+
 @dataclass(frozen=True)
 class ControllerMeta:
     """The controller that produced ``u`` during the run.
@@ -164,7 +168,8 @@ class ControllerMeta:
 
     with ``x`` the motor encoder (``feedback="motor"``) or the scale (``"table"``); ``u`` is held over
     the sample. ``kind="drakecreep"`` means the project's own cascade with the gains of
-    ``params.controller`` (the other fields are then unused).
+    ``params.controller``: the P-P law's ``kp``, ``kv``, ``saturation`` and ``position_filter`` are refused for it
+    (:meth:`from_dict`) unless left at their defaults, and ``sample_time`` is unused.
 
     Parameters
     ----------
@@ -198,8 +203,13 @@ class ControllerMeta:
         if self.feedback not in ("motor", "table"):
             raise InputError("controller.feedback", self.feedback, "one of motor, table")
         for name in ("kp", "kv"):
+            value = getattr(self, name)
+            if self.kind == "p_p_cascade" and isinstance(value, (int, float)) and not isinstance(value, bool) \
+                    and value < 0:  # said '>= 0.0', while 0 is refused below as needing '> 0'
+                raise InputError(f"controller.{name}", value,
+                                 "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
             # bounded as u_gain is: a gain of 1e300 replayed to overflow
-            object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), 0.0, hi=MAX_GAIN))
+            object.__setattr__(self, name, _finite(f"controller.{name}", value, 0.0, hi=MAX_GAIN))
             if self.kind == "p_p_cascade" and getattr(self, name) == 0.0:
                 # Left out, a gain reads as 0: a P-P cascade without its position or velocity gain cannot
                 # have produced a tracking run, and its replay would diagnose an open loop.
@@ -244,8 +254,11 @@ class ControllerMeta:
                 f"({taps}) over {self.sample_time:g} s")
 
     def to_dict(self):
-        """YAML-ready mapping."""
+        """YAML-ready mapping (without the P-P law's fields for kind ``drakecreep``)."""
         d = dataclasses.asdict(self)
+        if self.kind != "p_p_cascade":
+            d = {k: v for k, v in d.items() if k not in _P_P_FIELDS}
+            return d
         d["position_filter"] = list(self.position_filter)
         if math.isinf(self.saturation):
             d["saturation"] = ".inf"
@@ -268,6 +281,16 @@ class ControllerMeta:
                 if name not in data:
                     raise InputError(f"controller.{name}", "nothing (the key is missing)",
                                      "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
+        else:
+            # the P-P law's fields mean nothing for the project's cascade, whose gains are the params file's: a kp
+            # given here was ignored without a word (the defaults, which to_dict of an older version wrote, pass)
+            made = cls(**data)
+            for name in _P_P_FIELDS:
+                if name in data and getattr(made, name) != getattr(cls, name):
+                    raise InputError(f"controller.{name}", data[name],
+                                     f"nothing for kind {made.kind}: its gains and periods are the params file's "
+                                     "controller group (kp, kv, saturation and position_filter are the P-P law's)")
+            return made
         return cls(**data)
 
 

@@ -405,6 +405,21 @@ def test_bad_controller_metadata(tmp_path):
             load_measured(_write(tmp_path, meta=bad))
 
 
+def test_the_p_p_laws_fields_are_refused_for_the_projects_cascade_unless_at_their_defaults(tmp_path):
+    own = {"kind": "drakecreep", "sample_time": 0.001}
+    for name, value in (("kp", 5.0), ("kv", 200.0), ("saturation", 10.0), ("position_filter", [0.5, 0.5])):
+        with pytest.raises(InputError, match=f"controller.{name}: got .*; allowed: nothing for kind drakecreep: its "
+                                             "gains and periods are the params file's controller group"):
+            ControllerMeta.from_dict({**own, name: value})
+    # the defaults (an older to_dict wrote them) are read; to_dict leaves the P-P law's fields out
+    old = ControllerMeta.from_dict({**own, "kp": 0.0, "kv": 0.0, "saturation": ".inf", "position_filter": [1.0]})
+    assert old == ControllerMeta.from_dict(own)
+    assert set(old.to_dict()) == {"kind", "sample_time", "feedback"}
+    assert ControllerMeta.from_dict(old.to_dict()) == old
+    with pytest.raises(InputError, match="controller.kp: got -160.18; allowed: a number > 0 .the P-P cascade's gain"):
+        ControllerMeta.from_dict({**META["controller"], "kp": -160.18})  # said '>= 0.0', while 0 needs '> 0'
+
+
 def test_several_runs_and_round_trip(tmp_path):
     a, b = _rows(12), _rows(15, dt=2e-3)
     b["t"] = b["t"] + 5.0
