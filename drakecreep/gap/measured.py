@@ -123,6 +123,9 @@ _SATURATION_SLACK = 2.0
 #: in a stick test of a few micrometres the motor winds the screw up (100 N of friction on 50 N/um is 2 um)
 #: while the table may hardly move
 _TRAVEL_FACTOR = 100.0
+#: a P-P run's sample time and its controller's ``sample_time`` this far apart are refused on loading, before the gain
+#: fit (a time column in ms or min under a header in s); a smaller mismatch is refused by the replay, run by run
+_SAMPLE_TIME_FACTOR = 10.0
 #: Largest factor between a declared P-P gain and the one the recorded ``u`` follows (:func:`controller_gains`):
 #: a gain in the wrong unit (per mm/s for per m/s, a mistyped exponent) is off by decades; noise, quantization
 #: and a computation delay move the fitted gains by per cent (EMPS: 0.02 % and 0.03 %)
@@ -782,6 +785,12 @@ def check_recorded(run):
                              f"{np.ptp(b):.4g} m", f"a travel within a factor of {_TRAVEL_FACTOR:g} of {against}'s "
                              f"({what}; is the unit of one of them wrong?)")
     if ctrl is not None and ctrl.kind == "p_p_cascade":
+        if not 1.0 / _SAMPLE_TIME_FACTOR <= run.dt / ctrl.sample_time <= _SAMPLE_TIME_FACTOR:
+            # decades apart: the time column in another unit, which the gain fit below blamed on kv (a small
+            # mismatch is the replay's to refuse, run by run: drake_replay.check_replayable)
+            raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
+                             f"the run's sample time {run.dt:g} s, within a factor of {_SAMPLE_TIME_FACTOR:g} (is the "
+                             "unit of t wrong?)")
         fitted = controller_gains(run)
         if fitted is not None:
             kp, kv, lag, misfit = fitted

@@ -420,6 +420,15 @@ def test_the_p_p_laws_fields_are_refused_for_the_projects_cascade_unless_at_thei
         ControllerMeta.from_dict({**META["controller"], "kp": -160.18})  # said '>= 0.0', while 0 needs '> 0'
 
 
+def test_a_time_column_in_another_unit_is_named_by_the_sample_time_not_by_a_gain(tmp_path):
+    rows = _rows(n=200)
+    rows["u"] = _law(rows["x_ref"], rows["x_motor"])
+    rows["t"] = np.arange(200) * 1.0  # milliseconds under a header that says seconds
+    with pytest.raises(InputError, match=r"controller.sample_time \(run run\): got 0.001; allowed: the run's sample "
+                                         r"time 1 s, within a factor of 10 \(is the unit of t wrong\?\)"):
+        load_measured(_write(tmp_path, cols=rows))
+
+
 def test_several_runs_and_round_trip(tmp_path):
     a, b = _rows(12), _rows(15, dt=2e-3)
     b["t"] = b["t"] + 5.0
