@@ -682,6 +682,10 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
                          "columns among " + ", ".join(COLUMNS) + " (or map the file's names in file.columns)")
     missing = [c for c, (_, req) in COLUMNS.items() if req and c not in signals]
     if missing:
+        if isinstance(file_opts, dict) and file_opts.get("columns"):  # the header's names are not read then
+            raise InputError(f"{meta_path}: file.columns", ", ".join(signals),
+                             "a mapping that names the columns of " + ", ".join(missing) + " as well (with "
+                             "file.columns every signal is read from the column it names, none by the header)")
         raise InputError(f"{csv_path}: header", ",".join(signals), "the columns " + ", ".join(missing) + " as well")
     n_rows = len(next(iter(signals.values())))
     if n_rows < 1:

@@ -244,6 +244,14 @@ def test_other_formats_with_a_column_mapping(tmp_path, suffix):
         np.testing.assert_allclose(getattr(run, name), getattr(reference, name), rtol=1e-12, atol=1e-15)
 
 
+def test_a_mapping_that_leaves_signals_out_names_file_columns(tmp_path):
+    # the header names every signal, but a mapping replaces the header's names: the missing ones are named there
+    meta = {**META, "file": {"columns": {"x_ref": "x_motor"}}}
+    with pytest.raises(InputError, match=r"run.yaml: file.columns: got 'x_ref'; allowed: a mapping that names the "
+                                         r"columns of t, x_motor, u as well \(with file.columns every signal"):
+        load_measured(_write(tmp_path, meta=meta))
+
+
 def test_a_mapping_to_a_missing_column_names_it(tmp_path):
     path = _write(tmp_path)
     meta = {**META, "file": {"columns": {"t": "time"}}}
