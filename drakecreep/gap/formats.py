@@ -97,6 +97,11 @@ def _mat_frame(path, mat, wanted):
             columns[name] = a.astype(float).ravel()
         else:  # a scalar (a gain, a setting) stays out of the columns; named only if it is a signal's name
             refused[name] = (f"{a.size} value{'s' if a.size != 1 else ''}", "a vector of the run's samples")
+    if not columns and refused:  # a struct or cells holding the run: 'no data; allowed: a header line' was CSV's word
+        got = ", ".join(f"{name}: {what}" for name, (what, _) in list(refused.items())[:5])
+        raise InputError(str(path), f"no numeric vector variable ({got})",
+                         "the run's signals as numeric vectors t, x_ref, x_motor, u, ... (structs and cells are not "
+                         "read: save their fields as variables, scipy.io.savemat or MATLAB's save -struct)")
     lengths = {a.size for a in columns.values()}
     longest = max(lengths, default=0)
     for name, a in columns.items():
@@ -124,6 +129,15 @@ def _frame(path, fmt, key, separator=None, decimal=None, run_column="run", wante
         return read_csv_frame(path, str(path), "a CSV with a header line and data rows", separator, decimal,
                               text_columns=(run_column,))  # run labels as written: 1 and 1.0 are two runs
     if fmt == "parquet":
+        try:
+            import pyarrow.parquet as pq
+
+            names = pq.read_schema(path).names
+        except Exception:  # noqa: BLE001 - not a Parquet file: read_parquet below says so
+            names = []
+        twice = next((name for i, name in enumerate(names) if name in names[:i]), None)
+        if twice is not None:  # pyarrow refuses the table as 'ArrowInvalid' (a CSV's repeated column is named)
+            raise InputError(f"{path}: header", twice, "each column once")
         try:
             return _with_index(pd.read_parquet(path))
         except Exception as err:  # noqa: BLE001 - pyarrow raises many types for a corrupt file

@@ -69,6 +69,25 @@ def test_a_mat_file_keeps_its_scalars_and_other_variables_out_of_the_columns(tmp
     assert sorted(read_signals(_mat(tmp_path, **variables), "N")) == ["t", "u", "x_motor", "x_ref"]
 
 
+def test_a_mat_file_whose_run_is_a_struct_says_so(tmp_path):
+    frame = _frame()
+    run = {k: frame[k].to_numpy() for k in frame}
+    with pytest.raises(InputError, match=r"run.mat: got 'no numeric vector variable \(run: a MATLAB struct array\)'; "
+                                         r"allowed: the run's signals as numeric vectors"):
+        read_signals(_mat(tmp_path, run=run), "N")  # it said 'no data; allowed: a header line and data rows'
+
+
+def test_a_parquet_column_named_twice_is_named(tmp_path):
+    pa = pytest.importorskip("pyarrow")
+    import pyarrow.parquet as pq
+
+    frame = _frame()
+    arrays = [pa.array(frame[k]) for k in ("t", "x_ref", "x_motor", "u")] + [pa.array(frame["x_motor"])]
+    pq.write_table(pa.Table.from_arrays(arrays, names=["t", "x_ref", "x_motor", "u", "x_motor"]), tmp_path / "r.parquet")
+    with pytest.raises(InputError, match="r.parquet: header: got 'x_motor'; allowed: each column once"):
+        read_signals(tmp_path / "r.parquet", "N")  # it said 'not a readable Parquet file (ArrowInvalid)'
+
+
 @pytest.mark.parametrize("suffix", [".parquet", ".h5"])
 def test_a_table_indexed_by_time_reads_its_index_as_the_column(tmp_path, suffix):
     """df.set_index('t').to_parquet(...) keeps t as the index: it was reported missing ('the columns t as well')."""
