@@ -21,6 +21,7 @@ nominal_params.yaml when the nominal fit ends and ranking.json after each candid
 diagnosis.json, summary.txt and augmented_params.yaml (for simulate, margins and report --params).
 """
 
+import os
 import sys
 from pathlib import Path
 
@@ -85,6 +86,11 @@ def run(args):
                              "metadata beside it) or an EMPS .mat ('estimation' / 'validation' name the benchmark's)")
         if path and path not in EMPS_FILES:
             regular_file(option, path)  # a folder was told 'metadata: got 'adir.yaml''
+    if args.score and (args.score == args.data or (args.score not in EMPS_FILES and args.data not in EMPS_FILES
+                                                   and os.path.samefile(args.score, args.data))):
+        # allowed (whole runs of the file, as the EMPS protocol replays them), but not a held-out score: said so
+        print(f"drakecreep diagnose: note: --score {args.score} is DATA itself: its runs include those the model is "
+              "fitted on, so its score is not a held-out one", file=sys.stderr, flush=True)
     runs = _in_file("", lambda data: load_runs(data, existing_path("--meta", args.meta), split=False), args.data,
                     {"meta": "--meta"})
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)

@@ -39,6 +39,8 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert cli.main(["diagnose", str(csv_file), "--train", "w0,w1,w2", "--test", "w3,w4,w5", "--effects",
                      "asymmetric_friction,thermal_drift", "--out", str(out), "--json", "--score", str(csv_file)]) == 0
     captured = capsys.readouterr()
+    assert "note: --score " + str(csv_file) + " is DATA itself: its runs include those the model is fitted on" \
+        in captured.err
     data = json.loads(captured.out)
     assert data["claimed"] == ["asymmetric_friction"]
     assert "volatile bar" not in " ".join(data["summary"])  # three training runs: no warning on the null
@@ -84,7 +86,7 @@ def test_diagnose_claims_the_withheld_effect_and_writes_model_and_report(csv_fil
     assert {"regimes", "bands", "independence", "split"} <= set(data["unexplained"])
     params, flexible, delay = load_model(out / "augmented_model.yaml")
     assert abs(params["viscous_asym"] + 40.0) < 10.0 and not flexible and delay == 0.0
-    # --score replays the augmented model, fixed, on the whole runs of another file
+    # --score replays the augmented model, fixed, on whole runs (here the file's own: said not to be held out)
     scored = data["scored"]
     assert set(scored["augmented"]) == {"w0", "w1", "w2", "w3", "w4", "w5"}
     assert all(scored["augmented"][k]["force"] < scored["nominal"][k]["force"] for k in scored["augmented"])
