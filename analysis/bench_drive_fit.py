@@ -88,8 +88,8 @@ def signals(duration):
     three = ("motor_angle", "table_position", "force_command")
     print(f"\ncompiled diagram, a {duration:g} s ramp, least CPU s of four with every signal in its output / with the "
           "three a replay reads (the same integrator and accuracy; the three agree to the bit):")
-    for (name, params), feed in itertools.product(
-            (("test rig", test_rig()), ("paper", preset("paper")), ("rigid_axis", preset("rigid_axis"))), (0.5e-3, 3e-3)):
+    rigs = (("test rig", test_rig()), ("paper", preset("paper")), ("rigid_axis", preset("rigid_axis")))
+    for (name, params), feed in itertools.product(rigs, (0.5e-3, 3e-3)):
         drive = build_diagram(params, Scenario(feed=feed, duration=duration))
         cpu, logged = {}, {}
         for names in (None, three) * 4:  # alternately, four times each: the least CPU time of each
@@ -106,8 +106,8 @@ def signals(duration):
             data = log.FindLog(context).data()
             logged[names] = np.array([data[compiled.signal_names.index(n)] for n in three])
         same = np.array_equal(logged[None], logged[three])
-        print(f"{name:12s} {1e3 * feed:3.1f} mm/s {len(drive.signal_names):2d} signals {cpu[None]:6.2f} / 3 signals {cpu[three]:6.2f}: "
-              f"{cpu[None] / cpu[three]:.2f} x; {'to the bit' if same else 'DIFFERENT'}", flush=True)
+        print(f"{name:12s} {1e3 * feed:3.1f} mm/s {len(drive.signal_names):2d} signals {cpu[None]:6.2f} / 3 signals "
+              f"{cpu[three]:6.2f}: {cpu[None] / cpu[three]:.2f} x; {'to the bit' if same else 'DIFFERENT'}", flush=True)
 
 
 def coulomb_truth(rig):

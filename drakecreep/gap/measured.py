@@ -260,8 +260,7 @@ class ControllerMeta:
         """YAML-ready mapping (without the P-P law's fields for kind ``drakecreep``)."""
         d = dataclasses.asdict(self)
         if self.kind != "p_p_cascade":
-            d = {k: v for k, v in d.items() if k not in _P_P_FIELDS}
-            return d
+            return {k: v for k, v in d.items() if k not in _P_P_FIELDS}
         d["position_filter"] = list(self.position_filter)
         if math.isinf(self.saturation):
             d["saturation"] = ".inf"

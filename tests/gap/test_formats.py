@@ -83,7 +83,8 @@ def test_a_parquet_column_named_twice_is_named(tmp_path):
 
     frame = _frame()
     arrays = [pa.array(frame[k]) for k in ("t", "x_ref", "x_motor", "u")] + [pa.array(frame["x_motor"])]
-    pq.write_table(pa.Table.from_arrays(arrays, names=["t", "x_ref", "x_motor", "u", "x_motor"]), tmp_path / "r.parquet")
+    table = pa.Table.from_arrays(arrays, names=["t", "x_ref", "x_motor", "u", "x_motor"])
+    pq.write_table(table, tmp_path / "r.parquet")
     with pytest.raises(InputError, match="r.parquet: header: got 'x_motor'; allowed: each column once"):
         read_signals(tmp_path / "r.parquet", "N")  # it said 'not a readable Parquet file (ArrowInvalid)'
 
