@@ -1,5 +1,6 @@
 import os
 import signal
+from pathlib import Path
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
@@ -29,3 +30,27 @@ def ctrl_c_as_at_a_terminal():
     before = signal.signal(signal.SIGINT, signal.default_int_handler)
     yield
     signal.signal(signal.SIGINT, before)
+
+
+#: the test files that take longest (20-330 s each on one of two cores, session 66's ``--durations=0``), longest
+#: first: with ``--dist loadfile`` a worker takes whole files in the order collected, and a long file collected in
+#: the middle of the suite (test_drive_fit.py, a third of all the test time) left the other worker idle at the end
+LONGEST_FIRST = ("gap/test_drive_fit.py", "gap/test_benchmark.py", "studies/test_compensation.py",
+                 "gap/test_drake_diagnosis.py", "test_analysis_scripts.py", "report/test_loop_report.py",
+                 "cli/test_diagnose_drakecreep.py", "servo/test_tuning.py", "gap/test_screen.py",
+                 "sim/test_sweep_faults.py", "sim/test_sweep.py", "cli/test_gap_benchmark.py")
+
+
+def pytest_collection_modifyitems(config, items):
+    """Collect :data:`LONGEST_FIRST` first, longest first; every other file after them in its own order (a stable
+    sort: each file's tests stay together and in order, so its module fixtures are still built once)."""
+    root = Path(__file__).parent
+
+    def rank(item):
+        try:
+            name = Path(item.path).relative_to(root).as_posix()
+        except ValueError:
+            return len(LONGEST_FIRST)
+        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+
+    items.sort(key=rank)
