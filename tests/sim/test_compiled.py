@@ -1,4 +1,8 @@
 import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import LogVectorOutput
 
 from drakecreep.sim.compiled import compile_diagram, symbolic_equations
 from drakecreep.model.diagram import build_diagram
@@ -40,11 +44,6 @@ def test_continuous_controller_compiles_without_discrete_state(paper):
 
 
 def test_a_compiled_diagram_of_some_signals_simulates_them_to_the_same_bits(paper):
-    from pydrake.systems.analysis import Simulator
-    from pydrake.systems.primitives import LogVectorOutput
-    from pydrake.systems.framework import DiagramBuilder
-    import pytest
-
     drive = build_diagram(paper, Scenario(feed=1e-3, duration=0.05))
     some = ("force_command", "motor_angle", "nut_friction_force")
     logged = {}
