@@ -446,6 +446,14 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         tight = max(accuracy / 10.0, _ACCURACY_FLOOR)
         probe = _run(params, scenario, built, tight, end, wall_limit, notice)
         wall += probe.wall_time
+        if probe.status.startswith("interrupted"):
+            # a Ctrl-C or SIGTERM stops the command here too: it was read as a disagreement, the whole run was
+            # simulated again at the tighter accuracy and the command ended 'converged' (exit 0). The run is kept,
+            # its convergence unknown
+            result.status = f"{probe.status} in the convergence check (the run itself is complete, not checked)"
+            result.wall_time = wall
+            result.stats.update(accuracy=accuracy, convergence_check_accuracy=tight, convergence_runs=attempts)
+            return result
         agree, change, same_verdict = _agree(result, probe, end, sim.convergence_tolerance)
         attempts += 1
         if agree or attempts == 2 or tight == accuracy:
@@ -454,7 +462,7 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         accuracy = tight
         result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice)
         wall += result.wall_time
-        if result.metrics is None:
+        if result.metrics is None or not result.ok:  # (an interrupted rerun is not checked again either)
             break
     if result.metrics is not None:
         result.metrics = replace(result.metrics, converged=bool(agree))

@@ -161,6 +161,24 @@ def test_convergence_check_catches_a_missed_stick_slip(short_paper):
     assert summary["converged"] is True and summary["creep"] is True
 
 
+def test_a_ctrl_c_or_sigterm_in_the_convergence_check_stops_the_run_unchecked(short_paper, monkeypatch):
+    """It was read as a disagreement: the whole run simulated again at the tighter accuracy, 'converged', exit 0."""
+    calls, run = [], simulation._run
+
+    def interrupted_second(*args, **kwargs):
+        calls.append(args[3])  # the accuracy
+        out = run(*args, **kwargs)
+        if len(calls) == 2:  # the convergence check's probe, as a SIGTERM leaves it
+            out.status = "interrupted (SIGTERM) at t = 0.1 s"
+        return out
+
+    monkeypatch.setattr(simulation, "_run", interrupted_second)
+    r = simulate(short_paper, Scenario(feed=1e-4, load_case=3, duration=0.5))
+    assert len(calls) == 2 and calls[1] < calls[0]  # the run, then its tighter probe; no rerun
+    assert r.status.startswith("interrupted (SIGTERM)") and "in the convergence check" in r.status
+    assert r.metrics is not None and r.metrics.converged is None  # kept, and said not checked
+
+
 def test_convergence_check_reports_disagreement_and_can_be_off(short_paper):
     p = with_value(short_paper, "simulation.convergence_tolerance", 1e-9)  # no two accuracies agree to 1e-12 m/s
     r = simulate(p, Scenario(feed=1e-4, load_case=3, duration=0.5))
