@@ -205,15 +205,13 @@ class ControllerMeta:
             raise InputError("controller.kind", self.kind, "one of " + ", ".join(CONTROLLER_KINDS))
         if self.feedback not in ("motor", "table"):
             raise InputError("controller.feedback", self.feedback, "one of motor, table")
+        p_p = self.kind == "p_p_cascade"
         for name in ("kp", "kv"):
-            value = getattr(self, name)
-            if self.kind == "p_p_cascade" and isinstance(value, (int, float)) and not isinstance(value, bool) \
-                    and value < 0:  # said '>= 0.0', while 0 is refused below as needing '> 0'
-                raise InputError(f"controller.{name}", value,
-                                 "a number > 0 (the P-P cascade's gain; required for kind p_p_cascade)")
-            # bounded as u_gain is: a gain of 1e300 replayed to overflow
-            object.__setattr__(self, name, _finite(f"controller.{name}", value, 0.0, hi=MAX_GAIN))
-            if self.kind == "p_p_cascade" and getattr(self, name) == 0.0:
+            # bounded as u_gain is: a gain of 1e300 replayed to overflow; a P-P gain's sign is checked below, with
+            # its zero (a negative one was told '>= 0.0', while 0 needs '> 0')
+            object.__setattr__(self, name, _finite(f"controller.{name}", getattr(self, name), None if p_p else 0.0,
+                                                   hi=MAX_GAIN))
+            if p_p and getattr(self, name) <= 0.0:
                 # Left out, a gain reads as 0: a P-P cascade without its position or velocity gain cannot
                 # have produced a tracking run, and its replay would diagnose an open loop.
                 raise InputError(f"controller.{name}", getattr(self, name),

@@ -65,7 +65,17 @@ def symbolic_equations(feed_drive, inputs=(), signals=None):
     Returns
     -------
     SymbolicEquations
+
+    Raises
+    ------
+    ValueError
+        A name in ``signals`` that is not a signal of ``feed_drive``, or one named twice.
     """
+    if signals is not None:
+        unknown = [n for n in signals if n not in feed_drive.signal_names]
+        if unknown or len(set(signals)) < len(signals):
+            raise ValueError(f"signals: got {list(signals)}; allowed: distinct names among "
+                             + ", ".join(feed_drive.signal_names))
     diagram = feed_drive.diagram
     context0 = diagram.CreateDefaultContext()
     xc0 = context0.get_continuous_state_vector().CopyToVector()
@@ -175,13 +185,8 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
     Raises
     ------
     ValueError
-        A name in ``signals`` that is not a signal of ``feed_drive``, or one named twice.
+        As :func:`symbolic_equations`: a name in ``signals`` that is not a signal of ``feed_drive``, or one named twice.
     """
-    if signals is not None:
-        unknown = [n for n in signals if n not in feed_drive.signal_names]
-        if unknown or len(set(signals)) < len(signals):
-            raise ValueError(f"signals: got {list(signals)}; allowed: distinct names among "
-                             + ", ".join(feed_drive.signal_names))
     eq = symbolic_equations(feed_drive, inputs, signals)
     nu = len(eq.inputs)
     builder = DiagramBuilder()
