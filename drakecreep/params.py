@@ -235,6 +235,17 @@ MIN_SAMPLE_PERIOD = 1e-9
 #: the finest. At 1e-300 m the force limit 2 pi peak_torque / lead and the motor's speed feed 2 pi / lead left every
 #: float: simulate reported a still table and creep, exit 0, and margins, tune and report blamed '--feed: got 1.0'
 MIN_LEAD = 1e-4
+#: lightest table [kg], the lower end of ``table.mass``'s range: a gram, four decades below a feed drive's table
+#: (10-1000 kg; the paper's rig about 40 kg). At 1e-30 kg ``margins`` printed a damping ratio of 5e13 and negative
+#: margins, ``critical`` a creep verdict, and ``simulate`` stopped after 1 ms with a divergence; 1e-3 kg runs
+MIN_TABLE_MASS = 1e-3
+#: shortest current-loop time constant [s] other than 0 (ideal): a microsecond, two decades below a PWM drive's
+#: current loop (bandwidth 400-1600 Hz, 1e-4 to 4e-4 s). At 1e-15 s ``simulate`` diverged after 1 ms and
+#: ``margins`` overflowed; 1e-6 s runs (34 s for 1.5 s simulated), 0 is the ideal loop
+MIN_CURRENT_LOOP_TIME_CONSTANT = 1e-6
+#: tightest integrator target accuracy [-] other than 0 (the friction law's default): near a double's rounding of
+#: the scaled states; at 1e-300 ``simulate`` diverged after 1 ms (1e-12 runs, in about a minute per 1.5 s)
+MIN_ACCURACY = 1e-12
 #: most load cases a parameter set may define: a drive is tested under a handful (the paper's Table 7 has 3), and a
 #: file of 100 000 cases was read, built and checked for 49 s before a command said anything
 MAX_LOAD_CASES = 1000
@@ -329,6 +340,12 @@ class MotorParams(_Params):
     )
     viscous_damping: float = _q(1.0e-4, "N m s/rad", 0.0, doc="motor and bearing viscous drag")
 
+    def _check(self):
+        tau = self.current_loop_time_constant
+        if 0.0 < tau < MIN_CURRENT_LOOP_TIME_CONSTANT:
+            raise InputError("current_loop_time_constant", tau, f"0 (ideal) or a finite number in "
+                             f"[{MIN_CURRENT_LOOP_TIME_CONSTANT:g}, 0.1] s (a current loop is 1e-4 s to 4e-4 s)")
+
 
 @dataclass(frozen=True)
 class ScrewParams(_Params):
@@ -406,7 +423,7 @@ class NutParams(_Params):
 class TableParams(_Params):
     """Table (workbench) on rolling guides."""
 
-    mass: float = _q(40.0, "kg", 0.0, 1e5, lo_open=True, doc="table, nut seat and sliders")
+    mass: float = _q(40.0, "kg", MIN_TABLE_MASS, 1e5, doc="table, nut seat and sliders")
     guide_friction_coefficient: float = _q(0.003, "-", 0.0, 1.0, doc="rolling guides, per N of normal load")
     seal_force: float = _q(4.0, "N", 0.0, doc="seal and wiper drag of the slider blocks")
 
@@ -555,6 +572,11 @@ class SimulationParams(_Params):
     convergence_tolerance: float = _q(
         0.1, "-", 0.0, 10.0, lo_open=True, doc="largest fluctuation change accepted by the check, x feed"
     )
+
+    def _check(self):
+        if 0.0 < self.accuracy < MIN_ACCURACY:
+            raise InputError("accuracy", self.accuracy, f"0 (the friction law's default) or a finite number in "
+                             f"[{MIN_ACCURACY:g}, 0.1]")
 
 
 @dataclass(frozen=True)

@@ -95,7 +95,14 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
 @pytest.mark.parametrize(
     "data, field, fragment",
     [
-        ({"table": {"mass": -1.0}}, "table.mass", "(0.0, 100000.0] kg"),
+        ({"table": {"mass": -1.0}}, "table.mass", "[0.001, 100000.0] kg"),
+        # 1e-30 kg: margins printed a damping ratio of 5e13 and negative margins, critical a creep verdict
+        ({"table": {"mass": 1e-30}, "nut": {"mass": 0.0}}, "table.mass", "got 1e-30; allowed: a finite number in [0.001"),
+        # 1e-15 s: simulate diverged after 1 ms, margins overflowed; 0 (ideal) and 1e-6 s load
+        ({"motor": {"current_loop_time_constant": 1e-15}}, "motor.current_loop_time_constant",
+         "got 1e-15; allowed: 0 (ideal) or a finite number in [1e-06, 0.1] s"),
+        ({"simulation": {"accuracy": 1e-300}}, "simulation.accuracy",
+         "got 1e-300; allowed: 0 (the friction law's default) or a finite number in [1e-12, 0.1]"),
         ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
         # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
         ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),
@@ -134,6 +141,14 @@ def test_invalid_values_name_field_value_and_range(data, field, fragment):
     assert info.value.field == field
     assert fragment in str(info.value)
     assert "\n" not in str(info.value)
+
+
+def test_the_lower_ends_themselves_and_the_zeros_that_mean_ideal_load():
+    p = params_from_dict({"table": {"mass": 1e-3}, "motor": {"current_loop_time_constant": 1e-6},
+                          "simulation": {"accuracy": 1e-12}})
+    assert (p.table.mass, p.motor.current_loop_time_constant, p.simulation.accuracy) == (1e-3, 1e-6, 1e-12)
+    p = params_from_dict({"motor": {"current_loop_time_constant": 0.0}, "simulation": {"accuracy": 0.0}})
+    assert (p.motor.current_loop_time_constant, p.simulation.accuracy) == (0.0, 0.0)
 
 
 def test_load_cases_are_capped_before_they_are_built():

@@ -54,7 +54,7 @@ from drakecreep.sim.metrics import feed_metrics
 from drakecreep.params import save_params
 from drakecreep.scenario import MAX_FEED
 
-__all__ = ["SimulationResult", "simulate", "make_simulator", "check_run", "check_log_period", "check_step_budget",
+__all__ = ["SimulationResult", "simulate", "make_simulator", "integration_failure", "check_run", "check_log_period", "check_step_budget",
            "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS",
            "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE", "slow_run_notice"]
 
@@ -245,6 +245,18 @@ def _unit_tag(unit):
     return unit.replace(" ", "").replace("/", "_per_").replace("^", "")
 
 
+def integration_failure(err):
+    """One line for a Drake integrator's ``RuntimeError`` ``err``: its first line; when the step-size control gave
+    up, a divergence with the first sentence of Drake's message (it goes on with several sentences of advice, and
+    was cut off mid-sentence)."""
+    text = str(err).strip()
+    first = text.splitlines()[0] if text else type(err).__name__
+    if "minimum" in first.lower() and "step" in first.lower():
+        sentence = first.split(". ")[0].rstrip(".")
+        return f"diverged: the integrator needed a step below {MIN_STEP:g} s ({sentence})"
+    return first
+
+
 def make_simulator(system, context, sim, accuracy=None, integrator=None):
     """A Drake ``Simulator`` configured from :class:`~drakecreep.params.SimulationParams`.
 
@@ -289,8 +301,9 @@ def slow_run_notice(t, until, elapsed, steps, integrator):
     line = (f"slow run: {t:.3g} of {until:g} s simulated in {elapsed:.0f} s of computing, about "
             f"{projected / 60.0:.0f} min in all at this pace (mean step {t / steps:.2g} s, {integrator})")
     if integrator not in _IMPLICIT:
-        line += ("; an explicit integrator on stiff friction (LuGre bristles at a high speed) steps far below the "
-                 "controller's period: simulation.integrator: radau3 in a --params file steps over it")
+        line += ("; an explicit integrator on stiff friction (LuGre bristles at a high speed, a small "
+                 "friction.regularization_velocity) steps far below the controller's period: simulation.integrator: "
+                 "radau3 in a --params file steps over it")
     return line + "; --max-wall S stops the run and keeps what was computed"
 
 
@@ -609,10 +622,7 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None, notice=None)
     try:
         simulator.AdvanceTo(until)  # the log's periodic publish lands on `until` too
     except RuntimeError as err:
-        first = str(err).splitlines()[0] if str(err) else type(err).__name__
-        if "minimum" in first.lower() and "step" in first.lower():
-            first = f"diverged: the integrator needed a step below {MIN_STEP:g} s ({first[:120]})"
-        status = f"integration stopped at t = {context.get_time():.6g} s: {first}"
+        status = f"integration stopped at t = {context.get_time():.6g} s: {integration_failure(err)}"
     except KeyboardInterrupt as err:
         why = "SIGTERM" if isinstance(err, Terminated) else "Ctrl-C"
         status = f"interrupted ({why}) at t = {context.get_time():.6g} s"

@@ -80,6 +80,18 @@ def test_a_failing_run_keeps_what_was_computed(short_paper, monkeypatch):
     assert r.metrics is not None and r.metrics.window_end == pytest.approx(0.5, abs=1e-3)
 
 
+def test_a_divergence_is_said_in_drakes_first_sentence_not_cut_off_mid_word():
+    """Drake's step-size failure goes on with several sentences of advice; the status was its first 120 characters
+    ('... This is typically an indication that some part ')."""
+    drake = RuntimeError("Error control wants to select step smaller than minimum allowed (1e-09). This is typically "
+                         "an indication that some part of your system *with continuous state* is going unstable "
+                         "and/or is producing excessively large derivatives.\nmore")
+    assert simulation.integration_failure(drake) == ("diverged: the integrator needed a step below 1e-09 s (Error "
+                                                     "control wants to select step smaller than minimum allowed (1e-09))")
+    assert simulation.integration_failure(RuntimeError("gave up. Here.\nmore")) == "gave up. Here."
+    assert simulation.integration_failure(RuntimeError()) == "RuntimeError"
+
+
 def test_bad_scenarios():
     with pytest.raises(InputError, match="feed"):
         Scenario(feed=0.0)
