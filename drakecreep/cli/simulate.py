@@ -114,6 +114,8 @@ def run(args):
                                                         flush=True))
     result = simulate(params, scenario, backend=args.backend, wall_limit=args.max_wall, model=args.model,
                       multibody=multibody, notice=notice)
+    if result.metrics is not None and result.metrics.creep:
+        _no_verdict_when_overloaded(result, params, scenario)
     extra = {}
     if not args.no_plot and len(result.time) > 1:
         from drakecreep.report.plots import plot_feed
@@ -141,7 +143,7 @@ def run(args):
     if args.json:
         print_json(summary)
     else:
-        _print_text(result, paths)
+        _print_text(summary, result, paths)
         if study is not None:
             row = study.summary.iloc[0]
             print(f"plausible rigs ({spec.source}, seed {args.seed}): {share_line(row)}; "
@@ -154,8 +156,19 @@ def run(args):
     return 0
 
 
-def _print_text(result, paths):
-    s = result.summary()
+def _no_verdict_when_overloaded(result, params, scenario):
+    """A table that does not slide because the drive cannot hold the feed is no stick-slip: the run's summary
+    (printed, and in metrics.json) says ``creep: null`` and an ``overload`` of ``force_N`` beyond ``limit_N`` (a
+    1e-30 N m drive was reported as creeping, 100 % stuck without a cycle, where ``margins`` refused the feed). Only
+    after a run that sticks: the servo layer imports python-control, 1.3 s."""
+    from drakecreep.servo.linearize import sliding_overload
+
+    overload = sliding_overload(params, scenario)
+    if overload is not None:
+        result.stats.update(creep=None, overload={"force_N": float(overload[0]), "limit_N": float(overload[1])})
+
+
+def _print_text(s, result, paths):
     model = ""
     if s.get("model") == "multibody":
         joints = "rigid fixed joints" if s["rigid_joints"] else "fixed joints of Tables 1-2"
@@ -171,7 +184,7 @@ def _print_text(result, paths):
             ("table speed min / max", f"{s['min_speed_mm_s']:.5f} / {s['max_speed_mm_s']:.5f} mm/s"),
             ("stick fraction", f"{s['stick_fraction'] * 100:.2f} %"),
             ("stick-slip cycles", f"{s['stick_slip_cycles']} ({s['stick_slip_frequency_Hz']:.1f} Hz)"),
-            ("creep (stick-slip)", "yes" if s["creep"] else "no"),
+            ("creep (stick-slip)", _creep_text(s)),
             ("converged", _converged_text(s)),
             ("travel error max / rms", f"{s['following_error_max_um']:.3f} / {s['following_error_rms_um']:.3f} um"),
         ]
@@ -179,6 +192,14 @@ def _print_text(result, paths):
         for name, value in rows:
             print(f"  {name:<{width}}  {value}")
     print("wrote " + ", ".join(str(p) for p in paths.values()))
+
+
+def _creep_text(summary):
+    overload = summary.get("overload")
+    if overload is not None:
+        return (f"no verdict: the drive cannot hold this feed (it takes {overload['force_N']:.4g} N, beyond its force "
+                f"limit {overload['limit_N']:.4g} N: motor.peak_torque through screw.lead)")
+    return "yes" if summary["creep"] else "no"
 
 
 def _converged_text(summary):

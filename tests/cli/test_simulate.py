@@ -1,5 +1,9 @@
 """``drakecreep simulate``'s words for the convergence check (drakecreep.cli.simulate)."""
 
+import math
+
+import pytest
+
 from drakecreep.cli.simulate import _converged_text
 
 
@@ -22,3 +26,30 @@ def test_a_run_whose_verdict_flipped_says_so():
     failed = _converged_text(dict(converged=False, accuracy=1e-4, convergence_verdict_agrees=None,
                                   convergence_fluctuation_change_mm_s=None))
     assert "failed" in failed
+
+
+def test_a_drive_that_cannot_hold_the_feed_gets_no_creep_verdict(tmp_path, capsys):
+    """A 1 mN m drive against the paper rig's 119 N at load case 0: the table never slides, which is no stick-slip
+    (it was reported 'creep yes', 100 % stuck without a cycle). The text, the JSON and metrics.json say why."""
+    import json
+
+    from drakecreep import cli
+    from drakecreep.params import preset, save_params, with_value
+
+    path = tmp_path / "weak.yaml"
+    save_params(with_value(with_value(preset("paper"), "motor.peak_torque", 1e-3), "simulation.steady_start", 0.2), path)
+    args = ["simulate", "--params", str(path), "--load-case", "0", "--duration", "0.3", "--no-plot"]
+    assert cli.main(args + ["--out", str(tmp_path / "a")]) == 0
+    out = capsys.readouterr().out
+    assert "creep (stick-slip)      no verdict: the drive cannot hold this feed (it takes 118.6 N, beyond its force " \
+           "limit 1.257 N" in out and "stick fraction          100.00 %" in out
+    assert cli.main(args + ["--out", str(tmp_path / "b"), "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    kept = json.loads((tmp_path / "b" / "metrics.json").read_text())["summary"]
+    for s in (said, kept):
+        assert s["creep"] is None and s["overload"]["limit_N"] == pytest.approx(2 * math.pi * 1e-3 / 5e-3)
+    # a drive that can hold it keeps its verdict and has no overload
+    save_params(with_value(preset("paper"), "simulation.steady_start", 0.2), path)
+    assert cli.main(args + ["--out", str(tmp_path / "c"), "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert isinstance(said["creep"], bool) and "overload" not in said
