@@ -998,12 +998,19 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         compiled = compile_diagram(fd, inputs=("reference", "external_force"),
                                    signals=("motor_angle", "table_position", "force_command"))
         system = b.AddSystem(compiled.diagram)
-        b.AddSystem(reference)
-        b.AddSystem(ext)
-        mux = b.AddSystem(Multiplexer([2, 1]))
-        b.Connect(reference.get_output_port(), mux.get_input_port(0))
-        b.Connect(ext.get_output_port(), mux.get_input_port(1))
-        b.Connect(mux.get_output_port(0), system.GetInputPort("inputs"))
+        if run.f_ext is None or not np.any(f_ext):
+            # no external force (most runs): one source of [x_ref, v_ref, 0], the same inputs as the multiplexer's
+            # (a first-order hold of zeros is 0.0) without a multiplexer and a second source to evaluate at every
+            # stage of every step
+            inputs = b.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(
+                t, np.vstack([xr, vr, np.zeros_like(t)]))))
+        else:
+            b.AddSystem(reference)
+            b.AddSystem(ext)
+            inputs = b.AddSystem(Multiplexer([2, 1]))
+            b.Connect(reference.get_output_port(), inputs.get_input_port(0))
+            b.Connect(ext.get_output_port(), inputs.get_input_port(1))
+        b.Connect(inputs.get_output_port(0), system.GetInputPort("inputs"))
         logs = {"signals": LogVectorOutput(system.GetOutputPort("signals"), b, tick)}
         names = compiled.signal_names
         rows = [names.index(k) for k in ("motor_angle", "table_position", "force_command")]
