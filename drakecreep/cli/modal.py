@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from drakecreep.cli._common import existing_path
 from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 
@@ -100,7 +101,7 @@ def run(args):
     if args.fmin is not None and args.fmax is not None and not args.fmax > args.fmin:
         # the band search said 'frequency band: got (200.0, 100.0)'
         raise InputError("--fmax", args.fmax, f"a frequency above --fmin ({args.fmin:g} Hz)")
-    header, data = read_hammer_csv(args.file)
+    header, data = read_hammer_csv(existing_path("FILE.csv", args.file))
     # an option of the other kind of file was ignored without a word (--response velocity on an FRF)
     for option, value, frf in (("--pulse-width", args.pulse_width, False), ("--response", args.response, False),
                                ("--frf-type", args.frf_type, True)):

@@ -1,6 +1,6 @@
 """``drakecreep sweep SPEC.yaml``: run a parameter sweep (grid or random) and write its table (and map)."""
 
-from drakecreep.cli._common import print_json, workers
+from drakecreep.cli._common import existing_path, print_json, workers
 from drakecreep.errors import InputError
 from drakecreep.processes import usable_cpus
 
@@ -49,7 +49,7 @@ def run(args):
     if args.max_cases is not None and args.max_cases < 1:
         raise InputError("--max-cases", args.max_cases, "an integer >= 1")
     # everything is checked before the first case runs: the spec, the output folder, the scheduler
-    spec = load_spec(args.spec, max_cases=args.max_cases or MAX_CASES)
+    spec = load_spec(existing_path("SPEC.yaml", args.spec), max_cases=args.max_cases or MAX_CASES)
     check_output_dir(args.out)
     scheduler = connect_dask(args.scheduler) if args.scheduler is not None else None
     if scheduler is not None:

@@ -449,6 +449,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["params", "--check", "{tmp}/nothere.yaml"], "--check: got"),  # 'No such file or directory: ...'
     (["diagnose", "{example}", "--meta", "{tmp}/nothere.yaml"], "--meta: got"),
     (["uncertainty", "--spec", "{tmp}/nothere.yaml"], "--spec: got"),
+    # positional files too (they said 'No such file or directory: ...', no field)
+    (["sweep", "{tmp}/nothere.yaml"], "nothere.yaml'; allowed: an existing file (no such file or directory)"),
+    (["modal", "{tmp}/nothere.csv"], "nothere.csv'; allowed: an existing file (no such file or directory)"),
+    (["modal", "{tmp}"], "'; allowed: a regular file (this is a folder)"),
     # the option and mm/s, not the scenario's field in m/s; a placement that fails names both targets
     (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed > 0 mm/s"),
     (["report", "--out", "{tmp}/r", "--low-feed", "-0.1"], "--low-feed: got -0.1"),
@@ -651,3 +655,11 @@ def test_an_empty_mapping_as_parameter_file_is_refused_not_read_as_all_defaults(
     code, _, err = _run(["simulate", "--params", str(path), "--load-case", "0", "--out", str(tmp_path / "o")], capsys)
     _one_line_exit_2(code, err, "got 'an empty mapping ({})'; allowed: a YAML mapping of parameter groups")
     assert not (tmp_path / "o").exists()
+
+
+def test_a_missing_positional_file_is_named_by_its_metavar(tmp_path, capsys):
+    """sweep's SPEC.yaml and modal's FILE.csv said 'No such file or directory: ...', no field."""
+    for argv, field in ((["sweep", str(tmp_path / "nothere.yaml")], "SPEC.yaml"),
+                        (["modal", str(tmp_path / "nothere.csv")], "FILE.csv")):
+        code, _, err = _run(argv, capsys)
+        _one_line_exit_2(code, err, f"error: {field}: got '{argv[1]}'; allowed: an existing file")
