@@ -167,7 +167,15 @@ def _spec_from_data(data, where, name=None):
     base = preset(name)
     dists = []
     for path, spec in sample.items():
-        if not isinstance(spec, dict) or set(spec) != {"dist", "low", "high", "source"}:
+        keys = ("dist", "low", "high", "source")
+        if isinstance(spec, dict):  # the key at fault by name (the mapping was shown cut off after four items)
+            for key in spec:
+                if key not in keys:
+                    raise InputError(f"sample.{path}.{key}", "an unknown key", "one of dist, low, high, source")
+            for key in keys:
+                if key not in spec:
+                    raise InputError(f"sample.{path}.{key}", "nothing", "a value (each of dist, low, high, source)")
+        else:
             raise InputError(f"sample.{path}", spec, "a mapping with dist, low, high, source")
         dist = Distribution(path=str(path), **spec)
         # raises for an unknown path, naming the spec's key (it said '1: got '1'', no 'sample')

@@ -100,6 +100,13 @@ def test_spec_file_errors_name_the_key(tmp_path):
     with pytest.raises(InputError) as err:
         load_uncertainty(bad)
     assert err.value.field == "sample.sensors.encoder_counts_per_rev" and "real-valued" in err.value.allowed
+    # a key too many or too few, by name (the mapping was shown cut off after four items)
+    bad.write_text("preset: paper\nsample:\n  table.mass: {dist: uniform, low: 30, high: 50, source: s, sorce: t}\n")
+    with pytest.raises(InputError, match=r"^sample\.table\.mass\.sorce: got 'an unknown key'; allowed: one of dist, "):
+        load_uncertainty(bad)
+    bad.write_text("preset: paper\nsample:\n  table.mass: {dist: uniform, low: 30, source: s}\n")
+    with pytest.raises(InputError, match=r"^sample\.table\.mass\.high: got 'nothing'; allowed: a value"):
+        load_uncertainty(bad)
 
 
 def test_a_spec_of_another_preset_is_refused(tmp_path, capsys, monkeypatch):
