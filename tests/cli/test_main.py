@@ -61,7 +61,7 @@ def test_bad_parameter_file(tmp_path, capsys):
     path.write_text("table: {mass: -3}\n")
     assert main(["simulate", "--params", str(path), "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert "table.mass" in err and "-3" in err and "(0.0, 100000.0] kg" in err
+    assert "table.mass" in err and "-3" in err and "[0.001, 100000.0] kg" in err
 
 
 def test_params_prints_loadable_yaml(tmp_path, capsys):
