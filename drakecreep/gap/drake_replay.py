@@ -998,7 +998,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         compiled = compile_diagram(fd, inputs=("reference", "external_force"),
                                    signals=("motor_angle", "table_position", "force_command"))
         system = b.AddSystem(compiled.diagram)
-        if run.f_ext is None or not np.any(f_ext):
+        if not np.any(f_ext):
             # no external force (most runs): one source of [x_ref, v_ref, 0], the same inputs as the multiplexer's
             # (a first-order hold of zeros is 0.0) without a multiplexer and a second source to evaluate at every
             # stage of every step
