@@ -183,6 +183,7 @@ def main(argv=None):
     previous = _on_sigterm()
     try:
         _check_no_empty_values(parser, args)
+        _check_no_repeated_options(parser, args, sys.argv[1:] if argv is None else argv)
         return int(args.func(args) or 0)
     except DrakecreepError as err:
         _debug_traceback(debug)
@@ -244,6 +245,29 @@ def _check_no_empty_values(parser, args):
             if isinstance(v, str) and not v.strip():
                 name = max(action.option_strings, key=len) if action.option_strings else action.metavar or action.dest
                 raise InputError(name, v, "a non-empty value (leave the option out for its default)")
+
+
+def _check_no_repeated_options(parser, args, argv):
+    """Refuse an option that takes a value given more than once (``--feed 1 --feed 2`` ran at 2 mm/s without a
+    word: argparse keeps the last). Options that collect (``--method``, ``-vv``) and flags may repeat."""
+    from drakecreep.errors import InputError
+
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    by_name = {name: action for action in commands.choices[args.command]._actions
+               if isinstance(action, argparse._StoreAction) for name in action.option_strings}
+    given = {}
+    argv = [str(token) for token in argv]
+    for i, token in enumerate(argv):
+        if token == "--":  # what follows is positional
+            break
+        name, eq, value = token.partition("=")
+        action = by_name.get(name)
+        if action is not None:
+            given.setdefault(action, []).append(value if eq else (argv[i + 1] if i + 1 < len(argv) else ""))
+    for action, values in given.items():
+        if len(values) > 1:
+            raise InputError(max(action.option_strings, key=len), " then ".join(values),
+                             "the option once (the last value would win without a word)")
 
 
 #: errors of a path given by the user (exit 2); other OSErrors (a full disk, I/O errors) exit 1

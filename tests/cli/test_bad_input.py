@@ -449,6 +449,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["params", "--check", "{tmp}/nothere.yaml"], "--check: got"),  # 'No such file or directory: ...'
     (["diagnose", "{example}", "--meta", "{tmp}/nothere.yaml"], "--meta: got"),
     (["uncertainty", "--spec", "{tmp}/nothere.yaml"], "--spec: got"),
+    # an option given twice: the last value won without a word
+    (["simulate", "--out", "{tmp}/s", "--feed", "1", "--feed=2"], "--feed: got '1 then 2'; allowed: the option once"),
+    (["margins", "--load-case", "0", "--load-case", "3"], "--load-case: got '0 then 3'; allowed: the option once"),
     # positional files too (they said 'No such file or directory: ...', no field)
     (["sweep", "{tmp}/nothere.yaml"], "nothere.yaml'; allowed: an existing file (no such file or directory)"),
     (["modal", "{tmp}/nothere.csv"], "nothere.csv'; allowed: an existing file (no such file or directory)"),
@@ -663,3 +666,14 @@ def test_a_missing_positional_file_is_named_by_its_metavar(tmp_path, capsys):
                         (["modal", str(tmp_path / "nothere.csv")], "FILE.csv")):
         code, _, err = _run(argv, capsys)
         _one_line_exit_2(code, err, f"error: {field}: got '{argv[1]}'; allowed: an existing file")
+
+
+def test_options_that_collect_may_repeat():
+    """--method collects, -v counts, a flag twice says the same thing: none is refused; what follows -- is no option."""
+    from drakecreep import cli
+
+    parser = cli.build_parser()
+    for argv in (["compensate", "--method", "static", "--method", "lugre", "--out", "x"],
+                 ["margins", "-v", "-v", "-q", "-q"], ["sweep", "--", "--out"]):
+        args, _ = parser.parse_known_args(argv)
+        cli._check_no_repeated_options(parser, args, argv)
