@@ -453,8 +453,8 @@ def ballscrew_stiffness(nut: BallScrewNut = TABLE3_NUT, axial_force: float | Non
             raise InputError("conformity", nut.conformity,
                              f"a groove that keeps the contact within the ball: the {name} contact's semi-major axis "
                              f"is {float(c.a) * 1e3:.4g} mm at a ball load of {P:.4g} N, beyond the ball's radius "
-                             f"{radius * 1e3:.4g} mm, where Hertz theory does not apply (a larger conformity or a "
-                             "lower preload)")
+                             f"{radius * 1e3:.4g} mm, where Hertz theory does not apply (a larger conformity, a larger "
+                             "ball or a lower preload)")
     delta = float(s.approach + n.approach)
     da = delta / (np.sin(beta) * np.cos(lam))
     dr = delta / (np.cos(beta) * np.sin(lam))
