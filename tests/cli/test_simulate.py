@@ -1,4 +1,4 @@
-"""``drakecreep simulate``'s words for the convergence check (drakecreep.cli.simulate)."""
+"""``drakecreep simulate``'s words for its verdicts: the convergence check, and a drive that cannot hold the feed."""
 
 import math
 
