@@ -56,6 +56,37 @@ def test_pole_map_small(paper):
     assert pm.sim_creep.shape == (2,) and pm.sim_creep[0] and not pm.sim_creep[1]
 
 
+def test_pole_map_interpolates_each_column_to_the_poles_of_its_own_linearizations(paper, monkeypatch):
+    """The map linearizes three points of a stiffness's column and interpolates the others (A is affine in the
+    viscous coefficient): every point's rightmost poles are those of its own linearization; a column whose middle
+    point does not agree with the interpolation is linearized point by point."""
+    from drakecreep.servo.linearize import linearize_closed_loop, linearize_mechanism, nut_on_table, operating_point
+
+    sc = Scenario(feed=0.1e-3, load_case=3)
+    pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=5)
+    p0 = nut_on_table(paper)
+    for j, s in enumerate([0.5, 2.0]):
+        ps = polemap.scale_stiffness(p0, s)
+        op = operating_point(ps, sc)
+        rest = op.damping + op.friction_slope - ps.friction.viscous
+        for i in range(5):
+            p = with_value(ps, "friction.viscous", max(0.0, pm.damping[i, j] - rest))
+            for got, linearize in ((pm.closed_loop, linearize_closed_loop), (pm.mechanism, linearize_mechanism)):
+                own = linearize(p, sc).poles().real.max()
+                assert got[i, j] == pytest.approx(own, rel=1e-7, abs=1e-9 * max(1.0, abs(own))), (i, j)
+    calls = []
+    real = polemap.linearize_closed_loop
+    monkeypatch.setattr(polemap, "linearize_closed_loop", lambda *a: calls.append(1) or real(*a))
+    interpolated = polemap.pole_map(paper, sc, k_scales=[1.0], n_damping=5)
+    assert len(calls) == 3  # the ends and the middle of the one column
+    calls.clear()
+    monkeypatch.setattr(polemap, "AFFINE_TOLERANCE", -1.0)  # no column agrees: each point its own linearization
+    again = polemap.pole_map(paper, sc, k_scales=[1.0], n_damping=5)
+    assert len(calls) == 3 + 5
+    for key in ("closed_loop", "mechanism"):
+        assert np.allclose(getattr(again, key), getattr(interpolated, key), rtol=1e-7, atol=1e-9)
+
+
 def test_parameter_locus(paper):
     loc = polemap.parameter_locus(paper, Scenario(feed=1e-3, load_case=3), "mass", [20.0, 80.0])
     assert len(loc["poles"]) == 2
