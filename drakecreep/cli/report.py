@@ -1,7 +1,8 @@
 """``drakecreep report``: a self-contained HTML servo-loop report (margins, Bode, Nyquist, loci, pole map, runs)."""
 
-from drakecreep.cli._common import add_params_options, number, params_from_args
+from drakecreep.cli._common import add_params_options, number, params_from_args, workers
 from drakecreep.errors import InputError
+from drakecreep.processes import usable_cpus
 
 __all__ = ["add_parser", "run"]
 
@@ -19,6 +20,9 @@ def add_parser(subparsers):
                    help="low-speed feed of the simulation and the pole map (default 0.1)")
     p.add_argument("--load-case", type=int, default=3, metavar="N", help="load case (default 3)")
     p.add_argument("--no-sim-grid", action="store_true", help="skip the simulated creep markers on the pole map")
+    p.add_argument("--workers", type=workers, metavar="N", default=usable_cpus(),
+                   help="processes for the pole map's 36 creep simulations (default: the usable CPUs, %(default)s "
+                        "here)")
     p.add_argument("--json", action="store_true", help="print one JSON object (the written files and the margins)")
     p.set_defaults(func=run)
     return p
@@ -43,7 +47,7 @@ def run(args):
     if getattr(args, "friction", None):
         source += f", friction law {args.friction}"
     result = build_report(params, args.out, feed=scenario.feed, load_case=scenario.load_case, low_feed=low,
-                          source=source, sim_grid=None if args.no_sim_grid else (6, 6))
+                          source=source, sim_grid=None if args.no_sim_grid else (6, 6), workers=args.workers)
     if args.json:
         import json
 

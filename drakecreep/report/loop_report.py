@@ -95,7 +95,7 @@ def _table(header, rows):
 
 
 def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step_feed=10e-3,
-                 source="preset paper", sim_grid=(6, 6), map_size=(16, 20)):
+                 source="preset paper", sim_grid=(6, 6), map_size=(16, 20), workers=1):
     """Compute everything and write ``index.html`` (self-contained), ``margins.json`` and the PNGs.
 
     Parameters
@@ -115,6 +115,8 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
         Coarse stiffness x damping grid simulated for the pole map's creep markers.
     map_size : (int, int)
         Stiffness x damping points of the pole map.
+    workers : int
+        Processes for the ``sim_grid`` simulations (:func:`~drakecreep.servo.polemap.pole_map`).
 
     Returns
     -------
@@ -148,7 +150,7 @@ def build_report(params, out_dir, *, feed=1e-3, load_case=3, low_feed=1e-4, step
     crossings = {m: friction_slope_crossings(params, load_case, CROSSING_SPEEDS, m) for m in ("mechanism", "closed_loop")}
     t = lap("loci", t)
     pm = pole_map(params, low, k_scales=np.geomspace(0.25, 4.0, map_size[0]), n_damping=map_size[1],
-                  sim_grid=sim_grid)
+                  sim_grid=sim_grid, workers=workers)
     t = lap("pole_map", t)
 
     from drakecreep.sim.simulation import simulate

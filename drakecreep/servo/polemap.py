@@ -231,7 +231,17 @@ def _along_viscous(column, ops, scenario, linearize):
     return [a_lo if i == lo else a_hi if i == hi else a_mid if i == mid else at(f) for i, f in enumerate(fv)]
 
 
-def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, sim_grid=None, sim_duration=1.0):
+def _creeps(point):
+    """Whether the nonlinear drive creeps at ``point = (params, scenario)`` (a failed run counts as creep; module
+    level, so a process pool can pickle it)."""
+    from drakecreep.sim.simulation import simulate
+
+    r = simulate(*point)
+    return bool((not r.ok) or r.metrics is None or r.metrics.stick_fraction > 0.0)
+
+
+def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, sim_grid=None, sim_duration=1.0,
+             workers=1):
     """Rightmost poles over stiffness x effective damping at the scenario's feed.
 
     Parameters
@@ -249,6 +259,9 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
         Simulate the nonlinear drive on this many stiffness x damping points (e.g. ``(6, 6)``).
     sim_duration : float
         Simulated time per point (s); the metrics window is its second half.
+    workers : int
+        Processes for the ``sim_grid`` simulations (1: in this process; a pool never has more than the usable
+        CPUs, :func:`drakecreep.processes.pool_size`).
 
     Returns
     -------
@@ -286,15 +299,13 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
     result = PoleMap(feed=v, mass=M, friction_drop=dF, stiffness=K, damping=Y, closed_loop=cl, mechanism=mech,
                      nominal=(op0.stiffness, op0.damping + op0.friction_slope))
     if sim_grid:
-        from drakecreep.sim.simulation import simulate
-
         nk, ny = sim_grid
         ks = np.geomspace(k_scales.min(), k_scales.max(), nk)
         # rows from the lowest reachable damping (slightly inside, to stay visible on the plot) upwards
         span = damping_range[1] - damping_range[0]
         ys = np.linspace(damping_range[0], damping_range[1], ny + 1)[:-1] + 0.03 * span
         psim = with_value(params, "simulation.steady_start", 0.5 * sim_duration)
-        sk, sy, creep, unstable = [], [], [], []
+        sk, sy, unstable, points = [], [], [], []
         sc = Scenario(feed=scenario.feed, load_case=scenario.load_case, duration=sim_duration)
         for s in ks:
             ps = scale_stiffness(psim, s)
@@ -302,12 +313,17 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
                 fv = _viscous_for(ps, sc, y, 1.0)
                 p = with_value(ps, "friction.viscous", fv)
                 op = operating_point(p, sc)
-                r = simulate(p, sc)
-                m = r.metrics
                 sk.append(op.stiffness)
                 sy.append(op.damping + op.friction_slope)
                 unstable.append(bool(linearize_closed_loop(p, sc, op).poles().real.max() > 0))
-                creep.append(bool((not r.ok) or m is None or m.stick_fraction > 0.0))
+                points.append((p, sc))
+        if workers > 1 and len(points) > 1:
+            from drakecreep.processes import process_pool
+
+            with process_pool(workers) as pool:  # a Ctrl-C or an error ends the workers at once
+                creep = list(pool.map(_creeps, points))
+        else:
+            creep = [_creeps(point) for point in points]
         result.sim_stiffness = np.asarray(sk)
         result.sim_damping = np.asarray(sy)
         result.sim_creep = np.asarray(creep, dtype=bool)

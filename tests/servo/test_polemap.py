@@ -42,7 +42,8 @@ def test_pole_map_small(paper):
     # catalogue nut (157 N) the simulated point above the boundary still creeps at 0.1 mm/s
     paper = with_value(with_value(paper, "nut.preload_torque", 0.01), "nut.load_friction_coefficient", 0.01)
     sc = Scenario(feed=0.1e-3, load_case=3)
-    pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=3, sim_grid=(1, 2))
+    # the grid's simulations on a pool of two processes (tests/report/test_loop_report.py's run in this one)
+    pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=3, sim_grid=(1, 2), workers=2)
     assert pm.closed_loop.shape == (3, 2) == pm.damping.shape
     # the lowest damping row (no viscous friction on the falling branch) is unstable, the highest is stable
     assert np.all(pm.closed_loop[0] > 0) and np.all(pm.closed_loop[-1] < 0)
