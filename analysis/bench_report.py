@@ -40,7 +40,8 @@ def main():
         wall = time.perf_counter() - start
         if wall < best:
             best, timings = wall, result["timings"]
-    print(f"report (paper preset, {args.workers} worker(s)): {best:.1f} s wall  [{'; '.join(f'{k} {v:.1f} s' for k, v in timings.items())}]")
+    stages = "; ".join(f"{k} {v:.1f} s" for k, v in timings.items())
+    print(f"report (paper preset, {args.workers} worker(s)): {best:.1f} s wall  [{stages}]")
     print(f"baseline, one 5 s simulate(): {baseline:.2f} s -> report = {best / baseline:.0f} x baseline")
     print(f"written to {result['html']}")
     print("PASS: under 60 s" if best < 60 else "FAIL: over 60 s")
