@@ -979,9 +979,11 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     params = _phases_at(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)
-    reference = TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr])))
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)
-    ext = TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1)))
+
+    def sources():  # the reference [x_ref, v_ref] and f_ext, built only where they are wired
+        return (TrajectorySource(PiecewisePolynomial.FirstOrderHold(t, np.vstack([xr, vr]))),
+                TrajectorySource(PiecewisePolynomial.ZeroOrderHold(t, f_ext.reshape(1, -1))))
     feed = float(np.max(np.abs(vr))) or 1e-6
     scenario = Scenario(feed=min(max(feed, MIN_FEED), 1.0), load_case=int(load_case), duration=max(float(t[-1]), 1e-3))
     # u[k] is the force command the controller computes at t_k from the measurement at t_k (what the truth and a
@@ -1005,8 +1007,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
             inputs = b.AddSystem(TrajectorySource(PiecewisePolynomial.FirstOrderHold(
                 t, np.vstack([xr, vr, np.zeros_like(t)]))))
         else:
-            b.AddSystem(reference)
-            b.AddSystem(ext)
+            reference, ext = (b.AddSystem(source) for source in sources())
             inputs = b.AddSystem(Multiplexer([2, 1]))
             b.Connect(reference.get_output_port(), inputs.get_input_port(0))
             b.Connect(ext.get_output_port(), inputs.get_input_port(1))
@@ -1015,6 +1016,7 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         names = compiled.signal_names
         rows = [names.index(k) for k in ("motor_angle", "table_position", "force_command")]
     else:
+        reference, ext = sources()
         fd = build_diagram(params, scenario, reference=reference, external_force=ext)
         system = b.AddSystem(fd.diagram)
         logs = {key: LogVectorOutput(system.GetOutputPort(key), b, tick)
