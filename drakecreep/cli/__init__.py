@@ -228,6 +228,12 @@ def main(argv=None):
                 os.environ["TQDM_DISABLE"] = saved
 
 
+def _command_actions(parser, args):
+    """The argparse actions (options and arguments) of the command ``args`` ran."""
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return commands.choices[args.command]._actions
+
+
 def _check_no_empty_values(parser, args):
     """Refuse an option or argument given as an empty (or blank) string before the command runs.
 
@@ -237,8 +243,7 @@ def _check_no_empty_values(parser, args):
     """
     from drakecreep.errors import InputError
 
-    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    for action in commands.choices[args.command]._actions:
+    for action in _command_actions(parser, args):
         value = getattr(args, action.dest, None)
         values = value if isinstance(value, list) else [value]
         for v in values:
@@ -252,8 +257,7 @@ def _check_no_repeated_options(parser, args, argv):
     word: argparse keeps the last). Options that collect (``--method``, ``-vv``) and flags may repeat."""
     from drakecreep.errors import InputError
 
-    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    by_name = {name: action for action in commands.choices[args.command]._actions
+    by_name = {name: action for action in _command_actions(parser, args)
                if isinstance(action, argparse._StoreAction) for name in action.option_strings}
     given = {}
     argv = [str(token) for token in argv]
