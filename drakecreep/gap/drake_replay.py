@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.framework import DiagramBuilder, DiscreteStateIndex
 from pydrake.symbolic import Expression, MakeVectorVariable, Variable
 from pydrake.systems.primitives import Adder, LogVectorOutput, MatrixGain, SymbolicVectorSystem, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
@@ -582,7 +582,10 @@ class SampledReplay:
         state = np.concatenate([xc, xa, [j]])
         dynamics = list(c_next) + a_next + [j_next]
         system = SymbolicVectorSystem(time=time, state=state, input=inp, parameter=p_free, dynamics=dynamics,
-                                      output=[Expression(v) for v in state], time_period=dt)
+                                      time_period=dt)
+        # the logged output is the state itself: a state output port copies it, where symbolic outputs
+        # [x_i] would be evaluated through an environment of every variable at each logged sample
+        system.DeclareStateOutputPort("state", DiscreteStateIndex(0))
         b = DiagramBuilder()
         sysm = b.AddSystem(system)
         sysm.set_name("sampled_replay")
