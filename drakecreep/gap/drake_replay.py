@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 from pydrake.systems.analysis import Simulator
-from pydrake.systems.framework import DiagramBuilder, DiscreteStateIndex
+from pydrake.systems.framework import ContinuousStateIndex, DiagramBuilder, DiscreteStateIndex
 from pydrake.symbolic import Expression, MakeVectorVariable, Variable
 from pydrake.systems.primitives import Adder, LogVectorOutput, MatrixGain, SymbolicVectorSystem, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
@@ -706,8 +706,10 @@ def compiled_axis(flexible, initial_state, bristles=False):
     ctx.get_mutable_numeric_parameter(0).SetFromVector([Expression(v) for v in p])
     sym.GetInputPort("force").FixValue(ctx, [Expression(u[0])])
     xdot = sym.EvalTimeDerivatives(ctx).CopyToVector()
-    system = SymbolicVectorSystem(time=time, state=x, input=u, parameter=p, dynamics=xdot,
-                                  output=[Expression(v) for v in x])
+    system = SymbolicVectorSystem(time=time, state=x, input=u, parameter=p, dynamics=xdot)
+    # the output is the state itself: a state output port copies it (symbolic outputs [x_i] were evaluated
+    # through an environment of every variable)
+    system.DeclareStateOutputPort("state", ContinuousStateIndex(0))
     return system
 
 
