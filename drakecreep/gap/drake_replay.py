@@ -1048,7 +1048,10 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
         u = sampled("controller.controller_signals", t + after)[1]
     x_motor = angle * params.screw.lead / (2 * math.pi) + x_origin
     x_table = x_table + x_origin
-    force = u * run.u_gain + f_ext
+    # the controller's force command is in N; the run's u is in its u_units (u_gain N per unit): a run in A
+    # compares its u with the command over the gain, and the force is the command itself
+    force = u + f_ext
+    u = u / run.u_gain
     return DrakeReplayResult(run=run, x_motor=x_motor, x_table=x_table, u=u, force=force,
                              wall_time=_time.perf_counter() - start,
                              integrator_steps=int(simulator.get_integrator().get_num_steps_taken()))

@@ -1,6 +1,7 @@
 """The replay through the Drake diagram (drakecreep.gap.drake_replay) on a slice of the EMPS estimation run."""
 
 import dataclasses
+import math
 
 import numpy as np
 import pytest
@@ -226,6 +227,22 @@ def test_drakecreep_kind_replays_its_own_simulation():
     # the integrator stops at every speed-loop tick at least (analysis/bench_replay_drakecreep.py --speeds)
     ticks = (run.t[-1] - run.t[0]) / preset("rigid_axis").controller.velocity_period
     assert back.integrator_steps >= ticks
+
+
+def test_drakecreep_kind_run_in_amperes_replays_the_same_force():
+    """A run recorded in A (u_gain N per A, the motor's) replays to the force of the same run in N, and its u to
+    the command over the gain: the command was multiplied by the gain once more (a 1131 N/A drive's held-out
+    force error was 1e5 %)."""
+    from drakecreep.params import preset
+
+    p = preset("rigid_axis")
+    run, _ = _own_run(p)
+    gain = p.motor.torque_constant * 2.0 * math.pi / p.screw.lead
+    amps = dataclasses.replace(run, u=run.u / gain, meta=dataclasses.replace(run.meta, u_units="A", u_gain=gain))
+    newtons, back = replay_drakecreep(run), replay_drakecreep(amps)
+    assert np.array_equal(back.force, newtons.force)
+    assert np.allclose(back.u, newtons.u / gain, rtol=1e-12, atol=0.0)
+    assert np.linalg.norm(back.force - amps.force) < 0.01 * np.linalg.norm(amps.force)
 
 
 def test_drakecreep_kind_force_is_the_command_computed_at_the_sample():
