@@ -99,6 +99,7 @@ from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscil
                                       sustained_oscillation)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.model.controller import force_limit
+from drakecreep.model.nut_table import friction_levels
 from drakecreep.params import DriveParams, field_range, field_unit, get_value, save_params, with_value
 
 __all__ = [
@@ -170,6 +171,16 @@ MIN_DURATION = 0.1
 #: :func:`drakecreep.model.controller.force_limit`): the drive cannot have held the axis against much more, and the
 #: replay of such a run runs for minutes (a constant 1e5 N on the 10.6 kN paper preset: more than 120 s)
 MAX_EXTERNAL_FORCE = 2.0
+#: Largest drive force ``u x u_gain`` a run may record, in units of the drive's force limit: the cascade clips its
+#: command there, so a recorded force far beyond it has u in another unit (N data headed kN: 1000 x)
+MAX_DRIVE_FORCE = 2.0
+#: Smallest peak drive force of a run whose reference travels, in units of the params file's Coulomb friction at
+#: the load case: an axis that moves has pushed through its friction, so a peak a hundred times below it has u in
+#: another unit (N data headed mN: 1/1000) or a params file far from the rig
+MIN_DRIVE_FORCE = 0.01
+#: Longest sample step of a run, in position-loop periods of its params file: a trace sampled more coarsely shows
+#: nothing of the loop (milliseconds headed seconds: 1000 periods, a replay 1000 times the run's length)
+MAX_SAMPLE_PERIODS = 10.0
 #: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
 _STEP = 0.1
 _BOUND = 4.0
@@ -547,7 +558,10 @@ def check_run(run, params=None, load_case=0):
     it has at least :data:`MIN_SAMPLES` samples over :data:`MIN_DURATION` s, its declared sensor resolutions fit
     the lead of ``params`` (:func:`~drakecreep.gap.drake_replay.replay_params`), ``load_case`` is one of
     ``params``' and its external force stays within :data:`MAX_EXTERNAL_FORCE` times the drive's force limit.
-    Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
+    What a unit slip shows (each a replay of nonsense, or of a run a thousand times too long, before): the sample
+    step is at most :data:`MAX_SAMPLE_PERIODS` position-loop periods, and the peak drive force ``u x u_gain`` lies
+    between :data:`MIN_DRIVE_FORCE` times the params file's Coulomb friction and :data:`MAX_DRIVE_FORCE` times the
+    drive's force limit. Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
     reference was constant ran five minutes of fits before a fitted value left its range).
     """
     ctrl = run.meta.controller
@@ -564,7 +578,25 @@ def check_run(run, params=None, load_case=0):
                          "a reference that moves (the diagnosis compares the drive's motion and force)")
     params = run.meta.params if params is None else params
     replay_params(run, params)  # the declared sensor resolutions fit the params' lead
-    params.load_case(load_case)
+    load = params.load_case(load_case)
+    period = params.controller.position_period
+    if run.dt > MAX_SAMPLE_PERIODS * period:
+        raise InputError(f"t (run {run.label})", f"a sample step of {run.dt:.4g} s",
+                         f"at most {MAX_SAMPLE_PERIODS:g} x the params file's position-loop period ({period:g} s), "
+                         f"{MAX_SAMPLE_PERIODS * period:.4g} s (is the unit of t wrong?)")
+    drive = np.abs(run.u_gain * run.u)
+    peak = float(np.max(drive))
+    if peak > MAX_DRIVE_FORCE * force_limit(params):
+        raise InputError(f"u (run {run.label})", f"a drive force u x u_gain of {peak:.4g} N at data row "
+                         f"{int(np.argmax(drive)) + 1}", f"at most {MAX_DRIVE_FORCE:g} x the drive's force limit "
+                         f"({force_limit(params):.4g} N: the params file's peak torque through the lead); "
+                         f"is the unit of u or u_gain wrong?")
+    coulomb = friction_levels(params, load)[0]
+    if peak < MIN_DRIVE_FORCE * coulomb:
+        raise InputError(f"u (run {run.label})", f"a peak drive force u x u_gain of {peak:.4g} N",
+                         f"at least {MIN_DRIVE_FORCE:g} x the params file's Coulomb friction at load case "
+                         f"{load_case} ({coulomb:.4g} N): the axis moved, so the drive pushed through its friction; "
+                         f"is the unit of u or u_gain wrong?")
     limit = MAX_EXTERNAL_FORCE * force_limit(params)
     if run.f_ext is not None and float(np.max(np.abs(run.f_ext))) > limit:
         raise InputError(f"f_ext (run {run.label})", f"{float(np.max(np.abs(run.f_ext))):.3g} N",

@@ -217,3 +217,28 @@ def test_help_describes_the_drakecreep_kind_and_what_it_writes(capsys):
     out = " ".join(capsys.readouterr().out.split())
     assert stop.value.code == 0
     assert "Runs of controller kind drakecreep" in out and "augmented_params.yaml (for simulate, margins" in out
+
+
+@pytest.mark.parametrize("column, factor, says", [
+    ("u", 1000.0, "at most 2 x the drive's force limit"),  # N data headed kN
+    ("u", 1e-3, "at least 0.01 x the params file's Coulomb friction"),  # N data headed mN
+    ("t", 1000.0, "at most 10 x the params file's position-loop period"),  # ms headed s: a replay 1000 x as long
+])
+def test_a_unit_slip_of_a_drakecreep_run_is_one_line_exit_2(blank_csv, tmp_path, capsys, column, factor, says):
+    """The fuzzing helper's cases: N data headed kN hung, headed mN diagnosed to a 99075 % force error (exit 0),
+    milliseconds headed seconds hung; now each is refused before any replay (diagnose_drive's checks), naming the
+    column and the run. The blank file's references with a 50 N drive force (the rigid_axis preset: Coulomb
+    friction 17.8 N, force limit 10.6 kN)."""
+    import pandas as pd
+
+    path, yaml_path = blank_csv
+    frame = pd.read_csv(path)
+    head = next(c for c in frame.columns if c.split("[")[0] == column)
+    frame[head] = frame[head] * (50.0 if column == "u" else 1.0) * factor  # blank u: 1 N; a 50 N drive
+    bad = tmp_path / "bad.csv"
+    frame.to_csv(bad, index=False)
+    bad.with_suffix(".yaml").write_text(yaml_path.read_text())
+    code = cli.main(["diagnose", str(bad), "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert f"error: {column} (run r0): got " in err[0] and says in err[0]

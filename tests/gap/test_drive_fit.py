@@ -569,7 +569,8 @@ def _blank(label="b", n=N, params=RIG, kind="drakecreep"):
     meta = MeasuredMeta(u_units="N", u_gain=1.0, params=params, controller=ControllerMeta(kind=kind, **gains))
     t = np.arange(n) * 1e-3
     x = out_and_back(0.02, 0.0, n=n, dt=1e-3, leg=0.2, starts=(0.03, 0.26)) if n == N else np.zeros(n)
-    return MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.zeros(n), meta=meta, label=label)
+    # a drive force the params file's axis could have moved with (a zero u is no drive: check_run refuses it)
+    return MeasuredRun(t=t, x_ref=x, x_motor=x, u=np.full(n, 100.0), meta=meta, label=label)
 
 
 def test_bad_input_is_refused_before_any_replay(no_replay):
