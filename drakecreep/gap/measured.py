@@ -732,7 +732,7 @@ def check_recorded(run):
       steps of ``x_motor`` (``x_table``) are shorter than half the declared ``sensors.encoder_resolution``
       (``scale_resolution``), the resolution is in the wrong unit (5e-5 for a 50 nm count: millimetres written
       as metres), or not the one the positions were recorded at; the replay would count with it.
-    * A drive command ``u`` that is zero throughout gives the fit nothing to match.
+    * A drive command ``u`` that is zero, or one value, throughout gives the fit nothing to match.
     * A P-P cascade clips its output at ``controller.saturation``: a recorded ``|u|`` beyond twice it contradicts it.
     * A closed loop follows its reference and the table its motor: a travel of ``x_motor`` (``x_table``) more than
       100 times ``x_ref``'s (``x_motor``'s) or less than a hundredth of it has a unit wrong on one of them.
@@ -808,6 +808,11 @@ def check_recorded(run):
         raise InputError(f"x_table (run {run.label})", "constant while x_motor moves",
                          "the linear scale's reading of the table, or no x_table column (a motion within one count "
                          "of the scale cannot be scored against it)")
+    if np.ptp(run.u) == 0.0:
+        # a closed loop moves its command (a u of 1.0 in every row diagnosed to NaN errors, exit 0, and an
+        # inverse-dynamics mass of 5e-15 kg written to augmented_model.yaml)
+        raise InputError(f"u (run {run.label})", f"constant at {float(run.u[0]):g} {run.meta.u_units} throughout",
+                         "the drive command the controller gave (a closed loop moves it)")
 
 
 def controller_gains(run):

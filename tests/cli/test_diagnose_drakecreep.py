@@ -31,12 +31,13 @@ def own_csv(tmp_path_factory):
 @pytest.fixture(scope="module")
 def blank_csv(tmp_path_factory):
     """Runs with the project's controller declared, not simulated (for checks that stop before any work; a u of
-    zeros is refused at load, so any non-zero command)."""
+    zeros or of one value is refused at load, so any command that moves)."""
     folder = tmp_path_factory.mktemp("blank")
     meta = MeasuredMeta(u_units="N", u_gain=1.0, params=preset("rigid_axis"), controller=ControllerMeta(kind="drakecreep"))
     t = np.arange(N) * 1e-3
     runs = tuple(MeasuredRun(t=t, x_ref=out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6)),
-                             x_motor=out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6)), u=np.ones(N),
+                             x_motor=out_and_back(v, 0.0, n=N, leg=0.45, starts=(0.05, 0.6)),
+                             u=1.0 + 0.1 * np.sin(np.arange(N) * 0.01),
                              meta=meta, label=f"r{i}") for i, v in enumerate((0.02, 0.03, 0.025)))
     _, yaml_path = save_measured(MeasuredData(runs=runs, meta=meta), folder / "blank.csv")
     return folder / "blank.csv", yaml_path

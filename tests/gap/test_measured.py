@@ -165,6 +165,14 @@ def test_a_drive_command_that_is_zero_throughout_is_refused(tmp_path):
     assert err.value.field.endswith("u (run run)") and err.value.value == "zero throughout"
 
 
+def test_a_drive_command_of_one_value_throughout_is_refused(tmp_path):
+    """A u of 1.0 in every row (found by fuzzing) diagnosed to NaN errors with exit 0."""
+    cols = _rows()
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, {**cols, "u": 0 * cols["t"] + 1.0}))
+    assert err.value.field.endswith("u (run run)") and err.value.value.startswith("constant at 1 ")
+
+
 def test_not_a_number(tmp_path):
     cols = {k: list(v) for k, v in _rows().items()}
     cols["u"][2] = "abc"
@@ -591,7 +599,7 @@ def test_run_labels_are_read_as_written(tmp_path):
     for k, label in enumerate(("1", "1.0", "007")):
         for i in range(30):
             n = 30 * k + i
-            lines.append(f"{n * 1e-3},{n * 1e-5},{n * 1e-5},1.5,{label}")
+            lines.append(f"{n * 1e-3},{n * 1e-5},{n * 1e-5},{1.5 + 0.1 * (i % 2)},{label}")
     (tmp_path / "runs.csv").write_text("\n".join(lines) + "\n")
     (tmp_path / "runs.yaml").write_text("u_units: N\nu_gain: 1.0\n")
     data = load_measured(tmp_path / "runs.csv")
