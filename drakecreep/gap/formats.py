@@ -234,10 +234,15 @@ def read_signals(path, u_units, columns=None, units=None, key=None, separator=No
     by_file = {str(c): c for c in frame.columns}
     out = {}
     if mapping:
+        taken = {}
         for signal, column in mapping.items():
             if str(column) not in by_file:
                 raise InputError(f"{path}: file.columns.{signal}", column,
                                  "a column of the file: " + ", ".join(list(by_file)[:20]))
+            if str(column) in taken:  # x_motor read from x_ref's column replayed a motor that followed exactly
+                raise InputError(f"{path}: file.columns.{signal}", column,
+                                 f"a column not already mapped (it is {taken[str(column)]}'s): one column per signal")
+            taken[str(column)] = signal
             _, unit = parse_column(column)
             out[signal] = (by_file[str(column)], _unit_of(path, signal, unit, units))
     else:

@@ -167,3 +167,19 @@ def test_a_unit_that_is_no_string_is_refused_by_its_column():
 
     with pytest.raises(InputError, match=r"^f.csv: column t unit: got 5; allowed: one of s, ms"):
         unit_factor("t", 5, "N", "f.csv")
+
+
+def test_one_file_column_mapped_to_two_signals_is_refused(tmp_path):
+    """file.columns naming x_ref's column for x_motor too (found by fuzzing): the motor followed its reference
+    exactly and the diagnosis ran, exit 0, at twice the force error."""
+    frame = _frame()
+    frame.to_csv(tmp_path / "run.csv", index=False)
+    mapping = {"t": "t", "x_ref": "x_ref", "x_motor": "x_ref", "u": "u"}
+    with pytest.raises(InputError) as err:
+        read_signals(tmp_path / "run.csv", "N", columns=mapping, units={"t": "s", "x_ref": "m", "x_motor": "m",
+                                                                       "u": "N"})
+    assert err.value.field.endswith("file.columns.x_motor") and err.value.value == "x_ref"
+    assert "it is x_ref's" in err.value.allowed
+    signals = read_signals(tmp_path / "run.csv", "N", columns=dict(mapping, x_motor="x_motor"),
+                           units={"t": "s", "x_ref": "m", "x_motor": "m", "u": "N"})
+    assert np.array_equal(signals["x_motor"], frame["x_motor"].to_numpy())
