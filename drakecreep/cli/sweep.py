@@ -38,7 +38,7 @@ def add_parser(subparsers):
 def run(args):
     from drakecreep.files import check_output_dir
     from drakecreep.report.plots import plot_stability_map
-    from drakecreep.sim.sweep import MAX_CASES, MAX_RETRIES, connect_dask, load_spec, run_sweep
+    from drakecreep.sim.sweep import DEFAULT_MAP_COLOR, MAX_CASES, MAX_RETRIES, connect_dask, load_spec, run_sweep
 
     if args.scheduler is not None and args.workers:
         raise InputError("--workers", args.workers, "not with --scheduler (the cluster has its workers)")
@@ -59,13 +59,11 @@ def run(args):
     else:
         executor = "processes"
     extra = {}
-    if spec.plot:
-        color = spec.plot.get("color", "fluctuation_rate_percent")
-        if spec.metrics is None or color in spec.metrics:
-            def write_map(table, path):
-                plot_stability_map(table, spec.plot["x"], path, y=spec.plot.get("y", "feed"), color=color,
-                                   base=spec.base)
-            extra["map.png"] = write_map
+    if spec.plot:  # its colour is a column of the table (load_spec)
+        def write_map(table, path):
+            plot_stability_map(table, spec.plot["x"], path, y=spec.plot.get("y", "feed"),
+                               color=spec.plot.get("color", DEFAULT_MAP_COLOR), base=spec.base)
+        extra["map.png"] = write_map
     try:
         result = run_sweep(
             spec.base, spec.points, scenario=spec.scenario, executor=executor, workers=args.workers,

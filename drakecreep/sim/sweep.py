@@ -63,6 +63,7 @@ __all__ = [
     "metric_columns",
     "connect_dask",
     "MAX_CASES",
+    "DEFAULT_MAP_COLOR",
 ]
 
 #: point keys that set the :class:`~drakecreep.scenario.Scenario` rather than a parameter (``drive``:
@@ -77,6 +78,8 @@ CACHE_VERSION = 1
 #: default largest number of cases of one sweep (``max_cases`` / ``--max-cases`` raise it): 100 000 cases
 #: of a few seconds each are days of computing, and the case list alone must fit in memory
 MAX_CASES = 100_000
+#: the metric a spec's stability map (``plot``) is coloured by when it names no ``color``
+DEFAULT_MAP_COLOR = "fluctuation_rate_percent"
 
 
 def _check_size(n, max_cases, what="the sweep"):
@@ -871,6 +874,11 @@ def load_spec(path, max_cases=MAX_CASES):
         raise InputError("plot.y", plot["y"], f"a swept path or scenario field other than plot.x ({plot['x']})")
     if "color" in plot and plot["color"] not in known_metrics:
         raise InputError("plot.color", plot["color"], "one of " + ", ".join(known_metrics))
+    color = plot.get("color", DEFAULT_MAP_COLOR)
+    if plot and metrics is not None and color not in metrics:
+        # the map colours by a column of the table: one the metrics leave out was no map, without a word
+        raise InputError("plot.color", color if "color" in plot else f"{color} (the default)",
+                         "one of the spec's metrics, " + ", ".join(metrics) + f" (or add {color} to metrics)")
     return SweepSpec(base=base, points=points, scenario=scenario, metrics=metrics, plot=plot, source=str(path))
 
 

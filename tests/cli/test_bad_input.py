@@ -181,6 +181,11 @@ SPECS = {
     "plot_y_is_x": ("axes:\n  feed: [1.0e-3, 2.0e-3]\nplot: {x: feed, y: feed}\n",
                     "error: plot.y: got 'feed'; allowed: a swept path or scenario field other than plot.x (feed)"),
     "bad_plot_color": ("axes:\n  table.mass: [30, 40]\nplot: {x: table.mass, color: nope}\n", "plot.color"),
+    # a map coloured by a metric the table leaves out: the sweep ran, exit 0, and drew no map without a word (found
+    # by fuzzing in session 68)
+    "plot_color_not_in_metrics": ("axes:\n  feed: [1.0e-3, 2.0e-3]\nmetrics: [creep]\nplot: {x: feed}\n",
+                                  "error: plot.color: got 'fluctuation_rate_percent (the default)'; allowed: one of "
+                                  "the spec's metrics, creep (or add fluctuation_rate_percent to metrics)"),
     "duplicate_axis": ("axes:\n  table.mass: [30]\n  table.mass: [40]\n", "duplicate key"),
     "empty": ("", "empty"),
     "base_dev_zero": ("base: {file: /dev/zero}\naxes:\n  table.mass: [30, 40]\n", "base.file"),
