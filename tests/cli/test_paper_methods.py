@@ -99,6 +99,11 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
 @pytest.mark.parametrize("kind, options, field", [
     ("time", ["--pulse-width", "-1"], "--pulse-width: got -1.0"),  # was blamed on the frequency band
     ("time", ["--pulse-width", "nan"], "--pulse-width: got nan"),
+    # a window that cut the impulse changed the result (k 1.8e5 against 1.14e6 N/m), one that kept the whole record
+    # did nothing, each without a word (found by fuzzing)
+    ("time", ["--pulse-width", "1e-9"], "--pulse-width: got 1e-09; allowed: >= 4e-05 s, half the recorded impulse"),
+    ("time", ["--pulse-width", "1"], "--pulse-width: got 1.0; allowed: <= 0.0167 s, a third of the record (0.05 s"),
+    ("time", ["--exp-tau", "1e-9"], "--exp-tau: got 1e-09; allowed: >= 5.65e-05 s: the exponential window starts"),
     ("frf", ["--pulse-width", "1e-3"], "--pulse-width: got 0.001; allowed: only with a t,force,response file"),
     ("frf", ["--fmin", "nan"], "--fmin: got nan"),
     ("frf", ["--fmax", "inf"], "--fmax: got inf"),
