@@ -99,6 +99,7 @@ from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscil
                                       sustained_oscillation)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.model.controller import force_limit
+from drakecreep.model.compensators import rigid_inertia
 from drakecreep.model.nut_table import friction_levels
 from drakecreep.params import DriveParams, field_range, field_unit, get_value, save_params, with_value
 
@@ -113,6 +114,11 @@ __all__ = [
     "STRIBECK_STARTS",
     "MIN_SAMPLES",
     "MIN_DURATION",
+    "MAX_DRIVE_FORCE",
+    "MIN_DRIVE_FORCE",
+    "MAX_SAMPLE_PERIODS",
+    "MASS_FACTOR",
+    "inverse_dynamics_mass",
     "claims_withheld",
     "FittedParameter",
     "EffectResult",
@@ -178,6 +184,11 @@ MAX_DRIVE_FORCE = 2.0
 #: the load case: an axis that moves has pushed through its friction, so a peak a hundred times below it has u in
 #: another unit (N data headed mN: 1/1000) or a params file far from the rig
 MIN_DRIVE_FORCE = 0.01
+#: Factor by which a run's inverse-dynamics mass (IDIM-LS on its motor position and drive force, where it is
+#: determined within :data:`MASS_CHECK_STD` relative) may differ from the params file's rigid-body mass at the table
+#: (table, nut, and the rotor, coupling and screw inertia through the lead): positions in m headed mm read 1000 x
+MASS_FACTOR = 10.0
+MASS_CHECK_STD = 0.1
 #: Longest sample step of a run, in position-loop periods of its params file: a trace sampled more coarsely shows
 #: nothing of the loop (milliseconds headed seconds: 1000 periods, a replay 1000 times the run's length)
 MAX_SAMPLE_PERIODS = 10.0
@@ -561,7 +572,8 @@ def check_run(run, params=None, load_case=0):
     What a unit slip shows (each a replay of nonsense, or of a run a thousand times too long, before): the sample
     step is at most :data:`MAX_SAMPLE_PERIODS` position-loop periods, and the peak drive force ``u x u_gain`` lies
     between :data:`MIN_DRIVE_FORCE` times the params file's Coulomb friction and :data:`MAX_DRIVE_FORCE` times the
-    drive's force limit. Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
+    drive's force limit; the run's inverse-dynamics mass (:func:`inverse_dynamics_mass`), where it is determined, is
+    within :data:`MASS_FACTOR` of the params file's rigid-body mass at the table. Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
     reference was constant ran five minutes of fits before a fitted value left its range).
     """
     ctrl = run.meta.controller
@@ -597,11 +609,35 @@ def check_run(run, params=None, load_case=0):
                          f"at least {MIN_DRIVE_FORCE:g} x the params file's Coulomb friction at load case "
                          f"{load_case} ({coulomb:.4g} N): the axis moved, so the drive pushed through its friction; "
                          f"is the unit of u or u_gain wrong?")
+    mass = inverse_dynamics_mass(run)
+    rigid = rigid_inertia(params) * (2.0 * math.pi / params.screw.lead) ** 2
+    if mass is not None and not rigid / MASS_FACTOR <= mass <= rigid * MASS_FACTOR:
+        raise InputError(f"x_motor (run {run.label})", f"an inverse-dynamics mass of {mass:.4g} kg",
+                         f"within a factor of {MASS_FACTOR:g} of the params file's rigid-body mass at the table "
+                         f"({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead); is the unit of "
+                         "the positions (or of u) wrong?")
     limit = MAX_EXTERNAL_FORCE * force_limit(params)
     if run.f_ext is not None and float(np.max(np.abs(run.f_ext))) > limit:
         raise InputError(f"f_ext (run {run.label})", f"{float(np.max(np.abs(run.f_ext))):.3g} N",
                          f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "
                          "the params file's peak torque through the lead); is a unit wrong?")
+
+
+def inverse_dynamics_mass(run):
+    """The mass [kg] that IDIM-LS (:func:`drakecreep.gap.idim.fit_idim`: the motor position low-passed at a fifth
+    of the sampling rate, at most 100 Hz, every sample) reads from ``run``'s drive force, or None where the run does
+    not determine it within :data:`MASS_CHECK_STD` relative (too little acceleration, one direction only)."""
+    from drakecreep.gap.idim import fit_idim
+
+    border = min(20, run.n // 10)
+    try:
+        fit = fit_idim(run, cutoff=min(100.0, 0.2 / run.dt), decimation=1, border=border)
+    except (InputError, ValueError, np.linalg.LinAlgError):
+        return None
+    mass, std = float(fit.theta[0]), float(fit.std[0])
+    if not (math.isfinite(mass) and mass > 0.0 and std <= MASS_CHECK_STD * mass):
+        return None
+    return mass
 
 
 def _check_inputs(train, test, uncertain, effects, load_case):

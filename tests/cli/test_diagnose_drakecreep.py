@@ -220,6 +220,17 @@ def test_help_describes_the_drakecreep_kind_and_what_it_writes(capsys):
     assert "Runs of controller kind drakecreep" in out and "augmented_params.yaml (for simulate, margins" in out
 
 
+def _refusal(frame, yaml_path, tmp_path, capsys):
+    """Diagnose ``frame`` saved beside a copy of ``yaml_path``: the one line of a refusal (exit 2)."""
+    bad = tmp_path / "bad.csv"
+    frame.to_csv(bad, index=False)
+    bad.with_suffix(".yaml").write_text(yaml_path.read_text())
+    code = cli.main(["diagnose", str(bad), "--workers", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    return err[0]
+
+
 @pytest.mark.parametrize("column, factor, says", [
     ("u", 1000.0, "at most 2 x the drive's force limit"),  # N data headed kN
     ("u", 1e-3, "at least 0.01 x the params file's Coulomb friction"),  # N data headed mN
@@ -236,10 +247,32 @@ def test_a_unit_slip_of_a_drakecreep_run_is_one_line_exit_2(blank_csv, tmp_path,
     frame = pd.read_csv(path)
     head = next(c for c in frame.columns if c.split("[")[0] == column)
     frame[head] = frame[head] * (50.0 if column == "u" else 1.0) * factor  # blank u: 1 N; a 50 N drive
-    bad = tmp_path / "bad.csv"
-    frame.to_csv(bad, index=False)
-    bad.with_suffix(".yaml").write_text(yaml_path.read_text())
-    code = cli.main(["diagnose", str(bad), "--workers", "1"])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1, err
-    assert f"error: {column} (run r0): got " in err[0] and says in err[0]
+    err = _refusal(frame, yaml_path, tmp_path, capsys)
+    assert f"error: {column} (run r0): got " in err and says in err
+
+
+def test_positions_in_the_wrong_unit_are_refused_by_their_inverse_dynamics_mass(own_csv, tmp_path, capsys):
+    """Positions in m headed mm (found by fuzzing: exit 0 after 74 s, a 101 % force error, a viscous coefficient of
+    1.1e4 N s/m and a force ripple claimed for a lead error): the travel checks pass, every position being 1000 x
+    short, but the drive force then accelerates a mass 1000 x the params file's. The file as simulated reads its
+    own mass within 30 %."""
+    import math
+
+    import pandas as pd
+
+    from drakecreep.gap.drive_fit import inverse_dynamics_mass
+    from drakecreep.gap.measured import load_measured
+    from drakecreep.model.compensators import rigid_inertia
+
+    path, yaml_path = own_csv
+    data = load_measured(path)
+    params = data.meta.params
+    rigid = rigid_inertia(params) * (2.0 * math.pi / params.screw.lead) ** 2
+    masses = [inverse_dynamics_mass(r) for r in data.runs]
+    assert all(m is not None and abs(m / rigid - 1.0) < 0.3 for m in masses), (masses, rigid)
+    frame = pd.read_csv(path)
+    for column in frame.columns:
+        if column.split("[")[0] in ("x_ref", "x_motor", "x_table"):
+            frame[column] = frame[column] * 1e-3
+    err = _refusal(frame, yaml_path, tmp_path, capsys)
+    assert "x_motor (run " in err and "an inverse-dynamics mass of " in err and "within a factor of 10" in err
