@@ -103,6 +103,9 @@ MAX_SPEED = 10.0
 #: tens of kN; 1e7 N leaves three decades. A larger sample is a unit error or a corrupt cell (one cell of 1e300
 #: ran a diagnosis to overflowing fits and a mass of 1e301 kg)
 MAX_FORCE = 1e7
+#: Smallest peak drive force [N] (``u x u_gain``) a measured run may have: no drive moves an axis with less than a
+#: micronewton (a u of 1e-300 V ran to 'y: got all zero', an internal name, from the nominal's fit)
+MIN_PEAK_FORCE = 1e-6
 #: Share of a run's samples whose speed may exceed :data:`MAX_SPEED` (a reference step, an encoder glitch)
 _FAST_SHARE = 0.01
 #: Share of a position column's non-zero steps that may be shorter than half a declared count: a counting
@@ -758,6 +761,10 @@ def check_recorded(run):
                              f"{steps.min():.3g} m), so it moves by less than a count (a unit error?)")
     if not np.any(run.u):
         raise InputError(f"u (run {run.label})", "zero throughout", "the drive command the controller gave")
+    peak = float(np.max(np.abs(run.u))) * run.meta.u_gain
+    if peak < MIN_PEAK_FORCE:
+        raise InputError(f"u (run {run.label})", f"a peak drive force u x u_gain of {peak:.3g} N",
+                         f"at least {MIN_PEAK_FORCE:g} N (is the unit of u or u_gain wrong?)")
     ctrl = run.meta.controller
     if ctrl is not None and ctrl.kind == "p_p_cascade" and math.isfinite(ctrl.saturation):
         # the P-P cascade clips its output at the saturation, so a recorded u far beyond it contradicts it: a

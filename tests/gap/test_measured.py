@@ -165,6 +165,14 @@ def test_a_drive_command_that_is_zero_throughout_is_refused(tmp_path):
     assert err.value.field.endswith("u (run run)") and err.value.value == "zero throughout"
 
 
+def test_a_drive_force_below_a_micronewton_is_refused(tmp_path):
+    """A u of 1e-300 (varying) ran to 'y: got all zero', an internal name, from the nominal's fit (found by fuzzing)."""
+    cols = _rows()
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, {**cols, "u": 1e-300 * (1.0 + np.sin(cols["t"]))}))
+    assert err.value.field.endswith("u (run run)") and err.value.value.startswith("a peak drive force u x u_gain of ")
+
+
 def test_a_drive_command_of_one_value_throughout_is_refused(tmp_path):
     """A u of 1.0 in every row (found by fuzzing) diagnosed to NaN errors with exit 0."""
     cols = _rows()
