@@ -573,8 +573,9 @@ def check_run(run, params=None, load_case=0):
     step is at most :data:`MAX_SAMPLE_PERIODS` position-loop periods, and the peak drive force ``u x u_gain`` lies
     between :data:`MIN_DRIVE_FORCE` times the params file's Coulomb friction and :data:`MAX_DRIVE_FORCE` times the
     drive's force limit; the run's inverse-dynamics mass (:func:`inverse_dynamics_mass`), where it is determined, is
-    within :data:`MASS_FACTOR` of the params file's rigid-body mass at the table. Its reference moves: on a run that holds one position the friction has nothing to show (a file whose
-    reference was constant ran five minutes of fits before a fitted value left its range).
+    within :data:`MASS_FACTOR` of the params file's rigid-body mass at the table. Its reference moves: on a run
+    that holds one position the friction has nothing to show (a file whose reference was constant ran five minutes
+    of fits before a fitted value left its range).
     """
     ctrl = run.meta.controller
     if ctrl is None or ctrl.kind != "drakecreep":

@@ -175,11 +175,10 @@ def test_one_file_column_mapped_to_two_signals_is_refused(tmp_path):
     frame = _frame()
     frame.to_csv(tmp_path / "run.csv", index=False)
     mapping = {"t": "t", "x_ref": "x_ref", "x_motor": "x_ref", "u": "u"}
+    units = {"t": "s", "x_ref": "m", "x_motor": "m", "u": "N"}
     with pytest.raises(InputError) as err:
-        read_signals(tmp_path / "run.csv", "N", columns=mapping, units={"t": "s", "x_ref": "m", "x_motor": "m",
-                                                                       "u": "N"})
+        read_signals(tmp_path / "run.csv", "N", columns=mapping, units=units)
     assert err.value.field.endswith("file.columns.x_motor") and err.value.value == "x_ref"
     assert "it is x_ref's" in err.value.allowed
-    signals = read_signals(tmp_path / "run.csv", "N", columns=dict(mapping, x_motor="x_motor"),
-                           units={"t": "s", "x_ref": "m", "x_motor": "m", "u": "N"})
+    signals = read_signals(tmp_path / "run.csv", "N", columns=dict(mapping, x_motor="x_motor"), units=units)
     assert np.array_equal(signals["x_motor"], frame["x_motor"].to_numpy())
