@@ -153,6 +153,8 @@ def run(args):
         "sdof_fit": None if fit is None else {"fn_Hz": fit.fn, "zeta": fit.zeta, "k_N_per_m": fit.k,
                                               "m_kg": fit.m, "c_Ns_per_m": fit.c},
     }
+    if fit is None:
+        out["sdof_fit_failure"] = ident.fit_failure
     if args.json:
         print(json.dumps(to_jsonable(out), indent=2))  # a non-finite number as "inf", valid JSON
         return 0
@@ -166,7 +168,7 @@ def run(args):
         line += " (give --mass for k and c)"
     print(line)
     if fit is None:
-        print("SDOF fit: failed (no single mode in the band)")
+        print(f"SDOF fit: failed ({ident.fit_failure})")
     else:
         print(f"SDOF fit:   fn = {fit.fn:.5g} Hz, zeta = {fit.zeta:.4g}, k = {fit.k:.4g} N/m, "
               f"m = {fit.m:.4g} kg, c = {fit.c:.4g} N s/m")
