@@ -597,12 +597,12 @@ def check_run(run, params=None, load_case=0):
         raise InputError(f"t (run {run.label})", f"a sample step of {run.dt:.4g} s",
                          f"at most {MAX_SAMPLE_PERIODS:g} x the params file's position-loop period ({period:g} s), "
                          f"{MAX_SAMPLE_PERIODS * period:.4g} s (is the unit of t wrong?)")
-    drive = np.abs(run.u_gain * run.u)
+    drive, most = np.abs(run.u_gain * run.u), force_limit(params)
     peak = float(np.max(drive))
-    if peak > MAX_DRIVE_FORCE * force_limit(params):
+    if peak > MAX_DRIVE_FORCE * most:
         raise InputError(f"u (run {run.label})", f"a drive force u x u_gain of {peak:.4g} N at data row "
                          f"{int(np.argmax(drive)) + 1}", f"at most {MAX_DRIVE_FORCE:g} x the drive's force limit "
-                         f"({force_limit(params):.4g} N: the params file's peak torque through the lead); "
+                         f"({most:.4g} N: the params file's peak torque through the lead); "
                          f"is the unit of u or u_gain wrong?")
     coulomb = friction_levels(params, load)[0]
     if peak < MIN_DRIVE_FORCE * coulomb:
@@ -617,7 +617,7 @@ def check_run(run, params=None, load_case=0):
                          f"within a factor of {MASS_FACTOR:g} of the params file's rigid-body mass at the table "
                          f"({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead); is the unit of "
                          "the positions (or of u) wrong?")
-    limit = MAX_EXTERNAL_FORCE * force_limit(params)
+    limit = MAX_EXTERNAL_FORCE * most
     if run.f_ext is not None and float(np.max(np.abs(run.f_ext))) > limit:
         raise InputError(f"f_ext (run {run.label})", f"{float(np.max(np.abs(run.f_ext))):.3g} N",
                          f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "

@@ -217,17 +217,20 @@ def _along_viscous(column, ops, scenario, linearize):
     affine in it: the two ends are linearized and the rest interpolated, after a third linearization in the middle
     agrees to :data:`AFFINE_TOLERANCE` (else every point is linearized): 6 linearizations of a 20-row column
     instead of 40, the same poles."""
+    def every():  # each point linearized
+        return [linearize(p, scenario, op).A for p, op in zip(column, ops)]
+
     fv = np.array([p.friction.viscous for p in column])
     lo, hi, mid = int(np.argmin(fv)), int(np.argmax(fv)), len(column) // 2
     if len(column) < 3 or fv[hi] == fv[lo] or fv[mid] in (fv[lo], fv[hi]):
-        return [linearize(p, scenario, op).A for p, op in zip(column, ops)]
+        return every()
     a_lo, a_hi, a_mid = (linearize(column[i], scenario, ops[i]).A for i in (lo, hi, mid))
 
     def at(f):
         return a_lo + (f - fv[lo]) / (fv[hi] - fv[lo]) * (a_hi - a_lo)
 
     if np.max(np.abs(at(fv[mid]) - a_mid)) > AFFINE_TOLERANCE * max(np.max(np.abs(a_mid)), 1e-300):
-        return [linearize(p, scenario, op).A for p, op in zip(column, ops)]
+        return every()
     return [a_lo if i == lo else a_hi if i == hi else a_mid if i == mid else at(f) for i, f in enumerate(fv)]
 
 
