@@ -577,6 +577,10 @@ class SimulationParams(_Params):
         if 0.0 < self.accuracy < MIN_ACCURACY:
             raise InputError("accuracy", self.accuracy, f"0 (the friction law's default) or a finite number in "
                              f"[{MIN_ACCURACY:g}, 0.1]")
+        if self.steady_start < self.acceleration_time:
+            # metrics taken on the ramp measure the acceleration, not the feed: a creep verdict from them is wrong
+            raise InputError("steady_start", self.steady_start, f">= acceleration_time ({self.acceleration_time:g} s): "
+                             "the metrics window starts after the reference's ramp")
 
 
 @dataclass(frozen=True)

@@ -103,6 +103,9 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
          "got 1e-15; allowed: 0 (ideal) or a finite number in [1e-06, 0.1] s"),
         ({"simulation": {"accuracy": 1e-300}}, "simulation.accuracy",
          "got 1e-300; allowed: 0 (the friction law's default) or a finite number in [1e-12, 0.1]"),
+        # 0.01 s with the 0.05 s ramp: simulate measured the acceleration and called it a creep verdict
+        ({"simulation": {"steady_start": 0.01}}, "simulation.steady_start",
+         "got 0.01; allowed: >= acceleration_time (0.05 s)"),
         ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
         # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
         ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),

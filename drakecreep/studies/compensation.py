@@ -108,17 +108,22 @@ def _steady(params, duration):
 
 def check_duration(params, duration):
     """Refuse a run time the study cannot measure (:class:`InputError` naming ``duration``): its metrics window,
-    ``simulation.steady_start`` to the end and at least the run's last half, must hold :data:`MIN_WINDOW_SAMPLES`
-    recorded samples (1e-300 s was refused as 'simulation.log_period: got 0.00025', a field nobody had set)."""
+    ``simulation.steady_start`` to the end and at least the run's last half, must start after the reference's
+    acceleration ramp (``simulation.acceleration_time``) and hold :data:`MIN_WINDOW_SAMPLES` recorded samples
+    (1e-300 s was refused as 'simulation.log_period: got 0.00025', a field nobody had set; 0.01 s measured the
+    ramp of a 0.05 s acceleration and gave verdicts)."""
     sim = params.simulation
-    least = min(sim.steady_start, MIN_WINDOW_SAMPLES * sim.log_period) + MIN_WINDOW_SAMPLES * sim.log_period
+    least = max(min(sim.steady_start, MIN_WINDOW_SAMPLES * sim.log_period) + MIN_WINDOW_SAMPLES * sim.log_period,
+                2.0 * sim.acceleration_time)
     if isinstance(duration, bool) or not (isinstance(duration, (int, float)) and 0 < duration <= MAX_DURATION and (
             # as simulate's check of the window (check_log_period), on the window this study gives the run
-            (duration - min(sim.steady_start, 0.5 * duration)) / sim.log_period >= MIN_WINDOW_SAMPLES)):
+            (duration - min(sim.steady_start, 0.5 * duration)) / sim.log_period >= MIN_WINDOW_SAMPLES)
+            and min(sim.steady_start, 0.5 * duration) >= sim.acceleration_time):
         raise InputError("duration", duration,
                          f"a time in [{least:.3g}, {MAX_DURATION:g}] s (the metrics window, from "
-                         f"simulation.steady_start or the run's last half, needs {MIN_WINDOW_SAMPLES} recorded samples, "
-                         f"one every simulation.log_period = {sim.log_period:g} s)")
+                         f"simulation.steady_start or the run's last half, starts after the reference's ramp, "
+                         f"simulation.acceleration_time = {sim.acceleration_time:g} s, and needs {MIN_WINDOW_SAMPLES} "
+                         f"recorded samples, one every simulation.log_period = {sim.log_period:g} s)")
     return duration
 
 

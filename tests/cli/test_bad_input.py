@@ -518,8 +518,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     # the options, not the library's names ('duration: got 1000000000.0', 'calibration_rows: got (1,)')
     (["simulate", "--out", "{tmp}/s", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
     # a window of 5e-301 s: 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody had set
-    (["compensate", "--out", "{tmp}/c", "--duration", "1e-300"], "--duration: got 1e-300; allowed: a time in [0.01, 3600] s"),
-    (["compensate", "--out", "{tmp}/c", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in [0.01, 3600]"),
+    (["compensate", "--out", "{tmp}/c", "--duration", "1e-300"], "--duration: got 1e-300; allowed: a time in [0.1, 3600] s"),
+    (["compensate", "--out", "{tmp}/c", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in [0.1, 3600]"),
+    # inside the 0.05 s acceleration ramp: verdicts on the ramp, exit 0
+    (["compensate", "--out", "{tmp}/c", "--duration", "0.01"], "--duration: got 0.01; allowed: a time in [0.1, 3600]"),
     (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1"], "--calibrate: got '1'; allowed: two rows"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'"),

@@ -183,10 +183,11 @@ def test_every_run_is_checked_before_any_runs(short_paper, monkeypatch):
         evaluate(short_paper, ("none",), feeds_mm_s=(1.0,), load_cases=(9,), duration=2.0, workers=2)
 
 
-@pytest.mark.parametrize("duration", [1e-300, 0.0099, 1e9, float("nan")])
+@pytest.mark.parametrize("duration", [1e-300, 0.0099, 0.01, 0.0999, 1e9, float("nan")])
 def test_a_run_too_short_to_measure_names_the_duration(paper, monkeypatch, duration):
-    """1e-300 s was refused as 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody set:
-    the window (steady_start, or the run's last half) needs 20 samples of the 0.25 ms log, so 10 ms at least."""
+    """1e-300 s was refused as 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody set;
+    0.01 s gave verdicts measured on the 0.05 s acceleration ramp: the window (steady_start, or the run's last
+    half) starts after the ramp, so 0.1 s at least."""
     import drakecreep.studies.compensation as compensation
 
     def no_work(*args, **kwargs):
@@ -198,8 +199,19 @@ def test_a_run_too_short_to_measure_names_the_duration(paper, monkeypatch, durat
         with pytest.raises(InputError) as err:
             study()
         assert err.value.field == "duration"
-        assert "allowed: a time in [0.01, 3600] s (the metrics window" in str(err.value)
-    assert compensation.check_duration(paper, 0.01) == 0.01
+        assert "allowed: a time in [0.1, 3600] s (the metrics window" in str(err.value)
+        assert "acceleration_time = 0.05 s" in str(err.value)
+    assert compensation.check_duration(paper, 0.1) == 0.1
+
+
+def test_without_a_ramp_the_window_needs_only_its_samples(paper):
+    """With no acceleration ramp the least run is the window's 20 samples of the 0.25 ms log on either side."""
+    from drakecreep.studies.compensation import check_duration
+
+    no_ramp = with_value(paper, "simulation.acceleration_time", 0.0)
+    assert check_duration(no_ramp, 0.01) == 0.01
+    with pytest.raises(InputError, match=r"a time in \[0.01, 3600\] s"):
+        check_duration(no_ramp, 0.0099)
 
 
 def test_write_report_is_atomic(tmp_path, monkeypatch):
