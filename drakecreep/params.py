@@ -216,6 +216,14 @@ def _check_stiffness(name, value, off=False):
                          f"{MIN_STIFFNESS:g} N/m (smaller underflows the stiffness chain in series)")
 
 
+#: largest damping of an element of the axial chain [N s/m] (bearing, screw-nut pair, a seat joint), the upper end of
+#: their ranges: four decades above a real one's (60 and 900 N s/m on the paper's rig) and 50x the critical damping of
+#: a 1000 kg table on a 1e9 N/m chain. At 1e9-1e20 N s/m ``margins`` printed 'nan Hz' for the mode it overdamps and,
+#: at 1e20, an open-loop unstable pole the rounding of its -c/m eigenvalue made
+MAX_CHAIN_DAMPING = 1e8
+#: largest axial force [N] of a constant load and of a friction level (critical's --fs, --fd): 1000 t, three
+#: decades above a heavy machine axis's thrust
+MAX_AXIAL_FORCE = 1e6
 #: largest gains of the PI cascade, the upper ends of their ranges: 3-4 decades above any feed drive's (kp 40 1/s,
 #: kv 1.2e5 N s/m, ki 7.5e6 N/m on the paper's rig; a kv of 1e9 N s/m puts the velocity loop's crossover on a 300 kg
 #: axis near 0.5 MHz, far beyond any sampled loop). Gains of 1e20 were accepted and ran as an unstable loop chattering
@@ -362,7 +370,7 @@ class ScrewParams(_Params):
         0.1, "m", 0.0, lo_open=True, doc="thrust bearing to nut at table position 0"
     )
     bearing_stiffness: float = _q(9.38e6, "N/m", 0.0, lo_open=True, doc="bearing axial stiffness (Table 6)")
-    bearing_damping: float = _q(60.61, "N s/m", 0.0, doc="bearing axial damping (Table 6)")
+    bearing_damping: float = _q(60.61, "N s/m", 0.0, MAX_CHAIN_DAMPING, doc="bearing axial damping (Table 6)")
     chain_damping: str = _q(
         "viscous", "-", choices=("viscous", "loss_factor"),
         doc="bearing/nut damping as identified (viscous), or as hysteretic loss factors evaluated at damping_frequency",
@@ -376,7 +384,7 @@ class ScrewParams(_Params):
     seat_joint_stiffness: float = _q(
         0.0, "N/m", 0.0, doc="fixed joints of the bearing seat in series with the bearing (0 = rigid, off)",
     )
-    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the bearing seat joints")
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, MAX_CHAIN_DAMPING, doc="damping of the bearing seat joints")
 
     def _check(self):
         if self.root_diameter > self.nominal_diameter:
@@ -401,7 +409,7 @@ class NutParams(_Params):
     """Screw-nut pair: contact stiffness and damping, and its share of friction."""
 
     axial_stiffness: float = _q(51.6e6, "N/m", 0.0, lo_open=True, doc="screw-nut axial stiffness (Table 4)")
-    axial_damping: float = _q(898.88, "N s/m", 0.0, doc="screw-nut axial damping (Table 4)")
+    axial_damping: float = _q(898.88, "N s/m", 0.0, MAX_CHAIN_DAMPING, doc="screw-nut axial damping (Table 4)")
     mass: float = _q(0.335, "kg", 0.0, 1e3, doc="nut mass (Table 3), lumped into the table")
     preload_torque: float = _q(
         0.09, "N m", 0.0, doc="preload drag torque of the nut (THK: 0.05 tan(lead angle)^-0.5 Fa0 Ph / 2 pi)"
@@ -412,7 +420,7 @@ class NutParams(_Params):
     seat_joint_stiffness: float = _q(
         0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
     )
-    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, doc="damping of the nut seat joints")
+    seat_joint_damping: float = _q(0.0, "N s/m", 0.0, MAX_CHAIN_DAMPING, doc="damping of the nut seat joints")
 
     def _check(self):
         _check_stiffness("axial_stiffness", self.axial_stiffness)
@@ -451,7 +459,7 @@ class LoadParams(_Params):
         why="a drive is tested under a handful, the paper's Table 7 under 3; each is a run of its own"))
     gravity: float = _q(9.81, "m/s^2", 0.0, 100.0, doc="gravity (table weight on the guides)")
     constant_force: float = _q(
-        0.0, "N", -1e6, 1e6,
+        0.0, "N", -MAX_AXIAL_FORCE, MAX_AXIAL_FORCE,
         doc="an axial force on the table in every load case, the unloaded one included, added to its fx (> 0 "
             "opposes a feed in +x): a drive's current offset, the weight on an inclined axis, a cable carrier's "
             "pull; assumption: 0, the paper gives none",

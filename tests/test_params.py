@@ -106,6 +106,10 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         # 0.01 s with the 0.05 s ramp: simulate measured the acceleration and called it a creep verdict
         ({"simulation": {"steady_start": 0.01}}, "simulation.steady_start",
          "got 0.01; allowed: >= acceleration_time (0.05 s)"),
+        # 1e9-1e20 N s/m: margins printed 'nan Hz' and, at 1e20, an open-loop unstable pole made by round-off
+        ({"nut": {"axial_damping": 1e9}}, "nut.axial_damping", "got 1000000000.0; allowed: a finite number in [0.0, "
+         "100000000.0] N s/m"),
+        ({"screw": {"bearing_damping": 1e20}}, "screw.bearing_damping", "[0.0, 100000000.0] N s/m"),
         ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
         # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
         ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),

@@ -14,17 +14,20 @@ import math
 
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, print_json
 from drakecreep.errors import InputError
-from drakecreep.params import ABSURD
+from drakecreep.params import ABSURD, MAX_AXIAL_FORCE, MAX_CHAIN_DAMPING, MIN_STIFFNESS, MIN_TABLE_MASS
 
 __all__ = ["add_parser", "run"]
 
-#: override option -> (LumpedDrive field, factor from the option's unit to SI, may be zero)
+#: override option -> (LumpedDrive field, factor from the option's unit to SI, may be zero, SI range): the ranges
+#: of the parameter fields they stand for (a chain element's stiffness and damping, the table's mass, the largest
+#: constant force of a load case for a friction level); --stiffness 1e-26 with --mass 1e-20, --damping 1e12 and
+#: --fs 1e20 were accepted and printed a boundary of no drive
 OVERRIDES = {
-    "stiffness": ("stiffness", 1e6, False),
-    "damping": ("damping", 1.0, True),
-    "mass": ("mass", 1.0, False),
-    "fs": ("breakaway", 1.0, False),
-    "fd": ("coulomb", 1.0, False),
+    "stiffness": ("stiffness", 1e6, False, (MIN_STIFFNESS, ABSURD)),
+    "damping": ("damping", 1.0, True, (0.0, MAX_CHAIN_DAMPING)),
+    "mass": ("mass", 1.0, False, (MIN_TABLE_MASS, 1e5)),
+    "fs": ("breakaway", 1.0, False, (1e-6, MAX_AXIAL_FORCE)),
+    "fd": ("coulomb", 1.0, False, (1e-6, MAX_AXIAL_FORCE)),
 }
 #: the overrides' units, as their options take them
 _UNITS = {"stiffness": "N/um", "damping": "N s/m", "mass": "kg", "fs": "N", "fd": "N"}
@@ -61,15 +64,14 @@ def _drive(args):
         raise InputError("--load-case", args.load_case, params.load_cases_allowed)
     drive = lumped(params, args.load_case)
     changes = {}
-    for option, (field, unit, zero_ok) in OVERRIDES.items():
+    for option, (field, unit, zero_ok, (lo, hi)) in OVERRIDES.items():
         value = getattr(args, option)
         if value is None:
             continue
-        # the bounds of a parameter file's fields (params.ABSURD): 1e300 or 1e-300 overflowed to inf results
-        lo, hi = 1.0 / ABSURD / unit, min(ABSURD / unit, 1e5 if option == "mass" else math.inf)
-        if not (math.isfinite(value) and ((value == 0 and zero_ok) or lo <= value <= hi)):
-            raise InputError("--" + option, value,
-                             f"{'0 or ' if zero_ok else ''}a number in [{lo:g}, {hi:g}] {_UNITS[option]}")
+        # the bounds of a parameter file's fields: 1e300 or 1e-300 overflowed to inf results
+        if not (math.isfinite(value) and ((value == 0 and zero_ok) or lo <= value * unit <= hi)):
+            raise InputError("--" + option, value, f"{'0 or ' if zero_ok and lo > 0 else ''}a number in "
+                             f"[{lo / unit:g}, {hi / unit:g}] {_UNITS[option]}")
         changes[field] = value * unit
     drive = dataclasses.replace(drive, **changes)
     if drive.breakaway < drive.coulomb:

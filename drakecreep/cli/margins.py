@@ -86,7 +86,7 @@ def print_margins(summary):
 
 def run(args):
     """Compute and print the margins."""
-    from drakecreep.servo.loops import analyze_loops
+    from drakecreep.servo.loops import analyze_loops, resonance_text
 
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
@@ -111,5 +111,5 @@ def run(args):
         print("of which the computation delay: " + ", ".join(
             f"{loop} {c[loop]['phase_margin_deg']:.2f} deg PM, {c[loop]['gain_margin_dB']:.2f} dB GM, "
             f"{c[loop]['delay_margin_ms']:.3g} ms delay margin" for loop in ("velocity", "position")))
-    print(f"first mechanical resonance: {summary['resonance_Hz']:.4g} Hz, damping ratio {summary['resonance_damping']:.4g}")
+    print(f"first mechanical resonance: {resonance_text(summary['resonance_Hz'], summary['resonance_damping'], '.4g')}")
     return 0

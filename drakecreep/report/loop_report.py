@@ -21,7 +21,7 @@ from drakecreep.report import loop_plots
 from drakecreep.errors import InputError
 from drakecreep.files import OutputSet, to_jsonable
 from drakecreep.report.html import figure, page, table
-from drakecreep.servo.loops import LOOPS, analyze_loops
+from drakecreep.servo.loops import LOOPS, analyze_loops, resonance_text
 from drakecreep.model.motor import motor_inertia
 from drakecreep.params import params_to_dict, with_value
 from drakecreep.servo.polemap import friction_slope_crossings, parameter_locus, pole_map
@@ -263,7 +263,7 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, d
     def mm(vals):
         return ", ".join(f"{v * 1e3:.4g}" for v in vals) or "none"
 
-    zoom = f"{analysis.resonance_Hz:.1f} Hz, damping ratio {analysis.resonance_damping:.4f}"
+    zoom = resonance_text(analysis.resonance_Hz, analysis.resonance_damping, ".4g")
     cl = analysis.closed_loop_poles
     worst = cl[np.argmax(cl.real)]
     lm, sm_ = low_run.metrics, step.metrics

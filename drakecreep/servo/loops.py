@@ -48,6 +48,7 @@ __all__ = [
     "lift",
     "delayed_zoh",
     "plant_resonance",
+    "resonance_text",
     "LoopAnalysis",
     "analyze_loops",
 ]
@@ -346,6 +347,14 @@ def plant_resonance(P):
         return math.nan, math.nan
     p = min(poles, key=abs)
     return abs(p) / (2 * math.pi), -p.real / abs(p)
+
+
+def resonance_text(frequency_Hz, damping_ratio, fmt=".4g"):
+    """The first mechanical resonance in words: ``'73.51 Hz, damping ratio 0.013'``, or, where the plant has no
+    complex pole (:func:`plant_resonance` gives NaN: every mode overdamped), that it has none."""
+    if not math.isfinite(frequency_Hz):
+        return "none (no complex plant pole: every mode is overdamped)"
+    return f"{frequency_Hz:{fmt}} Hz, damping ratio {damping_ratio:{fmt}}"
 
 
 @dataclass

@@ -158,9 +158,14 @@ def test_critical_refuses_overflowing_values(argv, field, capsys):
 
 @pytest.mark.parametrize("argv, line", [
     # the unit of the option (N/um, not the model's N/m) in what is allowed
-    (["--stiffness", "-1"], "--stiffness: got -1.0; allowed: a number in [1e-26, 1e+14] N/um"),
-    (["--damping", "-5"], "--damping: got -5.0; allowed: 0 or a number in [1e-20, 1e+20] N s/m"),
-    (["--mass", "0"], "--mass: got 0.0; allowed: a number in [1e-20, 100000] kg"),
+    (["--stiffness", "-1"], "--stiffness: got -1.0; allowed: a number in [1e-06, 1e+14] N/um"),
+    (["--damping", "-5"], "--damping: got -5.0; allowed: a number in [0, 1e+08] N s/m"),
+    (["--mass", "0"], "--mass: got 0.0; allowed: a number in [0.001, 100000] kg"),
+    # the ranges of the parameter fields they stand for: these were accepted and printed a boundary of no drive
+    (["--stiffness", "1e-26", "--mass", "2"], "--stiffness: got 1e-26; allowed: a number in [1e-06, 1e+14] N/um"),
+    (["--mass", "1e-20"], "--mass: got 1e-20; allowed: a number in [0.001, 100000] kg"),
+    (["--damping", "1e12"], "--damping: got 1000000000000.0; allowed: a number in [0, 1e+08] N s/m"),
+    (["--fs", "1e20"], "--fs: got 1e+20; allowed: a number in [1e-06, 1e+06] N"),
     # --fd above the parameters' Fs named --fd, not '--fs: got 12.234376764999999', an option not given
     (["--fd", "100"], "--fd: got 100.0; allowed: <= Fs (12.2344 N, the parameters' breakaway; or give --fs)"),
     (["--fs", "1", "--fd", "2"], "--fs: got 1.0; allowed: >= Fd (2 N)"),
@@ -171,6 +176,6 @@ def test_critical_names_the_option_given_in_its_unit(argv, line, capsys):
 
 
 def test_critical_at_the_bounds_is_finite(capsys):
-    assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-20", "--damping", "0"]) == 0
+    assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-3", "--damping", "0"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert math.isfinite(out["natural_frequency_Hz"]) and math.isfinite(out["zeta"])

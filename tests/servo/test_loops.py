@@ -193,3 +193,14 @@ def test_bad_delay_in_the_margins_names_the_field():
     with pytest.raises(InputError) as err:
         loops.delayed_zoh(control.ss(control.tf([1.0], [1.0, 1.0])), 1e-3, -0.5)
     assert err.value.field == "controller.computation_delay"
+
+
+def test_an_overdamped_chain_has_no_resonance_and_says_so(paper):
+    """1e7 N s/m on the screw-nut pair (zeta about 6.5) overdamps the axial mode: margins printed 'nan Hz, damping
+    ratio nan'; the plant has no complex pole, and the text says that there is none."""
+    stiff = loops.analyze_loops(with_value(paper, "nut.axial_damping", 1e7), Scenario(feed=1e-3, load_case=3))
+    assert math.isnan(stiff.resonance_Hz)
+    assert loops.resonance_text(stiff.resonance_Hz, stiff.resonance_damping) == (
+        "none (no complex plant pole: every mode is overdamped)")
+    assert stiff.summary()["velocity"]["closed_loop_stable"]
+    assert loops.resonance_text(73.514, 0.013321) == "73.51 Hz, damping ratio 0.01332"
