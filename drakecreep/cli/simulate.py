@@ -41,7 +41,8 @@ def add_parser(subparsers):
                         "(no bending; the cheap configuration for creep runs, docs/multibody.md)")
     p.add_argument("--out", default="out/simulate", metavar="DIR", help="output folder (default out/simulate)")
     p.add_argument("--max-wall", type=positive_float, metavar="S",
-                   help="stop the run after S seconds of computing (what was computed is saved)")
+                   help="stop after S seconds of computing, the convergence check's reruns included (what was "
+                        "computed is saved)")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG")
     p.add_argument("--json", action="store_true", help="print one JSON object instead of the text summary")
     p.add_argument("--uncertainty", type=int, metavar="N",

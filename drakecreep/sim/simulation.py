@@ -307,8 +307,11 @@ def slow_run_notice(t, until, elapsed, steps, integrator):
     return line + "; --max-wall S stops the run and keeps what was computed"
 
 
-def _guard(simulator, root, read_speeds, bounds, wall_limit, until=None, notice=None, integrator=""):
+def _guard(simulator, root, read_speeds, bounds, wall_limit, until=None, notice=None, integrator="", deadline=None):
     """Install the divergence guard as the simulator's monitor; returns the dict it reports into.
+
+    ``wall_limit`` (s) stops the run at ``deadline`` (a ``time.perf_counter()`` reading; its start plus the
+    limit when None): :func:`simulate` gives each of its runs the deadline of the whole command.
 
     With ``notice`` (a callable taking one line) and ``until``, a run whose pace projects more than
     :data:`SLOW_NOTICE` s gets one :func:`slow_run_notice` once :data:`SLOW_NOTICE_AFTER` s have passed."""
@@ -316,6 +319,8 @@ def _guard(simulator, root, read_speeds, bounds, wall_limit, until=None, notice=
 
     report = dict(reason=None)
     start = time.perf_counter()
+    if wall_limit is not None and deadline is None:
+        deadline = start + wall_limit
     calls = [0]
     pending = [notice is not None and until is not None]
     v_max, w_max = bounds
@@ -335,7 +340,7 @@ def _guard(simulator, root, read_speeds, bounds, wall_limit, until=None, notice=
         elif abs(w) > w_max:
             reason = (f"diverged at t = {t:.6g} s: motor speed {w:.3g} rad/s beyond +-{w_max:.3g} rad/s "
                       f"(the table speed limit {v_max:g} m/s through the lead)")
-        elif wall_limit is not None and time.perf_counter() - start > wall_limit:
+        elif deadline is not None and time.perf_counter() > deadline:
             reason = f"stopped at t = {t:.6g} s: wall-clock limit of {wall_limit:g} s reached"
         if pending[0] and time.perf_counter() - start > SLOW_NOTICE_AFTER:
             pending[0] = False
@@ -413,7 +418,8 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         around the MultibodyPlant (controller, sensors, friction laws; the plant stays Drake's),
         ``leaf`` runs the leaf systems.
     wall_limit : float, optional
-        Stop after this many seconds of computing (the result says so in ``status``).
+        Stop after this many seconds of computing, the convergence check's runs included (the result says so
+        in ``status``; a limit reached in the check keeps the complete run).
     model : {"two_mass", "multibody"}
         The mechanics (:data:`MODELS`): the two-mass diagram, or the paper's rig in a MultibodyPlant
         with the same controller, sensors, friction laws and load case
@@ -441,12 +447,15 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
                 or not float(wall_limit) > 0:
             raise InputError("wall_limit", wall_limit, "a number of seconds > 0")
         wall_limit = float(wall_limit)
+    # one deadline for every run below (the run, the convergence check's probe and rerun): the limit applied to
+    # each of them let a 10 s --max-wall compute for up to 30 s
+    deadline = None if wall_limit is None else time.perf_counter() + wall_limit
     backend = check_run(params, scenario, backend=backend, model=model, multibody=multibody)
     sim = params.simulation
     accuracy = target_accuracy(params)
     built = (_build(params, scenario, backend) if model == "two_mass"
              else _build_multibody(params, scenario, multibody, backend))
-    result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice)
+    result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice, deadline)
     check = sim.convergence_check and built[5]["integrator"] not in FIXED_STEP and result.ok \
         and result.metrics is not None
     if not check:
@@ -457,12 +466,12 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
     attempts = 0
     while True:
         tight = max(accuracy / 10.0, _ACCURACY_FLOOR)
-        probe = _run(params, scenario, built, tight, end, wall_limit, notice)
+        probe = _run(params, scenario, built, tight, end, wall_limit, notice, deadline)
         wall += probe.wall_time
-        if probe.status.startswith("interrupted"):
+        if probe.status.startswith("interrupted") or "wall-clock limit" in probe.status:
             # a Ctrl-C or SIGTERM stops the command here too: it was read as a disagreement, the whole run was
-            # simulated again at the tighter accuracy and the command ended 'converged' (exit 0). The run is kept,
-            # its convergence unknown
+            # simulated again at the tighter accuracy and the command ended 'converged' (exit 0). So does the
+            # command's wall-clock limit. The run is kept, its convergence unknown
             result.status = f"{probe.status} in the convergence check (the run itself is complete, not checked)"
             result.wall_time = wall
             result.stats.update(accuracy=accuracy, convergence_check_accuracy=tight, convergence_runs=attempts)
@@ -472,9 +481,15 @@ def simulate(params, scenario, *, backend=None, wall_limit=None, model="two_mass
         if agree or attempts == 2 or tight == accuracy:
             break
         # the verdict moved: the whole run again at the tighter accuracy, then check that one
-        accuracy = tight
-        result = _run(params, scenario, built, accuracy, scenario.duration, wall_limit, notice)
-        wall += result.wall_time
+        rerun = _run(params, scenario, built, tight, scenario.duration, wall_limit, notice, deadline)
+        wall += rerun.wall_time
+        if "wall-clock limit" in rerun.status:
+            # the complete run is kept rather than the part of its rerun: its verdict disagreed with the check's
+            result.status = (f"{rerun.status} in the convergence check's rerun at accuracy {tight:g} (the run at "
+                             f"{accuracy:g} is complete and kept; the check at the tighter accuracy disagreed with it)")
+            agree = False
+            break
+        result, accuracy = rerun, tight
         if result.metrics is None or not result.ok:  # (an interrupted rerun is not checked again either)
             break
     if result.metrics is not None:
@@ -602,9 +617,9 @@ def _build_multibody(params, scenario, options, backend="compiled"):
     return feed_drive, root, loggers, init, read_speeds, info
 
 
-def _run(params, scenario, built, accuracy, until, wall_limit=None, notice=None):
+def _run(params, scenario, built, accuracy, until, wall_limit=None, notice=None, deadline=None):
     """One simulation from t = 0 to ``until`` at target ``accuracy`` on a diagram from :func:`_build`, watched
-    by the divergence guard."""
+    by the divergence guard (which stops it at ``deadline``, from ``wall_limit``: :func:`_guard`)."""
     sim = params.simulation
     feed_drive, root, loggers, init, read_speeds, info = built
     units = feed_drive.signal_units()
@@ -617,7 +632,7 @@ def _run(params, scenario, built, accuracy, until, wall_limit=None, notice=None)
     start = time.perf_counter()
     other = {} if info["integrator"] == sim.integrator else dict(integrator=info["integrator"])
     simulator = make_simulator(root, context, sim, accuracy, **other)
-    guard = _guard(simulator, root, read_speeds, bounds, wall_limit, until, notice, info["integrator"])
+    guard = _guard(simulator, root, read_speeds, bounds, wall_limit, until, notice, info["integrator"], deadline)
     status = "ok"
     try:
         simulator.AdvanceTo(until)  # the log's periodic publish lands on `until` too

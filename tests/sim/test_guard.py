@@ -60,6 +60,47 @@ def test_wall_clock_limit(short_paper, limit):
     assert r.time[-1] < 60.0
 
 
+def _runs_with_deadlines(monkeypatch, expire_at=None):
+    """Record the deadline each of simulate's runs gets; the run numbered ``expire_at`` (0 = the run, 1 = the
+    convergence check's probe, 2 = its rerun) gets one already passed, as if the command's limit ran out there."""
+    real, deadlines = simulation._run, []
+
+    def run(*args):
+        *head, deadline = args
+        deadlines.append(deadline)
+        if len(deadlines) - 1 == expire_at:
+            deadline = time.perf_counter() - 1.0
+        return real(*head, deadline)
+
+    monkeypatch.setattr(simulation, "_run", run)
+    return deadlines
+
+
+def test_the_wall_clock_limit_is_the_whole_commands(short_paper, monkeypatch):
+    """The limit applied to each of the up to three runs of a command (the run, the convergence check's probe,
+    its rerun): a 10 s --max-wall could compute for 30 s. Every run gets the one deadline."""
+    deadlines = _runs_with_deadlines(monkeypatch)
+    start = time.perf_counter()
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6), wall_limit=100.0)
+    assert r.ok and r.metrics.converged is not None and len(deadlines) >= 2
+    assert len(set(deadlines)) == 1 and start < deadlines[0] - 100.0 < time.perf_counter()
+
+
+def test_a_limit_reached_in_the_convergence_check_keeps_the_complete_run(short_paper, monkeypatch):
+    _runs_with_deadlines(monkeypatch, expire_at=1)
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6), wall_limit=100.0)
+    assert not r.ok and "wall-clock limit of 100 s reached in the convergence check" in r.status
+    assert r.time[-1] == pytest.approx(0.6) and r.metrics is not None and r.metrics.converged is None
+
+
+def test_a_limit_reached_in_the_rerun_keeps_the_complete_run_unconverged(short_paper, monkeypatch):
+    _runs_with_deadlines(monkeypatch, expire_at=2)
+    monkeypatch.setattr(simulation, "_agree", lambda *args: (False, 1e-3, False))  # the check disagrees
+    r = simulate(short_paper, Scenario(feed=1e-3, load_case=3, duration=0.6), wall_limit=100.0)
+    assert not r.ok and "reached in the convergence check's rerun at accuracy" in r.status
+    assert r.time[-1] == pytest.approx(0.6) and r.metrics.converged is False
+
+
 @pytest.mark.parametrize("limit", [0, -1.0, np.float64("nan"), True, np.bool_(True), "5", 1j])
 def test_a_wall_clock_limit_that_is_no_positive_number_is_refused(short_paper, limit):
     with pytest.raises(InputError, match="wall_limit"):
