@@ -1,6 +1,6 @@
 """``drakecreep diagram``: draw the feed-drive diagram (Graphviz, from Drake)."""
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "controller_caption"]
 
 
 def add_parser(subparsers):
@@ -35,6 +35,18 @@ def run(args):
     # 'load_case: got 3', an option diagram does not have): the blocks drawn are the same for every load case
     scenario = Scenario(load_case=min(Scenario().load_case, len(params.loads.cases)))
     drive = build_diagram(params, scenario, continuous=continuous)
-    path = draw_diagram(drive.diagram, args.out)
+    source = args.params or f"preset {args.preset}"
+    path = draw_diagram(drive.diagram, args.out, title=f"{source}: {controller_caption(params, continuous)}")
     print(f"wrote {path}")
     return 0
+
+
+def controller_caption(params, continuous=None):
+    """The controller variant drawn, in words: one :class:`~drakecreep.model.controller.CascadeController` block
+    either way, so the drawing's caption says which (``--controller continuous`` drew the same picture as
+    ``sampled``)."""
+    g = params.controller
+    if continuous if continuous is not None else not g.sampled:
+        return "continuous PI cascade controller"
+    return (f"sampled PI cascade controller: velocity loop every {g.velocity_period * 1e3:g} ms, position loop every "
+            f"{g.position_period * 1e3:g} ms, computation delay {g.computation_delay:g} velocity samples")

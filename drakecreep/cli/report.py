@@ -20,9 +20,9 @@ def add_parser(subparsers):
                    help="low-speed feed of the simulation and the pole map (default 0.1)")
     p.add_argument("--load-case", type=int, default=3, metavar="N", help="load case (default 3)")
     p.add_argument("--no-sim-grid", action="store_true", help="skip the simulated creep markers on the pole map")
-    p.add_argument("--workers", type=workers, metavar="N", default=usable_cpus(),
-                   help="processes for the pole map's 36 creep simulations (default: the usable CPUs, %(default)s "
-                        "here)")
+    p.add_argument("--workers", type=workers, metavar="N",
+                   help=f"processes for the pole map's 36 creep simulations (default: the usable CPUs, {usable_cpus()} "
+                        "here; not with --no-sim-grid)")
     p.add_argument("--json", action="store_true", help="print one JSON object (the written files and the margins)")
     p.set_defaults(func=run)
     return p
@@ -36,6 +36,9 @@ def run(args):
     from drakecreep.report.loop_report import build_report
     from drakecreep.scenario import Scenario
 
+    if args.no_sim_grid and args.workers is not None:  # it ran on one process without a word
+        raise InputError("--workers", args.workers, "only with the pole map's creep simulations (not with "
+                         "--no-sim-grid, which runs none)")
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     if not args.low_feed > 0:
@@ -47,7 +50,8 @@ def run(args):
     if getattr(args, "friction", None):
         source += f", friction law {args.friction}"
     result = build_report(params, args.out, feed=scenario.feed, load_case=scenario.load_case, low_feed=low,
-                          source=source, sim_grid=None if args.no_sim_grid else (6, 6), workers=args.workers)
+                          source=source, sim_grid=None if args.no_sim_grid else (6, 6),
+                          workers=args.workers or usable_cpus())
     if args.json:
         import json
 

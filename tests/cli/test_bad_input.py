@@ -464,6 +464,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     # the option and mm/s, not the scenario's field in m/s; a placement that fails names both targets
     (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed > 0 mm/s"),
     (["report", "--out", "{tmp}/r", "--low-feed", "-0.1"], "--low-feed: got -0.1"),
+    # without the creep simulations there is nothing to run on them: ignored without a word
+    (["report", "--out", "{tmp}/r", "--no-sim-grid", "--workers", "2"], "--workers: got 2; allowed: only with the "
+                                                                         "pole map's creep simulations"),
     (["margins", "--feed", "-1"], "--feed: got -1.0"),
     (["margins", "--friction", "gms"], "--friction: got 'gms'; allowed: coulomb, stribeck or lugre"),  # 'friction.law'
     (["tune", "--friction", "gms"], "--friction: got 'gms'"),

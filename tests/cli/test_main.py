@@ -94,6 +94,21 @@ def test_diagram_dot_and_svg(tmp_path):
     assert (tmp_path / "d.svg").read_text().lstrip().startswith("<?xml")
 
 
+def test_diagram_says_which_controller_it_draws(tmp_path, capsys):
+    """The controller is one block either way: --controller continuous drew the same picture as sampled."""
+    texts = {}
+    for variant in ("sampled", "continuous"):
+        assert main(["diagram", "--controller", variant, "--out", str(tmp_path / f"{variant}.dot")]) == 0
+        texts[variant] = (tmp_path / f"{variant}.dot").read_text()
+    assert ('label="preset paper: sampled PI cascade controller: velocity loop every 0.25 ms, position loop every '
+            '1 ms, computation delay 1 velocity samples"') in texts["sampled"]
+    assert 'label="preset paper: continuous PI cascade controller"' in texts["continuous"]
+    assert main(["diagram", "--out", str(tmp_path / "default.dot")]) == 0
+    assert "sampled PI cascade" in (tmp_path / "default.dot").read_text()  # the preset's variant
+    assert not list(tmp_path.glob(".*"))  # written atomically: no temporary file left
+    capsys.readouterr()
+
+
 def test_params_check_and_preset_are_one_or_the_other(tmp_path, capsys):
     """'params --check FILE --preset rigid_axis' printed the file and ignored the preset without a word."""
     from drakecreep.params import preset, save_params
