@@ -476,7 +476,12 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["tune", "--bandwidth", "0"], "--bandwidth: got 0.0; allowed: a bandwidth of at least 0.01 Hz"),
     (["tune", "--phase-margin", "1e-300"], "--phase-margin: got 1e-300; allowed: an angle in [10, 90) deg (below"),
     (["tune", "--phase-margin", "-1"], "--phase-margin: got -1.0; allowed: an angle in [10, 90) deg"),
-    (["tune", "--phase-margin", "89.999"], "--phase-margin: got 89.999; allowed: a target a PI can reach"),  # every crossover needs ki < 0
+    # every crossover needs ki < 0: the pair is out of reach, named by the option given
+    (["tune", "--phase-margin", "89.999"], "--phase-margin: got '40 Hz at a phase margin of 89.999 deg'; allowed: a "
+                                           "bandwidth and phase margin this PI can place together (at every crossover"),
+    # just under the sampled loop's bound (500 Hz): blamed '--phase-margin: got 60.0', an option not given
+    (["tune", "--bandwidth", "499.99"], "--bandwidth: got '499.99 Hz at a phase margin of 60 deg'; allowed: a "
+                                        "bandwidth and phase margin"),
     (["uncertainty", "--spec", "{tmp}/token.txt"], "got 'a YAML str'"),
     (["diagnose", "{example}", "--meta", "{tmp}/token.txt"], "got 'a YAML str'"),  # the axial frequency overflowed to inf, exit 0
     (["modal", "{tmp}/frf_1e300.csv"], "largest magnitude"),  # zeta = inf in the JSON, exit 0

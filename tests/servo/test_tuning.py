@@ -76,4 +76,16 @@ def test_an_unreachable_low_target_says_which_way_to_go(paper):
     # the plant's phase at 0.015-0.06 Hz leaves a PI no way down to 60 deg: a higher margin (or bandwidth)
     with pytest.raises(InputError, match=r"kv = -[0-9.]+.*a higher margin or bandwidth") as err:
         tune(paper, SC, bandwidth_Hz=0.05, phase_margin_deg=60.0)
-    assert err.value.field == "phase-margin"
+    # the pair is out of reach, not one target alone: named as the pair (the CLI names the option given)
+    assert err.value.field == "bandwidth" and err.value.pair
+    assert "got '0.05 Hz at a phase margin of 60 deg'" in str(err.value)
+
+
+def test_the_clis_default_targets_are_the_librarys():
+    import inspect
+
+    from drakecreep.cli import tune as cli_tune
+
+    defaults = inspect.signature(tune).parameters
+    assert (cli_tune.DEFAULT_BANDWIDTH_HZ, cli_tune.DEFAULT_PHASE_MARGIN_DEG) == (
+        defaults["bandwidth_Hz"].default, defaults["phase_margin_deg"].default)
