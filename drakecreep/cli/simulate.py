@@ -59,7 +59,7 @@ def run(args):
     from drakecreep.files import check_output_dir
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
-    from drakecreep.sim.simulation import simulate
+    from drakecreep.sim.simulation import check_window, simulate
 
     params = params_from_args(args)
     if args.controller:
@@ -67,12 +67,7 @@ def run(args):
     feed = feed_from_mm_s(args.feed)
     if not 0 <= args.load_case <= len(params.loads.cases):
         raise InputError("--load-case", args.load_case, params.load_cases_allowed)
-    check_duration(args.duration)
-    if params.simulation.steady_start >= args.duration:
-        raise InputError(
-            "--duration", args.duration,
-            f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window",
-        )
+    check_window(params, check_duration(args.duration), "--duration")
     scenario = Scenario(feed=feed, load_case=args.load_case, duration=args.duration)
     multibody = None
     if args.model == "multibody":

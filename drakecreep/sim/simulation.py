@@ -51,11 +51,11 @@ from drakecreep.sim.compiled import compile_diagram
 from drakecreep.model.diagram import build_diagram
 from drakecreep.errors import InputError, Terminated
 from drakecreep.sim.metrics import feed_metrics
-from drakecreep.params import save_params
+from drakecreep.params import SimulationParams, save_params
 from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "integration_failure", "check_run", "check_log_period",
-           "check_step_budget", "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS",
+           "check_window", "check_step_budget", "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES", "MAX_STEPS",
            "MIN_WINDOW_SAMPLES", "MODELS", "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE", "slow_run_notice"]
 
 #: integrators without error control: they step at ``max_step``
@@ -226,6 +226,22 @@ def check_log_period(log_period, duration, steady_start=None):
                          f"<= {(duration - steady_start) / MIN_WINDOW_SAMPLES:.3g} s: at least {MIN_WINDOW_SAMPLES} "
                          f"recorded samples in the metrics window ({steady_start:g}-{duration:g} s; a longer "
                          "duration or an earlier simulation.steady_start widens it)")
+
+
+def check_window(params, duration, field="duration"):
+    """Refuse a run ``duration`` (s) that ends before its metrics window could hold :data:`MIN_WINDOW_SAMPLES`
+    recorded samples after ``simulation.steady_start`` even at the default log period: an :class:`InputError`
+    naming ``field`` (a CLI's option; ``simulate --duration 1.0000001`` blamed 'simulation.log_period', a field
+    nobody had set). A window that only a coarser ``simulation.log_period`` leaves short is the log period's, as
+    :func:`check_log_period` says."""
+    sim = params.simulation
+    log_period = min(sim.log_period, SimulationParams().log_period)
+    if not (duration > sim.steady_start and (duration - sim.steady_start) / log_period >= MIN_WINDOW_SAMPLES):
+        least = sim.steady_start + MIN_WINDOW_SAMPLES * log_period
+        raise InputError(field, duration, f">= {least:.6g} s: simulation.steady_start ({sim.steady_start:g} s) "
+                         f"and then the metrics window's {MIN_WINDOW_SAMPLES} recorded samples, one every "
+                         f"simulation.log_period ({sim.log_period:g} s)")
+    return duration
 
 
 def check_step_budget(params, duration):

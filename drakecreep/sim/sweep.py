@@ -244,7 +244,7 @@ def make_cases(base, points, scenario=None, metric=None):
     InputError
         Naming the path and value of the first invalid point.
     """
-    from drakecreep.sim.simulation import check_log_period, check_step_budget  # pydrake, as simulate: not at import
+    from drakecreep.sim.simulation import check_log_period, check_step_budget, check_window  # pydrake, as simulate: not at import
 
     check_params(base, "base")
     if isinstance(points, (str, bytes, Mapping)) or not hasattr(points, "__iter__"):  # 'str' has no attribute 'items'
@@ -272,8 +272,7 @@ def make_cases(base, points, scenario=None, metric=None):
             else:
                 params = with_value(params, path, value)
         scen = scenario_with_drive(**fields)
-        if params.simulation.steady_start >= scen.duration:
-            raise InputError("duration", scen.duration, f"> simulation.steady_start ({params.simulation.steady_start} s)")
+        check_window(params, scen.duration)
         check_log_period(params.simulation.log_period, scen.duration, params.simulation.steady_start)
         check_step_budget(params, scen.duration)
         params.load_case(scen.load_case)  # validates the load case number

@@ -525,6 +525,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["diagnose", "estimation", "--meta", "{tmp}/spec.yaml"], "--meta: got '"),
     # the options, not the library's names ('duration: got 1000000000.0', 'calibration_rows: got (1,)')
     (["simulate", "--out", "{tmp}/s", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
+    # a metrics window of 0.1 us: blamed 'simulation.log_period: got 0.00025', a field nobody had set
+    (["simulate", "--out", "{tmp}/s", "--duration", "1.0000001"], "--duration: got 1.0000001; allowed: >= 1.005 s: "
+                                                                  "simulation.steady_start (1 s) and then the metrics"),
     # a window of 5e-301 s: 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody had set
     (["compensate", "--out", "{tmp}/c", "--duration", "1e-300"], "--duration: got 1e-300; allowed: a time in [0.1, 3600] s"),
     (["compensate", "--out", "{tmp}/c", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in [0.1, 3600]"),
