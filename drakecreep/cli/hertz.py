@@ -8,6 +8,9 @@ import math
 
 __all__ = ["add_parser", "run"]
 
+#: the paper's Table 3 groove/ball radius ratio and preload, the defaults of --conformity and --preload
+DEFAULT_CONFORMITY = 1.04
+DEFAULT_PRELOAD_N = 579.0
 PAPER = {"ka_N_per_m": 48.6e6, "fa_Hz": 1917.0, "kr_N_per_m": 1.83e5, "fr_Hz": 117.63}
 
 
@@ -20,9 +23,10 @@ def add_parser(subparsers):
     p.add_argument("--diameter", type=float, default=25.0, metavar="MM", help="screw d0 (25)")
     p.add_argument("--contact-angle", type=float, default=45.0, metavar="DEG", help="beta (45)")
     p.add_argument("--lead", type=float, default=5.0, metavar="MM", help="Ph (5)")
-    p.add_argument("--conformity", type=float, default=1.04,
-                   help="groove/ball radius ratio r (1.04)")
-    p.add_argument("--preload", type=float, default=579.0, metavar="N", help="axial force Fa (579)")
+    p.add_argument("--conformity", type=float, default=DEFAULT_CONFORMITY,
+                   help=f"groove/ball radius ratio r ({DEFAULT_CONFORMITY:g})")
+    p.add_argument("--preload", type=float, default=DEFAULT_PRELOAD_N, metavar="N",
+                   help=f"axial force Fa ({DEFAULT_PRELOAD_N:g})")
     p.add_argument("--mass", type=float, default=0.335, metavar="KG", help="M for frequencies (0.335)")
     p.add_argument("--youngs-modulus", type=float, default=206.0, metavar="GPA",
                    help="E of screw, ball and nut (206, assumed: the paper prints none)")
@@ -71,6 +75,12 @@ def run(args):
     except InputError as err:  # the option, not the model's field
         if err.field != "conformity":
             raise
+        if args.conformity == DEFAULT_CONFORMITY and args.preload != DEFAULT_PRELOAD_N:
+            # the load the user changed, not the catalogue groove they left (--preload 1e7 blamed '--conformity')
+            raise InputError("--preload", args.preload,
+                             f"an axial force below {err.load_limit:.4g} N for this groove (--conformity "
+                             f"{args.conformity:g}) and ball: beyond, the contact ellipse outgrows the ball and Hertz "
+                             "theory does not apply") from None
         raise err.renamed("--conformity") from None
     out = {
         "ball_load_N": r.ball_load,

@@ -446,15 +446,19 @@ def ballscrew_stiffness(nut: BallScrewNut = TABLE3_NUT, axial_force: float | Non
     s = point_contact(P, curv["screw"], nut.ball, nut.screw)
     n = point_contact(P, curv["nut"], nut.ball, nut.nut)
     radius = 0.5 * nut.ball_diameter
+    # the semi-major axis grows as P^(1/3): the largest axial force whose contacts stay within the ball
+    load_limit = Fa * min(radius / float(s.a), radius / float(n.a)) ** 3
     for name, c in (("screw", s), ("nut", n)):
         # Hertz theory takes the contact as small against the bodies; an ellipse longer than the ball is none
         # (conformity 1.0000000001 gave a = 314 mm on a 3.175 mm ball, and an axial stiffness 1900 x the paper's)
         if not float(c.a) < radius:
-            raise InputError("conformity", nut.conformity,
+            err = InputError("conformity", nut.conformity,
                              f"a groove that keeps the contact within the ball: the {name} contact's semi-major axis "
                              f"is {float(c.a) * 1e3:.4g} mm at a ball load of {P:.4g} N, beyond the ball's radius "
                              f"{radius * 1e3:.4g} mm, where Hertz theory does not apply (a larger conformity, a larger "
-                             "ball or a lower preload)")
+                             f"ball or an axial force below {load_limit:.4g} N)")
+            err.load_limit = load_limit  # N: the axial force this groove and ball carry within Hertz theory
+            raise err
     delta = float(s.approach + n.approach)
     da = delta / (np.sin(beta) * np.cos(lam))
     dr = delta / (np.cos(beta) * np.sin(lam))

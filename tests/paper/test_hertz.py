@@ -97,3 +97,18 @@ def test_a_contact_longer_than_the_ball_is_refused():
         ballscrew_stiffness(dataclasses.replace(TABLE3_NUT, conformity=1.0001))
     near = ballscrew_stiffness(dataclasses.replace(TABLE3_NUT, conformity=1.001))  # a long contact, still inside
     assert 0.5 * TABLE3_NUT.ball_diameter > float(near.screw_contact.a) > 0.3 * TABLE3_NUT.ball_diameter
+
+
+def test_the_load_limit_of_a_contact_is_where_it_reaches_the_ball():
+    """The refusal's axial force limit (a grows as P^(1/3)) is the edge: just below it the contact fits the ball,
+    just above it it does not (the CLI's '--preload' refusal quotes it)."""
+    import dataclasses
+
+    with pytest.raises(InputError) as err:
+        ballscrew_stiffness(TABLE3_NUT, axial_force=1e7)
+    limit = err.value.load_limit
+    assert 1e3 < limit < 1e7 and f"an axial force below {limit:.4g} N" in str(err.value)
+    inside = ballscrew_stiffness(TABLE3_NUT, axial_force=0.999 * limit)
+    assert float(inside.screw_contact.a) == pytest.approx(0.5 * TABLE3_NUT.ball_diameter, rel=1e-3)
+    with pytest.raises(InputError):
+        ballscrew_stiffness(dataclasses.replace(TABLE3_NUT), axial_force=1.001 * limit)
