@@ -360,26 +360,36 @@ def check_output_dir(path, field="--out"):
         written.
     """
     path = Path(path)
+    problem = _folder_problem(path)
+    if problem is not None:
+        allowed, why = problem
+        raise InputError(field, str(path), f"{allowed} ({why})" if why else allowed)
+    return path
+
+
+def _folder_problem(path):
+    """None once ``path`` is a folder (created if needed) a file can be written in; else ``(allowed, why)``: what
+    a folder must be, and why this one is not (None where ``allowed`` says it all)."""
     try:  # a name longer than the system allows raises here (ENAMETOOLONG: 'File name too long: ...', no option)
         if path.exists() and not path.is_dir():
-            raise InputError(field, str(path), "a folder (this is an existing file)")
+            return "a folder", "this is an existing file"
     except OSError as err:
-        raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
+        return "a folder that can be created", err.strerror
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
-        raise InputError(field, str(path), "a folder (a parent is an existing file)") from None
+        return "a folder", "a parent is an existing file"
     except OSError as err:
-        raise InputError(field, str(path), f"a folder that can be created ({err.strerror})") from None
+        return "a folder that can be created", err.strerror
     if not os.access(path, os.W_OK | os.X_OK):
-        raise InputError(field, str(path), "a writable folder")
+        return "a writable folder", None
     try:  # what write_atomic will do (os.access says yes to root where a file system refuses, e.g. /sys)
         fd, tmp = tempfile.mkstemp(dir=path, prefix=".drakecreep.", suffix=".check")
-    except OSError as err:
-        raise InputError(field, str(path), f"a writable folder ({err.strerror})") from None
+    except OSError as err:  # (/proc answers ENOENT: 'No such file or directory' named a folder that exists)
+        return "a writable folder", f"creating a file in it failed: {err.strerror}"
     os.close(fd)
     os.unlink(tmp)
-    return path
+    return None
 
 
 def check_output_file(path, field="--out"):
@@ -399,11 +409,18 @@ def check_output_file(path, field="--out"):
                              "the file would replace)")
     except OSError as err:  # ENAMETOOLONG
         raise InputError(field, str(path), f"a file that can be written ({err.strerror})") from None
-    folder = check_output_dir(path.parent, field)
+    # the file the user named, and what is wrong with its folder ('--write: got '/proc'; ... No such file or
+    # directory' named the folder of /proc/version, which exists)
+    problem = _folder_problem(path.parent)
+    if problem is not None:
+        allowed, why = problem
+        why = "not writable" if why is None else f"cannot be created: {why}" if "created" in allowed else why
+        raise InputError(field, str(path), f"a file in a writable folder ({path.parent}: {why})")
     try:  # what write_atomic will do: a temporary file beside the target
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.stem}.", suffix=".check")
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".check")
     except OSError as err:
-        raise InputError(field, str(path), f"a file in a writable folder ({err.strerror})") from None
+        raise InputError(field, str(path), f"a file in a writable folder (creating a file in {path.parent} failed: "
+                         f"{err.strerror})") from None
     os.close(fd)
     os.unlink(tmp)
     return path

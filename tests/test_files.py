@@ -155,14 +155,21 @@ def test_output_dir_is_probed_with_a_file(tmp_path, monkeypatch):
         raise PermissionError(13, "Permission denied")
 
     monkeypatch.setattr(tempfile, "mkstemp", refuse)
-    with pytest.raises(InputError, match=r"--out: got .*; allowed: a writable folder \(Permission denied\)"):
+    with pytest.raises(InputError, match=r"--out: got .*; allowed: a writable folder \(creating a file in it failed: "
+                                         r"Permission denied\)"):
         check_output_dir(tmp_path)
+    # a file in such a folder is named itself, with what is wrong with its folder ('--write: got '/proc'; ... No
+    # such file or directory' named the folder of /proc/version, which exists)
+    with pytest.raises(InputError, match=r"--write: got '.*p.yaml'; allowed: a file in a writable folder \(.*: "
+                                         r"creating a file in it failed: Permission denied\)"):
+        check_output_file(tmp_path / "p.yaml", "--write")
 
 
 def test_output_file_checks(tmp_path):
     (tmp_path / "afile").write_text("x")
-    for bad, why in ((tmp_path, "existing folder"), (tmp_path / "afile" / "p.yaml", "existing file"),
-                     ("/proc/no/such/p.yaml", "--write")):
+    for bad, why in ((tmp_path, "existing folder"), (tmp_path / "afile" / "p.yaml", "afile: this is an existing file"),
+                     ("/proc/no/such/p.yaml", "--write: got '/proc/no/such/p.yaml'; allowed: a file in a writable "
+                                              "folder \\(/proc/no/such: cannot be created: ")):
         with pytest.raises(InputError, match=why):
             check_output_file(bad, "--write")
     assert check_output_file(tmp_path / "new" / "p.yaml", "--write") == tmp_path / "new" / "p.yaml"

@@ -437,6 +437,10 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["hertz", "--balls", "0"], "--balls"),
     (["hertz", "--youngs-modulus", "1e308"], "--youngs-modulus"),
     (["hertz", "--preload", "inf"], "--preload"),
+    # the load the user changed, not the catalogue groove they left: blamed '--conformity: got 1.04'
+    (["hertz", "--preload", "1e7"], "--preload: got 10000000.0; allowed: an axial force below 1.487e+05 N for this "
+                                    "groove (--conformity 1.04)"),
+    (["hertz", "--preload", "1e7", "--conformity", "1.1"], "--conformity: got 1.1; allowed: a groove that keeps"),
     (["hertz", "--lead", "-1"], "--lead"),
     (["hertz", "--mass", "1e-300"], "--mass: got 1e-300"),
     (["hertz", "--contact-angle", "90"], "--contact-angle: got 90.0; allowed: an angle in [5, 85] deg"),
