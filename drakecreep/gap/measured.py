@@ -1011,9 +1011,19 @@ def load_emps(path=None):
                         sensors=SensorMeta(encoder_resolution=EMPS_ENCODER_RESOLUTION, scale_resolution=0.0),
                         source=f"EMPS benchmark (Janot, Gautier, Brunot 2019): {path.name}",
                         notes=_EMPS_NOTES)
-    run = MeasuredRun(t=array("t"), x_ref=array("qg"), x_motor=array("qm"), u=u, f_ext=f_ext, meta=meta,
-                      label=path.stem)
+    try:
+        run = MeasuredRun(t=array("t"), x_ref=array("qg"), x_motor=array("qm"), u=u, f_ext=f_ext, meta=meta,
+                          label=path.stem)
+        check_recorded(run)  # as a measured CSV's runs: a vir of zeros reached the fit as 'y: got 'all zero''
+    except InputError as err:  # the file's variables, not the run's columns ('x_motor: got nan at sample 100')
+        head, _, rest = err.field.partition(" ")
+        name = _EMPS_VARIABLES.get(head)
+        raise err.renamed(f"{path}: {name}" if name else f"{path}: {err.field}") from None
     return MeasuredData(runs=(run,), meta=meta)
+
+
+#: a run's columns -> the EMPS file's variables they are read from (``u`` is ``vir`` less the pulses)
+_EMPS_VARIABLES = {"t": "t", "x_ref": "qg", "x_motor": "qm", "u": "vir", "f_ext": "pulses_N"}
 
 
 def check_split(train, test):

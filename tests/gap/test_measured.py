@@ -538,6 +538,24 @@ def test_an_emps_file_of_complex_signals_is_refused_by_name(tmp_path, name):
     assert err.value.allowed == "real numbers"
 
 
+@pytest.mark.parametrize("name, change, said", [
+    # both named the run's column, a name the file does not have ('x_motor: got ...'); zeros reached the fit as
+    # 'y: got 'all zero'' (the force it fits), after the load
+    ("qm", lambda a: np.where(np.arange(a.size).reshape(a.shape) == 100, np.nan, a), "nan at sample 100"),
+    ("vir", np.zeros_like, "zero throughout"),
+    ("t", lambda a: a[::-1].copy(), "after t[0]"),
+])
+def test_a_bad_emps_variable_is_named_as_the_file_names_it(tmp_path, name, change, said):
+    import scipy.io
+
+    mat = {k: v for k, v in scipy.io.loadmat(str(emps_path("estimation"))).items() if not k.startswith("__")}
+    mat[name] = change(mat[name])
+    scipy.io.savemat(tmp_path / "DATA_EMPS.mat", mat)
+    with pytest.raises(InputError) as err:
+        load_emps(tmp_path / "DATA_EMPS.mat")
+    assert err.value.field == f"{tmp_path / 'DATA_EMPS.mat'}: {name}" and said in str(err.value.value)
+
+
 def test_emps_controller_law_reproduces_the_recorded_output():
     """The documented law, fed the recorded qm and qg, gives the recorded u (after removing the pulses)."""
     for which, worst in (("estimation", 0.01), ("validation", 0.1)):
