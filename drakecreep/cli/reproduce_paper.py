@@ -75,7 +75,7 @@ def run(args):
             if err.field != "calibration_rows":
                 raise
             raise InputError("--calibrate", args.calibrate, err.allowed) from None
-        name = f"{name}, calibrated on rows {args.calibrate}"
+        name = f"{name}, calibrated on rows {','.join(map(str, rows))}"  # (not the text as typed: ' 4 , 6')
     elif name == "paper":
         rows = ()
     report = write_report(args.out, params, name, calibration_rows=rows or CALIBRATION_ROWS,

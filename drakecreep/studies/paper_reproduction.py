@@ -171,10 +171,18 @@ def calibrate(params=None, rows=CALIBRATION_ROWS, start=CALIBRATION_START, max_n
     """
     from scipy.optimize import least_squares
 
-    rows = _check_rows(rows)
     table = {r["row"]: r for r in paper_rows()}
-    if len(rows) != len(CALIBRATED_FIELDS) or len({(table[i]["load_case"], table[i]["feed_mm_s"]) for i in rows}) < 2:
-        raise InputError("calibration_rows", rows, "two rows of different experiments (two amplitudes are fitted)")
+
+    def experiment(i):
+        return table[i]["load_case"], table[i]["feed_mm_s"]
+
+    rows = tuple(rows) if isinstance(rows, (tuple, list)) else (rows,)
+    if len(rows) != len(CALIBRATED_FIELDS) or not set(rows) <= set(table) or len({experiment(i) for i in rows}) < 2:
+        # one message for every way to miss it ('1' said 'two rows of different experiments', '4,4' 'one or two
+        # distinct rows', the reproduction's own rule)
+        same = [f"{a} and {b}" for a in table for b in table if a < b and experiment(a) == experiment(b)]
+        raise InputError("calibration_rows", rows, f"two rows of {sorted(table)} from different experiments (two "
+                         f"amplitudes are fitted; rows {', '.join(same)} are the same experiment), e.g. 4,6")
     base = preset("paper") if params is None else params
     checked = base.simulation.convergence_check
     base = with_value(base, "simulation.convergence_check", False)

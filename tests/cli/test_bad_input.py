@@ -539,7 +539,11 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["compensate", "--out", "{tmp}/c", "--duration", "0.01"], "--duration: got 0.01; allowed: a time in [0.1, 3600]"),
     (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1"], "--calibrate: got '1'; allowed: two rows"),
-    (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'"),
+    # one rule in every message: '4,4' said 'one or two distinct rows', contradicting '1' (two rows)
+    (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'; allowed: two rows of "
+                                                                     "[1, 2, 3, 4, 5, 6] from different experiments"),
+    (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1,2,3"], "--calibrate: got '1,2,3'; allowed: two rows of "
+                                                                       "[1, 2, 3, 4, 5, 6] from different experiments"),
     # a name longer than the system allows: 'File name too long: /tmp/...', no option (found by the fourth pass)
     (["simulate", "--params", "{tmp}/" + "a" * 300 + ".yaml"], "--params: got"),
     (["diagnose", "{tmp}/" + "a" * 300 + ".csv"], "DATA: got"),

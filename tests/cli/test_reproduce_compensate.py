@@ -17,7 +17,7 @@ def test_reproduce_paper_bad_calibration_rows_exit_2(tmp_path, capsys):
     assert main(["reproduce-paper", "--out", str(tmp_path), "--calibrate", "3,5"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     # one line naming the option (the library's parameter, calibration_rows, was named before 21dcdc5)
-    assert len(err) == 1 and "--calibrate: got '3,5'; allowed: two rows of different experiments" in err[0]
+    assert len(err) == 1 and "--calibrate: got '3,5'; allowed: two rows of [1, 2, 3, 4, 5, 6] from different experiments" in err[0]
 
 
 def test_reproduce_paper_sensitivity_needs_validate_exit_2_before_work(tmp_path, capsys):
