@@ -97,7 +97,7 @@ def run(args):
     op = summary["operating_point"]
     print(f"operating point: feed {op['feed_mm_s']:g} mm/s, load case {scenario.load_case}, "
           f"K = {op['stiffness_N_per_um']:.4g} N/um, C1 = {op['friction_slope_C1_Ns_per_m']:.4g} N s/m, "
-          f"zeta = {op['zeta']:.4g}")
+          f"zeta = {op['zeta']:.4g} (friction of the {op['friction_on_table']})")
     print_margins(summary)
     if "computation_delay_samples" in summary:
         print(f"computation delay: {summary['computation_delay_samples']:g} velocity samples "

@@ -387,6 +387,15 @@ class LoopAnalysis:
     scenario: object = None
     extra: dict = field(default_factory=dict)
 
+    @property
+    def friction_on_table(self):
+        """Whose friction ``op.friction_slope`` (C1) and ``op.zeta`` take: the guides', and the ball nut's lumped
+        with them where the model puts it on the screw (:func:`drakecreep.servo.linearize.nut_on_table`; ``critical``
+        takes the guides' alone, the friction on the paper's lumped mass, so the two differ below the Stribeck
+        velocity)."""
+        on_screw = self.params is not None and self.params.friction.nut_friction_on == "screw"
+        return "guides and ball nut, the nut's drag lumped on the table" if on_screw else "guides and ball nut"
+
     def summary(self):
         """JSON-ready dict: the configured variant's loops at the top, the other variant under its name."""
         main = "sampled" if self.sampled else "continuous"
@@ -420,6 +429,7 @@ class LoopAnalysis:
             stiffness_N_per_um=self.op.stiffness * 1e-6, damping_Ns_per_m=self.op.damping,
             friction_slope_C1_Ns_per_m=self.op.friction_slope, mass_kg=self.op.mass, zeta=self.op.zeta,
             spring_force_N=self.op.spring_force, friction_force_N=self.op.friction_force,
+            friction_on_table=self.friction_on_table,
         )
         return out
 

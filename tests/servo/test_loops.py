@@ -204,3 +204,22 @@ def test_an_overdamped_chain_has_no_resonance_and_says_so(paper):
         "none (no complex plant pole: every mode is overdamped)")
     assert stiff.summary()["velocity"]["closed_loop_stable"]
     assert loops.resonance_text(73.514, 0.013321) == "73.51 Hz, damping ratio 0.01332"
+
+
+def test_the_operating_point_says_whose_friction_its_slope_takes(analysis, paper, capsys):
+    """margins' C1 takes the guides' and the nut's friction together, critical's the guides' alone: the summary
+    says which, so the two commands' different zeta below the Stribeck velocity is explained where it is printed."""
+    op = analysis.summary()["operating_point"]
+    assert op["friction_on_table"] == "guides and ball nut, the nut's drag lumped on the table"
+    table = with_value(paper, "friction.nut_friction_on", "table")
+    assert loops.analyze_loops(table, Scenario(feed=1e-3, load_case=3)).friction_on_table == "guides and ball nut"
+    # below the Stribeck velocity the two slopes differ by the nut's share of the friction drop (-3.5e5 against
+    # -2.1e4 N s/m at 0.1 mm/s, docs/physics_review.md)
+    import json
+
+    from drakecreep.cli import main
+
+    slow = loops.operating_point(paper, Scenario(feed=1e-4, load_case=3))
+    assert main(["critical", "--feed", "0.1", "--json", "-q"]) == 0
+    c1_guides = json.loads(capsys.readouterr().out)["C1_Ns_per_m"]
+    assert slow.friction_slope < 5 * c1_guides < 0
