@@ -1016,8 +1016,7 @@ def load_emps(path=None):
                           label=path.stem)
         check_recorded(run)  # as a measured CSV's runs: a vir of zeros reached the fit as 'y: got 'all zero''
     except InputError as err:  # the file's variables, not the run's columns ('x_motor: got nan at sample 100')
-        head, _, rest = err.field.partition(" ")
-        name = _EMPS_VARIABLES.get(head)
+        name = _EMPS_VARIABLES.get(err.field.split(" ", 1)[0])
         raise err.renamed(f"{path}: {name}" if name else f"{path}: {err.field}") from None
     return MeasuredData(runs=(run,), meta=meta)
 
