@@ -4,7 +4,7 @@ import os
 
 from drakecreep.cli._common import (add_params_options, check_duration, comma_items, distinct, existing_path,
                                     feed_from_mm_s, params_from_args, positive_float, print_json, workers)
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, renaming
 from drakecreep.processes import usable_cpus
 
 __all__ = ["add_parser", "run", "run_study", "check_study", "share_line", "spec_from_args", "DEFAULT_FEEDS_MM_S"]
@@ -80,7 +80,8 @@ def spec_from_args(args):
         return load_uncertainty(existing_path("--spec", args.spec), None if args.params else args.preset)
     if args.params:
         raise InputError("--spec", None, "an uncertainty spec file: with --params the preset's spec does not apply")
-    return uncertainty_spec(args.preset)
+    # the option, not the library's name ('preset: got 'rigid_axis'')
+    return renaming(lambda field: "--preset" if field == "preset" else field, uncertainty_spec, args.preset)
 
 
 def check_study(params, samples, feeds, load_cases, *, seed=0, duration=3.0, out=None):
@@ -96,10 +97,10 @@ def check_study(params, samples, feeds, load_cases, *, seed=0, duration=3.0, out
                                                f"of {len(feeds)} feed(s) x {len(load_cases)} load case(s))")
     if not 0 <= seed < 2**63:  # as a sweep spec's seed
         raise InputError("--seed", seed, "an integer in [0, 2**63)")
-    check_duration(duration)
-    if params.simulation.steady_start >= duration:
-        raise InputError("--duration", duration,
-                         f"> simulation.steady_start ({params.simulation.steady_start:g} s), the start of the metrics window")
+    from drakecreep.sim.simulation import check_window
+
+    # the metrics window's samples and the run's, named as the option ('duration: got 1.001' came from the sweep)
+    check_window(params, check_duration(duration), "--duration")
     if out is not None:
         check_output_dir(out)
 

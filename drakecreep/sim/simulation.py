@@ -229,18 +229,24 @@ def check_log_period(log_period, duration, steady_start=None):
 
 
 def check_window(params, duration, field="duration"):
-    """Refuse a run ``duration`` (s) that ends before its metrics window could hold :data:`MIN_WINDOW_SAMPLES`
-    recorded samples after ``simulation.steady_start`` even at the default log period: an :class:`InputError`
-    naming ``field`` (a CLI's option; ``simulate --duration 1.0000001`` blamed 'simulation.log_period', a field
-    nobody had set). A window that only a coarser ``simulation.log_period`` leaves short is the log period's, as
-    :func:`check_log_period` says."""
+    """Refuse a run ``duration`` (s) the recorded samples cannot measure even at the default log period: its metrics
+    window after ``simulation.steady_start`` must hold :data:`MIN_WINDOW_SAMPLES` and the run at most
+    :data:`MAX_SAMPLES`; an :class:`InputError` naming ``field`` (a CLI's option; ``simulate --duration 1.0000001``
+    and ``--duration 600`` blamed 'simulation.log_period', a field nobody had set). What only the params file's own
+    ``simulation.log_period`` makes too few or too many is the log period's, as :func:`check_log_period` says."""
     sim = params.simulation
-    log_period = min(sim.log_period, SimulationParams().log_period)
-    if not (duration > sim.steady_start and (duration - sim.steady_start) / log_period >= MIN_WINDOW_SAMPLES):
-        least = sim.steady_start + MIN_WINDOW_SAMPLES * log_period
+    default = SimulationParams().log_period
+    finest = min(sim.log_period, default)
+    if not (duration > sim.steady_start and (duration - sim.steady_start) / finest >= MIN_WINDOW_SAMPLES):
+        least = sim.steady_start + MIN_WINDOW_SAMPLES * finest
         raise InputError(field, duration, f">= {least:.6g} s: simulation.steady_start ({sim.steady_start:g} s) "
                          f"and then the metrics window's {MIN_WINDOW_SAMPLES} recorded samples, one every "
                          f"simulation.log_period ({sim.log_period:g} s)")
+    coarsest = max(sim.log_period, default)
+    if duration / coarsest > MAX_SAMPLES:
+        raise InputError(field, duration, f"<= {MAX_SAMPLES * coarsest:.6g} s: at most {MAX_SAMPLES} recorded samples "
+                         f"per run, one every simulation.log_period ({sim.log_period:g} s; a coarser one in a params "
+                         "file records a longer run)")
     return duration
 
 

@@ -363,6 +363,17 @@ def test_output_folder_is_checked_before_the_work(argv, tmp_path, capsys):
     assert afile.read_text() == "keep me\n"
 
 
+def test_a_sweep_checks_its_output_folder_before_it_builds_the_cases(tmp_path, capsys):
+    """A 100 x 1000 grid took 27 s to build before '--out' was refused: the folder comes first (a spec with a
+    bad axis shows the order without the wait)."""
+    afile = tmp_path / "afile"
+    afile.write_text("keep me\n")
+    spec = tmp_path / "spec.yaml"
+    spec.write_text("axes:\n  table.mas: [30, 40]\n")
+    code, _, err = _run(["sweep", str(spec), "--out", str(afile)], capsys, timeout=20)
+    _one_line_exit_2(code, err, "--out")
+
+
 def test_missing_score_file_is_found_before_the_diagnosis(tmp_path, capsys):
     code, _, err = _run(["diagnose", "estimation", "--score", str(tmp_path / "nothere.mat")], capsys, timeout=20)
     _one_line_exit_2(code, err, "nothere.mat")
@@ -538,6 +549,14 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     # inside the 0.05 s acceleration ramp: verdicts on the ramp, exit 0
     (["compensate", "--out", "{tmp}/c", "--duration", "0.01"], "--duration: got 0.01; allowed: a time in [0.1, 3600]"),
     (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
+    # more samples than a run records at the default log period, and a window too short: both blamed a field
+    # nobody had set ('simulation.log_period: got 0.00025', 'duration: got 1.001' from the sweep under the study)
+    (["simulate", "--out", "{tmp}/s", "--duration", "600"], "--duration: got 600.0; allowed: <= 500 s: at most "
+                                                           "2000000 recorded samples per run"),
+    (["uncertainty", "--duration", "3600", "--samples", "1"], "--duration: got 3600.0; allowed: <= 500 s"),
+    (["uncertainty", "--duration", "1.001", "--samples", "1"], "--duration: got 1.001; allowed: >= 1.005 s"),
+    (["uncertainty", "--preset", "rigid_axis", "--samples", "1"], "--preset: got 'rigid_axis'; allowed: a preset "
+                                                                  "with an uncertainty spec"),
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "1"], "--calibrate: got '1'; allowed: two rows"),
     # one rule in every message: '4,4' said 'one or two distinct rows', contradicting '1' (two rows)
     (["reproduce-paper", "--out", "{tmp}/p", "--calibrate", "4,4"], "--calibrate: got '4,4'; allowed: two rows of "
