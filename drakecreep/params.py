@@ -221,9 +221,10 @@ def _check_stiffness(name, value, off=False):
 #: a 1000 kg table on a 1e9 N/m chain. At 1e9-1e20 N s/m ``margins`` printed 'nan Hz' for the mode it overdamps and,
 #: at 1e20, an open-loop unstable pole the rounding of its -c/m eigenvalue made
 MAX_CHAIN_DAMPING = 1e8
-#: largest axial force [N] of a constant load and of a friction level (critical's --fs, --fd): 1000 t, three
-#: decades above a heavy machine axis's thrust
-MAX_AXIAL_FORCE = 1e6
+#: largest force [N] of a load (a load case's fx, fy, fz, the constant force) and of a friction level (critical's
+#: --fs, --fd): 1000 t, three decades above a heavy machine axis's thrust. A load case's fz of -1e12 N was
+#: accepted, and simulate reported a table that cannot move (3e9 N of guide friction) as sliding without creep
+MAX_LOAD_FORCE = 1e6
 #: largest gains of the PI cascade, the upper ends of their ranges: 3-4 decades above any feed drive's (kp 40 1/s,
 #: kv 1.2e5 N s/m, ki 7.5e6 N/m on the paper's rig; a kv of 1e9 N s/m puts the velocity loop's crossover on a 300 kg
 #: axis near 0.5 MHz, far beyond any sampled loop). Gains of 1e20 were accepted and ran as an unstable loop chattering
@@ -445,9 +446,10 @@ class LoadCase(_Params):
     ``|m g + fz| + |fy|`` (:func:`drakecreep.model.nut_table.friction_split`).
     """
 
-    fx: float = _q(0.0, "N", doc="axial force opposing the feed")
-    fy: float = _q(0.0, "N", doc="lateral force on the guides")
-    fz: float = _q(0.0, "N", doc="vertical force on the table, downwards positive (< 0 lifts)")
+    fx: float = _q(0.0, "N", -MAX_LOAD_FORCE, MAX_LOAD_FORCE, doc="axial force opposing the feed")
+    fy: float = _q(0.0, "N", -MAX_LOAD_FORCE, MAX_LOAD_FORCE, doc="lateral force on the guides")
+    fz: float = _q(0.0, "N", -MAX_LOAD_FORCE, MAX_LOAD_FORCE,
+                   doc="vertical force on the table, downwards positive (< 0 lifts)")
 
 
 @dataclass(frozen=True)
@@ -459,7 +461,7 @@ class LoadParams(_Params):
         why="a drive is tested under a handful, the paper's Table 7 under 3; each is a run of its own"))
     gravity: float = _q(9.81, "m/s^2", 0.0, 100.0, doc="gravity (table weight on the guides)")
     constant_force: float = _q(
-        0.0, "N", -MAX_AXIAL_FORCE, MAX_AXIAL_FORCE,
+        0.0, "N", -MAX_LOAD_FORCE, MAX_LOAD_FORCE,
         doc="an axial force on the table in every load case, the unloaded one included, added to its fx (> 0 "
             "opposes a feed in +x): a drive's current offset, the weight on an inclined axis, a cable carrier's "
             "pull; assumption: 0, the paper gives none",

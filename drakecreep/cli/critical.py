@@ -14,7 +14,7 @@ import math
 
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, print_json
 from drakecreep.errors import InputError
-from drakecreep.params import ABSURD, MAX_AXIAL_FORCE, MAX_CHAIN_DAMPING, MIN_STIFFNESS, MIN_TABLE_MASS
+from drakecreep.params import ABSURD, MAX_LOAD_FORCE, MAX_CHAIN_DAMPING, MIN_STIFFNESS, MIN_TABLE_MASS
 
 __all__ = ["add_parser", "run"]
 
@@ -26,8 +26,8 @@ OVERRIDES = {
     "stiffness": ("stiffness", 1e6, False, (MIN_STIFFNESS, ABSURD)),
     "damping": ("damping", 1.0, True, (0.0, MAX_CHAIN_DAMPING)),
     "mass": ("mass", 1.0, False, (MIN_TABLE_MASS, 1e5)),
-    "fs": ("breakaway", 1.0, False, (1e-6, MAX_AXIAL_FORCE)),
-    "fd": ("coulomb", 1.0, False, (1e-6, MAX_AXIAL_FORCE)),
+    "fs": ("breakaway", 1.0, False, (1e-6, MAX_LOAD_FORCE)),
+    "fd": ("coulomb", 1.0, False, (1e-6, MAX_LOAD_FORCE)),
 }
 #: the overrides' units, as their options take them
 _UNITS = {"stiffness": "N/um", "damping": "N s/m", "mass": "kg", "fs": "N", "fd": "N"}

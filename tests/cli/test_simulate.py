@@ -53,3 +53,27 @@ def test_a_drive_that_cannot_hold_the_feed_gets_no_creep_verdict(tmp_path, capsy
     assert cli.main(args + ["--out", str(tmp_path / "c"), "--json"]) == 0
     said = json.loads(capsys.readouterr().out)
     assert isinstance(said["creep"], bool) and "overload" not in said
+
+
+def test_an_overloaded_drive_that_lags_without_sticking_gets_no_verdict_either(tmp_path, capsys, monkeypatch):
+    """3e9 N of guide friction (a load case's fz of -1e12 N, refused since) was reported 'creep no' at 28 % of the
+    feed: the overload is asked for when the table lags the feed, not only when it sticks."""
+    import dataclasses
+    import json
+
+    import drakecreep.servo.linearize as linearize
+    import drakecreep.sim.simulation as simulation
+    from drakecreep import cli
+
+    real = simulation.simulate
+
+    def lagging(*args, **kwargs):  # the run as such a drive gives it: sliding, no stick, far below the feed
+        r = real(*args, **kwargs)
+        r.metrics = dataclasses.replace(r.metrics, stick_slip_cycles=0, stick_fraction=0.0, mean_speed=0.28e-3)
+        return r
+
+    monkeypatch.setattr(simulation, "simulate", lagging)
+    monkeypatch.setattr(linearize, "sliding_overload", lambda params, scenario: (3e9, 8.9e3))
+    assert cli.main(["simulate", "--duration", "1.1", "--no-plot", "--json", "--out", str(tmp_path / "o")]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["creep"] is None and said["overload"] == {"force_N": 3e9, "limit_N": 8.9e3}
