@@ -47,6 +47,7 @@ from drakecreep.data import emps_data_dir
 from drakecreep.errors import InputError, renaming
 from drakecreep.files import write_atomic, write_text
 from drakecreep.gap.formats import read_signals
+from drakecreep.params import MAX_LOAD_FORCE
 
 __all__ = [
     "U_UNITS",
@@ -99,10 +100,11 @@ MAX_GAIN = 1e9
 #: milliseconds labelled ``us``, move a thousand times too fast), which would otherwise run a whole diagnosis on a
 #: model that cannot follow it
 MAX_SPEED = 10.0
-#: Largest plausible force [N]: the drive's ``u x u_gain`` or an external force. Feed drives push with up to
-#: tens of kN; 1e7 N leaves three decades. A larger sample is a unit error or a corrupt cell (one cell of 1e300
-#: ran a diagnosis to overflowing fits and a mass of 1e301 kg)
-MAX_FORCE = 1e7
+#: Largest plausible force [N]: the drive's ``u x u_gain`` or an external force, the bound of every load force
+#: (:data:`drakecreep.params.MAX_LOAD_FORCE`, 1e6 N). Feed drives push with up to tens of kN. A larger sample is a
+#: unit error or a corrupt cell (one cell of 1e300 ran a diagnosis to overflowing fits and a mass of 1e301 kg; a
+#: u_gain of 1e6 N/V on the EMPS run, 1.5e6 N at its peak under the former 1e7 N bound, a 2.7e6 kg axis, exit 0)
+MAX_FORCE = MAX_LOAD_FORCE
 #: Smallest peak drive force [N] (``u x u_gain``) a measured run may have: no drive moves an axis with less than a
 #: micronewton (a u of 1e-300 V ran to 'y: got all zero', an internal name, from the nominal's fit)
 MIN_PEAK_FORCE = 1e-6

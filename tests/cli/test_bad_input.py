@@ -291,7 +291,9 @@ MEASURED = {
                                   "run.csv: file.units.t: got 's'; allowed: the unit the file's header gives the column, ms"),
     "empty_unit_brackets": (GOOD_CSV.replace("t,", "t[],", 1).encode(), GOOD_META,  # read as SI (fuzzing pass)
                             "run.csv: column t unit: got ''; allowed: one of s, ms, us, µs in the brackets"),
-    "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+07 N"),
+    "u_corrupt_cell": (GOOD_CSV.replace("0.5\n", "1e300\n", 1).encode(), GOOD_META, "forces up to 1e+06 N"),
+    # a u_gain far off (1e6 N/V for 35 on the EMPS run): diagnosed as a 2.7e6 kg axis, exit 0, under the former 1e7 N
+    "u_gain_absurd": (GOOD_CSV.encode(), "u_units: V\nu_gain: 3.0e+6\n", "forces up to 1e+06 N (u x u_gain)"),
     "run_label_nan": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,nan\n")
                       .encode(), GOOD_META, "column run"),
     "run_label_empty": (GOOD_CSV.replace("t,x_ref,x_motor,u\n", "t,x_ref,x_motor,u,run\n").replace("0.5\n", "0.5,a\n")
