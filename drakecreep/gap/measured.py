@@ -523,6 +523,29 @@ def _named(prefix, build, *args, **kwargs):
     return renaming(lambda field: field if prefix == f"{field}: " else f"{prefix}{field}", build, *args, **kwargs)
 
 
+def _check_controller_and_params(where, raw, ctrl, params, units, gain):
+    """Refuse metadata a diagnosis would ignore without a word: a params file beside a controller that does not
+    replay it (the ``p_p_cascade`` law is the metadata's own; a params file gives it only the torque constant, for
+    ``u_units: A`` without ``u_gain``), and a ``kind: drakecreep`` controller's ``feedback`` or ``sample_time`` that
+    contradict the params file, whose controller is the one replayed (both were accepted and ignored)."""
+    drakecreep = ctrl is not None and ctrl.kind == "drakecreep"
+    if params is not None and not drakecreep and not (units == "A" and gain is None):
+        raise InputError(f"{where}: params", "a params file",
+                         "only with controller kind drakecreep, whose cascade it describes, or to derive u_gain from "
+                         "u_units A (a p_p_cascade run replays the law of its metadata, not the params file's)")
+    if not drakecreep or params is None or not isinstance(raw, dict):
+        return
+    g = params.controller
+    if "feedback" in raw and ctrl.feedback != g.position_feedback:
+        raise InputError(f"{where}: controller.feedback", ctrl.feedback,
+                         f"the params file's controller.position_feedback ({g.position_feedback}), or left out: "
+                         "kind drakecreep replays the params file's controller")
+    if "sample_time" in raw and not math.isclose(ctrl.sample_time, g.position_period, rel_tol=1e-6):
+        raise InputError(f"{where}: controller.sample_time", ctrl.sample_time,
+                         f"the params file's controller.position_period ({g.position_period:g} s), or left out: "
+                         "kind drakecreep replays the params file's controller")
+
+
 def _meta_from_dict(data, meta_path):
     from drakecreep.files import resolve_reference
     from drakecreep.params import load_params, params_from_dict
@@ -558,8 +581,9 @@ def _meta_from_dict(data, meta_path):
         else:
             allowed = "a number > 0 [N per A] (or params to derive it)" if units == "A" else "a number > 0 [N per V]"
             raise InputError(f"{where}: u_gain", None, allowed)
-    ctrl = data.get("controller")
-    ctrl = _named(f"{where}: ", ControllerMeta.from_dict, ctrl) if ctrl is not None else None
+    raw = data.get("controller")
+    ctrl = _named(f"{where}: ", ControllerMeta.from_dict, raw) if raw is not None else None
+    _check_controller_and_params(where, raw, ctrl, params, units, data.get("u_gain"))
     sensors = data.get("sensors") or {}
     if not isinstance(sensors, dict):
         raise InputError(f"{where}: sensors", sensors, "a mapping encoder_resolution, scale_resolution")

@@ -301,8 +301,36 @@ def test_params_file_relative_to_metadata(tmp_path):
 
     p = with_value(preset("paper"), "screw.lead", 4e-3)
     save_params(p, tmp_path / "rig.yaml")
-    data = load_measured(_write(tmp_path, meta={**META, "params": "rig.yaml"}))
+    data = load_measured(_write(tmp_path, meta={**DRAKECREEP_META, "params": "rig.yaml"}))
     assert data.meta.params.screw.lead == 4e-3
+
+
+#: a run of the project's own cascade: its controller is the params file's
+DRAKECREEP_META = {"u_units": "N", "u_gain": 1.0, "controller": {"kind": "drakecreep"}, "source": "synthetic"}
+
+
+@pytest.mark.parametrize("meta, field, allowed", [
+    # a params file beside the P-P law: never read (only u_units A without u_gain takes its torque constant)
+    ({**META, "params": "rig.yaml"}, "run.yaml: params", "only with controller kind drakecreep"),
+    ({k: v for k, v in META.items() if k != "controller"} | {"params": "rig.yaml"}, "run.yaml: params",
+     "only with controller kind drakecreep"),
+    # kind drakecreep replays the params file's controller: a feedback or sample time that contradicts it was ignored
+    ({**DRAKECREEP_META, "params": "rig.yaml", "controller": {"kind": "drakecreep", "feedback": "table"}},
+     "run.yaml: controller.feedback", "the params file's controller.position_feedback (motor), or left out"),
+    ({**DRAKECREEP_META, "params": "rig.yaml", "controller": {"kind": "drakecreep", "sample_time": 0.005}},
+     "run.yaml: controller.sample_time", "the params file's controller.position_period (0.001 s), or left out"),
+])
+def test_metadata_a_diagnosis_would_ignore_is_refused(tmp_path, meta, field, allowed):
+    from drakecreep.params import save_params
+
+    save_params(preset("paper"), tmp_path / "rig.yaml")
+    with pytest.raises(InputError) as err:
+        load_measured(_write(tmp_path, meta=meta))
+    assert err.value.field.endswith(field) and err.value.allowed.startswith(allowed)
+    # what agrees with the params file, or is left out, loads
+    agreeing = {**DRAKECREEP_META, "params": "rig.yaml",
+                "controller": {"kind": "drakecreep", "feedback": "motor", "sample_time": 0.001}}
+    assert load_measured(_write(tmp_path, meta=agreeing)).meta.controller.kind == "drakecreep"
 
 
 def test_an_empty_params_mapping_or_file_is_refused_not_read_as_the_default_rig(tmp_path):
