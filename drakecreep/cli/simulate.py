@@ -60,7 +60,7 @@ def run(args):
     from drakecreep.files import check_output_dir
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
-    from drakecreep.sim.simulation import check_window, simulate
+    from drakecreep.sim.simulation import check_window, shortest_run, simulate
 
     params = params_from_args(args)
     if args.controller:
@@ -84,13 +84,23 @@ def run(args):
         multibody = MultibodyOptions(n_segments=segments, rigid_joints=args.rigid_joints,
                                      screw_bending=not args.axial_screw)
         travel, segment = abs(feed) * args.duration, params.screw.length / segments
+        if segment / abs(feed) < shortest_run(params) * (1.0 - 1e-9):
+            # no duration both holds the metrics window and keeps the nut on its segment: the feed is too fast ('<=
+            # 0.3 s' and '>= 1.005 s' sent the user back and forth)
+            raise InputError("--feed", args.feed, f"<= {segment / shortest_run(params) * 1e3:.4g} mm/s with "
+                             f"{segments} segments (the multibody nut stays on one screw segment of "
+                             f"{segment * 1e3:g} mm for the shortest run, {shortest_run(params):g} s"
+                             + ("; fewer --segments make it longer)" if segments > 2 else ")"))
         if travel > segment * (1.0 + 1e-9):
             raise InputError("--duration", args.duration,
                              f"<= {segment / abs(feed):g} s at {args.feed:g} mm/s (the multibody nut stays on one "
                              f"screw segment of {segment * 1e3:g} mm)")
-    elif args.segments is not None or args.rigid_joints or args.axial_screw:
-        raise InputError("--segments/--rigid-joints/--axial-screw", args.segments if args.segments is not None else True,
-                         "only with --model multibody")
+    else:
+        given = ([("--segments", args.segments)] if args.segments is not None else []) + [
+            (option, True) for option, on in (("--rigid-joints", args.rigid_joints), ("--axial-screw", args.axial_screw))
+            if on]
+        if given:  # the option given, not all three ('--segments/--rigid-joints/--axial-screw: got True')
+            raise InputError(given[0][0], given[0][1], "only with --model multibody")
     spec = None
     if args.uncertainty is not None:
         from drakecreep.cli.uncertainty import check_study, spec_from_args

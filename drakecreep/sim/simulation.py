@@ -55,7 +55,7 @@ from drakecreep.params import SimulationParams, save_params
 from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "integration_failure", "check_run", "check_log_period",
-           "check_window", "check_step_budget", "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES",
+           "check_window", "shortest_run", "check_step_budget", "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW", "MAX_SAMPLES",
            "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS", "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE", "slow_run_notice"]
 
 #: integrators without error control: they step at ``max_step``
@@ -228,6 +228,13 @@ def check_log_period(log_period, duration, steady_start=None):
                          "duration or an earlier simulation.steady_start widens it)")
 
 
+def shortest_run(params):
+    """The shortest run [s] :func:`check_window` takes: ``simulation.steady_start`` and then the metrics window's
+    :data:`MIN_WINDOW_SAMPLES` samples at the finer of ``simulation.log_period`` and its default."""
+    sim = params.simulation
+    return sim.steady_start + MIN_WINDOW_SAMPLES * min(sim.log_period, SimulationParams().log_period)
+
+
 def check_window(params, duration, field="duration"):
     """Refuse a run ``duration`` (s) the recorded samples cannot measure even at the default log period: its metrics
     window after ``simulation.steady_start`` must hold :data:`MIN_WINDOW_SAMPLES` and the run at most
@@ -238,7 +245,7 @@ def check_window(params, duration, field="duration"):
     default = SimulationParams().log_period
     finest = min(sim.log_period, default)
     if not (duration > sim.steady_start and (duration - sim.steady_start) / finest >= MIN_WINDOW_SAMPLES):
-        least = sim.steady_start + MIN_WINDOW_SAMPLES * finest
+        least = shortest_run(params)
         raise InputError(field, duration, f">= {least:.6g} s: simulation.steady_start ({sim.steady_start:g} s) "
                          f"and then the metrics window's {MIN_WINDOW_SAMPLES} recorded samples, one every "
                          f"simulation.log_period ({sim.log_period:g} s)")

@@ -28,7 +28,14 @@ def test_simulate_multibody_json(paper, tmp_path, capsys):
     (["simulate", "--rigid-joints"], "--rigid-joints"),
     (["simulate", "--model", "multibody", "--axial-screw"], "--axial-screw"),
     (["simulate", "--axial-screw"], "--axial-screw"),
-    (["simulate", "--model", "multibody", "--feed", "50", "--duration", "5"], "--duration"),
+    (["simulate", "--model", "multibody", "--feed", "50", "--duration", "5"], "--duration: got 5.0; allowed: <= 2 s"),
+    # no duration both holds the metrics window and keeps the nut on its segment: '<= 0.3 s' and '>= 1.005 s' sent
+    # the user back and forth; it is the feed
+    (["simulate", "--model", "multibody", "--segments", "2", "--feed", "1000", "--duration", "1.1"],
+     "--feed: got 1000.0; allowed: <= 298.5 mm/s with 2 segments"),
+    # the option given, not all three ('--segments/--rigid-joints/--axial-screw: got True'); 0 too
+    (["simulate", "--segments", "0"], "--segments: got 0; allowed: only with --model multibody"),
+    (["simulate", "--axial-screw", "--rigid-joints"], "--rigid-joints: got True; allowed: only with --model"),
     (["simulate", "--model", "four_mass"], "--model"),
 ])
 def test_simulate_multibody_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
