@@ -122,6 +122,9 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--exp-tau", "1e-3"], "--exp-tau: got 0.001; allowed: a longer window time constant: 1/tau = 1e+03 1/s"),
     ("frf", ["--exp-tau", "1e-300"], "--exp-tau: got 1e-300; allowed: a longer window time constant"),
     ("time", ["--exp-tau", "1e-4"], "--exp-tau: got 0.0001; allowed: a longer window time constant"),
+    # a window that damps the mode beyond what half-power reads: 1 ms on a 300 Hz mode read it at 206 Hz, exit 0
+    ("time", ["--exp-tau", "3e-4"], "--exp-tau: got 0.0003; allowed: a longer window time constant: the window's "
+                                    "1/tau = 3.33e+03 1/s damps the windowed mode to zeta = "),
     # an option of the other kind of file was ignored without a word
     ("frf", ["--response", "velocity"], "--response: got 'velocity'; allowed: only with a t,force,response file"),
     ("time", ["--frf-type", "mobility"], "--frf-type: got 'mobility'; allowed: only with an f_Hz,re,im file"),
