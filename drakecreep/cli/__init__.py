@@ -89,6 +89,10 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = _NEGATIVE_NUMBER  # before any option is added (argparse checks them with it)
 
     def error(self, message):
+        if message.startswith("argument ") and "; allowed: " in message:
+            # a type of cli._common: 'argument --workers: got '0'; allowed: ...', the refusals' own form without the
+            # word argparse puts before the option
+            message = message[len("argument "):]
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 

@@ -17,9 +17,9 @@ def number(text):
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: a number") from None
     if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"{text!r} must be finite")
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: a finite number")
     return value
 
 
@@ -61,7 +61,7 @@ def positive_float(text):
     """argparse type: a finite number > 0."""
     value = number(text)
     if value <= 0:
-        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number > 0")
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: a finite number > 0")
     return value
 
 
@@ -124,14 +124,15 @@ MAX_WORKERS = 256
 
 
 def _integer_at_least(text, minimum, maximum=None):
+    """An integer in ``[minimum, maximum]``; else an argparse type error in the refusals' own form (``--n-null -1``
+    said '... must be >= 0' where ``--n-null 1001`` said '--n-null: got 1001; allowed: an integer in [0, 1000]')."""
+    allowed = f"an integer >= {minimum}" if maximum is None else f"an integer in [{minimum}, {maximum}]"
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if value < minimum:
-        raise argparse.ArgumentTypeError(f"{text!r} must be >= {minimum}")
-    if maximum is not None and value > maximum:
-        raise argparse.ArgumentTypeError(f"{text!r} must be <= {maximum}")
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: {allowed}") from None
+    if value < minimum or (maximum is not None and value > maximum):
+        raise argparse.ArgumentTypeError(f"got {text!r}; allowed: {allowed}")
     return value
 
 
