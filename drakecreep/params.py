@@ -185,17 +185,20 @@ def _q(default, unit, lo=None, hi=None, *, lo_open=False, choices=None, doc=""):
     )
 
 
-def _allowed(meta):
+def _allowed(meta, integer=False):
+    """What a field takes, in words: its choices, or a number (an integer for an int field: '-1' and '1.5' of one
+    field were answered 'a finite number >= 0' and 'an integer') in its range and unit."""
     if meta.get("choices"):
         return "one of " + ", ".join(str(c) for c in meta["choices"])
     lo, hi = meta.get("lo"), meta.get("hi")
     unit = f" {meta['unit']}" if meta.get("unit") not in (None, "", "-") else ""
+    word = "an integer" if integer else "a finite number"
     if lo is not None and hi is not None:
         left = "(" if meta.get("lo_open") else "["
-        return f"a finite number in {left}{lo}, {hi}]{unit}"
+        return f"{word} in {left}{lo}, {hi}]{unit}"
     if lo is not None:
-        return f"a finite number {'>' if meta.get('lo_open') else '>='} {lo}{unit}"
-    return f"a finite number{unit}"
+        return f"{word} {'>' if meta.get('lo_open') else '>='} {lo}{unit}"
+    return f"{word}{unit}"
 
 
 #: largest magnitude of a float field without a stated upper bound, in its SI unit: 1e8 times the largest
@@ -300,14 +303,15 @@ class _Params:
                     raise InputError(f.name, value, _allowed(meta))
                 continue
             # numbers.Real and Integral: NumPy's scalars (np.float32, np.int64) are numbers too
+            integer = kind is int
             if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise InputError(f.name, value, _allowed(meta) if kind is float else "an integer")
+                raise InputError(f.name, value, _allowed(meta, integer))
             if kind is int and not isinstance(value, int):
                 if isinstance(value, numbers.Integral) or float(value).is_integer():
                     value = int(value)
                     object.__setattr__(self, f.name, value)
                 else:
-                    raise InputError(f.name, value, "an integer")
+                    raise InputError(f.name, value, _allowed(meta, integer))
             if kind is float:
                 try:
                     value = float(value)
@@ -317,14 +321,15 @@ class _Params:
             if kind is int and abs(value) > MAX_INT:
                 raise InputError(f.name, value, f"an integer of magnitude <= {MAX_INT}")
             if not math.isfinite(value):
-                raise InputError(f.name, value, _allowed(meta))
+                raise InputError(f.name, value, _allowed(meta, integer))
             lo, hi = meta.get("lo"), meta.get("hi")
             if hi is None and abs(value) > ABSURD:
-                raise InputError(f.name, value, _allowed(meta) + f" of magnitude <= {ABSURD:g} (larger is no feed drive)")
+                raise InputError(f.name, value, _allowed(meta, integer) + f" of magnitude <= {ABSURD:g} (larger is no "
+                                 "feed drive)")
             if lo is not None and (value < lo or (meta.get("lo_open") and value == lo)):
-                raise InputError(f.name, value, _allowed(meta))
+                raise InputError(f.name, value, _allowed(meta, integer))
             if hi is not None and value > hi:
-                raise InputError(f.name, value, _allowed(meta))
+                raise InputError(f.name, value, _allowed(meta, integer))
         self._check()
 
     def _check(self):

@@ -113,6 +113,11 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
         # -1e12 N: 3e9 N of guide friction, reported by simulate as sliding without creep at 28 % of the feed
         ({"loads": {"cases": [{"fz": -1e12}]}}, "loads.cases[0].fz", "[-1000000.0, 1000000.0] N"),
         ({"loads": {"cases": [{"fx": 1e19}]}}, "loads.cases[0].fx", "[-1000000.0, 1000000.0] N"),
+        # one field, one description: -1 said 'a finite number >= 0 counts/rev', 1.5 'an integer'
+        ({"sensors": {"encoder_counts_per_rev": -1}}, "sensors.encoder_counts_per_rev",
+         "got -1; allowed: an integer >= 0 counts/rev"),
+        ({"sensors": {"encoder_counts_per_rev": 1.5}}, "sensors.encoder_counts_per_rev",
+         "got 1.5; allowed: an integer >= 0 counts/rev"),
         ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
         # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
         ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),
