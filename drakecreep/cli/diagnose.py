@@ -243,9 +243,11 @@ def _run_drakecreep_kind(args, train, test, score_runs):
 
     from drakecreep.files import OutputSet
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-    from drakecreep.gap.drive_fit import diagnose_drive
+    from drakecreep.gap.drive_fit import check_run, diagnose_drive
     from drakecreep.report.drive_report import write_drive_report
 
+    for r in train + test:  # named by the file, as every other check ('u (run r0): got ...' alone did not say which)
+        _in_file(f"{args.data}: ", check_run, r)
     say = _say(args)
     kwargs = {}
     if args.uncertain:

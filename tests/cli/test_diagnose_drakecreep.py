@@ -248,7 +248,8 @@ def test_a_unit_slip_of_a_drakecreep_run_is_one_line_exit_2(blank_csv, tmp_path,
     head = next(c for c in frame.columns if c.split("[")[0] == column)
     frame[head] = frame[head] * (50.0 if column == "u" else 1.0) * factor  # blank u: 1 N; a 50 N drive
     err = _refusal(frame, yaml_path, tmp_path, capsys)
-    assert f"error: {column} (run r0): got " in err and says in err
+    # named by the file too, as every other check ('u (run r0): got ...' alone did not say which file)
+    assert f"error: {tmp_path / 'bad.csv'}: {column} (run r0): got " in err and says in err
 
 
 def test_positions_in_the_wrong_unit_are_refused_by_their_inverse_dynamics_mass(own_csv, tmp_path, capsys):
@@ -275,4 +276,4 @@ def test_positions_in_the_wrong_unit_are_refused_by_their_inverse_dynamics_mass(
         if column.split("[")[0] in ("x_ref", "x_motor", "x_table"):
             frame[column] = frame[column] * 1e-3
     err = _refusal(frame, yaml_path, tmp_path, capsys)
-    assert "x_motor (run " in err and "an inverse-dynamics mass of " in err and "within a factor of 10" in err
+    assert "bad.csv: x_motor (run " in err and "an inverse-dynamics mass of " in err and "within a factor of 10" in err
