@@ -271,7 +271,12 @@ def make_cases(base, points, scenario=None, metric=None):
                 fields[path] = value
             else:
                 params = with_value(params, path, value)
-        scen = scenario_with_drive(**fields)
+        try:
+            scen = scenario_with_drive(**fields)
+        except InputError as err:  # the load cases this params file has ('1.0': 'an integer >= 0'; '7': '0..3')
+            if err.field != "load_case":
+                raise
+            raise InputError("load_case", fields["load_case"], params.load_cases_allowed) from None
         check_window(params, scen.duration)
         check_log_period(params.simulation.log_period, scen.duration, params.simulation.steady_start)
         check_step_budget(params, scen.duration)

@@ -168,6 +168,9 @@ SPECS = {
     "seed_negative": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: -1}\n", "seed"),
     "seed_huge": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 2, seed: " + "9" * 400 + "}\n",
                   "seed"),
+    # one description of a load case, the params file's: 1.0 said 'an integer >= 0', 7 'an integer in 0..3'
+    "load_case_float": ("axes:\n  load_case: [1.0]\n", "axes.load_case: got 1.0; allowed: an integer in 0..3"),
+    "load_case_missing": ("axes:\n  load_case: [7]\n", "axes.load_case: got 7; allowed: an integer in 0..3"),
     "n_huge": ("axes:\n  table.mass: {low: 30, high: 40}\nsample: {mode: random, n: 1000000000}\n", "--max-cases"),
     "grid_huge": ("axes:\n  table.mass: {start: 30, stop: 40, num: 100000}\n  feed: {start: 1.0e-4, stop: 1.0e-3, "
                   "num: 100000}\n", "--max-cases"),
