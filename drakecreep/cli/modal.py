@@ -72,13 +72,19 @@ def _check_windows(args, force, dt, estimated):
                          f"at the record's start and would keep less than 1 % of the impulse at {peak:.3g} s")
 
 
-def _span(header, data):
-    """The frequencies a file covers, as text: its FRF's f_Hz, or 0 to Nyquist of a time record."""
+def _limits(header, data):
+    """The lowest and the highest frequency a file covers [Hz]: its FRF's f_Hz, or 0 to a time record's Nyquist."""
     from drakecreep.paper.modal import FRF_COLUMNS
 
     if header == FRF_COLUMNS:
-        return f"{data[0, 0]:g}-{data[-1, 0]:g} Hz"
-    return f"0-{0.5 / float(np.median(np.diff(data[:, 0]))):g} Hz"
+        return float(data[0, 0]), float(data[-1, 0])
+    return 0.0, 0.5 / float(np.median(np.diff(data[:, 0])))
+
+
+def _span(header, data):
+    """The frequencies a file covers, as text (:func:`_limits`)."""
+    lowest, highest = _limits(header, data)
+    return f"{lowest:g}-{highest:g} Hz"
 
 
 def _identify(args, header, data, band):
@@ -137,7 +143,13 @@ def run(args):
         if err.field == "exp_tau":
             raise err.renamed("--exp-tau") from None
         if err.field in ("frequency band", "band") and band is not None:  # a band past the file's data
-            option, value = ("--fmin", args.fmin) if args.fmin is not None else ("--fmax", args.fmax)
+            # the end given alone, or above the file's data; else the upper end: below the data, or the end of a
+            # band too narrow ('--fmin 0 --fmax 1e-9' blamed --fmin)
+            highest = _limits(header, data)[1]
+            if args.fmax is None or (args.fmin is not None and args.fmin >= highest):
+                option, value = "--fmin", args.fmin
+            else:
+                option, value = "--fmax", args.fmax
             top = "f_Hz" if header == FRF_COLUMNS else "frequencies"
             raise InputError(option, value, f"{err.allowed} (the file's {top} run {_span(header, data)}; "
                              "--fmin and --fmax select within them)") from None

@@ -118,6 +118,10 @@ def test_modal_bad_csv_header_exits_2(tmp_path, capsys):
     ("frf", ["--fmin", "5000"], "--fmin: got 5000.0; allowed: a band with at least 3 FRF points (the file's f_Hz run "
                                 "10-500 Hz"),
     ("frf", ["--fmax", "5"], "--fmax: got 5.0; allowed: a band with at least 3 FRF points (the file's f_Hz run 10-500"),
+    # both ends given: the one outside the data, or the upper end of a band too narrow ('--fmin 0 --fmax 1e-9'
+    # blamed --fmin)
+    ("frf", ["--fmin", "0", "--fmax", "1e-9"], "--fmax: got 1e-09; allowed: a band with at least 3 FRF points"),
+    ("frf", ["--fmin", "5000", "--fmax", "6000"], "--fmin: got 5000.0; allowed: a band with at least 3 FRF points"),
     # a window shorter than the data's decay: zeta = -0.82 (exit 0), at 1e-300 s an OverflowError (exit 1)
     ("frf", ["--exp-tau", "1e-3"], "--exp-tau: got 0.001; allowed: a longer window time constant: 1/tau = 1e+03 1/s"),
     ("frf", ["--exp-tau", "1e-300"], "--exp-tau: got 1e-300; allowed: a longer window time constant"),
