@@ -14,7 +14,7 @@ import math
 
 from drakecreep.cli._common import add_params_options, feed_from_mm_s, params_from_args, print_json
 from drakecreep.errors import InputError
-from drakecreep.params import ABSURD, MAX_LOAD_FORCE, MAX_CHAIN_DAMPING, MIN_STIFFNESS, MIN_TABLE_MASS
+from drakecreep.params import ABSURD, MAX_CHAIN_DAMPING, MAX_LOAD_FORCE, MIN_STIFFNESS, MIN_TABLE_MASS
 
 __all__ = ["add_parser", "run"]
 
