@@ -56,7 +56,8 @@ from drakecreep.scenario import MAX_FEED
 
 __all__ = ["SimulationResult", "simulate", "make_simulator", "integration_failure", "check_run", "check_log_period",
            "check_window", "shortest_run", "check_step_budget", "target_accuracy", "FIXED_STEP", "ACCURACY_BY_LAW",
-           "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS", "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE", "slow_run_notice"]
+           "MAX_SAMPLES", "MAX_STEPS", "MIN_WINDOW_SAMPLES", "MODELS", "MAX_TABLE_SPEED", "MIN_STEP", "SLOW_NOTICE",
+           "slow_run_notice"]
 
 #: integrators without error control: they step at ``max_step``
 FIXED_STEP = ("runge_kutta2",)
