@@ -86,8 +86,9 @@ def paper_rows():
 def _check_rows(rows):
     allowed = {r["row"] for r in paper_rows()}
     rows = tuple(rows)
-    if not rows or len(rows) > 2 or len(set(rows)) != len(rows) or not set(rows) <= allowed:
-        raise InputError("calibration_rows", rows, f"one or two distinct rows of {sorted(allowed)}")
+    if len(rows) > 2 or len(set(rows)) != len(rows) or not set(rows) <= allowed:
+        raise InputError("calibration_rows", rows, f"none (every row a prediction), or one or two distinct rows of "
+                         f"{sorted(allowed)}")
     return rows
 
 

@@ -77,3 +77,21 @@ def test_reproduce_paper_names_a_params_file_without_the_papers_load_cases(tmp_p
     assert main(["reproduce-paper", "--out", str(tmp_path / "o"), "--params", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--params: got " in err[0] and "the paper's load cases 1-3 (loads.cases; it has 2)" in err[0]
+
+
+def test_a_params_file_is_scored_on_every_row_as_a_prediction(tmp_path, capsys):
+    """Rows 4 and 6 of a params file were marked 'calibrated', and left out of the worst predicted error, on a
+    model fitted to none of them; with --preset paper the JSON said 'predicted' where the written table said
+    'calibrated'. The rows a model was fitted to are known for the paper_calibrated preset and --calibrate only."""
+    from drakecreep.params import preset, save_params
+
+    save_params(preset("paper_calibrated"), tmp_path / "p.yaml")
+    assert main(["reproduce-paper", "--params", str(tmp_path / "p.yaml"), "--no-critical", "--no-plots", "--json",
+                 "--out", str(tmp_path / "o")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert [r["calibrated"] for r in out["rows"]] == [False] * 6
+    table = (tmp_path / "o" / "table8_9.md").read_text()
+    assert "| calibrated |" not in table and table.count("| predicted |") == 6
+    import pandas as pd
+
+    assert not pd.read_csv(tmp_path / "o" / "table8_9.csv")["calibrated"].any()
