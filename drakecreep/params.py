@@ -228,6 +228,21 @@ MAX_CHAIN_DAMPING = 1e8
 #: --fs, --fd): 1000 t, three decades above a heavy machine axis's thrust. A load case's fz of -1e12 N was
 #: accepted, and simulate reported a table that cannot move (3e9 N of guide friction) as sliding without creep
 MAX_LOAD_FORCE = 1e6
+#: largest bristle damping [N s/m] (LuGre sigma1), the upper end of its range: three decades above the paper rig's
+#: 2e3; 1e8-1e10 ran for minutes to a creep verdict on a table pushed backwards
+MAX_BRISTLE_DAMPING = 1e6
+#: largest viscous friction [N s/m], the upper end of its range: the pole map's damping axis reaches 5e6 N s/m (the
+#: paper's D^2 curve), the paper rig has 200; 1e9 projected minutes of a run, 1e12 diverged at once
+MAX_VISCOUS = 1e8
+#: bristle stiffness range [N/m] (LuGre sigma0): from a chain element's least (:data:`MIN_STIFFNESS`) to three decades
+#: above the paper rig's 1e8 (1e20 diverged at once; 1e-300 was accepted)
+MAX_BRISTLE_STIFFNESS = 1e11
+#: fewest counts per revolution of a motor encoder that is not ideal (0): a resolver or the coarsest incremental
+#: encoder gives thousands; 1 count per turn ran past 90 s to a creep verdict of a table at -64 mm/s
+MIN_ENCODER_COUNTS = 100
+#: shortest period [m] of a lead error or a cogging along the travel: 10 um, forty times below the finest ball
+#: passage of a 5 mm lead (Ph/12 = 417 um); 1e-12 m diverged at once, a 1e-15 m cogging projected 47 min
+MIN_DISTURBANCE_PERIOD = 1e-5
 #: largest gains of the PI cascade, the upper ends of their ranges: 3-4 decades above any feed drive's (kp 40 1/s,
 #: kv 1.2e5 N s/m, ki 7.5e6 N/m on the paper's rig; a kv of 1e9 N s/m puts the velocity loop's crossover on a 300 kg
 #: axis near 0.5 MHz, far beyond any sampled loop). Gains of 1e20 were accepted and ran as an unstable loop chattering
@@ -481,7 +496,7 @@ class FrictionParams(_Params):
     static_ratio: float = _q(1.5, "-", 1.0, 10.0, doc="breakaway / Coulomb force Fs/Fc")
     stribeck_velocity: float = _q(1.0e-4, "m/s", MIN_STRIBECK_VELOCITY, 1.0, doc="vs")
     stribeck_exponent: float = _q(2.0, "-", 0.2, 4.0, doc="delta in exp(-|v/vs|^delta)")
-    viscous: float = _q(200.0, "N s/m", 0.0, doc="viscous coefficient Fv")
+    viscous: float = _q(200.0, "N s/m", 0.0, MAX_VISCOUS, doc="viscous coefficient Fv")
     coulomb_asymmetry: float = _q(
         0.0, "-", -0.9, 0.9,
         doc="dry-friction levels (1 + a) times their mean moving +x, (1 - a) moving -x (seals, gravity on an "
@@ -491,8 +506,8 @@ class FrictionParams(_Params):
         0.0, "-", -0.9, 0.9,
         doc="viscous coefficient (1 + a) Fv moving +x, (1 - a) Fv moving -x; assumption: 0, the paper gives none",
     )
-    bristle_stiffness: float = _q(2.0e7, "N/m", 0.0, lo_open=True, doc="LuGre sigma0")
-    bristle_damping: float = _q(2.0e3, "N s/m", 0.0, doc="LuGre sigma1")
+    bristle_stiffness: float = _q(2.0e7, "N/m", MIN_STIFFNESS, MAX_BRISTLE_STIFFNESS, doc="LuGre sigma0")
+    bristle_damping: float = _q(2.0e3, "N s/m", 0.0, MAX_BRISTLE_DAMPING, doc="LuGre sigma1")
     regularization_velocity: float = _q(
         1.0e-6, "m/s", 0.0, 1.0, lo_open=True, doc="tanh width replacing sign() in coulomb/stribeck"
     )
@@ -559,6 +574,12 @@ class SensorParams(_Params):
         doc="sample period of a speed measured by differencing the scale (studies.table_fluctuation)",
     )
 
+    def _check(self):
+        if 0 < self.encoder_counts_per_rev < MIN_ENCODER_COUNTS:
+            raise InputError("encoder_counts_per_rev", self.encoder_counts_per_rev,
+                             f"0 (ideal) or an integer >= {MIN_ENCODER_COUNTS} counts/rev (a resolver or the "
+                             "coarsest incremental encoder gives thousands)")
+
 
 @dataclass(frozen=True)
 class SimulationParams(_Params):
@@ -574,8 +595,9 @@ class SimulationParams(_Params):
     acceleration_time: float = _q(0.05, "s", 0.0, 100.0, doc="reference ramps up to the feed in this time")
     steady_start: float = _q(1.0, "s", 0.0, doc="metrics are taken from this time to the end")
     stick_threshold: float = _q(
-        0.2, "-", 0.0, 1.0, lo_open=True,
-        doc="stuck when v < this x feed (above the regularized laws' creep while stuck, see sim.metrics.stick_slip)",
+        0.2, "-", 0.0, 0.5, lo_open=True,
+        doc="stuck when v < this x feed (above the regularized laws' creep while stuck, see sim.metrics.stick_slip; "
+            "at most half the feed: at 1.0 a smooth run's ripple about the feed counted as stick-slip)",
     )
     backend: str = _q("compiled", "-", choices=("compiled", "leaf"), doc="symbolic fast path or leaf systems")
     convergence_check: bool = field(
@@ -621,7 +643,7 @@ class DisturbanceParams(_Params):
 
     lead_error_amplitude: float = _q(0.0, "m", 0.0, 1e-3, doc="amplitude a of the kinematic lead error")
     lead_error_period: float = _q(
-        5.0e-3 / 12.0, "m", 0.0, 0.1, lo_open=True, doc="travel per cycle of the lead error"
+        5.0e-3 / 12.0, "m", MIN_DISTURBANCE_PERIOD, 0.1, doc="travel per cycle of the lead error"
     )
     lead_error_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                                  doc="phase of the lead error at the screw's position 0")
@@ -637,7 +659,7 @@ class DisturbanceParams(_Params):
                              doc="phase of both ripples at t = 0, a simulation's start (a replayed run's first sample)")
     cogging_force: float = _q(0.0, "N", 0.0, 1e4, doc="amplitude c of a cogging torque on the motor, at the "
                                                        "table's scale (torque x 2 pi / lead)")
-    cogging_period: float = _q(5.0e-3 / 6.0, "m", 0.0, 0.1, lo_open=True,
+    cogging_period: float = _q(5.0e-3 / 6.0, "m", MIN_DISTURBANCE_PERIOD, 0.1,
                                doc="travel per cycle of the cogging: the lead over its order per motor revolution")
     cogging_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                               doc="phase of the cogging at the screw's position 0")
@@ -645,6 +667,15 @@ class DisturbanceParams(_Params):
                                                          "cogging_period / 2)")
     cogging_2_phase: float = _q(0.0, "rad", -2.0 * math.pi, 2.0 * math.pi,
                                 doc="phase of the cogging's second harmonic at the screw's position 0")
+
+    def _check(self):
+        slope = 2.0 * math.pi * (self.lead_error_amplitude + 2.0 * self.lead_error_2_amplitude) / self.lead_error_period
+        if slope >= 1.0:
+            # the nut's travel x + e(x) turns back where e' < -1: a 1 mm error at the 0.42 mm default period ran the
+            # nut backwards, a creep verdict on a kinematics no screw has
+            raise InputError("lead_error_amplitude", self.lead_error_amplitude,
+                             f"a lead error whose slope 2 pi (a + 2 a2) / period stays below 1 (here {slope:.3g} at "
+                             f"lead_error_period {self.lead_error_period:g} m): the nut's travel turns back beyond")
 
     @property
     def has_lead_error(self):

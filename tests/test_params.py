@@ -118,6 +118,20 @@ def test_decimal_and_hex_integers_still_load(tmp_path):
          "got -1; allowed: an integer >= 0 counts/rev"),
         ({"sensors": {"encoder_counts_per_rev": 1.5}}, "sensors.encoder_counts_per_rev",
          "got 1.5; allowed: an integer >= 0 counts/rev"),
+        # fields that ran to nonsense (found by helper-31): a smooth run's ripple counted as stick-slip at a stick
+        # threshold of the whole feed; friction that diverged at once or pushed the table backwards for minutes;
+        # one encoder count per turn; a lead error whose slope ran the nut backwards
+        ({"simulation": {"stick_threshold": 1.0}}, "simulation.stick_threshold", "(0.0, 0.5]"),
+        ({"friction": {"viscous": 1e12}}, "friction.viscous", "[0.0, 100000000.0] N s/m"),
+        ({"friction": {"bristle_damping": 1e8}}, "friction.bristle_damping", "[0.0, 1000000.0] N s/m"),
+        ({"friction": {"bristle_stiffness": 1e20}}, "friction.bristle_stiffness", "[1.0, 100000000000.0] N/m"),
+        ({"friction": {"bristle_stiffness": 1e-300}}, "friction.bristle_stiffness", "[1.0, 100000000000.0] N/m"),
+        ({"sensors": {"encoder_counts_per_rev": 1}}, "sensors.encoder_counts_per_rev",
+         "got 1; allowed: 0 (ideal) or an integer >= 100 counts/rev"),
+        ({"disturbance": {"lead_error_amplitude": 1e-3}}, "disturbance.lead_error_amplitude",
+         "a lead error whose slope 2 pi (a + 2 a2) / period stays below 1 (here 15.1"),
+        ({"disturbance": {"lead_error_period": 1e-12}}, "disturbance.lead_error_period", "[1e-05, 0.1] m"),
+        ({"disturbance": {"cogging_period": 1e-15}}, "disturbance.cogging_period", "[1e-05, 0.1] m"),
         ({"screw": {"lead": 0.0}}, "screw.lead", "[0.0001, 0.1] m"),
         # 2 pi peak_torque / lead overflowed: simulate reported creep of a still table, exit 0; margins blamed '--feed'
         ({"screw": {"lead": 1e-300}}, "screw.lead", "got 1e-300; allowed: a finite number in [0.0001, 0.1] m"),

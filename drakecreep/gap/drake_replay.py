@@ -873,7 +873,7 @@ def replay_params(run, params=None, quantize=True):
     """
     import dataclasses
 
-    from drakecreep.params import MAX_INT, DriveParams
+    from drakecreep.params import MAX_INT, MIN_ENCODER_COUNTS, DriveParams
 
     if params is None:
         check_replayable(run)
@@ -891,6 +891,10 @@ def replay_params(run, params=None, quantize=True):
         if abs(counts - round(counts)) > 1e-6 * counts or round(counts) < 1:
             raise InputError("sensors.encoder_resolution", declared.encoder_resolution,
                              f"a whole fraction of the lead {params.screw.lead:g} m (lead / counts per revolution)")
+        if round(counts) < MIN_ENCODER_COUNTS:  # (the params' own bound, named by the metadata's field)
+            raise InputError("sensors.encoder_resolution", declared.encoder_resolution,
+                             f"at most the lead / {MIN_ENCODER_COUNTS}, {params.screw.lead / MIN_ENCODER_COUNTS:.3g} m "
+                             f"(an encoder of at least {MIN_ENCODER_COUNTS} counts per revolution), or 0 for none")
         sensors = dataclasses.replace(sensors, encoder_counts_per_rev=int(round(counts)))
     if declared.scale_resolution > 0:
         try:
