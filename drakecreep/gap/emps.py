@@ -15,6 +15,7 @@ from drakecreep.gap.idim import (
     fit_idim,
     score_idim,
 )
+from drakecreep.errors import renaming
 from drakecreep.gap.measured import emps_data_dir, load_emps
 from drakecreep.gap.replay import PUBLISHED_REPLAY_ERRORS, SIGNALS, replay, replay_errors
 
@@ -47,7 +48,8 @@ def reference_results(data_dir=None):
     folder = Path(data_dir) if data_dir is not None else emps_data_dir()
     estimation = load_emps(folder / "DATA_EMPS.mat").run()
     validation = load_emps(folder / "DATA_EMPS_PULSES.mat").run()
-    fit = fit_idim(estimation)  # the only fit
+    # the only fit; its refusals name the file ('samples: got 10' and 'run: got 'DATA_EMPS'' named none)
+    fit = renaming(lambda field: f"{folder / 'DATA_EMPS.mat'}: {field}", fit_idim, estimation)
     idim = {
         "params": fit.params,
         "std": dict(zip(PARAMETER_NAMES, map(float, fit.std))),

@@ -1024,7 +1024,6 @@ def load_emps(path=None):
         return float(a.item())
 
     gtau = scalar("gtau")
-    controller = dataclasses.replace(EMPS_CONTROLLER, kp=scalar("kp"), kv=scalar("kv"))
     vir = array("vir").ravel()
     u, f_ext = vir, None
     if "pulses_N" in mat:
@@ -1033,22 +1032,27 @@ def load_emps(path=None):
             raise InputError(f"{path}: pulses_N", f"length {pulses.size}", f"length {vir.size} like vir")
         u = vir - pulses
         f_ext = gtau * pulses
-    meta = MeasuredMeta(u_units="V", u_gain=gtau, controller=controller,
-                        sensors=SensorMeta(encoder_resolution=EMPS_ENCODER_RESOLUTION, scale_resolution=0.0),
-                        source=f"EMPS benchmark (Janot, Gautier, Brunot 2019): {path.name}",
-                        notes=_EMPS_NOTES)
-    try:
+    try:  # the metadata's checks too ('u_gain: got -35.15', 'controller.kp: got 1e+300' named no file)
+        controller = dataclasses.replace(EMPS_CONTROLLER, kp=scalar("kp"), kv=scalar("kv"))
+        meta = MeasuredMeta(u_units="V", u_gain=gtau, controller=controller,
+                            sensors=SensorMeta(encoder_resolution=EMPS_ENCODER_RESOLUTION, scale_resolution=0.0),
+                            source=f"EMPS benchmark (Janot, Gautier, Brunot 2019): {path.name}",
+                            notes=_EMPS_NOTES)
         run = MeasuredRun(t=array("t"), x_ref=array("qg"), x_motor=array("qm"), u=u, f_ext=f_ext, meta=meta,
                           label=path.stem)
         check_recorded(run)  # as a measured CSV's runs: a vir of zeros reached the fit as 'y: got 'all zero''
     except InputError as err:  # the file's variables, not the run's columns ('x_motor: got nan at sample 100')
+        if err.field.startswith(str(path)):  # (a check that names the file already)
+            raise
         name = _EMPS_VARIABLES.get(err.field.split(" ", 1)[0])
         raise err.renamed(f"{path}: {name}" if name else f"{path}: {err.field}") from None
     return MeasuredData(runs=(run,), meta=meta)
 
 
-#: a run's columns -> the EMPS file's variables they are read from (``u`` is ``vir`` less the pulses)
-_EMPS_VARIABLES = {"t": "t", "x_ref": "qg", "x_motor": "qm", "u": "vir", "f_ext": "pulses_N"}
+#: a run's columns and metadata fields -> the EMPS file's variables they are read from (``u`` is ``vir`` less the
+#: pulses)
+_EMPS_VARIABLES = {"t": "t", "x_ref": "qg", "x_motor": "qm", "u": "vir", "f_ext": "pulses_N", "u_gain": "gtau",
+                   "controller.kp": "kp", "controller.kv": "kv"}
 
 
 def check_split(train, test):

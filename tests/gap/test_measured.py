@@ -572,6 +572,9 @@ def test_an_emps_file_of_complex_signals_is_refused_by_name(tmp_path, name):
     ("qm", lambda a: np.where(np.arange(a.size).reshape(a.shape) == 100, np.nan, a), "nan at sample 100"),
     ("vir", np.zeros_like, "zero throughout"),
     ("t", lambda a: a[::-1].copy(), "after t[0]"),
+    # the metadata's fields too ('u_gain: got -35.15', 'controller.kp: got 1e+300' named no file)
+    ("gtau", lambda a: -a, "-35.15"),
+    ("kp", lambda a: a * 0 + 1e300, "1e+300"),
 ])
 def test_a_bad_emps_variable_is_named_as_the_file_names_it(tmp_path, name, change, said):
     import scipy.io
