@@ -85,10 +85,11 @@ def _drive(args):
 
 def run(args):
     """Compute and print the creep boundary."""
+    from drakecreep.cli.margins import POSITIVE_FEED
     from drakecreep.paper import creep
 
     if not (math.isfinite(args.feed) and args.feed > 0):
-        raise InputError("--feed", args.feed, "a finite speed > 0 in mm/s")
+        raise InputError("--feed", args.feed, POSITIVE_FEED)
     feed_from_mm_s(args.feed)  # the range of every command (1e300 mm/s overflowed the friction law)
     d, source, law_name, nut_on = _drive(args)
     # the lumped mass carries the friction the model applies to the table (drakecreep.model.lumped)

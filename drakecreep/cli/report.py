@@ -31,7 +31,7 @@ def add_parser(subparsers):
 def run(args):
     """Build the report and print where it is."""
     from drakecreep.cli._common import feed_from_mm_s
-    from drakecreep.cli.margins import check_feed, scenario_from_args
+    from drakecreep.cli.margins import POSITIVE_FEED, check_feed, scenario_from_args
     from drakecreep.files import check_output_dir
     from drakecreep.report.loop_report import build_report
     from drakecreep.scenario import Scenario
@@ -42,7 +42,7 @@ def run(args):
     params = params_from_args(args)
     scenario = scenario_from_args(args, params)
     if not args.low_feed > 0:
-        raise InputError("--low-feed", args.low_feed, "a feed > 0 mm/s")
+        raise InputError("--low-feed", args.low_feed, POSITIVE_FEED)
     low = feed_from_mm_s(args.low_feed, "--low-feed")
     check_feed(params, Scenario(feed=low, load_case=scenario.load_case), "--low-feed", args.low_feed)
     check_output_dir(args.out)  # before the computation, not after it

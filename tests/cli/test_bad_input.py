@@ -482,7 +482,9 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     (["modal", "{tmp}/nothere.csv"], "nothere.csv'; allowed: an existing file (no such file or directory)"),
     (["modal", "{tmp}"], "'; allowed: a regular file (this is a folder)"),
     # the option and mm/s, not the scenario's field in m/s; a placement that fails names both targets
-    (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed > 0 mm/s"),
+    (["report", "--out", "{tmp}/r", "--feed", "-1"], "--feed: got -1.0; allowed: a feed in [1e-4, 1000] mm/s (> 0"),
+    # one description of a feed in every analysis ('a finite speed > 0 in mm/s' in critical)
+    (["critical", "--feed", "0"], "--feed: got 0.0; allowed: a feed in [1e-4, 1000] mm/s (> 0"),
     (["report", "--out", "{tmp}/r", "--low-feed", "-0.1"], "--low-feed: got -0.1"),
     # without the creep simulations there is nothing to run on them: ignored without a word
     (["report", "--out", "{tmp}/r", "--no-sim-grid", "--workers", "2"], "--workers: got 2; allowed: only with the "
@@ -666,9 +668,14 @@ def test_a_drive_that_cannot_slide_names_the_feed_option_or_the_params(tmp_path,
 
     weak = tmp_path / "weak.yaml"
     save_params(with_value(preset("paper"), "motor.peak_torque", 0.001), weak)
+    # no feed slides at all: the load case (it said '--feed: got 1.0', an option not given, 'allowed: a feed the
+    # drive can slide at', where none can)
     for argv in (["margins"], ["tune"], ["report", "--out", str(tmp_path / "r")]):
         code, _, err = _run(argv + ["--params", str(weak), "--load-case", "0"], capsys)
-        _one_line_exit_2(code, err, "--feed: got 1.0; allowed: a feed in mm/s the drive can slide at: at load case 0")
+        _one_line_exit_2(code, err, "--load-case: got 0; allowed: a load case the drive can hold at some feed: this "
+                                    "one takes at least ")
+    code, _, err = _run(["margins", "--params", str(weak), "--load-case", "0", "--feed", "5"], capsys)
+    _one_line_exit_2(code, err, "--load-case: got 0")
     # Stribeck friction that rises at low speed: 1 mm/s slides, 0.1 mm/s and the loci's 0.02 mm/s do not
     stribeck = preset("paper")
     for path, value in (("motor.peak_torque", 0.6), ("friction.law", "stribeck"), ("friction.static_ratio", 3.0),
