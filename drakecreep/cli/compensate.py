@@ -62,7 +62,13 @@ def run(args):
     if args.speed_source is not None:
         from drakecreep.params import with_value
 
+        if not params.controller.sampled:  # a continuous controller's compensators read the ideal speed
+            raise InputError("--speed-source", args.speed_source, "only with a sampled controller (controller.sampled: "
+                             "the continuous one's compensators read the ideal speed; the results were the same)")
         params = with_value(params, "compensation.speed_source", args.speed_source)
+    twice = sorted({m for m in args.method or () if args.method.count(m) > 1})
+    if twice:  # as --feeds 1,1 (a method given twice was run once without a word)
+        raise InputError("--method", ",".join(args.method), f"each method once ({', '.join(twice)} given twice)")
     from drakecreep.files import check_output_dir
 
     feeds = _list(args.feeds, "--feeds", float, lambda v: 1e-4 <= v <= MAX_FEED * 1e3,

@@ -37,7 +37,8 @@ def run(args):
     drive = build_diagram(params, scenario, continuous=continuous)
     source = args.params or f"preset {args.preset}"
     path = draw_diagram(drive.diagram, args.out, title=f"{source}: {controller_caption(params, continuous)}")
-    print(f"wrote {path}")
+    dot = path.with_suffix(".dot")
+    print(f"wrote {path}" + (f", {dot}" if dot != path else ""))  # the Graphviz source is written beside it too
     return 0
 
 

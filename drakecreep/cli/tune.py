@@ -55,6 +55,12 @@ def run(args):
         from drakecreep.files import check_output_file
 
         check_output_file(args.write, "--write")
+        import os
+
+        if args.params and os.path.exists(args.write) and os.path.samefile(args.write, args.params):
+            # save_params writes plain YAML: the input's comments (sources, assumptions) were lost without a word
+            raise InputError("--write", args.write, "a file other than --params (writing the tuned gains over it "
+                             "would drop its comments: write a new file and compare)")
     try:
         result = tune(params, scenario, bandwidth, phase_margin)
     except InputError as err:

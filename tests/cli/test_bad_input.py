@@ -553,6 +553,12 @@ def test_unexpected_error_is_one_line_and_points_to_debug(monkeypatch, capsys):
     # a window of 5e-301 s: 'simulation.log_period: got 0.00025; allowed: <= 2.5e-302 s', a field nobody had set
     (["compensate", "--out", "{tmp}/c", "--duration", "1e-300"], "--duration: got 1e-300; allowed: a time in [0.1, 3600] s"),
     (["compensate", "--out", "{tmp}/c", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in [0.1, 3600]"),
+    # an option with no effect: a continuous controller's compensators read the ideal speed (the same CSV, exit 0);
+    # a method given twice was run once without a word, where --feeds 1,1 is refused
+    (["compensate", "--out", "{tmp}/c", "--params", "{tmp}/continuous.yaml", "--speed-source", "encoder"],
+     "--speed-source: got 'encoder'; allowed: only with a sampled controller"),
+    (["compensate", "--out", "{tmp}/c", "--method", "static", "--method", "static"],
+     "--method: got 'static,static'; allowed: each method once (static given twice)"),
     # inside the 0.05 s acceleration ramp: verdicts on the ramp, exit 0
     (["compensate", "--out", "{tmp}/c", "--duration", "0.01"], "--duration: got 0.01; allowed: a time in [0.1, 3600]"),
     (["uncertainty", "--duration", "1e9"], "--duration: got 1000000000.0; allowed: a time in (0, 3600]"),
@@ -597,6 +603,7 @@ def test_bad_options(argv, fragment, tmp_path, capsys):
         np.savetxt(tmp_path / f"frf_{name}.csv", np.column_stack([f, h.real, h.imag]), delimiter=",",
                    header="f_Hz,re,im", comments="")
     (tmp_path / "spec.yaml").write_text("axes:\n  table.mass: [30, 40]\n")
+    (tmp_path / "continuous.yaml").write_text("controller: {sampled: false}\n")
     from drakecreep.data import example_path
 
     example = example_path("emps_segment.csv")
@@ -658,6 +665,16 @@ def test_tune_write_target_is_checked_before_the_tuning(target, tmp_path, capsys
     code, _, err = _run(["tune", "--write", target.format(tmp=tmp_path)], capsys)
     _one_line_exit_2(code, err, "--write")
     assert (tmp_path / "afile").read_text() == "keep me\n"
+
+
+def test_tune_does_not_write_over_its_own_params_file(tmp_path, capsys):
+    """--write onto --params replaced the commented input file (its sources and assumptions) without a word."""
+    path = tmp_path / "p.yaml"
+    code, out, _ = _run(["params", "--preset", "paper"], capsys)
+    path.write_text(out)
+    code, _, err = _run(["tune", "--params", str(path), "--write", str(path)], capsys)
+    _one_line_exit_2(code, err, "--write: got ", "allowed: a file other than --params")
+    assert path.read_text() == out
 
 
 def test_a_drive_that_cannot_slide_names_the_feed_option_or_the_params(tmp_path, monkeypatch, capsys):
