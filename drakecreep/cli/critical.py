@@ -113,6 +113,10 @@ def run(args):
         "v0_self_consistent_mm_per_s": None if math.isnan(v0_sc) else v0_sc * 1e3,
         "creep_predicted": cond.creep,
     }
+    overload = _overload(args, d.load_case)
+    if overload is not None:  # a drive that cannot hold the feed is no stick-slip (it said 'creep at v: no')
+        result["creep_predicted"] = None
+        result["overload"] = {"force_N": overload[0], "limit_N": overload[1]}
     if args.json:
         print_json(result)
         return 0
@@ -130,5 +134,24 @@ def run(args):
                                     else f"{v0 * 1e3:.4g} mm/s"))
     print("v0, C1 at v0      = " + ("n/a (no root in 1e-4..1000 mm/s)" if math.isnan(v0_sc)
                                     else f"{v0_sc * 1e3:.4g} mm/s"))
-    print(f"creep at v        : {'yes' if result['creep_predicted'] else 'no'}")
+    if overload is not None:
+        print(f"creep at v        : no verdict: the drive cannot hold this feed (it takes {overload[0]:.4g} N, beyond "
+              f"its force limit {overload[1]:.4g} N: motor.peak_torque through screw.lead)")
+    else:
+        print(f"creep at v        : {'yes' if result['creep_predicted'] else 'no'}")
     return 0
+
+
+def _overload(args, load_case):
+    """``(force, limit)`` [N] when the parameters' drive cannot slide at ``--feed`` under the load case, else None;
+    not asked with friction overrides (``--fs``, ``--fd``: a what-if of the lumped drive, not of the parameters)."""
+    if args.fs is not None or args.fd is not None:
+        return None
+    from drakecreep.scenario import Scenario
+    from drakecreep.servo.linearize import sliding_overload
+
+    params = params_from_args(args)
+    if params.friction.law == "gms":  # (no steady sliding force to compare)
+        return None
+    overload = sliding_overload(params, Scenario(feed=args.feed * 1e-3, load_case=load_case))
+    return None if overload is None else (float(overload[0]), float(overload[1]))

@@ -186,3 +186,17 @@ def test_critical_at_the_bounds_is_finite(capsys):
     assert cli.main(["critical", "--json", "--stiffness", "1e14", "--mass", "1e-3", "--damping", "0"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert math.isfinite(out["natural_frequency_Hz"]) and math.isfinite(out["zeta"])
+
+
+def test_critical_gives_no_verdict_where_the_drive_cannot_hold_the_feed(tmp_path, capsys):
+    """A 0.1 N m drive at 50 mm/s (136 N of friction against a 126 N limit) was 'creep at v: no', as 1e6 N of load
+    was: the drive that cannot slide gets no verdict, as in simulate; at 1 mm/s it slides and keeps its verdict."""
+    (tmp_path / "weak.yaml").write_text("motor: {peak_torque: 0.1}\n")
+    base = ["critical", "--params", str(tmp_path / "weak.yaml"), "--load-case", "0"]
+    out = run_json(capsys, base + ["--feed", "50"])
+    assert out["creep_predicted"] is None and out["overload"]["force_N"] > out["overload"]["limit_N"]
+    assert out["overload"]["limit_N"] == pytest.approx(2 * math.pi * 0.1 / 5e-3)
+    slow = run_json(capsys, base)
+    assert slow["creep_predicted"] is False and "overload" not in slow
+    # a what-if of the lumped drive's friction is not held to the parameters' drive
+    assert run_json(capsys, base + ["--feed", "50", "--fs", "2", "--fd", "1"])["creep_predicted"] is not None
