@@ -119,14 +119,16 @@ def run(args):
     if "computation_delay_samples" in summary:
         print(f"computation delay: {summary['computation_delay_samples']:g} velocity samples "
               f"({summary['computation_delay_ms']:.3g} ms; controller.computation_delay), in the sampled loops")
+    unstable = "n/a (unstable when closed: no margins)"
     if "sampling_phase_cost_deg" in summary:
         c = summary["sampling_phase_cost_deg"]
-        print(f"phase lost to sampling, hold and computation delay: velocity {c['velocity']:.1f} deg, "
-              f"position {c['position']:.1f} deg")
+        print("phase lost to sampling, hold and computation delay: " + ", ".join(
+            f"{loop} " + (unstable if c[loop] is None else f"{c[loop]:.1f} deg") for loop in ("velocity", "position")))
     if "computation_delay_cost" in summary:
         c = summary["computation_delay_cost"]
         print("of which the computation delay: " + ", ".join(
-            f"{loop} {c[loop]['phase_margin_deg']:.2f} deg PM, {c[loop]['gain_margin_dB']:.2f} dB GM, "
-            f"{c[loop]['delay_margin_ms']:.3g} ms delay margin" for loop in ("velocity", "position")))
+            f"{loop} " + (unstable if c[loop] is None else f"{c[loop]['phase_margin_deg']:.2f} deg PM, "
+                          f"{c[loop]['gain_margin_dB']:.2f} dB GM, {c[loop]['delay_margin_ms']:.3g} ms delay margin")
+            for loop in ("velocity", "position")))
     print(f"first mechanical resonance: {resonance_text(summary['resonance_Hz'], summary['resonance_damping'], '.4g')}")
     return 0

@@ -255,8 +255,11 @@ def _html(params, source, analysis, summary, op, crossings, pm, step, low_run, d
     cost = summary.get("sampling_phase_cost_deg")
     cost_text = ""
     if cost:
-        cost_text = (f"<p>Sampling and hold cost <b>{cost['velocity']:.1f} deg</b> of phase margin in the velocity loop "
-                     f"and <b>{cost['position']:.1f} deg</b> in the position loop (continuous minus sampled).</p>")
+        def said(loop):  # (None: the loop is unstable when closed, so it has no margins to take a difference of)
+            return "n/a (unstable when closed)" if cost[loop] is None else f"<b>{cost[loop]:.1f} deg</b>"
+
+        cost_text = (f"<p>Sampling and hold cost {said('velocity')} of phase margin in the velocity loop "
+                     f"and {said('position')} in the position loop (continuous minus sampled).</p>")
     mech = crossings["mechanism"]
     whole = crossings["closed_loop"]
 

@@ -406,18 +406,23 @@ class LoopAnalysis:
             if g is not None:
                 out["computation_delay_samples"] = g.computation_delay
                 out["computation_delay_ms"] = g.computation_delay * g.velocity_period * 1e3
+            # the costs are differences of margins: of a loop unstable when closed (sampled, or continuous) there
+            # are no margins, and a difference of them is none (a 'cost' of 228 deg out of 175 lost in all, printed)
+            stable = {loop: self.margins["sampled"][loop]["closed_loop_stable"]
+                      and self.margins["continuous"][loop]["closed_loop_stable"] for loop in LOOPS}
             undelayed = self.extra.get("undelayed_margins")
             if undelayed:
                 # what the computation delay alone costs: sampled margins without it minus with it
                 out["computation_delay_cost"] = {
-                    loop: {k: undelayed[loop][k] - self.margins["sampled"][loop][k]
-                           for k in ("phase_margin_deg", "gain_margin_dB", "delay_margin_ms")}
+                    loop: ({k: undelayed[loop][k] - self.margins["sampled"][loop][k]
+                            for k in ("phase_margin_deg", "gain_margin_dB", "delay_margin_ms")}
+                           if stable[loop] and undelayed[loop]["closed_loop_stable"] else None)
                     for loop in LOOPS
                 }
             out["continuous"] = {loop: dict(self.margins["continuous"][loop]) for loop in LOOPS}
             out["sampling_phase_cost_deg"] = {
-                loop: self.margins["continuous"][loop]["phase_margin_deg"] - self.margins["sampled"][loop][
-                    "phase_margin_deg"] for loop in LOOPS
+                loop: (self.margins["continuous"][loop]["phase_margin_deg"] - self.margins["sampled"][loop][
+                    "phase_margin_deg"]) if stable[loop] else None for loop in LOOPS
             }
         cl = self.closed_loop_poles
         worst = cl[np.argmax(cl.real)]

@@ -130,6 +130,11 @@ def test_creeping_operating_point_is_flagged_unstable(paper):
     assert not a.margins["sampled"]["velocity"]["closed_loop_stable"]
     assert a.margins["sampled"]["velocity"]["delay_margin_ms"] == 0.0
     assert a.margins["sampled"]["velocity"]["open_loop_unstable_poles"] > 0
+    # an unstable loop has no margins, so no cost of sampling or delay in them (a 'cost' of 228 deg out of 175 lost
+    # in all was printed); the stable position loop keeps its numbers
+    s = a.summary()
+    assert s["sampling_phase_cost_deg"]["velocity"] is None and s["computation_delay_cost"]["velocity"] is None
+    assert s["position"]["closed_loop_stable"] == (s["sampling_phase_cost_deg"]["position"] is not None)
 
 
 def test_unknown_loop(paper):
