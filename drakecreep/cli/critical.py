@@ -55,7 +55,8 @@ def add_parser(subparsers):
 
 
 def _drive(args):
-    """The lumped drive of the parameters with the what-if overrides applied (validated)."""
+    """The lumped drive of the parameters with the what-if overrides applied (validated), the source's name and the
+    parameters."""
     from drakecreep.model.lumped import lumped
 
     params = params_from_args(args)
@@ -80,7 +81,7 @@ def _drive(args):
         raise InputError("--fs", drive.breakaway, f">= Fd ({drive.coulomb:g} N)")
     source = args.params or f"preset {args.preset}"
     return drive, source + (" with " + ", ".join("--" + o for o in OVERRIDES if getattr(args, o) is not None)
-                            if changes else ""), params.friction.law, params.friction.nut_friction_on
+                            if changes else ""), params
 
 
 def run(args):
@@ -91,7 +92,8 @@ def run(args):
     if not (math.isfinite(args.feed) and args.feed > 0):
         raise InputError("--feed", args.feed, POSITIVE_FEED)
     feed_from_mm_s(args.feed)  # the range of every command (1e300 mm/s overflowed the friction law)
-    d, source, law_name, nut_on = _drive(args)
+    d, source, params = _drive(args)
+    law_name, nut_on = params.friction.law, params.friction.nut_friction_on
     # the lumped mass carries the friction the model applies to the table (drakecreep.model.lumped)
     friction_on_mass = ("guides only (the ball nut's drag acts on the screw, motor side of the spring)"
                         if nut_on == "screw" else "guides and ball nut")
@@ -113,7 +115,7 @@ def run(args):
         "v0_self_consistent_mm_per_s": None if math.isnan(v0_sc) else v0_sc * 1e3,
         "creep_predicted": cond.creep,
     }
-    overload = _overload(args, d.load_case)
+    overload = _overload(args, params, d.load_case)
     if overload is not None:  # a drive that cannot hold the feed is no stick-slip (it said 'creep at v: no')
         result["creep_predicted"] = None
         result["overload"] = {"force_N": overload[0], "limit_N": overload[1]}
@@ -142,7 +144,7 @@ def run(args):
     return 0
 
 
-def _overload(args, load_case):
+def _overload(args, params, load_case):
     """``(force, limit)`` [N] when the parameters' drive cannot slide at ``--feed`` under the load case, else None;
     not asked with friction overrides (``--fs``, ``--fd``: a what-if of the lumped drive, not of the parameters)."""
     if args.fs is not None or args.fd is not None:
@@ -150,8 +152,5 @@ def _overload(args, load_case):
     from drakecreep.scenario import Scenario
     from drakecreep.servo.linearize import sliding_overload
 
-    params = params_from_args(args)
-    if params.friction.law == "gms":  # (no steady sliding force to compare)
-        return None
     overload = sliding_overload(params, Scenario(feed=args.feed * 1e-3, load_case=load_case))
     return None if overload is None else (float(overload[0]), float(overload[1]))

@@ -84,12 +84,13 @@ def run(args):
         multibody = MultibodyOptions(n_segments=segments, rigid_joints=args.rigid_joints,
                                      screw_bending=not args.axial_screw)
         travel, segment = abs(feed) * args.duration, params.screw.length / segments
-        if segment / abs(feed) < shortest_run(params) * (1.0 - 1e-9):
+        shortest = shortest_run(params)
+        if segment / abs(feed) < shortest * (1.0 - 1e-9):
             # no duration both holds the metrics window and keeps the nut on its segment: the feed is too fast ('<=
             # 0.3 s' and '>= 1.005 s' sent the user back and forth)
-            raise InputError("--feed", args.feed, f"<= {segment / shortest_run(params) * 1e3:.4g} mm/s with "
+            raise InputError("--feed", args.feed, f"<= {segment / shortest * 1e3:.4g} mm/s with "
                              f"{segments} segments (the multibody nut stays on one screw segment of "
-                             f"{segment * 1e3:g} mm for the shortest run, {shortest_run(params):g} s"
+                             f"{segment * 1e3:g} mm for the shortest run, {shortest:g} s"
                              + ("; fewer --segments make it longer)" if segments > 2 else ")"))
         if travel > segment * (1.0 + 1e-9):
             raise InputError("--duration", args.duration,

@@ -54,7 +54,6 @@ __all__ = [
     "MIN_U_GAIN",
     "MAX_U_GAIN",
     "MAX_SPEED",
-    "MAX_FORCE",
     "MAX_TAPS",
     "MAX_TAP_GAIN",
     "COLUMNS",
@@ -100,11 +99,6 @@ MAX_GAIN = 1e9
 #: milliseconds labelled ``us``, move a thousand times too fast), which would otherwise run a whole diagnosis on a
 #: model that cannot follow it
 MAX_SPEED = 10.0
-#: Largest plausible force [N]: the drive's ``u x u_gain`` or an external force, the bound of every load force
-#: (:data:`drakecreep.params.MAX_LOAD_FORCE`, 1e6 N). Feed drives push with up to tens of kN. A larger sample is a
-#: unit error or a corrupt cell (one cell of 1e300 ran a diagnosis to overflowing fits and a mass of 1e301 kg; a
-#: u_gain of 1e6 N/V on the EMPS run, 1.5e6 N at its peak under the former 1e7 N bound, a 2.7e6 kg axis, exit 0)
-MAX_FORCE = MAX_LOAD_FORCE
 #: Smallest peak drive force [N] (``u x u_gain``) a measured run may have: no drive moves an axis with less than a
 #: micronewton (a u of 1e-300 V ran to 'y: got all zero', an internal name, from the nominal's fit)
 MIN_PEAK_FORCE = 1e-6
@@ -437,9 +431,13 @@ class MeasuredRun:
             if a is None:
                 continue
             i = int(np.argmax(np.abs(a)))
-            if abs(float(a[i])) * gain > MAX_FORCE:
+            # the largest plausible force: MAX_LOAD_FORCE, the bound of every load force (1e6 N; feed drives push
+            # with up to tens of kN). A larger sample is a unit error or a corrupt cell (one cell of 1e300 ran a
+            # diagnosis to a mass of 1e301 kg; a u_gain of 1e6 N/V on the EMPS run, 1.5e6 N at its peak under the
+            # former 1e7 N bound, to a 2.7e6 kg axis, exit 0)
+            if abs(float(a[i])) * gain > MAX_LOAD_FORCE:
                 raise InputError(f"{name} (run {self.label})", f"{float(a[i]):.3g} at sample {i + 1}",
-                                 f"forces up to {MAX_FORCE:g} N" + (" (u x u_gain)" if name == "u" else "")
+                                 f"forces up to {MAX_LOAD_FORCE:g} N" + (" (u x u_gain)" if name == "u" else "")
                                  + " (is a unit wrong, or a cell corrupt?)")
         for name in _ARRAYS:
             a = getattr(self, name)

@@ -232,8 +232,12 @@ def check_log_period(log_period, duration, steady_start=None):
 def shortest_run(params):
     """The shortest run [s] :func:`check_window` takes: ``simulation.steady_start`` and then the metrics window's
     :data:`MIN_WINDOW_SAMPLES` samples at the finer of ``simulation.log_period`` and its default."""
-    sim = params.simulation
-    return sim.steady_start + MIN_WINDOW_SAMPLES * min(sim.log_period, SimulationParams().log_period)
+    return params.simulation.steady_start + MIN_WINDOW_SAMPLES * _finest_log_period(params.simulation)
+
+
+def _finest_log_period(sim):
+    """The finer of ``sim.log_period`` and its default [s]: the log period a window too short is the duration's at."""
+    return min(sim.log_period, SimulationParams().log_period)
 
 
 def check_window(params, duration, field="duration"):
@@ -243,14 +247,13 @@ def check_window(params, duration, field="duration"):
     and ``--duration 600`` blamed 'simulation.log_period', a field nobody had set). What only the params file's own
     ``simulation.log_period`` makes too few or too many is the log period's, as :func:`check_log_period` says."""
     sim = params.simulation
-    default = SimulationParams().log_period
-    finest = min(sim.log_period, default)
-    if not (duration > sim.steady_start and (duration - sim.steady_start) / finest >= MIN_WINDOW_SAMPLES):
+    if not (duration > sim.steady_start
+            and (duration - sim.steady_start) / _finest_log_period(sim) >= MIN_WINDOW_SAMPLES):
         least = shortest_run(params)
         raise InputError(field, duration, f">= {least:.6g} s: simulation.steady_start ({sim.steady_start:g} s) "
                          f"and then the metrics window's {MIN_WINDOW_SAMPLES} recorded samples, one every "
                          f"simulation.log_period ({sim.log_period:g} s)")
-    coarsest = max(sim.log_period, default)
+    coarsest = max(sim.log_period, SimulationParams().log_period)
     if duration / coarsest > MAX_SAMPLES:
         raise InputError(field, duration, f"<= {MAX_SAMPLES * coarsest:.6g} s: at most {MAX_SAMPLES} recorded samples "
                          f"per run, one every simulation.log_period ({sim.log_period:g} s; a coarser one in a params "
