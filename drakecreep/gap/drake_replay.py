@@ -41,7 +41,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
-from drakecreep.gap.residuals import classify_regimes
+from drakecreep.gap.residuals import classify_regimes, transmission_position
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, applied_force,
                                    axis_friction, axis_parameters, axis_ripple, has_bristles, lead_error, nut_load)
 from drakecreep.model.delay import split_delay
@@ -789,8 +789,10 @@ def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
     """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
 
     Velocity and acceleration of the measured and simulated motor positions go through the same IDIM
-    processing (Butterworth ``cutoff`` forward-backward, central differences); ``x_table`` is added when the
-    run has a linear scale; ``force_level`` (the run's own friction level) when the result carries its
+    processing (Butterworth ``cutoff`` forward-backward, central differences); ``table_position`` is added when the
+    run has a linear scale, and with it ``transmission``, the error of the position the screw adds between the
+    motor and the table (:func:`transmission_position`: its windup and any kinematic error) unless the measured
+    one is constant; ``force_level`` (the run's own friction level) when the result carries its
     parameters; ``force_constant_speed`` (for each regime of :data:`REGIME_ERRORS`) the force error over the
     samples of that regime (:func:`drakecreep.gap.residuals.classify_regimes` of the reference and the measured
     speed) when the run has at least :data:`MIN_REGIME_SAMPLES` of them; ``force_band_<lo>-<hi>_Hz`` the force
@@ -811,6 +813,9 @@ def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
     }
     if run.x_table is not None:
         out["table_position"] = relative_error(run.x_table, result.x_table)
+        deflection = transmission_position(run.x_motor, run.x_table)
+        if np.any(deflection != 0):
+            out["transmission"] = relative_error(deflection, transmission_position(result.x_motor, result.x_table))
     if result.parameters:
         out["force_level"] = _force_level_error(result, cutoff, order)
     regimes = classify_regimes(np.arange(run.n) * run.dt, run.x_ref, dq)

@@ -38,6 +38,7 @@ __all__ = [
     "order_spectrum",
     "time_spectrum",
     "operating_map",
+    "transmission_position",
     "whiteness",
     "BANDS_HZ",
     "frequency_bands",
@@ -478,6 +479,14 @@ def independence(residual, inputs, lags=25, level=0.99):
     return out
 
 
+def transmission_position(x_motor, x_table):
+    """What the screw adds between the motor and the table [m]: ``x_table - x_motor``, less its mean (a constant is
+    the scale's mounting datum, not the transmission's): the windup of the axial chain plus any kinematic error
+    of the screw (a lead error), which a motor encoder cannot see and a linear scale can."""
+    d = np.asarray(x_table, dtype=float) - np.asarray(x_motor, dtype=float)
+    return d - d.mean()
+
+
 def motor_table_split(x_motor, x_table, x_motor_sim, x_table_sim=None):
     """Is the position gap before or after the screw? (runs with a linear scale)
 
@@ -495,8 +504,7 @@ def motor_table_split(x_motor, x_table, x_motor_sim, x_table_sim=None):
     xm, xt, xs = (np.asarray(a, dtype=float) for a in (x_motor, x_table, x_motor_sim))
     xts = xs if x_table_sim is None else np.asarray(x_table_sim, dtype=float)
     em = xm - xs
-    et = (xt - xm) - (xts - xs)
-    et = et - et.mean()  # a constant scale offset is a mounting datum, not a gap
+    et = transmission_position(xm, xt) - transmission_position(xs, xts)
     e_m, e_t = float(em @ em), float(et @ et)
     share = e_t / (e_m + e_t) if e_m + e_t > 0 else 0.0
     where = "after the screw" if share > 0.67 else ("before the screw" if share < 0.33 else "both")

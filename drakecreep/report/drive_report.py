@@ -146,7 +146,7 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
     parts.append(table(["effect", "training gain [% of SSE]", "held-out gain [points of %]",
                         "pooled held-out shrink [%] (in run-to-run nulls)", "claimed", "why", "fitted fields"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
-    sig = [s for s in ("position", "velocity", "acceleration", "force", "table_position")
+    sig = [s for s in ("position", "velocity", "acceleration", "force", "table_position", "transmission")
            if all(s in e for e in result.test_errors.values())]
     parts.append(table(["held-out run"] + [f"{s.replace('_', ' ')} error [%] params file → fitted → augmented"
                                            for s in sig],

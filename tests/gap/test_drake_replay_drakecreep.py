@@ -208,3 +208,27 @@ def test_a_run_under_an_axial_load_replays_from_where_it_started(load_case, cons
     if constant_force:  # at rest before the first leg the drive holds the constant force
         base = replay_drakecreep(_run(_rig()))
         assert np.mean(sim.u[:15] - base.u[:15]) == pytest.approx(constant_force, rel=0.02)
+
+
+def test_the_replay_errors_carry_the_screws_transmission_on_runs_with_a_scale():
+    """``transmission``: the error of ``x_table - x_motor`` less its mean, measured against replayed, [%]; only on
+    runs with a linear scale whose measured transmission moves. A replay of a run measured by the rig itself
+    (the 1 um lead error in both) has none; the same run replayed without the lead error misses the error's share
+    of the transmission (the rest is the windup under the 30 N external force, which both replays carry)."""
+    from drakecreep.gap.drake_replay import drake_replay_errors
+    from drakecreep.gap.residuals import transmission_position
+
+    rig = _rig()
+    sim = replay_drakecreep(_run(rig), rig)
+    run = dataclasses.replace(_run(rig), x_motor=sim.x_motor, x_table=sim.x_table)
+    d = transmission_position(run.x_motor, run.x_table)
+    assert abs(d.mean()) < 1e-18 and np.ptp(d) > rig.disturbance.lead_error_amplitude  # the error, whole
+    same = drake_replay_errors(replay_drakecreep(run, rig), bands=False)
+    assert same["transmission"] < 0.1
+    without = drake_replay_errors(replay_drakecreep(run, with_value(rig, "disturbance.lead_error_amplitude", 0.0)),
+                                  bands=False)
+    assert without["transmission"] > 100 * same["transmission"] and without["transmission"] > 10.0
+    assert "transmission" not in drake_replay_errors(replay_drakecreep(_run(rig), rig), bands=False)  # no scale
+    rigid = dataclasses.replace(run, x_table=run.x_motor.copy())  # a scale that reads the motor: nothing moves
+    assert "table_position" in drake_replay_errors(replay_drakecreep(rigid, rig), bands=False)
+    assert "transmission" not in drake_replay_errors(replay_drakecreep(rigid, rig), bands=False)

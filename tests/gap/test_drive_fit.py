@@ -338,6 +338,11 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
     assert not second or (second[0].path == "disturbance.lead_error_2_amplitude"
                           and second[0].value < 0.05 * amplitude.value)
     assert seal.path == "table.seal_force" and amplitude.path == "disturbance.lead_error_amplitude"
+    # every run has a linear scale: the error was fitted and decided on the screw's transmission, where its held-out
+    # error all but vanishes, beyond that transmission's own run-to-run null
+    assert best.reason.startswith("passes on the screw's transmission (linear scale)")
+    assert result.transmission_null is not None and best.replay["transmission"]["shrink"] > 0.99
+    assert best.replay["transmission"]["threshold"] == result.transmission_null
     assert seal.contains(truth.table.seal_force) and seal.prior == RIG.table.seal_force and not result.warnings
     assert amplitude.contains(2e-6) and amplitude.unit == "m"
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
@@ -406,18 +411,23 @@ def test_a_lead_error_outside_the_candidates_is_located_after_the_screw_at_its_o
     assert hint in result.summary() and result.to_json()["hints"] == [hint]
 
 
+def _cogging_case():
+    """An 8 N cogging at order 4 with 3 N at order 8, which the params file lacks, and five runs of it."""
+    truth = RIG
+    for path, value in (("disturbance.cogging_force", 8.0), ("disturbance.cogging_period", RIG.screw.lead / 4),
+                        ("disturbance.cogging_phase", 0.7), ("disturbance.cogging_2_force", 3.0),
+                        ("disturbance.cogging_2_phase", -1.0)):
+        truth = with_value(truth, path, value)
+    return truth, simulated_runs(truth, SPEEDS + (0.022,), declared=RIG, n=N, noise=NOISE, seed=600)
+
+
 def test_a_cogging_named_is_fitted_claimed_and_kept_in_the_params():
     """An 8 N cogging at order 4 (a 1.25 mm period) with 3 N at order 8, which the params file lacks, with ``cogging``
     named (it is not a default candidate): its order is found on the grid, both harmonics' amplitudes and phases
     fitted, it is claimed on three held-out runs and kept, both amplitudes refitted beside the seal force with
     intervals that hold the truth; the held-out error falls below half. (The fundamental alone on two held-out
     runs: the same fit, 2.96 -> 0.77 % and 1.89 -> 0.60 %, stays under the Student bar of one degree of freedom.)"""
-    truth = RIG
-    for path, value in (("disturbance.cogging_force", 8.0), ("disturbance.cogging_period", RIG.screw.lead / 4),
-                        ("disturbance.cogging_phase", 0.7), ("disturbance.cogging_2_force", 3.0),
-                        ("disturbance.cogging_2_phase", -1.0)):
-        truth = with_value(truth, path, value)
-    runs = simulated_runs(truth, SPEEDS + (0.022,), declared=RIG, n=N, noise=NOISE, seed=600)
+    truth, runs = _cogging_case()
     assert "cogging" not in drive_fit.NOT_IN_MODEL and "cogging" in drive_fit.ON_REQUEST
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("cogging",))
     assert result.claimed == ("cogging",)
@@ -684,6 +694,9 @@ def test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null():
     truth = with_value(truth, "controller.computation_delay", 3.0)  # a second effect the params file lacks
     runs = simulated_runs(truth, SPEEDS + (0.028,), declared=RIG, n=N, noise=NOISE, seed=31,
                           origins=(0.011, 0.052, 0.027, 0.083, 0.064))
+    # without a linear scale: the force's null and the force's fit are what this test is about (with one, the lead
+    # error is decided on the screw's transmission, test_a_lead_error_on_a_linear_scale_...)
+    runs = [dataclasses.replace(r, x_table=None) for r in runs]
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("lead_error",))
     assert result.replay_null is not None and result.replay_null < 0.05
     assert result.claimed == ("lead_error",)
@@ -696,6 +709,8 @@ def test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null():
     (lead,) = [c for c in result.candidates if c.name == "lead_error"]
     assert lead.train_gain * result.train_sse / result.train_variance > stats.chi2.ppf(0.999, 3)
     assert result.params.disturbance.lead_error_amplitude == pytest.approx(3e-6, rel=0.1)
+    assert result.transmission_null is None and "transmission" not in lead.replay
+    assert not lead.reason.startswith("passes on the screw's transmission")
 
 
 def _residual_runs(lines_per_run, n=3000, dt=1e-3, noise=1.0, seed=0):
@@ -823,3 +838,56 @@ def test_one_string_or_a_name_twice_is_refused_before_any_replay(kwargs, message
     runs = load_runs(example_path("drive_lead_error.csv"), split=False)
     with pytest.raises(InputError, match="^" + re.escape(message)):
         diagnose_drive(runs[:1], runs[1:3], **kwargs)
+
+
+def test_a_cogging_is_not_read_as_a_lead_error_on_a_linear_scale():
+    """An 8 N cogging at order 4 with 3 N at order 8 (the cogging test's truth), the lead error the only candidate,
+    every run with a scale: the cogging's force is fixed to the screw too, but its windup is under one count of
+    the scale, so no lead error is fitted, and none is claimed."""
+    truth, runs = _cogging_case()
+    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("lead_error",))
+    assert result.claimed == () and result.transmission_null is not None
+    (lead,) = result.candidates
+    assert lead.values["disturbance.lead_error_amplitude"] <= RIG.sensors.scale_resolution
+    assert not lead.passes and lead.reason == "no lead error beyond the transmission's noise on the training runs"
+
+
+def _errors(force, transmission=None):
+    return {f"r{i}": {"force": f, **({} if transmission is None else {"transmission": transmission[i]})}
+            for i, f in enumerate(force)}
+
+
+def test_a_lead_error_on_a_linear_scale_is_decided_on_the_transmission():
+    """``_held_out_on_scale`` on per-run errors [%]: the transmission must shrink run by run beyond its Student bar
+    and pooled beyond its own run-to-run null, with most runs better; the force must not get worse by more than its
+    null; without either null nothing passes. The force's gain is kept for the ranking, not what decides."""
+    nominal = _errors([20.0, 21.0, 19.0, 22.0, 18.0], [80.0, 85.0, 90.0, 70.0, 75.0])
+    lead = _errors([19.9, 21.0, 19.1, 21.9, 18.0], [3.0, 4.0, 2.5, 3.5, 5.0])
+    ok = drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, lead, 0.01, 0.05)
+    assert ok.passes and ok.reason.startswith("passes on the screw's transmission (linear scale)")
+    assert ok.gain < ok.threshold  # the force gain alone would not have passed
+    assert ok.replay["transmission"]["shrink"] > 0.99 and ok.replay["transmission"]["runs_better"] == 5
+    # the force worse than its run-to-run null: not claimed, and the reason says so
+    worse = _errors([21.0, 22.0, 20.0, 23.0, 19.0], [3.0, 4.0, 2.5, 3.5, 5.0])
+    bad = drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, worse, 0.01, 0.05)
+    assert not bad.passes and bad.reason.startswith("the force gets worse")
+    # within the force's null the same rise passes
+    assert drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, worse, 0.2, 0.05).passes
+    # a transmission shrink within its own null, or on a minority of runs, is not a lead error
+    small = _errors([20.0, 21.0, 19.0, 22.0, 18.0], [79.0, 84.0, 89.0, 69.5, 74.0])
+    within = drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, small, 0.01, 0.05)
+    assert not within.passes and within.reason.startswith("not on the transmission")
+    mixed = _errors([20.0, 21.0, 19.0, 22.0, 18.0], [3.0, 4.0, 95.0, 75.0, 80.0])
+    assert not drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, mixed, 0.01, 0.05).passes
+    # no null, no claim; no training gain, no claim
+    assert drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, lead, 0.01, None).reason.startswith(
+        "provisional")
+    assert not drive_fit._held_out_on_scale("lead_error", {}, 0.9, nominal, lead, None, 0.05).passes
+    assert not drive_fit._held_out_on_scale("lead_error", {}, 0.0, nominal, lead, 0.01, 0.05).passes
+    # _held_out takes this path for the lead error when every run's errors carry the transmission, else the force's
+    replayer = SimpleNamespace(errors=lambda test, params: lead)
+    via = drive_fit._held_out("lead_error", {}, 0.9, list(nominal), RIG, nominal, replayer, 0.01, 0.05, True)
+    assert via.passes and via.reason == ok.reason
+    force_only = drive_fit._held_out("lead_error", {}, 0.9, list(nominal), RIG, nominal, replayer, 0.01, 0.05,
+                                     False)
+    assert not force_only.passes and "transmission" not in force_only.replay
