@@ -150,7 +150,7 @@ def _overload(args, params, load_case):
     if args.fs is not None or args.fd is not None:
         return None
     from drakecreep.scenario import Scenario
-    from drakecreep.servo.linearize import sliding_overload
+    from drakecreep.model.steady import sliding_overload
 
     overload = sliding_overload(params, Scenario(feed=args.feed * 1e-3, load_case=load_case))
     return None if overload is None else (float(overload[0]), float(overload[1]))

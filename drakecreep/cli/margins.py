@@ -64,7 +64,7 @@ def check_feed(params, scenario, option, mm_s):
     """Raise :class:`InputError` naming ``option`` (a feed of ``mm_s`` mm/s) when the drive cannot slide steadily at
     ``scenario``'s feed: the force it takes is beyond the drive's limit (the operating point said 'feed: got 0.001',
     the scenario's field in m/s, and blamed the feed for what is mostly the params' load and friction)."""
-    from drakecreep.servo.linearize import sliding_overload
+    from drakecreep.model.steady import nut_on_table, sliding_overload, steady_sliding
 
     overload = sliding_overload(params, scenario)
     if overload is not None:
@@ -78,9 +78,11 @@ def check_feed(params, scenario, option, mm_s):
                              f"takes at least {min(n[0] for n in needs):.4g} N at 1e-4 to 1000 mm/s, beyond the "
                              f"drive's limit {limit:.4g} N (motor.peak_torque through screw.lead against the params "
                              "file's load and friction)")
+        _, friction, spring, _, _ = steady_sliding(nut_on_table(params), scenario)
         raise InputError(option, mm_s, f"a feed in mm/s the drive can slide at: at load case {scenario.load_case} it "
-                         f"takes {force:.4g} N, beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
-                         "screw.lead; the load and the friction take most of it at a low feed)")
+                         f"takes {force:.4g} N (load {spring - friction:.4g} N, friction {friction:.4g} N, motor drag "
+                         f"{force - spring:.4g} N), beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
+                         "screw.lead)")
 
 
 def print_margins(summary):

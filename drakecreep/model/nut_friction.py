@@ -6,7 +6,7 @@ at the table's scale, and it loads the motor side of the screw's elasticity, whe
 and a friction compensator act. The law and its shape are the drive's (``params.friction``); only the
 level is the nut's. The viscous term is not: ``friction.viscous`` is the axis's one viscous coefficient
 ``Fv``, and it acts with the guides on the table wherever the nut's Coulomb level acts
-(:func:`nut_friction_params`), as in the linearization (``servo.linearize.nut_on_table``).
+(:func:`nut_friction_params`), as in the linearization (``model.steady.nut_on_table``).
 """
 
 import dataclasses

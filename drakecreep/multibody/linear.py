@@ -11,7 +11,7 @@ feed (the guides' and the nut's steady-state friction as constant loads), the mo
 it (:func:`~drakecreep.multibody.diagram.loaded_equilibrium`); every body moving with the rigid-body
 feed motion (the null vector of the stiffness, scaled to the feed at the table); LuGre's bristle states
 at their steady value. Unlike the two-mass linearization (which lumps the nut on the table,
-:func:`drakecreep.servo.linearize.nut_on_table`), the nut's friction acts on the screw here.
+:func:`drakecreep.model.steady.nut_on_table`), the nut's friction acts on the screw here.
 """
 
 from __future__ import annotations

@@ -57,7 +57,7 @@ def check_sliding(params, load_case, feeds, source="the params"):
     [m/s], the loci's (:data:`LOCI`) and the crossings' (:data:`CROSSING_SPEEDS`), its force within the drive's
     limit. A params file whose drive cannot hold its load and friction was refused in the loci, after the loop
     analysis, as 'feed: got 2e-05' (a speed of the feed locus, in m/s)."""
-    from drakecreep.servo.linearize import sliding_overload
+    from drakecreep.model.steady import sliding_overload
 
     speeds = dict(LOCI)["feed"]
     cases = [(params, v, None) for v in (*feeds, *speeds, *CROSSING_SPEEDS)]

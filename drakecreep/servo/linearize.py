@@ -43,16 +43,15 @@ from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.paper.creep import friction_slope
 from drakecreep.model.diagram import build_diagram, build_plant
 from drakecreep.errors import InputError
-from drakecreep.params import with_value
 from drakecreep.model.friction import make_friction_law
 from drakecreep.model.motor import motor_inertia
 from drakecreep.model.screw import ScrewDrive, axial_damping, axial_stiffness, screw_inertia
-from drakecreep.model.nut_table import NutTable, friction_levels, moving_mass
+from drakecreep.model.nut_table import NutTable, moving_mass
+from drakecreep.model.steady import nut_on_table, steady_sliding
 
 __all__ = [
     "OperatingPoint",
     "operating_point",
-    "sliding_overload",
     "linearize_plant",
     "linearize_controller",
     "linearize_closed_loop",
@@ -121,48 +120,6 @@ class OperatingPoint:
         return (self.damping + self.friction_slope) / (2.0 * math.sqrt(self.stiffness * self.mass))
 
 
-def nut_on_table(params):
-    """``params`` with the ball nut's friction lumped on the table for the linear analysis.
-
-    The linearization (operating point, plant, controller, closed loop) models one friction law on the
-    table; the nut's drag on the screw (``friction.nut_friction_on: screw``, the default since issue 15) is
-    not linearized yet, so its level is lumped with the guides' here: the same total Coulomb level and
-    steady motor torque, but its slope acts at the table's speed instead of the screw's. An approximation,
-    stated in ``docs/physics_review.md``.
-    """
-    if params.friction.nut_friction_on == "table":
-        return params
-    return with_value(params, "friction.nut_friction_on", "table")
-
-
-def _sliding(params, scenario):
-    """The friction law and its levels ``(law, fc, fs)``, the steady friction and spring forces, the motor torque
-    and the force command at ``scenario``'s feed and load case."""
-    load = params.load_case(scenario.load_case)
-    ratio = params.screw.lead / (2.0 * math.pi)
-    law = make_friction_law(params.friction)
-    fc, fs = friction_levels(params, load)
-    friction = float(law.steady_state_force(scenario.feed, fc, fs))
-    spring = load.fx + friction
-    torque = spring * ratio + params.motor.viscous_damping * scenario.feed / ratio
-    return (law, fc, fs), friction, spring, torque, torque / ratio
-
-
-def sliding_overload(params, scenario):
-    """``(force, limit)`` [N] when the drive cannot slide steadily at ``scenario``'s feed and load case, else None.
-
-    ``force`` is the command that would hold it sliding: the load's axial force, the friction at that speed and
-    the motor's viscous drag, at the table (the ball nut's friction lumped on the table, :func:`nut_on_table`);
-    ``limit`` is :func:`drakecreep.model.controller.force_limit`. :func:`operating_point` exists only while
-    ``|force| < limit``. None for the GMS law too, which has no steady sliding to linearize (the operating point
-    says so).
-    """
-    if params.friction.law == "gms":
-        return None
-    force, limit = _sliding(nut_on_table(params), scenario)[-1], force_limit(params)
-    return (force, limit) if abs(force) >= limit else None
-
-
 def operating_point(params, scenario):
     """Steady sliding state of ``build_diagram(params, scenario, continuous=True, ideal_sensors=True)``.
 
@@ -189,7 +146,7 @@ def operating_point(params, scenario):
     g = params.controller
     v = scenario.feed
     ratio = params.screw.lead / (2.0 * math.pi)
-    (law, fc, fs), friction, spring, torque, force_cmd = _sliding(params, scenario)
+    (law, fc, fs), friction, spring, torque, force_cmd = steady_sliding(params, scenario)
     omega = v / ratio
     if abs(force_cmd) >= force_limit(params):
         raise InputError("feed", v, f"a feed whose force {force_cmd:.4g} N is below the drive limit {force_limit(params):.4g} N")

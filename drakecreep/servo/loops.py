@@ -390,7 +390,7 @@ class LoopAnalysis:
     @property
     def friction_on_table(self):
         """Whose friction ``op.friction_slope`` (C1) and ``op.zeta`` take: the guides', and the ball nut's lumped
-        with them where the model puts it on the screw (:func:`drakecreep.servo.linearize.nut_on_table`; ``critical``
+        with them where the model puts it on the screw (:func:`drakecreep.model.steady.nut_on_table`; ``critical``
         takes the guides' alone, the friction on the paper's lumped mass, so the two differ below the Stribeck
         velocity)."""
         on_screw = self.params is not None and self.params.friction.nut_friction_on == "screw"

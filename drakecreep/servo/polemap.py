@@ -271,7 +271,7 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
     PoleMap
     """
     # the simulations check the linear model, which lumps the nut's friction on the table: simulate that one
-    from drakecreep.servo.linearize import nut_on_table
+    from drakecreep.model.steady import nut_on_table
 
     params = nut_on_table(params)
     k_scales = np.geomspace(0.25, 4.0, 16) if k_scales is None else np.asarray(k_scales, dtype=float)

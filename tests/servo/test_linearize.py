@@ -48,7 +48,7 @@ def test_operating_point_matches_a_simulation(paper):
     p = with_value(with_value(p, "sensors.encoder_counts_per_rev", 0), "sensors.scale_resolution", 0.0)
     p = with_value(p, "simulation.steady_start", 0.3)
     p = with_value(p, "simulation.accuracy", 1e-7)
-    # the linear analysis lumps the nut's friction on the table (lin.nut_on_table): simulate that diagram
+    # the linear analysis lumps the nut's friction on the table (model.steady.nut_on_table): simulate that diagram
     p = with_value(with_value(p, "friction.nut_friction_on", "table"), "simulation.convergence_check", False)
     sc = Scenario(feed=10e-3, load_case=3, duration=0.8)
     res = simulate(p, sc)

@@ -61,7 +61,8 @@ def test_pole_map_interpolates_each_column_to_the_poles_of_its_own_linearization
     """The map linearizes three points of a stiffness's column and interpolates the others (A is affine in the
     viscous coefficient): every point's rightmost poles are those of its own linearization; a column whose middle
     point does not agree with the interpolation is linearized point by point."""
-    from drakecreep.servo.linearize import linearize_closed_loop, linearize_mechanism, nut_on_table, operating_point
+    from drakecreep.model.steady import nut_on_table
+    from drakecreep.servo.linearize import linearize_closed_loop, linearize_mechanism, operating_point
 
     sc = Scenario(feed=0.1e-3, load_case=3)
     pm = polemap.pole_map(paper, sc, k_scales=[0.5, 2.0], n_damping=5)
