@@ -11,6 +11,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from drakecreep.servo.loops import LOOPS  # noqa: E402
+from drakecreep.servo.polemap import damping_width  # noqa: E402
 
 __all__ = [
     "plot_bode",
@@ -288,10 +289,16 @@ def plot_pole_map(pm, path):
     ax.plot([pm.nominal[0] * 1e-6], [pm.nominal[1]], "y*", ms=16, mec="k", zorder=6)
     handles.append(plt.Line2D([], [], marker="*", color="y", mec="k", ms=12, ls="", label="parameters used"))
     ax.set_xscale("log")
-    span = pm.damping.max() - pm.damping.min()
-    ax.set_ylim(pm.damping.min() - 0.02 * span, pm.damping.max())
+    # linear near zero, logarithmic beyond (the damping rows are even on it, polemap.damping_width): the paper's
+    # curve sets the top at megagrams per second while the unstable band lies within a few 1e5 N s/m of zero
+    width = damping_width((pm.damping.min(), pm.damping.max()))
+    ax.set_yscale("asinh", linear_width=width)
+    u0, u1 = np.arcsinh(pm.damping.min() / width), np.arcsinh(pm.damping.max() / width)
+    ax.set_ylim(width * np.sinh(u0 - 0.02 * (u1 - u0)), pm.damping.max())
+    ticks = [t for t in ax.get_yticks() if t == 0 or abs(t) >= 0.3 * width]  # none crowding the zero's label
+    ax.set_yticks(ticks)
     ax.set_xlabel("axial stiffness K of the screw chain (N/um)")
-    ax.set_ylabel("effective damping C + C1 (N s/m)")
+    ax.set_ylabel("effective damping C + C1 (N s/m; linear near 0, logarithmic beyond)")
     ax.set_title(f"pole map at feed {pm.feed * 1e3:g} mm/s, M = {pm.mass:.4g} kg, Fs - Fc = {pm.friction_drop:.3g} N",
                  fontsize=9)
     ax.legend(handles=handles, fontsize=7.5, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2)

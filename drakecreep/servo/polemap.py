@@ -38,6 +38,7 @@ __all__ = [
     "friction_slope_crossings",
     "PoleMap",
     "pole_map",
+    "damping_width",
     "paper_creep_damping",
     "LOCUS_PARAMETERS",
 ]
@@ -243,6 +244,16 @@ def _creeps(point):
     return bool((not r.ok) or r.metrics is None or r.metrics.stick_fraction > 0.0)
 
 
+def damping_width(damping_range):
+    """The linear width [N s/m] of the pole map's damping axis: rows and plot are even in ``asinh(y / width)``, linear
+    within about ``width`` of zero and logarithmic beyond it. Half the larger of the range's ends' magnitudes below
+    zero and a tenth of its top (at least 1 N s/m): the unstable band, ``C + C1`` below or about 0, had 7 % of a
+    linear axis whose top the paper's ``D^2 = 4 pi zeta`` curve sets at 5e6 N s/m (paper rig, 0.1 mm/s), and
+    about a quarter of this one."""
+    lo, hi = (float(v) for v in damping_range)
+    return max(0.5 * max(-lo, 0.0), 0.1 * max(hi, 0.0) if lo >= 0 else 0.0, 1.0)
+
+
 def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, sim_grid=None, sim_duration=1.0,
              workers=1):
     """Rightmost poles over stiffness x effective damping at the scenario's feed.
@@ -284,7 +295,9 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
         hi = 1.3 * float(paper_creep_damping(op0.stiffness * k_scales.min(), M, dF, v))
         hi = max(hi, op0.damping + op0.friction_slope + 100.0, lo + 100.0)
         damping_range = (lo, hi)
-    targets = np.linspace(damping_range[0], damping_range[1], n_damping)
+    width = damping_width(damping_range)
+    targets = width * np.sinh(np.linspace(np.arcsinh(damping_range[0] / width), np.arcsinh(damping_range[1] / width),
+                                          n_damping))
     K = np.zeros(len(k_scales))
     Y = np.zeros((n_damping, len(k_scales)))
     cl = np.zeros_like(Y)
@@ -305,8 +318,8 @@ def pole_map(params, scenario, k_scales=None, n_damping=20, damping_range=None, 
         nk, ny = sim_grid
         ks = np.geomspace(k_scales.min(), k_scales.max(), nk)
         # rows from the lowest reachable damping (slightly inside, to stay visible on the plot) upwards
-        span = damping_range[1] - damping_range[0]
-        ys = np.linspace(damping_range[0], damping_range[1], ny + 1)[:-1] + 0.03 * span
+        u0, u1 = np.arcsinh(damping_range[0] / width), np.arcsinh(damping_range[1] / width)
+        ys = width * np.sinh(np.linspace(u0, u1, ny + 1)[:-1] + 0.03 * (u1 - u0))  # even on the plot's axis
         psim = with_value(params, "simulation.steady_start", 0.5 * sim_duration)
         sk, sy, unstable, points = [], [], [], []
         sc = Scenario(feed=scenario.feed, load_case=scenario.load_case, duration=sim_duration)
