@@ -367,20 +367,25 @@ def check_output_dir(path, field="--out"):
     return path
 
 
+#: What an output folder that could not be created must be (:func:`_folder_problem`).
+_CREATABLE = "a folder that can be created"
+
+
 def _folder_problem(path):
     """None once ``path`` is a folder (created if needed) a file can be written in; else ``(allowed, why)``: what
-    a folder must be, and why this one is not (None where ``allowed`` says it all)."""
+    a folder must be, and why this one is not (None where ``allowed`` says it all). ``allowed`` is
+    :data:`_CREATABLE` exactly when the folder could not be created."""
     try:  # a name longer than the system allows raises here (ENAMETOOLONG: 'File name too long: ...', no option)
         if path.exists() and not path.is_dir():
             return "a folder", "this is an existing file"
     except OSError as err:
-        return "a folder that can be created", err.strerror
+        return _CREATABLE, err.strerror
     try:
         path.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         return "a folder", "a parent is an existing file"
     except OSError as err:
-        return "a folder that can be created", err.strerror
+        return _CREATABLE, err.strerror
     if not os.access(path, os.W_OK | os.X_OK):
         return "a writable folder", None
     try:  # what write_atomic will do (os.access says yes to root where a file system refuses, e.g. /sys)
@@ -414,7 +419,7 @@ def check_output_file(path, field="--out"):
     problem = _folder_problem(path.parent)
     if problem is not None:
         allowed, why = problem
-        why = "not writable" if why is None else f"cannot be created: {why}" if "created" in allowed else why
+        why = "not writable" if why is None else f"cannot be created: {why}" if allowed == _CREATABLE else why
         raise InputError(field, str(path), f"a file in a writable folder ({path.parent}: {why})")
     try:  # what write_atomic will do: a temporary file beside the target
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".check")
