@@ -9,7 +9,7 @@ from drakecreep.files import to_jsonable
 from drakecreep.params import PRESETS, load_params, preset, with_value
 
 __all__ = ["add_params_options", "params_from_args", "positive_float", "print_json", "feed_from_mm_s", "number", "workers",
-           "count", "MAX_WORKERS", "comma_items", "distinct", "names"]
+           "count", "integer_in", "MAX_WORKERS", "comma_items", "distinct", "names"]
 
 
 def number(text):
@@ -144,6 +144,11 @@ def workers(text):
 def count(text):
     """argparse type: a count, an integer >= 0."""
     return _integer_at_least(text, 0)
+
+
+def integer_in(text, minimum, maximum):
+    """argparse type (in a wrapper that gives the bounds): an integer in ``[minimum, maximum]``."""
+    return _integer_at_least(text, minimum, maximum)
 
 
 def feed_from_mm_s(value, option="--feed"):

@@ -4,7 +4,7 @@ declared params file for drakecreep), scored on audit runs it never sees."""
 
 import sys
 
-from drakecreep.cli._common import count, names, print_json
+from drakecreep.cli._common import integer_in, names, print_json
 
 __all__ = ["add_parser", "run"]
 
@@ -22,11 +22,12 @@ def add_parser(subparsers):
     p.add_argument("--kinds", nargs="+", metavar="KIND",
                    help="controller kinds of the truth: p_p_cascade (the default) and/or drakecreep (diagnosed by "
                         "diagnose_drive on the params file its user would write, minutes per dataset)")
-    p.add_argument("--n-per-effect", type=count, default=10, help="datasets per library effect with SNR >= 3 (default 10)")
-    p.add_argument("--n-null", type=count, default=10, help="null datasets per controller kind (default 10)")
-    p.add_argument("--n-ool", type=count, default=6,
+    p.add_argument("--n-per-effect", type=datasets, default=10,
+                   help="datasets per library effect with SNR >= 3 (default 10)")
+    p.add_argument("--n-null", type=datasets, default=10, help="null datasets per controller kind (default 10)")
+    p.add_argument("--n-ool", type=datasets, default=6,
                    help="datasets per out-of-library and per no-candidate effect and kind (default 6)")
-    p.add_argument("--samples", type=count, default=3000, help="samples per run at 1 kHz (default 3000)")
+    p.add_argument("--samples", type=samples, default=3000, help="samples per run at 1 kHz (default 3000)")
     p.add_argument("--effects", help="comma-separated candidates of the diagnosis of the one kind given (default: "
                                      "all; a subset is for quick checks: the reported figures use all)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
@@ -36,6 +37,17 @@ def add_parser(subparsers):
 
 #: largest --n-per-effect / --n-null / --n-ool (datasets of minutes each)
 MAX_DATASETS = 1000
+
+
+def datasets(text):
+    """argparse type of --n-per-effect, --n-null and --n-ool: an integer in [0, :data:`MAX_DATASETS`] (one range, said
+    one way: -1 had been 'an integer >= 0' and 1001 'an integer in [0, 1000]')."""
+    return integer_in(text, 0, MAX_DATASETS)
+
+
+def samples(text):
+    """argparse type of --samples: an integer in [600, :data:`MAX_SAMPLES`]."""
+    return integer_in(text, 600, MAX_SAMPLES)
 #: longest run of --samples (1000 s at 1 kHz)
 MAX_SAMPLES = 1_000_000
 
@@ -47,12 +59,6 @@ def run(args):
                                           run_benchmark)
 
     kinds = DEFAULT_KINDS if args.kinds is None else check_kinds(args.kinds, "--kinds")
-    if not 600 <= args.samples <= MAX_SAMPLES:
-        raise InputError("--samples", args.samples, f"an integer in [600, {MAX_SAMPLES}] samples per run (1 kHz)")
-    for option in ("--n-per-effect", "--n-null", "--n-ool"):
-        n = getattr(args, option[2:].replace("-", "_"))
-        if n > MAX_DATASETS:  # each dataset is minutes of fitting: 999999999 never ended
-            raise InputError(option, n, f"an integer in [0, {MAX_DATASETS}]")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
     effects = None if args.effects is None else check_effects(kinds, names(args.effects, "--effects"), "--effects")

@@ -27,8 +27,15 @@ def test_gap_benchmark_rejects_bad_arguments(capsys):
     with pytest.raises(SystemExit) as exc:
         cli.main(["gap-benchmark", "--n-null", "-1"])
     assert exc.value.code == 2
-    # in the refusals' own form ('... must be >= 0' where --n-null 1001 said '--n-null: got 1001; allowed: ...')
-    assert capsys.readouterr().err.strip() == "drakecreep gap-benchmark: error: --n-null: got '-1'; allowed: an integer >= 0"
+    # in the refusals' own form ('... must be >= 0' where --n-null 1001 said '--n-null: got 1001; allowed: ...'), and
+    # one range said one way ('an integer >= 0' for -1, 'an integer in [0, 1000]' for 1001)
+    assert capsys.readouterr().err.strip() == ("drakecreep gap-benchmark: error: --n-null: got '-1'; allowed: an "
+                                               "integer in [0, 1000]")
+    for option, bad, allowed in (("--n-ool", "1001", "[0, 1000]"), ("--samples", "-3", "[600, 1000000]"),
+                                 ("--samples", "599", "[600, 1000000]")):
+        with pytest.raises(SystemExit):
+            cli.main(["gap-benchmark", option, bad])
+        assert capsys.readouterr().err.strip().endswith(f"{option}: got '{bad}'; allowed: an integer in {allowed}")
 
 
 def test_the_help_names_every_kind_and_the_default_the_run_takes(capsys, monkeypatch):
@@ -53,7 +60,9 @@ def test_the_help_names_every_kind_and_the_default_the_run_takes(capsys, monkeyp
 
 
 def test_gap_benchmark_rejects_short_runs_before_work(capsys):
-    assert cli.main(["gap-benchmark", "--samples", "10"]) == 2
+    with pytest.raises(SystemExit) as exc:  # by its argparse type: before anything of the library is imported
+        cli.main(["gap-benchmark", "--samples", "10"])
+    assert exc.value.code == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--samples" in err
 
@@ -84,7 +93,11 @@ def test_gap_benchmark_refuses_sizes_that_never_end_before_starting(capsys, monk
         raise AssertionError("the benchmark started")
 
     monkeypatch.setattr(benchmark, "run_benchmark", started)
-    assert cli.main(["gap-benchmark"] + argv) == 2
+    try:  # the sizes by their argparse type, the kinds when the run starts
+        code = cli.main(["gap-benchmark"] + argv)
+    except SystemExit as exit_:
+        code = exit_.code
+    assert code == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and err.startswith(f"drakecreep gap-benchmark: error: {field}: got ")
 
