@@ -72,10 +72,11 @@ CANDIDATE_FIELDS = {"lead_error": 5, "cogging": 5, "force_ripple": 3, "stribeck"
 def training_chi2(row, candidate):
     """``(statistic, degrees of freedom)`` of ``candidate``'s training SSE reduction on ``row`` (None without the
     training fit's SSE and variance): ``train_gain * train_sse / train_variance`` against a chi-square of
-    :data:`CANDIDATE_FIELDS` degrees of freedom."""
+    :data:`CANDIDATE_FIELDS` degrees of freedom; None too for a lead error decided on the screw's transmission
+    (rows since session 70 carry its ``transmission`` replay test)."""
     sse, var = row.get("train_sse"), row.get("train_variance")
-    if sse is None or var is None or not var > 0:
-        return None
+    if sse is None or var is None or not var > 0 or candidate.get("transmission") is not None:
+        return None  # (a lead error decided on the screw's transmission: its train_gain is not the force's)
     return candidate["train_gain"] * sse / var, CANDIDATE_FIELDS[candidate["effect"]]
 
 

@@ -552,13 +552,16 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
+                # the lead error on runs with a linear scale is decided on the screw's transmission (its train_gain
+                # is that SSE's, not the force's): the replay test it passed or failed there
+                "transmission": (c.replay or {}).get("transmission"),
                 "values": dict(c.values),
                 "test_force_runs": ([float(c.test_errors[k]["force"]) for k in labels]
                                     if all(k in c.test_errors for k in labels) else None)}
                for c in res.candidates]
     row = _row(ds, claimed, ranking, friction=res.params.friction.law, uncertain=list(kw.get("uncertain", DEFAULT_UNCERTAIN)),
                test_force_nominal_runs=[float(res.nominal_test_errors[k]["force"]) for k in labels],
-               replay_null=res.replay_null,
+               replay_null=res.replay_null, transmission_null=res.transmission_null,
                null_test_force_runs=res.null_test_force,
                train_sse=res.train_sse, train_variance=res.train_variance,
                test_force_nominal=rms_force_error(res.nominal_test_errors),
