@@ -1148,11 +1148,11 @@ def _lead_error_on_scale(runs, base, replayer, base_sims):
                                      residual)
     if not values:
         return {}, 0.0
-    count = base.sensors.scale_resolution
-    if values[amp] <= count:  # below one count of the scale: not told from its rounding
+    resolution = base.sensors.scale_resolution
+    if values[amp] <= resolution:  # one count of the scale at most: not told from its rounding
         return dict(values, **{amp: 0.0}), 0.0
     two, sse2 = _second_harmonic(_KINEMATIC, runs, base, values, sse, trial, replayer, None, residual)
-    if min(two[amp], two.get(amp2, 0.0)) > count:
+    if min(two[amp], two.get(amp2, 0.0)) > resolution:
         values, sse = two, sse2
     return values, 1.0 - sse / sse0
 
