@@ -37,6 +37,8 @@ def add_parser(subparsers):
 
 #: largest --n-per-effect / --n-null / --n-ool (datasets of minutes each)
 MAX_DATASETS = 1000
+#: longest run of --samples (1000 s at 1 kHz)
+MAX_SAMPLES = 1_000_000
 
 
 def datasets(text):
@@ -48,8 +50,6 @@ def datasets(text):
 def samples(text):
     """argparse type of --samples: an integer in [600, :data:`MAX_SAMPLES`]."""
     return integer_in(text, 600, MAX_SAMPLES)
-#: longest run of --samples (1000 s at 1 kHz)
-MAX_SAMPLES = 1_000_000
 
 
 def run(args):

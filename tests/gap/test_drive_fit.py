@@ -841,9 +841,9 @@ def test_one_string_or_a_name_twice_is_refused_before_any_replay(kwargs, message
 
 def test_a_cogging_is_not_read_as_a_lead_error_on_a_linear_scale():
     """An 8 N cogging at order 4 with 3 N at order 8 (the cogging test's truth), the lead error the only candidate,
-    every run with a scale: the cogging's force is fixed to the screw too, but its windup is under one count of
-    the scale, so no lead error is fitted, and none is claimed."""
-    truth, runs = _cogging_case()
+    every run with a scale: the cogging is fixed to the motor's angle, as a lead error to the screw's, but the
+    windup it causes is under one count of the scale, so no lead error is fitted, and none is claimed."""
+    _, runs = _cogging_case()
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("lead_error",))
     assert result.claimed == () and result.transmission_null is not None
     (lead,) = result.candidates
