@@ -86,7 +86,7 @@ def _drive(args):
 
 def run(args):
     """Compute and print the creep boundary."""
-    from drakecreep.cli.margins import POSITIVE_FEED
+    from drakecreep.cli._common import POSITIVE_FEED
     from drakecreep.paper import creep
 
     if not (math.isfinite(args.feed) and args.feed > 0):

@@ -1,15 +1,13 @@
 """``drakecreep margins``: gain, phase and delay margins, crossover, bandwidth and Ms of both servo loops."""
 
-import dataclasses
 import math
 
-import numpy as np
-
-from drakecreep.cli._common import add_params_options, feed_from_mm_s, number, params_from_args, print_json
+from drakecreep.cli._common import (POSITIVE_FEED, add_params_options, check_feed, feed_from_mm_s, number,
+                                    params_from_args, print_json)
 from drakecreep.errors import InputError
 from drakecreep.files import to_jsonable
 
-__all__ = ["add_parser", "run", "scenario_from_args", "check_feed"]
+__all__ = ["add_parser", "run", "scenario_from_args"]
 
 _ROWS = (
     ("gain_margin_dB", "gain margin", "dB", "{:.1f}"),
@@ -53,36 +51,6 @@ def scenario_from_args(args, params):
     scenario = Scenario(feed=feed, load_case=args.load_case)
     check_feed(params, scenario, "--feed", args.feed)
     return scenario
-
-
-#: what a feed option of the linear analyses takes (margins, tune, report, critical): one way, in the range of every
-#: command's feeds (critical said 'a finite speed > 0 in mm/s', the others 'a feed > 0 mm/s')
-POSITIVE_FEED = "a feed in [1e-4, 1000] mm/s (> 0: the analysis takes a feed in +x)"
-
-
-def check_feed(params, scenario, option, mm_s):
-    """Raise :class:`InputError` naming ``option`` (a feed of ``mm_s`` mm/s) when the drive cannot slide steadily at
-    ``scenario``'s feed: the force it takes is beyond the drive's limit (the operating point said 'feed: got 0.001',
-    the scenario's field in m/s, and blamed the feed for what is mostly the params' load and friction)."""
-    from drakecreep.model.steady import nut_on_table, sliding_overload, steady_sliding
-
-    overload = sliding_overload(params, scenario)
-    if overload is not None:
-        force, limit = overload
-        feeds = np.geomspace(1e-7, 1.0, 43)  # the commands' feeds, 1e-4 to 1000 mm/s
-        needs = [sliding_overload(params, dataclasses.replace(scenario, feed=float(v))) for v in feeds]
-        if all(n is not None for n in needs):
-            # no feed slides: the load and the friction are the drive's, not the feed's ('--feed: got 1.0', an option
-            # not given, 'allowed: a feed the drive can slide at', where none can)
-            raise InputError("--load-case", scenario.load_case, f"a load case the drive can hold at some feed: this one "
-                             f"takes at least {min(n[0] for n in needs):.4g} N at 1e-4 to 1000 mm/s, beyond the "
-                             f"drive's limit {limit:.4g} N (motor.peak_torque through screw.lead against the params "
-                             "file's load and friction)")
-        _, friction, spring, _, _ = steady_sliding(nut_on_table(params), scenario)
-        raise InputError(option, mm_s, f"a feed in mm/s the drive can slide at: at load case {scenario.load_case} it "
-                         f"takes {force:.4g} N (load {spring - friction:.4g} N, friction {friction:.4g} N, motor drag "
-                         f"{force - spring:.4g} N), beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
-                         "screw.lead)")
 
 
 def print_margins(summary):

@@ -2,8 +2,8 @@
 
 import sys
 
-from drakecreep.cli._common import (add_params_options, check_duration, feed_from_mm_s, number, params_from_args,
-                                    positive_float, print_json)
+from drakecreep.cli._common import (add_params_options, check_duration, check_feed, feed_from_mm_s, number,
+                                    params_from_args, positive_float, print_json)
 from drakecreep.errors import InputError
 
 __all__ = ["add_parser", "run"]
@@ -56,7 +56,6 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from drakecreep.cli.margins import check_feed
     from drakecreep.files import check_output_dir
     from drakecreep.params import with_value
     from drakecreep.scenario import Scenario
