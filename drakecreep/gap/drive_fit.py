@@ -1475,6 +1475,16 @@ def _replay_null(train, test, fit, replayer, nominal_errors):
     return float(max(changes["force"])), tuple(runs), transmission
 
 
+def _force_test(current_errors, errs, null):
+    """The held-out force errors ``errs`` against ``current_errors``: the paired gain [points of %], its standard
+    error, its Student bar and :func:`~drakecreep.gap.claims.replay_test` with the run-to-run ``null``."""
+    labels = list(current_errors)
+    gain, se = paired_gain(current_errors, errs)
+    bar = float(stats.t.ppf(1 - ALPHA, len(labels) - 1) * se)
+    rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
+    return gain, se, bar, rt
+
+
 def _held_out(name, values, train_gain, test, current, current_errors, replayer, null, transmission_null=None,
               kinematic=False):
     """Replay the candidate on the held-out runs and decide whether it passes (the lead error on runs with a linear
@@ -1483,11 +1493,8 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
     if kinematic and name == _KINEMATIC and all("transmission" in current_errors[k] and "transmission" in errs[k]
                                                 for k in current_errors):
         return _held_out_on_scale(name, values, train_gain, current_errors, errs, null, transmission_null)
-    gain, se = paired_gain(current_errors, errs)
+    gain, se, bar, rt = _force_test(current_errors, errs, null)
     n = len(test)
-    bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
-    labels = list(current_errors)
-    rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
     nulls = rt["shrink"] / null if null else None  # the pooled shrink in run-to-run nulls
     large = nulls is not None and nulls > POOLED_FACTOR
     ok = bool(null is not None and train_gain > 0 and (gain > bar or large) and rt["passes"])
@@ -1524,14 +1531,12 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
     """
     labels = list(current_errors)
     n = len(labels)
-    gain, se = paired_gain(current_errors, errs)
-    bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
+    gain, se, bar, rt = _force_test(current_errors, errs, null)
     lr = log_ratios([current_errors[k]["transmission"] for k in labels], [errs[k]["transmission"] for k in labels])
     mean, se_t = mean_and_standard_error(lr)
     bar_t = float(stats.t.ppf(1 - ALPHA, n - 1) * se_t)
     rt_t = replay_test(_energy(current_errors, labels, "transmission"), _energy(errs, labels, "transmission"),
                        0.0 if transmission_null is None else transmission_null)
-    rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
     rt["transmission"] = rt_t
     force_ok = null is not None and rt["shrink"] >= -null
     ok = bool(transmission_null is not None and null is not None and train_gain > 0 and mean > bar_t
