@@ -13,7 +13,9 @@ with its own product path, :func:`drakecreep.gap.drive_fit.diagnose_drive`, on t
 user would write (:func:`declared_params`: the truth's effect-free physics mapped onto ``DriveParams``, its
 friction levels off by a drawn factor). For that kind only Stribeck, lead error, the time ripple and the
 control delay have a ``DriveParams`` candidate (:data:`EXPECTED_DRIVE`); every other withheld effect is out of
-its library (the right answer is "unexplained"), and its audit has no true-effect fit (no relative shrink).
+its library (the right answer is "unexplained"). The true effect of that kind is not fitted: the truth's own
+values are written into the fitted params file (:func:`true_drive_values`), where a ``DriveParams`` field holds
+them.
 
 Kinds of dataset (:attr:`Dataset.category`):
 
@@ -50,6 +52,7 @@ effect outside the library can be checked for where it was found, not only for b
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import sys
 import time
@@ -89,6 +92,7 @@ __all__ = [
     "benchmark_specs",
     "diagnose_dataset",
     "true_effect_fit",
+    "true_drive_values",
     "audit_replay",
     "evaluate",
     "check_kinds",
@@ -473,6 +477,57 @@ def true_effect_fit(result, ds, max_nfev=6):
     return fit_candidate(label, ds.train, ds.test, result.nominal, max_nfev, start, alternative)
 
 
+def true_drive_values(truth, params):
+    """The truth's withheld effect as ``DriveParams`` values: what a ``drakecreep``-kind diagnosis can do at best.
+
+    The four effects of :data:`EXPECTED_DRIVE`, each onto the fields its candidate fits, with the truth's values
+    (:func:`drakecreep.gap.truth.draw_truth`, :func:`drakecreep.gap.truth.simulate_batch`):
+
+    * ``lead_error``: ``a (sin(2 pi x / Ph + phase) + h2 sin(4 pi x / Ph + phase2))`` on the motor's travel
+      ``x``: the params file's lead error over the lead, the same phases (``x_motor`` counts from the truth's
+      position 0), ``a2 = h2 a``. Exact;
+    * ``stribeck``: the table's ``Fs / Fc`` and ``vs`` as ``friction.static_ratio`` and ``stribeck_velocity``
+      (the exponent 2 of :func:`declared_params`). Exact on the table; the params file's law also shapes the
+      nut's drag on the screw, which the truth gives no Stribeck drop;
+    * ``time_ripple``: ``-A sin(2 pi f t + phase)`` on the motor side as ``disturbance.force_ripple``,
+      ``ripple_frequency`` and ``ripple_phase`` on the table (``t`` from each run's first sample in both): the
+      same force below the axial mode, not above it;
+    * ``control_delay``: ``d`` recorded samples are ``d`` times the speed loop's ticks per sample added to the
+      params file's ``controller.computation_delay``.
+
+    Parameters
+    ----------
+    truth : drakecreep.gap.truth.Truth
+        A ``drakecreep``-kind truth with at most one withheld effect.
+    params : drakecreep.params.DriveParams
+        The params file the truth's values go into (its ``controller.computation_delay`` is the base delay).
+
+    Returns
+    -------
+    dict or None
+        ``path -> value``; None when no withheld effect, or one without a ``DriveParams`` candidate.
+    """
+    effects = dict(truth.effects)
+    if len(effects) != 1:
+        return None
+    (name, e), = effects.items()
+    if name == "lead_error":
+        return {"disturbance.lead_error_period": float(truth.lead),
+                "disturbance.lead_error_amplitude": float(e["amplitude_m"]),
+                "disturbance.lead_error_phase": float(e["phase"]),
+                "disturbance.lead_error_2_amplitude": float(e["h2"] * e["amplitude_m"]),
+                "disturbance.lead_error_2_phase": float(e["phase2"])}
+    if name == "stribeck":
+        return {"friction.static_ratio": float(e["Fs_ratio"]), "friction.stribeck_velocity": float(e["vs_m_s"])}
+    if name == "time_ripple":
+        return {"disturbance.force_ripple": float(e["amplitude_N"]),
+                "disturbance.ripple_frequency": float(e["freq_Hz"]), "disturbance.ripple_phase": float(e["phase"])}
+    if name == "control_delay":
+        return {"controller.computation_delay": float(params.controller.computation_delay
+                                                      + T.VEL_DIV * e["delay_samples"])}
+    return None
+
+
 def audit_replay(runs, models):
     """Closed-loop Drake replay of the audit runs with each model, parameters fixed.
 
@@ -532,11 +587,13 @@ def _audit_fields(a, claimed):
 
 def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None):
     """One benchmark row of a ``drakecreep`` dataset: ``diagnose_drive`` on the declared params file, its default
-    uncertain fields (or ``uncertain``), then the audit runs replayed with the fitted params file (nominal) and the
-    augmented one (no true-effect fit for this kind: module docstring)."""
+    uncertain fields (or ``uncertain``), then the audit runs replayed with the fitted params file (nominal), the
+    augmented one, and the nominal with the truth's own values of its effect (:func:`true_drive_values`; not
+    fitted, unlike the ``p_p_cascade`` kind's true effect)."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, diagnose_drive
     from drakecreep.gap.residuals import oscillation_log_errors
+    from drakecreep.params import with_value
 
     t0 = time.perf_counter()
     kw = {} if effects is None else {"effects": tuple(effects)}
@@ -588,6 +645,12 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
 
         a = {"nominal": replayed(res.nominal)}
         a["claimed"] = replayed(res.params) if claimed else a["nominal"]
+        true = true_drive_values(ds.truth, res.nominal) if ds.expected is not None else None
+        if true is not None:
+            try:
+                a["true"] = replayed(functools.reduce(lambda p, kv: with_value(p, *kv), true.items(), res.nominal))
+            except InputError:  # a truth's value outside the field's range: no true model
+                a["true"] = None
         row.update(_audit_fields(a, claimed))
         if res.oscillation and a["nominal"] is not None and a["claimed"] is not None:
             row["audit_oscillation_nepers"] = {k: float(np.mean(a[k]["oscillation_nepers"]))

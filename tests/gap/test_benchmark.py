@@ -8,7 +8,8 @@ from drakecreep.errors import InputError
 from drakecreep.gap import truth as T
 from drakecreep.gap.benchmark import (DECLARED_AT, DECLARED_SPREAD, DEV_SEEDS, EXPECTED, EXPECTED_DRIVE, HELDOUT_SEEDS,
                                       benchmark_specs, category_of, declared_params, design, evaluate, expected_of,
-                                      generate_dataset, out_and_back, run_benchmark, score_rows)
+                                      generate_dataset, out_and_back, run_benchmark, score_rows,
+                                      true_drive_values)
 
 
 def test_specs_cover_every_effect_and_axis_and_keep_seed_sets_apart():
@@ -124,6 +125,52 @@ def test_declared_params_carry_the_truths_effect_free_physics():
                    off.friction.viscous / p.friction.viscous]
         assert all(f != 1.0 and abs(math.log(f)) < 5 * DECLARED_SPREAD for f in factors), factors
         assert off.table.mass == p.table.mass and off.screw == p.screw
+
+
+def test_the_truths_effect_goes_into_the_params_file_field_by_field():
+    """Each drakecreep-kind library effect onto the fields its candidate fits, with the truth's values; none for a
+    null, an effect without a DriveParams candidate or two effects at once."""
+    rng = np.random.default_rng
+    base = declared_params(T.draw_truth(rng(DEV_SEEDS), "drakecreep", "rigid"))
+    assert set(EXPECTED_DRIVE) == {"lead_error", "stribeck", "time_ripple", "control_delay"}
+    for seed, effect in enumerate(EXPECTED_DRIVE):
+        tr = T.draw_truth(rng(DEV_SEEDS + seed), "drakecreep", "flexible", (effect,))
+        e, v = tr.effects[effect], true_drive_values(tr, base)
+        if effect == "lead_error":
+            assert v["disturbance.lead_error_period"] == tr.lead
+            assert v["disturbance.lead_error_2_amplitude"] == pytest.approx(e["h2"] * e["amplitude_m"], rel=1e-15)
+            assert (v["disturbance.lead_error_amplitude"], v["disturbance.lead_error_phase"],
+                    v["disturbance.lead_error_2_phase"]) == (e["amplitude_m"], e["phase"], e["phase2"])
+        elif effect == "stribeck":
+            assert v == {"friction.static_ratio": e["Fs_ratio"], "friction.stribeck_velocity": e["vs_m_s"]}
+        elif effect == "time_ripple":
+            assert v == {"disturbance.force_ripple": e["amplitude_N"], "disturbance.ripple_frequency": e["freq_Hz"],
+                         "disturbance.ripple_phase": e["phase"]}
+        else:
+            assert v == {"controller.computation_delay":
+                         base.controller.computation_delay + T.VEL_DIV * e["delay_samples"]}
+    for withheld in ((), ("cogging",), ("backlash",), ("lead_error", "stribeck")):
+        assert true_drive_values(T.draw_truth(rng(DEV_SEEDS), "drakecreep", "rigid", withheld), base) is None
+
+
+@pytest.mark.parametrize("effect, error", [("lead_error", "transmission"), ("time_ripple", "force")])
+def test_the_truths_own_values_shrink_its_audit_replay(effect, error):
+    """The truth's values in its exact params file (no friction factor) make the audit replay closer: the lead
+    error's phases and the ripple's sign are the truth's. A sign or a phase off would make the error grow."""
+    import functools
+
+    from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+    from drakecreep.params import with_value
+
+    ds = generate_dataset(DEV_SEEDS + 7, withheld=(effect,), kind="drakecreep", axis="rigid", n_samples=1500)
+    exact = declared_params(ds.truth)
+    true = functools.reduce(lambda p, kv: with_value(p, *kv), true_drive_values(ds.truth, exact).items(), exact)
+
+    def energy(params):
+        return np.mean([drake_replay_errors(replay_drakecreep(r, params))[error] ** 2 for r in ds.audit])
+
+    without, with_truth = energy(exact), energy(true)
+    assert with_truth < 0.5 * without, (without, with_truth)
 
 
 def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
