@@ -234,6 +234,38 @@ def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
     assert not (tmp_path / "x.json").exists()
 
 
+def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path):
+    """The true effect's audit shrink of an older drakecreep-kind row: the dataset regenerated from the row's seed
+    gives the row's own audit energy again, and the truth's ripple in the fitted params file shrinks the audit; a
+    row whose energy is not reproduced gets no relative shrink; bad options are refused before any work."""
+    from drakecreep.gap.benchmark import DEV_SEEDS, generate_dataset
+
+    spec = importlib.util.spec_from_file_location("dts", ANALYSIS / "drive_true_shrink.py")
+    dts = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dts)
+    seed, withheld = DEV_SEEDS + 7, ["time_ripple"]
+    ds = generate_dataset(seed, withheld=tuple(withheld), kind="drakecreep", axis="rigid", n_samples=600)
+    fitted = {"table.seal_force": 1.1 * ds.train[0].meta.params.table.seal_force}  # as a nominal fit would give
+    nominal = dts._energy(ds.audit, dts._set(ds.train[0].meta.params, fitted))
+    row = {"seed": seed, "withheld": withheld, "kind": "drakecreep", "axis": "rigid", "snr": 4.0, "claimed": [],
+           "expected": "force_ripple", "audit_shrink": 0.0, "claimed_model": {"fitted": fitted, "effects": {}},
+           "audit": {"nominal": {"energy": nominal}, "claimed": {"energy": nominal}}}
+    r = dts.true_shrink(row, n_samples=600)
+    assert r["reproduced"] and r["check"] < 1e-9 and r["base"] == "nominal"
+    assert 0 < r["true_shrink"] < 1 and r["relative"] == 0.0  # nothing claimed: none of the true shrink
+    off = dict(row, audit={"nominal": {"energy": nominal}, "claimed": {"energy": 1.01 * nominal}})
+    r = dts.true_shrink(off, n_samples=600)
+    assert not r["reproduced"] and r["check"] == pytest.approx(1 - 1 / 1.01, abs=1e-9) and r["relative"] is None
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
+    for args, field in ((("--tolerance", "0"), "--tolerance: got 0.0"), (("--samples", "10"), "--samples: got 10"),
+                        (("--json", str(tmp_path)), "--json: got"), ((), "rows: cannot read")):
+        argv = [str(rows), *args] if args else [str(tmp_path / "none.json")]
+        out = subprocess.run([sys.executable, str(ANALYSIS / "drive_true_shrink.py"), *argv], cwd=tmp_path, env=env,
+                             capture_output=True, text=True, timeout=300)
+        assert out.returncode == 2 and "Traceback" not in out.stderr and field in out.stderr.strip().splitlines()[-1]
+
+
 def test_the_shipped_drive_example_is_what_its_script_makes():
     """``drakecreep/data/examples/drive_lead_error.csv`` (runs of the project's controller) is what
     ``analysis/make_drive_example.py`` writes: its runs, sample by sample, and its metadata's params file, the test
