@@ -30,7 +30,7 @@ from drakecreep.files import write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
                                       check_effects, check_uncertain, run_benchmark, score_rows)
-from study_cli import seed_list
+from study_cli import read_rows, seed_list
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
            "median_relative_shrink_snr3": ">= 70 %", "claims_making_audit_worse": "0"}
@@ -83,21 +83,6 @@ def report(res):
               f"claimed {f(e.get('claimed'))} true {f(e.get('true'))}  {r['seconds']:.0f} s")
 
 
-def _read_rows(ap, option, path):
-    """The parsed rows file ``path`` given to ``option``, or one line naming what is wrong with it (exit 2)."""
-    try:
-        with open(path) as fh:
-            data = json.load(fh)
-    except OSError as err:
-        ap.error(f"{option}: cannot read {path!r} ({err.strerror}); allowed: a rows file written by --json")
-    except ValueError as err:
-        ap.error(f"{option}: {path!r} is not JSON ({err}); allowed: a rows file written by --json")
-    if not isinstance(data, dict) or not isinstance(data.get("datasets"), list) \
-            or not all(isinstance(r, dict) and "seed" in r for r in data["datasets"]):
-        ap.error(f"{option}: {path!r} has no list of dataset rows with seeds; allowed: a rows file written by --json")
-    return data
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n-per-effect", type=int, default=3, help="diagnosed datasets per library effect with SNR >= 3")
@@ -135,7 +120,7 @@ def main():
     if args.score:
         by_seed = {}  # a resumed shard repeats the rows it resumed from: each dataset is scored once
         for path in args.score:
-            for row in _read_rows(ap, "--score", path)["datasets"]:
+            for row in read_rows(ap, "--score", path)["datasets"]:
                 by_seed[row["seed"]] = row
         data = {"datasets": list(by_seed.values())}
         data["scores"] = score_rows(data["datasets"])
@@ -161,7 +146,7 @@ def main():
         ap.error(str(err))
     done = []
     if args.resume:
-        earlier = _read_rows(ap, "--resume", args.resume)
+        earlier = read_rows(ap, "--resume", args.resume)
         if earlier.get("seed") != seed:
             raise SystemExit(f"--resume: {args.resume} has seeds from {earlier.get('seed')}; this run's are from {seed}")
         done = earlier["datasets"]

@@ -41,6 +41,7 @@ from drakecreep.files import check_output_file, write_text
 from drakecreep.gap.benchmark import N_SAMPLES, generate_dataset, true_drive_values
 from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
 from drakecreep.params import with_value
+from study_cli import read_rows
 
 
 def _set(params, values):
@@ -91,19 +92,9 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
 
 
 def _rows(ap, path, min_snr):
-    """The ``drakecreep``-kind library rows without a true shrink in the rows file ``path`` (one line if unreadable)."""
-    try:
-        with open(path) as fh:
-            data = json.load(fh)
-    except OSError as err:
-        ap.error(f"rows: cannot read {path!r} ({err.strerror}); allowed: a rows file of bench_gap_benchmark.py --json")
-    except ValueError as err:
-        ap.error(f"rows: {path!r} is not JSON ({err}); allowed: a rows file of bench_gap_benchmark.py --json")
-    keys = ("seed", "withheld", "kind", "axis", "expected", "snr")
-    if not isinstance(data, dict) or not isinstance(data.get("datasets"), list) \
-            or not all(isinstance(r, dict) and all(k in r for k in keys) for r in data["datasets"]):
-        ap.error(f"rows: {path!r} has no list of dataset rows with {', '.join(keys)}; allowed: a rows file of "
-                 "bench_gap_benchmark.py --json")
+    """The ``drakecreep``-kind library rows without a true shrink in the rows file ``path``."""
+    data = read_rows(ap, "rows", path, keys=("seed", "withheld", "kind", "axis", "expected", "snr"),
+                     writer="bench_gap_benchmark.py --json")
     return [r for r in data["datasets"] if r["kind"] == "drakecreep" and r["expected"] is not None
             and r["snr"] >= min_snr and r.get("true_shrink") is None]
 

@@ -4,10 +4,29 @@ names spent datasets (:func:`out_and_specs`), or ``OUT.json SEED:EFFECT[:AXIS]..
 (:func:`out_and_cases`, :func:`case_type`)."""
 
 import argparse
+import json
 import sys
 
 from drakecreep.errors import InputError
 from drakecreep.gap import benchmark
+
+
+def read_rows(ap, option, path, keys=("seed",), writer="--json"):
+    """The parsed rows file ``path`` given to ``option`` (what ``writer``, a ``--json`` of ``bench_gap_benchmark.py``,
+    writes), or one line of ``ap.error`` naming what is wrong with it (exit 2): unreadable, not JSON, or rows
+    without ``keys``."""
+    allowed = f"allowed: a rows file written by {writer}"
+    try:
+        with open(path) as fh:
+            data = json.load(fh)
+    except OSError as err:
+        ap.error(f"{option}: cannot read {path!r} ({err.strerror}); {allowed}")
+    except ValueError as err:
+        ap.error(f"{option}: {path!r} is not JSON ({err}); {allowed}")
+    if not isinstance(data, dict) or not isinstance(data.get("datasets"), list) \
+            or not all(isinstance(r, dict) and all(k in r for k in keys) for r in data["datasets"]):
+        ap.error(f"{option}: {path!r} has no list of dataset rows with {', '.join(keys)}; {allowed}")
+    return data
 
 
 def shard_main(description, study, score, argv=None):

@@ -234,12 +234,13 @@ def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
     assert not (tmp_path / "x.json").exists()
 
 
-def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path):
+def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch):
     """The true effect's audit shrink of an older drakecreep-kind row: the dataset regenerated from the row's seed
     gives the row's own audit energy again, and the truth's ripple in the fitted params file shrinks the audit; a
     row whose energy is not reproduced gets no relative shrink; bad options are refused before any work."""
     from drakecreep.gap.benchmark import DEV_SEEDS, generate_dataset
 
+    monkeypatch.syspath_prepend(str(ANALYSIS))  # its study_cli, as when run from analysis/
     spec = importlib.util.spec_from_file_location("dts", ANALYSIS / "drive_true_shrink.py")
     dts = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dts)
