@@ -13,9 +13,11 @@ seed, effect, kind and axis (:func:`drakecreep.gap.benchmark.generate_dataset`, 
 the params file the diagnosis fitted, ``claimed_model["fitted"]`` written into the dataset's declared one, and
 replays the audit runs:
 
-* with that params file as the row had it (its claimed effects too): the result must **reproduce** the row's own
+* with that params file as the row had it (its claimed effects too): the result should **reproduce** the row's own
   audit energy (``audit["claimed"]``, which is ``audit["nominal"]`` when nothing was claimed) within
-  ``--tolerance``, or the row is reported as not reproduced and not counted (another code, another dataset);
+  ``--tolerance`` (the same code and dataset). Rows written at older code differ by the replay's changes since
+  (up to 2 % on the rows of held-out runs 3-6); each row prints the difference, and the median is given over all rows
+  and over the reproduced ones alone;
 * with the fitted values and the truth's effect instead of the claims: the true model.
 
 The base of the true model is the nominal fit where nothing was claimed (what the benchmark now uses), and the
@@ -61,7 +63,7 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
     dict
         ``seed``, ``effect``, ``snr``, ``claimed``, ``base`` ("nominal" or "refit"), ``reproduced`` (the row's own
         audit energy replayed again, relative difference within ``tolerance``), ``check`` (that difference),
-        ``true_energy``, ``true_shrink``, ``audit_shrink`` and ``relative`` (None unless reproduced and the true
+        ``true_energy``, ``true_shrink``, ``audit_shrink`` and ``relative`` (None unless the true
         shrink is positive).
     """
     t0 = time.perf_counter()
@@ -86,7 +88,7 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
     e_true = _energy(ds.audit, _set(fitted, true))
     shrink = 1.0 - e_true / row["audit"]["nominal"]["energy"]
     out.update(true_energy=e_true, true_shrink=shrink,
-               relative=(row["audit_shrink"] / shrink if out["reproduced"] and shrink > 0 else None),
+               relative=(row["audit_shrink"] / shrink if shrink > 0 else None),
                seconds=time.perf_counter() - t0)
     return out
 
@@ -130,9 +132,11 @@ def main(argv=None):
               f"  {r['seconds']:.0f} s", flush=True)
         if args.json:
             write_text(args.json, json.dumps(out, indent=1))
-    rel = [r["relative"] for r in out if r["snr"] >= 3 and r["relative"] is not None]
-    if rel:
-        print(f"median relative shrink, SNR >= 3: {100 * float(np.median(rel)):.0f} % (n={len(rel)}; target >= 70 %)")
+    for label, keep in (("", lambda r: True), (", reproduced rows", lambda r: r["reproduced"])):
+        rel = [r["relative"] for r in out if r["snr"] >= 3 and r["relative"] is not None and keep(r)]
+        if rel:
+            print(f"median relative shrink, SNR >= 3{label}: {100 * float(np.median(rel)):.0f} % (n={len(rel)}; "
+                  "target >= 70 %)")
     return 0
 
 
