@@ -172,6 +172,32 @@ def test_the_truths_own_values_shrink_its_audit_replay(effect, error):
     assert with_truth < 0.5 * without, (without, with_truth)
 
 
+def test_a_drakecreep_rows_true_shrink_is_the_truths_values_in_the_nominal_params_file(monkeypatch):
+    """The audit of a library dataset replays the nominal params file with the truth's values of its effect (a
+    stand-in diagnosis that claims nothing, so the row's own audit shrink is 0); not where the runs oscillate."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap import benchmark, drive_fit
+
+    ds = generate_dataset(DEV_SEEDS + 7, withheld=("time_ripple",), kind="drakecreep", axis="rigid", n_samples=600)
+    nominal = ds.train[0].meta.params
+
+    def diagnosis(train, test, progress=False, **kw):
+        return SimpleNamespace(claimed=(), nominal_test_errors={r.label: {"force": 10.0} for r in test}, candidates=(),
+                               params=nominal, nominal=nominal, replay_null=0.01, transmission_null=None,
+                               null_test_force=[], train_sse=1.0, train_variance=1.0, test_errors={}, seconds=0.0,
+                               warnings=(), oscillation=oscillation, where={}, fitted=())
+
+    monkeypatch.setattr(drive_fit, "diagnose_drive", diagnosis)
+    oscillation = None
+    row = benchmark._evaluate_drive(ds)
+    assert row["expected"] == "force_ripple" and row["audit_shrink"] == 0.0
+    assert row["audit"]["true"]["energy"] < row["audit"]["nominal"]["energy"] and 0 < row["true_shrink"] < 1
+    oscillation = {"freq_Hz": 60.0}
+    row = benchmark._evaluate_drive(ds)
+    assert "true" not in row["audit"] and row["true_shrink"] is None
+
+
 def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     """One short null of the drakecreep kind (two cheap candidates and one uncertain field, to stay fast: 42 s
     against 100-114 s with the three default fields, session 65): the runs carry the declared params file, the row
