@@ -18,7 +18,7 @@ replays the audit runs:
   ``--tolerance`` (the same code and dataset). Rows written at older code differ by the replay's changes since
   (up to 2 % on the rows of held-out runs 3-6); each row prints the difference, and the median is given over all rows
   and over the reproduced ones alone;
-* with the fitted values and the truth's effect instead of the claims: the true model.
+* with the fitted uncertain fields and the truth's effect instead of the claims: the true model.
 
 The base of the true model is the nominal fit where nothing was claimed (what the benchmark now uses), and the
 final refit where something was (the row does not keep the nominal fit's values): there the true effect is judged
@@ -42,6 +42,7 @@ from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap.benchmark import N_SAMPLES, generate_dataset, true_drive_values
 from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
+from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN
 from drakecreep.params import with_value
 from study_cli import read_rows
 
@@ -71,10 +72,15 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
                           n_samples=n_samples)
     declared = ds.train[0].meta.params
     model = row["claimed_model"]
-    fitted = _set(declared, model["fitted"])
-    as_row = fitted
+    # the row's final model: the claims' values, then the final refit (the uncertain fields and the claims'
+    # amplitudes refitted with them); the true model's base: the fitted uncertain fields alone (a claimed ripple's
+    # refitted amplitude stays out of it)
+    as_row = declared
     for values in model["effects"].values():
         as_row = _set(as_row, values)
+    as_row = _set(as_row, model["fitted"])
+    uncertain = set(row.get("uncertain") or DEFAULT_UNCERTAIN)
+    fitted = _set(declared, {k: v for k, v in model["fitted"].items() if k in uncertain})
     own = row["audit"]["claimed"]["energy"]
     again = _energy(ds.audit, as_row)
     check = abs(again / own - 1.0)

@@ -236,25 +236,34 @@ def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
 
 def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch):
     """The true effect's audit shrink of an older drakecreep-kind row: the dataset regenerated from the row's seed
-    gives the row's own audit energy again, and the truth's ripple in the fitted params file shrinks the audit; a
-    row whose energy is not reproduced is flagged; bad options are refused before any work."""
-    from drakecreep.gap.benchmark import DEV_SEEDS, generate_dataset
+    gives the row's own audit energy again (its claim's values, then the final refit's, a refitted amplitude
+    among them), and the true model is the fitted uncertain fields with the truth's effect (not the claim's
+    refitted amplitude); a row whose energy is not reproduced is flagged; bad options are refused before any work."""
+    from drakecreep.gap.benchmark import DEV_SEEDS, generate_dataset, true_drive_values
 
     monkeypatch.syspath_prepend(str(ANALYSIS))  # its study_cli, as when run from analysis/
     spec = importlib.util.spec_from_file_location("dts", ANALYSIS / "drive_true_shrink.py")
     dts = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dts)
-    seed, withheld = DEV_SEEDS + 7, ["time_ripple"]
+    seed, withheld = DEV_SEEDS + 7, ["lead_error"]
     ds = generate_dataset(seed, withheld=tuple(withheld), kind="drakecreep", axis="rigid", n_samples=600)
-    fitted = {"table.seal_force": 1.1 * ds.train[0].meta.params.table.seal_force}  # as a nominal fit would give
-    nominal = dts._energy(ds.audit, dts._set(ds.train[0].meta.params, fitted))
-    row = {"seed": seed, "withheld": withheld, "kind": "drakecreep", "axis": "rigid", "snr": 4.0, "claimed": [],
-           "expected": "force_ripple", "audit_shrink": 0.0, "claimed_model": {"fitted": fitted, "effects": {}},
-           "audit": {"nominal": {"energy": nominal}, "claimed": {"energy": nominal}}}
+    declared = ds.train[0].meta.params
+    uncertain = {"table.seal_force": 1.1 * declared.table.seal_force}  # as a nominal fit would give
+    ripple = {"disturbance.force_ripple": 1.0, "disturbance.ripple_frequency": 7.0, "disturbance.ripple_phase": 0.3}
+    fitted = dict(uncertain, **{"disturbance.force_ripple": 2.0})  # the final refit moved the claim's amplitude
+    nominal = dts._energy(ds.audit, dts._set(declared, uncertain))
+    claimed = dts._energy(ds.audit, dts._set(dts._set(declared, ripple), fitted))
+    true = dts._energy(ds.audit, dts._set(dts._set(declared, uncertain), true_drive_values(ds.truth, declared)))
+    row = {"seed": seed, "withheld": withheld, "kind": "drakecreep", "axis": "rigid", "snr": 4.0,
+           "claimed": ["force_ripple"], "expected": "lead_error", "audit_shrink": 1 - claimed / nominal,
+           "uncertain": ["table.seal_force"],
+           "claimed_model": {"fitted": fitted, "effects": {"force_ripple": ripple}},
+           "audit": {"nominal": {"energy": nominal}, "claimed": {"energy": claimed}}}
     r = dts.true_shrink(row, n_samples=600)
-    assert r["reproduced"] and r["check"] < 1e-9 and r["base"] == "nominal"
-    assert 0 < r["true_shrink"] < 1 and r["relative"] == 0.0  # nothing claimed: none of the true shrink
-    off = dict(row, audit={"nominal": {"energy": nominal}, "claimed": {"energy": 1.01 * nominal}})
+    assert r["reproduced"] and r["check"] < 1e-9 and r["base"] == "refit"
+    assert r["true_energy"] == pytest.approx(true, rel=1e-12) and r["true_shrink"] == pytest.approx(1 - true / nominal)
+    assert r["relative"] == (None if r["true_shrink"] <= 0 else pytest.approx(row["audit_shrink"] / r["true_shrink"]))
+    off = dict(row, audit={"nominal": {"energy": nominal}, "claimed": {"energy": 1.01 * claimed}})
     r = dts.true_shrink(off, n_samples=600)
     assert not r["reproduced"] and r["check"] == pytest.approx(1 - 1 / 1.01, abs=1e-9)
     env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
