@@ -88,7 +88,7 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
            "claimed": row["claimed"], "base": "refit" if row["claimed"] else "nominal", "check": check,
            "reproduced": bool(check <= tolerance), "audit_shrink": row["audit_shrink"],
            "oscillating": bool(row.get("oscillation"))}
-    true = true_drive_values(ds.truth, fitted)
+    true = true_drive_values(ds.truth)
     if true is None:  # Stribeck: no true model without a refit of the levels
         out.update(true_energy=None, true_shrink=None, relative=None, seconds=time.perf_counter() - t0)
         return out

@@ -253,7 +253,7 @@ def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch)
     fitted = dict(uncertain, **{"disturbance.force_ripple": 2.0})  # the final refit moved the claim's amplitude
     nominal = dts._energy(ds.audit, dts._set(declared, uncertain))
     claimed = dts._energy(ds.audit, dts._set(dts._set(declared, ripple), fitted))
-    true = dts._energy(ds.audit, dts._set(dts._set(declared, uncertain), true_drive_values(ds.truth, declared)))
+    true = dts._energy(ds.audit, dts._set(dts._set(declared, uncertain), true_drive_values(ds.truth)))
     row = {"seed": seed, "withheld": withheld, "kind": "drakecreep", "axis": "rigid", "snr": 4.0,
            "claimed": ["force_ripple"], "expected": "lead_error", "audit_shrink": 1 - claimed / nominal,
            "uncertain": ["table.seal_force"],

@@ -478,7 +478,7 @@ def true_effect_fit(result, ds, max_nfev=6):
     return fit_candidate(label, ds.train, ds.test, result.nominal, max_nfev, start, alternative)
 
 
-def true_drive_values(truth, params):
+def true_drive_values(truth):
     """The truth's withheld effect as ``DriveParams`` values: what a ``drakecreep``-kind diagnosis can do at best.
 
     Three effects of :data:`EXPECTED_DRIVE`, each onto the fields its candidate fits, with the truth's values
@@ -504,13 +504,12 @@ def true_drive_values(truth, params):
     ----------
     truth : drakecreep.gap.truth.Truth
         A ``drakecreep``-kind truth with at most one withheld effect.
-    params : drakecreep.params.DriveParams
-        The params file the truth's values go into (unused fields stay as they are).
 
     Returns
     -------
     dict or None
-        ``path -> value``; None for no withheld effect, more than one, or one without a true model here.
+        ``path -> value`` to set in a params file (its other fields stay as they are); None for no withheld
+        effect, more than one, or one without a true model here.
     """
     effects = dict(truth.effects)
     if len(effects) != 1:
@@ -649,7 +648,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
         a["claimed"] = replayed(res.params) if claimed else a["nominal"]
         # no true model where the held-out runs oscillate: a free phase blinds the sample-by-sample force error
         # (a truth's unstable delay gave true shrinks of -71 to +0.02 %, analysis/drive_true_shrink.py)
-        true = true_drive_values(ds.truth, res.nominal) if ds.expected is not None and not res.oscillation else None
+        true = true_drive_values(ds.truth) if ds.expected is not None and not res.oscillation else None
         if true is not None:
             try:
                 a["true"] = replayed(functools.reduce(lambda p, kv: with_value(p, *kv), true.items(), res.nominal))

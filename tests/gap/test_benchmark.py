@@ -131,11 +131,10 @@ def test_the_truths_effect_goes_into_the_params_file_field_by_field():
     """Three drakecreep-kind library effects onto the fields their candidates fit, with the truth's values; none for
     Stribeck (its drop needs the levels refitted), a null, an effect without a DriveParams candidate or two."""
     rng = np.random.default_rng
-    base = declared_params(T.draw_truth(rng(DEV_SEEDS), "drakecreep", "rigid"))
     assert set(EXPECTED_DRIVE) == {"lead_error", "stribeck", "time_ripple", "control_delay"}
     for seed, effect in enumerate(EXPECTED_DRIVE):
         tr = T.draw_truth(rng(DEV_SEEDS + seed), "drakecreep", "flexible", (effect,))
-        e, v = tr.effects[effect], true_drive_values(tr, base)
+        e, v = tr.effects[effect], true_drive_values(tr)
         if effect == "lead_error":
             assert v["disturbance.lead_error_period"] == tr.lead
             assert v["disturbance.lead_error_2_amplitude"] == pytest.approx(e["h2"] * e["amplitude_m"], rel=1e-15)
@@ -149,7 +148,7 @@ def test_the_truths_effect_goes_into_the_params_file_field_by_field():
         else:
             assert v == {"controller.computation_delay": 4.0 * e["delay_samples"]} and T.VEL_DIV == 4
     for withheld in ((), ("cogging",), ("backlash",), ("lead_error", "time_ripple")):
-        assert true_drive_values(T.draw_truth(rng(DEV_SEEDS), "drakecreep", "rigid", withheld), base) is None
+        assert true_drive_values(T.draw_truth(rng(DEV_SEEDS), "drakecreep", "rigid", withheld)) is None
 
 
 @pytest.mark.parametrize("effect, error", [("lead_error", "transmission"), ("time_ripple", "force")])
@@ -163,7 +162,7 @@ def test_the_truths_own_values_shrink_its_audit_replay(effect, error):
 
     ds = generate_dataset(DEV_SEEDS + 7, withheld=(effect,), kind="drakecreep", axis="rigid", n_samples=1500)
     exact = declared_params(ds.truth)
-    true = functools.reduce(lambda p, kv: with_value(p, *kv), true_drive_values(ds.truth, exact).items(), exact)
+    true = functools.reduce(lambda p, kv: with_value(p, *kv), true_drive_values(ds.truth).items(), exact)
 
     def energy(params):
         return np.mean([drake_replay_errors(replay_drakecreep(r, params))[error] ** 2 for r in ds.audit])
