@@ -493,7 +493,8 @@ def true_drive_values(truth):
     * ``control_delay``: ``d`` recorded samples as ``controller.computation_delay = d`` times the speed loop's ticks
       per sample. The truth applies each speed-loop output at once, so ``d`` ticks are its whole delay, replacing
       the params file's (the declared file keeps the default 1). On three development datasets (rigid, 1500
-      samples, ``d`` 2 and 3) the audit force error was least at ``4 d`` ticks, 1-4 % more at ``4 d + 1``.
+      samples, ``d`` 2 and 3) the audit force energy was least at ``4 d`` ticks on two, at ``4 d - 1`` on the
+      third (0.5 % below), and 0.06-4.5 % above ``4 d`` at ``4 d + 1``.
 
     Not ``stribeck``: its drop cannot be written onto a fitted params file. The nominal fit's friction levels
     absorb the drop; the truth's ``Fs / Fc`` and ``vs`` on top of them made held-out dataset 39100006's audit
