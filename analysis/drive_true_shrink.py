@@ -31,7 +31,6 @@ Run: ``PYTHONPATH=. python analysis/drive_true_shrink.py ROWS.json [...] [--json
 """
 
 import argparse
-import functools
 import json
 import sys
 import time
@@ -42,13 +41,8 @@ from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap.benchmark import N_SAMPLES, generate_dataset, true_drive_values
 from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN
-from drakecreep.params import with_value
+from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, _with
 from study_cli import read_rows
-
-
-def _set(params, values):
-    return functools.reduce(lambda p, kv: with_value(p, *kv), values.items(), params)
 
 
 def _energy(runs, params):
@@ -77,10 +71,10 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
     # refitted amplitude stays out of it)
     as_row = declared
     for values in model["effects"].values():
-        as_row = _set(as_row, values)
-    as_row = _set(as_row, model["fitted"])
+        as_row = _with(as_row, values)
+    as_row = _with(as_row, model["fitted"])
     uncertain = set(row.get("uncertain") or DEFAULT_UNCERTAIN)
-    fitted = _set(declared, {k: v for k, v in model["fitted"].items() if k in uncertain})
+    fitted = _with(declared, {k: v for k, v in model["fitted"].items() if k in uncertain})
     own = row["audit"]["claimed"]["energy"]
     again = _energy(ds.audit, as_row)
     check = abs(again / own - 1.0)
@@ -92,7 +86,7 @@ def true_shrink(row, n_samples=N_SAMPLES, tolerance=1e-6):
     if true is None:  # Stribeck: no true model without a refit of the levels
         out.update(true_energy=None, true_shrink=None, relative=None, seconds=time.perf_counter() - t0)
         return out
-    e_true = _energy(ds.audit, _set(fitted, true))
+    e_true = _energy(ds.audit, _with(fitted, true))
     shrink = 1.0 - e_true / row["audit"]["nominal"]["energy"]
     out.update(true_energy=e_true, true_shrink=shrink,
                relative=(row["audit_shrink"] / shrink if shrink > 0 else None),

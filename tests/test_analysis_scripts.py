@@ -240,6 +240,7 @@ def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch)
     among them), and the true model is the fitted uncertain fields with the truth's effect (not the claim's
     refitted amplitude); a row whose energy is not reproduced is flagged; bad options are refused before any work."""
     from drakecreep.gap.benchmark import DEV_SEEDS, generate_dataset, true_drive_values
+    from drakecreep.gap.drive_fit import _with
 
     monkeypatch.syspath_prepend(str(ANALYSIS))  # its study_cli, as when run from analysis/
     spec = importlib.util.spec_from_file_location("dts", ANALYSIS / "drive_true_shrink.py")
@@ -251,9 +252,9 @@ def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch)
     uncertain = {"table.seal_force": 1.1 * declared.table.seal_force}  # as a nominal fit would give
     ripple = {"disturbance.force_ripple": 1.0, "disturbance.ripple_frequency": 7.0, "disturbance.ripple_phase": 0.3}
     fitted = dict(uncertain, **{"disturbance.force_ripple": 2.0})  # the final refit moved the claim's amplitude
-    nominal = dts._energy(ds.audit, dts._set(declared, uncertain))
-    claimed = dts._energy(ds.audit, dts._set(dts._set(declared, ripple), fitted))
-    true = dts._energy(ds.audit, dts._set(dts._set(declared, uncertain), true_drive_values(ds.truth)))
+    nominal = dts._energy(ds.audit, _with(declared, uncertain))
+    claimed = dts._energy(ds.audit, _with(_with(declared, ripple), fitted))
+    true = dts._energy(ds.audit, _with(_with(declared, uncertain), true_drive_values(ds.truth)))
     row = {"seed": seed, "withheld": withheld, "kind": "drakecreep", "axis": "rigid", "snr": 4.0,
            "claimed": ["force_ripple"], "expected": "lead_error", "audit_shrink": 1 - claimed / nominal,
            "uncertain": ["table.seal_force"],

@@ -30,8 +30,7 @@ def add_parser(subparsers):
 
 def run(args):
     """Build the report and print where it is."""
-    from drakecreep.cli._common import feed_from_mm_s
-    from drakecreep.cli._common import POSITIVE_FEED, check_feed
+    from drakecreep.cli._common import POSITIVE_FEED, check_feed, feed_from_mm_s
     from drakecreep.cli.margins import scenario_from_args
     from drakecreep.files import check_output_dir
     from drakecreep.report.loop_report import build_report

@@ -52,7 +52,6 @@ effect outside the library can be checked for where it was found, not only for b
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 import sys
 import time
@@ -593,9 +592,8 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     augmented one, and the nominal with the truth's own values of its effect (:func:`true_drive_values`; not
     fitted, unlike the ``p_p_cascade`` kind's true effect; not where the held-out runs oscillate)."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-    from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, diagnose_drive
+    from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, _with, diagnose_drive
     from drakecreep.gap.residuals import oscillation_log_errors
-    from drakecreep.params import with_value
 
     t0 = time.perf_counter()
     kw = {} if effects is None else {"effects": tuple(effects)}
@@ -652,7 +650,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
         true = true_drive_values(ds.truth) if ds.expected is not None and not res.oscillation else None
         if true is not None:
             try:
-                a["true"] = replayed(functools.reduce(lambda p, kv: with_value(p, *kv), true.items(), res.nominal))
+                a["true"] = replayed(_with(res.nominal, true))
             except InputError:  # a truth's value outside the field's range: no true model
                 a["true"] = None
         row.update(_audit_fields(a, claimed))

@@ -155,14 +155,12 @@ def test_the_truths_effect_goes_into_the_params_file_field_by_field():
 def test_the_truths_own_values_shrink_its_audit_replay(effect, error):
     """The truth's values in its exact params file (no friction factor) make the audit replay closer: the lead
     error's phases and the ripple's sign are the truth's. A sign or a phase off would make the error grow."""
-    import functools
-
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
-    from drakecreep.params import with_value
+    from drakecreep.gap.drive_fit import _with
 
     ds = generate_dataset(DEV_SEEDS + 7, withheld=(effect,), kind="drakecreep", axis="rigid", n_samples=1500)
     exact = declared_params(ds.truth)
-    true = functools.reduce(lambda p, kv: with_value(p, *kv), true_drive_values(ds.truth).items(), exact)
+    true = _with(exact, true_drive_values(ds.truth))
 
     def energy(params):
         return np.mean([drake_replay_errors(replay_drakecreep(r, params))[error] ** 2 for r in ds.audit])
