@@ -378,24 +378,23 @@ def dataset_spec(text):
     return int(seed), () if withheld == "null" else (withheld,), axis
 
 
-def _idim_energy(runs):
+def _idim_energy(runs, mass):
     """Mean square residual [N^2] of the nominal inverse-dynamics least squares of the Drake path on ``runs``.
 
     The screen's nominal (:mod:`drakecreep.gap.screen`): the rigid replay axis's own force function
-    (``M ddq + f(dq) + offset``, ``tanh``-regularised friction) on the screen's IDIM signals, the mass from
-    :func:`drakecreep.gap.identify.idim_start`, viscous, Coulomb and offset by linear least squares on every
+    (``M ddq + f(dq) + offset``, ``tanh``-regularised friction) on the screen's IDIM signals, the ``mass`` of
+    :func:`drakecreep.gap.identify.idim_start` (:func:`snr`), viscous, Coulomb and offset by linear least squares on every
     run stacked (not normalised per run), on the samples faster than :data:`~drakecreep.gap.screen.SLOW_SHARE` of the top speed.
     At standstill and in reversals the force is the static friction the controller holds, which no rigid
     inverse dynamics determines: on effect-free twins those 20 % of the samples carry about 90 % of the
     residual energy and would make the SNR a measure of stiction, not of the effect (the rigid diagnosis's
     SNR left out the samples below 1 % of the top speed for the same reason).
     """
-    from drakecreep.gap.identify import idim_start
     from drakecreep.gap.screen import _project, _signals, _sliding
     from drakecreep.model.axis import AXIS_PARAMETERS
 
     values = dict(AXIS_PARAMETERS)
-    values["mass"] = idim_start(runs).parameters["mass"]
+    values["mass"] = mass
     sig = [_signals(r) for r in runs]
     v_top = max(float(np.max(np.abs(s[2]))) for s in sig)
     sig = _sliding(sig, v_top, SLOW_SHARE)
@@ -414,8 +413,24 @@ def snr(runs, twin):
     Returns
     -------
     float
+
+    Notes
+    -----
+    Each side's nominal has the mass :func:`drakecreep.gap.identify.idim_start` gives on its own runs. Where the
+    effect leaves the runs no positive inverse-dynamics mass (a control delay whose truth oscillates in a saturated
+    limit cycle: candidate 97106044 of held-out run 3bz's draw gave -162 kg, and the error ended the whole run), the
+    twin's mass stands for it: the same axis, and the residual then holds the effect whole.
     """
-    return float(math.sqrt(max(_idim_energy(runs) / _idim_energy(twin) - 1.0, 0.0)))
+    from drakecreep.gap.identify import idim_start
+
+    m_twin = idim_start(twin).parameters["mass"]
+    try:
+        m_runs = idim_start(runs).parameters["mass"]
+    except InputError as err:  # no positive mass on the runs with the effect (idim_start's refusal of a reversed u)
+        if err.field != "u":
+            raise
+        m_runs = m_twin
+    return float(math.sqrt(max(_idim_energy(runs, m_runs) / _idim_energy(twin, m_twin) - 1.0, 0.0)))
 
 
 def _check_kind(kind):

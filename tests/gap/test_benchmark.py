@@ -1,4 +1,5 @@
 import ast
+import math
 import pathlib
 
 import numpy as np
@@ -432,3 +433,25 @@ def test_a_study_names_a_dataset_by_seed_withheld_effect_and_axis():
                        ("1:null:wobbly", "axis"), ("-1:null:rigid", "dataset")):
         with pytest.raises(InputError, match=field):
             dataset_spec(bad)
+
+
+def test_snr_survives_runs_without_a_positive_inverse_dynamics_mass():
+    """A withheld effect that leaves the runs no positive IDIM mass (an unstable delay's limit cycle; here the
+    drive force reversed) gets the twin's mass instead of ending the benchmark: a large SNR, the same as with the
+    twin's mass given by hand, while a dataset whose runs have a mass keeps its own."""
+    import dataclasses
+
+    from drakecreep.gap.benchmark import _idim_energy, snr
+    from drakecreep.gap.identify import idim_start
+
+    ds = _dataset(DEV_SEEDS + 7, ("time_ripple",), {})
+    flipped = [dataclasses.replace(r, u=-r.u) for r in ds.train]
+    with pytest.raises(InputError, match="inverse-dynamics mass"):
+        idim_start(flipped)
+    m_twin = idim_start(ds.twin_train).parameters["mass"]
+    value = snr(flipped, ds.twin_train)
+    assert value == pytest.approx(math.sqrt(_idim_energy(flipped, m_twin) / _idim_energy(ds.twin_train, m_twin) - 1))
+    assert value > 10 * max(ds.snr, 1.0)
+    m_own = idim_start(ds.train).parameters["mass"]
+    assert ds.snr == pytest.approx(math.sqrt(max(_idim_energy(ds.train, m_own)
+                                                 / _idim_energy(ds.twin_train, m_twin) - 1, 0)))
