@@ -42,6 +42,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay, simulate_each
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
+from drakecreep.gap.residuals import OSCILLATION_SHARE, dominant_oscillation
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT",
@@ -161,8 +162,7 @@ def idim_start(runs, instruments=None, **preprocess):
     if Z is None and not full[0] > 0:  # least squares on the measured signals: named in their terms (the axis
         # refused it as 'axis.mass'); an instrumental-variable mass that is not positive is the caller's to drop
         raise InputError("u", f"a drive force whose inverse-dynamics mass is {full[0]:.3g} kg",
-                         "a u that pushes the axis the way it accelerates (is the sign of u or u_gain, or the "
-                         "direction of x_motor, reversed?)")
+                         "a u that pushes the axis the way it accelerates (" + _no_mass_cause(runs) + ")")
     if full[2] < 0:
         warnings.append(f"IDIM gives a negative Coulomb level ({full[2]:.3g} N): set to 0")
         full[2] = 0.0
@@ -348,6 +348,26 @@ class _Problem:
         # the residual is also clipped to +-NONFINITE_RESIDUAL per sample
         big = NONFINITE_RESIDUAL
         return np.clip(np.nan_to_num(np.concatenate(parts), nan=big), -big, big)  # +-inf: clipped to +-big
+
+
+def _no_mass_cause(runs):
+    """The likely cause of a non-positive least-squares mass, for :func:`idim_start`'s refusal: a limit cycle of
+    the drive force on most runs (an unstable real loop swamps the rigid inverse dynamics: a benchmark truth with a
+    delay gave -162 kg), else a reversed sign."""
+    hits = []
+    for r in runs:
+        try:
+            o = dominant_oscillation(r.u, r.dt)
+        except InputError:  # too short, or nothing above the search's lowest frequency: no oscillation to name
+            continue
+        if o["share"] >= OSCILLATION_SHARE:
+            hits.append(o)
+    if 2 * len(hits) > len(runs):
+        f = float(np.median([o["freq_Hz"] for o in hits]))
+        share = float(np.median([o["share"] for o in hits]))
+        return (f"the drive force oscillates at {f:.0f} Hz on {len(hits)} of {len(runs)} runs, "
+                f"{100 * share:.0f} % of its variance: is the real loop unstable? A limit cycle hides the mass")
+    return "is the sign of u or u_gain, or the direction of x_motor, reversed?"
 
 
 def identify(runs, uncertain=("viscous", "coulomb", "offset"), *, flexible=False, delay=0.0, fixed=None,

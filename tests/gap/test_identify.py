@@ -264,3 +264,17 @@ def test_a_stiff_parameter_beside_a_viscous_one_keeps_its_interval():
     # columns of the same size give the two the same std in scaled units
     assert 0.5 < (std["bristle_stiffness"] / 1e12) / (std["viscous"] / 100.0) < 2.0
     assert not warnings
+
+
+def test_a_limit_cycle_in_the_drive_force_is_named_when_it_leaves_no_mass(runs):
+    """An unstable loop's limit cycle can leave no positive inverse-dynamics mass (a benchmark truth with a delay:
+    -162 kg): the refusal names the oscillation, its frequency and share, instead of asking about u's sign;
+    the same runs without it are asked about the sign."""
+    flipped = [dataclasses.replace(r, u=-r.u) for r in runs]
+    cycle = [dataclasses.replace(r, u=r.u + 20 * np.std(r.u) * np.sin(2 * np.pi * 157.0 * r.t)) for r in flipped]
+    with pytest.raises(InputError, match=r"^u: got 'a drive force whose inverse-dynamics mass is -") as err:
+        idim_start(cycle)
+    assert "oscillates at 15" in str(err.value) and f"on {len(runs)} of {len(runs)} runs" in str(err.value)
+    assert "is the real loop unstable?" in str(err.value) and "sign of u" not in str(err.value)
+    with pytest.raises(InputError, match="is the sign of u or u_gain"):
+        idim_start(flipped)
