@@ -385,10 +385,10 @@ def _idim_energy(runs, mass):
     (``M ddq + f(dq) + offset``, ``tanh``-regularised friction) on the screen's IDIM signals, the ``mass`` of
     :func:`drakecreep.gap.identify.idim_start` (:func:`snr`), viscous, Coulomb and offset by linear least squares
     on every run stacked (not normalised per run), on the samples faster than
-    :data:`~drakecreep.gap.screen.SLOW_SHARE` of the top speed. At standstill and in reversals the force is the static friction the controller holds, which no rigid
-    inverse dynamics determines: on effect-free twins those 20 % of the samples carry about 90 % of the
-    residual energy and would make the SNR a measure of stiction, not of the effect (the rigid diagnosis's
-    SNR left out the samples below 1 % of the top speed for the same reason).
+    :data:`~drakecreep.gap.screen.SLOW_SHARE` of the top speed. At standstill and in reversals the force is the
+    static friction the controller holds, which no rigid inverse dynamics determines: on effect-free twins those
+    20 % of the samples carry about 90 % of the residual energy and would make the SNR a measure of stiction, not
+    of the effect (the rigid diagnosis's SNR left out the samples below 1 % of the top speed for the same reason).
     """
     from drakecreep.gap.screen import _project, _signals, _sliding
     from drakecreep.model.axis import AXIS_PARAMETERS
