@@ -70,6 +70,8 @@ __all__ = [
     "replay_drakecreep",
     "replay_params",
     "check_replayable",
+    "check_travel",
+    "at_origin",
     "QUICK_REPLAY_SETTINGS",
     "quick_replay_params",
     "simulated_runs",
@@ -911,15 +913,43 @@ def replay_params(run, params=None, quantize=True):
     return dataclasses.replace(params, sensors=sensors)
 
 
-def _phases_at(params, x_origin):
-    """``params`` with the phases of what is fixed to the screw and the motor (the lead error, the cogging) moved
-    from the screw's position 0 to ``x_origin`` [m] (the motor's travel at the replayed diagram's angle 0; the
-    run's first position, where the diagram starts): they are fixed to the machine, not to the run."""
+def check_travel(run, params, x_origin=None):
+    """Raise :class:`InputError` unless ``run``'s positions keep the nut on ``params``' screw.
+
+    A run's positions are the params file's table coordinates (at table position 0 the nut is
+    ``screw.nut_start_distance`` from the thrust bearing): the replay puts the nut where the run was
+    (:func:`at_origin`), so that the shaft's stiffness is the one at the run's position. Every position of
+    ``x_motor`` and ``x_ref`` (and ``x_origin``, the diagram's table position 0, when given) must lie between
+    ``-nut_start_distance`` and ``length - nut_start_distance``.
+    """
+    screw = params.screw
+    lo, hi = -screw.nut_start_distance, screw.length - screw.nut_start_distance
+    x = np.concatenate([run.x_motor, run.x_ref] + ([[x_origin]] if x_origin is not None else []))
+    first, last = float(np.min(x)), float(np.max(x))
+    if not (lo < first and last < hi):
+        raise InputError(f"x_motor (run {run.label})", f"positions from {first:.6g} to {last:.6g} m",
+                         f"table positions in the params file's coordinates that keep the nut on the screw, between "
+                         f"{lo:.6g} and {hi:.6g} m (at 0 the nut is screw.nut_start_distance = "
+                         f"{screw.nut_start_distance:g} m from the thrust bearing, the shaft {screw.length:g} m long)")
+
+
+def at_origin(params, x_origin):
+    """``params`` with what is fixed to the machine moved from its table position 0 to ``x_origin`` [m] (the
+    motor's travel at the replayed diagram's angle 0; the run's first position, where the diagram starts): the
+    phases of what is fixed to the screw and the motor (the lead error, the cogging) and the nut's distance from
+    the thrust bearing (``screw.nut_start_distance + x_origin``), so that the shaft's stiffness is the one where
+    the run was. They belong to the machine, not to the run.
+
+    Replaying a run at 0.094 m of a flexible axis with the nut at ``nut_start_distance`` instead, as before
+    session 73, made the chain 14 % stiffer and 31 % more damped than where the run was (development dataset
+    9014, docs/gap_benchmark.md 3cb): the truth's delay of 8 speed-loop ticks, which drives its 207 Hz axial mode
+    unstable, left that replay stable, and at the run's position it oscillates at 203 Hz like the truth.
+    """
     from drakecreep.params import with_value
 
-    d = params.disturbance
     if x_origin == 0.0:
         return params
+    d = params.disturbance
     for on, period, phases in ((d.has_lead_error, d.lead_error_period, ("lead_error_phase", "lead_error_2_phase")),
                                (d.has_cogging, d.cogging_period, ("cogging_phase", "cogging_2_phase"))):
         if not on:
@@ -928,7 +958,7 @@ def _phases_at(params, x_origin):
         for harmonic, name in enumerate(phases, start=1):
             value = getattr(d, name) + harmonic * turn
             params = with_value(params, f"disturbance.{name}", math.remainder(value, 2.0 * math.pi))
-    return params
+    return with_value(params, "screw.nut_start_distance", params.screw.nut_start_distance + x_origin)
 
 
 def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="compiled"):
@@ -984,13 +1014,18 @@ def replay_drakecreep(run, params=None, quantize=True, load_case=0, backend="com
     # the diagram starts at rest with its table at 0 and the screw wound up by the axial load (the load case's fx,
     # with loads.constant_force): the motor at theta0, the position feedback reading x_ref0. The run's first
     # readings are that state: the origin is where the run's feedback sensor puts the diagram's
-    rest = initial_conditions(params, Scenario(load_case=int(load_case)))
-    if ctrl.position_feedback == "table" and run.x_table is not None:
-        x_origin = float(run.x_table[0])
-    else:
-        x_origin = float(run.x_motor[0]) - (rest["x_ref0"] if ctrl.position_feedback == "motor"
-                                            else rest["theta0"] * params.screw.lead / (2 * math.pi))
-    params = _phases_at(params, x_origin)
+    def origin(p):
+        if ctrl.position_feedback == "table" and run.x_table is not None:
+            return float(run.x_table[0])
+        rest = initial_conditions(p, Scenario(load_case=int(load_case)))
+        return float(run.x_motor[0]) - (rest["x_ref0"] if ctrl.position_feedback == "motor"
+                                        else rest["theta0"] * p.screw.lead / (2 * math.pi))
+
+    x_origin = origin(params)
+    check_travel(run, params, x_origin)
+    x_origin = origin(at_origin(params, x_origin))  # the windup of the shaft where the run was (a load case's)
+    check_travel(run, params, x_origin)
+    params = at_origin(params, x_origin)
     xr = run.x_ref - x_origin
     vr = np.gradient(xr, t)
     f_ext = run.f_ext if run.f_ext is not None else np.zeros(run.n)

@@ -97,8 +97,8 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError, name_list
 from drakecreep.gap.claims import ALPHA, POOLED_FACTOR, log_ratios, mean_and_standard_error, replay_test
 from drakecreep.gap.drake_diagnosis import paired_gain
-from drakecreep.gap.drake_replay import (check_replayable, drake_replay_errors, replay_drakecreep, replay_params,
-                                         rms_force_error)
+from drakecreep.gap.drake_replay import (check_replayable, check_travel, drake_replay_errors, replay_drakecreep,
+                                         replay_params, rms_force_error)
 from drakecreep.gap.measured import check_split
 from drakecreep.gap.residuals import (dominant_oscillation, oscillates_at, oscillation_log_errors,
                                       sustained_oscillation, transmission_position)
@@ -587,7 +587,8 @@ def check_run(run, params=None, load_case=0):
     Checked before any simulation, for the diagnosed runs and for runs the result is scored on: the run's
     controller is of kind ``drakecreep`` with a params file (:func:`~drakecreep.gap.drake_replay.check_replayable`),
     it has at least :data:`MIN_SAMPLES` samples over :data:`MIN_DURATION` s, its declared sensor resolutions fit
-    the lead of ``params`` (:func:`~drakecreep.gap.drake_replay.replay_params`), ``load_case`` is one of
+    the lead of ``params`` (:func:`~drakecreep.gap.drake_replay.replay_params`), its positions keep the nut on the
+    screw (:func:`~drakecreep.gap.drake_replay.check_travel`), ``load_case`` is one of
     ``params``' and its external force stays within :data:`MAX_EXTERNAL_FORCE` times the drive's force limit.
     What a unit slip shows (each a replay of nonsense, or of a run a thousand times too long, before): the sample
     step is at most :data:`MAX_SAMPLE_PERIODS` position-loop periods, and the peak drive force ``u x u_gain`` lies
@@ -611,6 +612,7 @@ def check_run(run, params=None, load_case=0):
                          "a reference that moves (the diagnosis compares the drive's motion and force)")
     params = run.meta.params if params is None else params
     replay_params(run, params)  # the declared sensor resolutions fit the params' lead
+    check_travel(run, params)  # the replay puts the nut where the run was
     load = params.load_case(load_case)
     period = params.controller.position_period
     if run.dt > MAX_SAMPLE_PERIODS * period:

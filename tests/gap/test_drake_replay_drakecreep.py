@@ -89,23 +89,23 @@ def test_coarser_declared_encoder_changes_the_replay():
 def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
     """A run that starts at ``x0`` meets the lead error at phase ``phi + 2 pi x0 / P``: its replay is the replay of
     the same run started at 0 with that phase, and differs from a run at another position."""
-    from drakecreep.gap.drake_replay import _phases_at
+    from drakecreep.gap.drake_replay import at_origin
 
     rig = with_value(_rig(), "disturbance.lead_error_phase", 0.4)
     period = rig.disturbance.lead_error_period
     x0 = 0.123 * period + 3 * period  # an eighth of a period off, three periods along
     at0 = _run(rig)
     moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
-    shifted = with_value(rig, "disturbance.lead_error_phase",
-                         math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi))
+    shifted = _nut_moved(with_value(rig, "disturbance.lead_error_phase",
+                                    math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi)), x0)
     a = replay_drakecreep(moved, rig)
     b = replay_drakecreep(at0, shifted)
     assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
     plain = replay_drakecreep(at0, rig)
     assert np.max(np.abs(plain.x_table - b.x_table)) > 0.2 * rig.disturbance.lead_error_amplitude
-    assert _phases_at(rig, 0.0) is rig
+    assert at_origin(rig, 0.0) is rig
     off = with_value(rig, "disturbance.lead_error_amplitude", 0.0)
-    assert _phases_at(off, x0) is off
+    assert at_origin(off, x0) == _nut_moved(off, x0)
     with pytest.raises(InputError, match="disturbance.lead_error_phase"):
         with_value(rig, "disturbance.lead_error_phase", 7.0)
 
@@ -119,21 +119,26 @@ def _started_elsewhere(rig, period, name):
     shifted = with_value(with_value(rig, f"disturbance.{name}_phase",
                                     math.remainder(0.4 + 2 * math.pi * x0 / period, 2 * math.pi)),
                          f"disturbance.{name}_2_phase", math.remainder(-1.3 + 4 * math.pi * x0 / period, 2 * math.pi))
-    return at0, moved, shifted, x0
+    return at0, moved, _nut_moved(shifted, x0), x0
+
+
+def _nut_moved(params, x0):
+    """``params`` with the nut ``x0`` further from the thrust bearing (where a run started at ``x0`` has it)."""
+    return with_value(params, "screw.nut_start_distance", params.screw.nut_start_distance + x0)
 
 
 def test_cogging_is_fixed_to_the_motor_not_to_the_run():
     """A run that starts at ``x0`` meets the cogging at ``phi + 2 pi x0 / P`` and its second harmonic at
     ``phi2 + 4 pi x0 / P``: its replay is that of the same run started at 0 with those phases (the start in
     equilibrium either way), and differs from the run at 0 with the phases as written."""
-    from drakecreep.gap.drake_replay import _phases_at
+    from drakecreep.gap.drake_replay import at_origin
 
     rig = with_value(_rig(), "disturbance.lead_error_amplitude", 0.0)  # the cogging alone
     for path, value in (("disturbance.cogging_force", 4.0), ("disturbance.cogging_phase", 0.4),
                         ("disturbance.cogging_2_force", 1.5), ("disturbance.cogging_2_phase", -1.3)):
         rig = with_value(rig, path, value)
     at0, moved, shifted, x0 = _started_elsewhere(rig, rig.disturbance.cogging_period, "cogging")
-    assert _phases_at(rig, x0) == shifted
+    assert at_origin(rig, x0) == shifted
     a = replay_drakecreep(moved, rig)
     b = replay_drakecreep(at0, shifted)
     assert np.max(np.abs((a.x_motor - x0) - b.x_motor)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
@@ -232,3 +237,62 @@ def test_the_replay_errors_carry_the_screws_transmission_on_runs_with_a_scale():
     rigid = dataclasses.replace(run, x_table=run.x_motor.copy())  # a scale that reads the motor: nothing moves
     assert "table_position" in drake_replay_errors(replay_drakecreep(rigid, rig), bands=False)
     assert "transmission" not in drake_replay_errors(replay_drakecreep(rigid, rig), bands=False)
+
+
+def test_the_nut_is_replayed_where_the_run_was():
+    """A run's positions are the params file's table coordinates: a run that starts ``x0`` along is the run at 0
+    with the nut ``x0`` further from the thrust bearing (a softer shaft), exactly, and not the run at 0."""
+    from drakecreep.model.screw import axial_stiffness
+
+    rig = with_value(_rig(), "disturbance.lead_error_amplitude", 0.0)
+    at0 = _run(rig)
+    x0 = 0.3
+    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
+    a = replay_drakecreep(moved, rig)
+    b = replay_drakecreep(at0, _nut_moved(rig, x0))
+    assert np.max(np.abs((a.x_table - x0) - b.x_table)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
+    plain = replay_drakecreep(at0, rig)
+    # the shaft between the bearing and the nut is 0.1 m long at 0 and 0.4 m at x0: the chain (the bearing's
+    # 9.4 N/um in series) is 3.1 % softer, and the table lags the motor by at least half that much more
+    softer = axial_stiffness(rig.screw, rig.nut, 0.0) / axial_stiffness(rig.screw, rig.nut, x0) - 1.0
+    lag = lambda r: np.max(np.abs(r.x_motor - r.x_table))  # noqa: E731
+    assert softer > 0.02 and lag(a) > (1.0 + 0.5 * softer) * lag(plain) > 0
+
+
+def test_a_run_that_leaves_the_screw_is_refused_before_any_replay():
+    """Positions that put the nut beyond either end of the shaft name the run, the positions and the range."""
+    from drakecreep.gap.drake_replay import check_travel
+    from drakecreep.gap.drive_fit import check_run
+
+    rig = _rig()
+    at0 = _run(rig)
+    off = rig.screw.length - rig.screw.nut_start_distance
+    for shift in (off, -rig.screw.nut_start_distance - 0.001):
+        far = dataclasses.replace(at0, x_ref=at0.x_ref + shift, x_motor=at0.x_motor + shift)
+        for check in (lambda: check_travel(far, rig), lambda: replay_drakecreep(far, rig), lambda: check_run(far, rig)):
+            with pytest.raises(InputError) as err:
+                check()
+            assert err.value.field == f"x_motor (run {far.label})"
+            assert f"between {-rig.screw.nut_start_distance:.6g} and {off:.6g} m" in err.value.allowed
+    check_travel(at0, rig)  # the run at 0 stays on the screw
+
+
+def test_a_delay_that_makes_the_truths_axial_mode_unstable_does_so_in_the_replay():
+    """Development dataset 9014 (flexible, the truth's delay of 2 samples = 8 speed-loop ticks): its truth
+    oscillates at its axial mode, 207 Hz. Its exact params file (:func:`drakecreep.gap.benchmark.declared_params`
+    without a drawn factor) with those 8 ticks does too, with the nut where the run was (0.094 m); one sample less
+    (4 ticks) does not. Before the nut followed the run, the replay at 8 ticks was stable (docs/gap_benchmark.md
+    3cb)."""
+    from drakecreep.gap import benchmark as B
+    from drakecreep.gap.residuals import OSCILLATION_SHARE, dominant_oscillation, oscillates_at
+
+    ds = B.generate_dataset(9014, withheld=("control_delay",), kind="drakecreep", axis="flexible")
+    assert ds.truth.effects["control_delay"]["delay_samples"] == 2
+    run = ds.train[0]
+    measured = dominant_oscillation(run.force, run.dt)
+    assert measured["share"] > OSCILLATION_SHARE and abs(measured["freq_Hz"] - ds.truth.f_axial) < 10.0
+    exact = B.declared_params(ds.truth)
+    delayed = replay_drakecreep(run, with_value(exact, "controller.computation_delay", 8.0))
+    assert oscillates_at(delayed.force, run.dt, measured["freq_Hz"])[0]
+    shorter = replay_drakecreep(run, with_value(exact, "controller.computation_delay", 4.0))
+    assert dominant_oscillation(shorter.force, run.dt)["share"] < OSCILLATION_SHARE
