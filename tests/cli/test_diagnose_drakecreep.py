@@ -252,6 +252,22 @@ def test_a_unit_slip_of_a_drakecreep_run_is_one_line_exit_2(blank_csv, tmp_path,
     assert f"error: {tmp_path / 'bad.csv'}: {column} (run r0): got " in err and says in err
 
 
+def test_a_run_that_puts_the_nut_off_the_screw_is_one_line_exit_2(blank_csv, tmp_path, capsys):
+    """A run's positions are the params file's table coordinates and the replay puts the nut where the run was
+    (docs 3cb): positions 2 m along the rigid_axis preset's shaft are refused before any replay, with the range."""
+    import pandas as pd
+
+    path, yaml_path = blank_csv
+    frame = pd.read_csv(path)
+    frame["u[N]"] = frame["u[N]"] * 50.0  # a 50 N drive (blank u: 1 N)
+    for column in ("x_ref[m]", "x_motor[m]"):
+        frame[column] = frame[column] + 2.0
+    err = _refusal(frame, yaml_path, tmp_path, capsys)
+    screw = preset("rigid_axis").screw
+    assert f"error: {tmp_path / 'bad.csv'}: x_motor (run r0): got 'positions from 2 to " in err, err
+    assert f"between {-screw.nut_start_distance:g} and {screw.length - screw.nut_start_distance:g} m" in err, err
+
+
 def test_positions_in_the_wrong_unit_are_refused_by_their_inverse_dynamics_mass(own_csv, tmp_path, capsys):
     """Positions in m headed mm (found by fuzzing: exit 0 after 74 s, a 101 % force error, a viscous coefficient of
     1.1e4 N s/m and a force ripple claimed for a lead error): the travel checks pass, every position being 1000 x
