@@ -890,3 +890,21 @@ def test_a_lead_error_on_a_linear_scale_is_decided_on_the_transmission():
     force_only = drive_fit._held_out("lead_error", {}, 0.9, list(nominal), RIG, nominal, replayer, 0.01, 0.05,
                                      False)
     assert not force_only.passes and "transmission" not in force_only.replay
+
+
+def test_a_limit_cycle_is_not_refused_as_a_unit_slip_by_its_inverse_dynamics_mass(monkeypatch):
+    """A run whose inverse-dynamics mass is 33 times the params file's is refused as a unit slip, unless its drive
+    force is a limit cycle (held-out run 3cc's unstable control delay 99106000: 2229 kg against 67.7 kg, refused
+    before any fit with "is the unit of the positions wrong?"). The diagnosis has its own rule for such runs."""
+    from drakecreep.gap.residuals import OSCILLATION_SHARE, dominant_oscillation
+    from drakecreep.model.compensators import rigid_inertia
+
+    rigid = rigid_inertia(RIG) * (2.0 * math.pi / RIG.screw.lead) ** 2
+    monkeypatch.setattr(drive_fit, "inverse_dynamics_mass", lambda run: 33.0 * rigid)
+    run = _runs(RIG)[0]
+    with pytest.raises(InputError, match="inverse-dynamics mass"):
+        drive_fit.check_run(run)
+    cycle = 20.0 * np.std(run.u) * np.sin(2 * np.pi * 207.0 * run.t)  # the force of an unstable loop at 207 Hz
+    unstable = dataclasses.replace(run, u=run.u + cycle)
+    assert dominant_oscillation(unstable.force, unstable.dt)["share"] >= OSCILLATION_SHARE
+    drive_fit.check_run(unstable)  # not refused
