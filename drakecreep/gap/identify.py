@@ -42,7 +42,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.drake_replay import diverged_result, drake_replay_errors, make_replay, simulate_each
 from drakecreep.gap.idim import PARAMETER_NAMES, idim_signals, regressor, relative_error
-from drakecreep.gap.residuals import OSCILLATION_SHARE, dominant_oscillation
+from drakecreep.gap.residuals import limit_cycle
 from drakecreep.model.axis import AXIS_PARAMETERS, AXIS_UNITS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
 __all__ = ["IdimStart", "Identified", "idim_start", "identify", "correlation_time", "LOG_SCALED", "CORRELATION_LIMIT",
@@ -354,14 +354,7 @@ def _no_mass_cause(runs):
     """The likely cause of a non-positive least-squares mass, for :func:`idim_start`'s refusal: a limit cycle of
     the drive force on most runs (an unstable real loop swamps the rigid inverse dynamics: a benchmark truth with a
     delay gave -162 kg), else a reversed sign."""
-    hits = []
-    for r in runs:
-        try:
-            o = dominant_oscillation(r.u, r.dt)
-        except InputError:  # too short, or nothing above the search's lowest frequency: no oscillation to name
-            continue
-        if o["share"] >= OSCILLATION_SHARE:
-            hits.append(o)
+    hits = [o for o in (limit_cycle(r.u, r.dt) for r in runs) if o is not None]
     if 2 * len(hits) > len(runs):
         f = float(np.median([o["freq_Hz"] for o in hits]))
         share = float(np.median([o["share"] for o in hits]))

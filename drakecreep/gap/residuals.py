@@ -33,6 +33,7 @@ from drakecreep.errors import InputError
 
 __all__ = [
     "REGIMES",
+    "limit_cycle",
     "classify_regimes",
     "regime_shares",
     "order_spectrum",
@@ -555,6 +556,17 @@ def dominant_oscillation(record, dt, f_min=OSCILLATION_MIN_HZ):
     rms = _band_rms(f, p, df, float(f[k]))
     var = float(np.var(r))
     return {"freq_Hz": float(f[k]), "rms": rms, "share": rms * rms / var if var > 0 else 0.0}
+
+
+def limit_cycle(record, dt, f_min=OSCILLATION_MIN_HZ):
+    """A record's :func:`dominant_oscillation` when it holds at least :data:`OSCILLATION_SHARE` of the variance (a
+    sustained oscillation: the limit cycle of an unstable loop), else None; None too for a record too short to
+    search, or sampled too coarsely for ``f_min``."""
+    try:
+        o = dominant_oscillation(record, dt, f_min)
+    except InputError:
+        return None
+    return o if o["share"] >= OSCILLATION_SHARE else None
 
 
 def _paired_bands(measured, simulated, dt, f_min):

@@ -222,3 +222,16 @@ def test_fixed_to_tells_a_force_fixed_to_the_travel_from_one_fixed_in_time():
     noise = [rng.normal(size=t.size) for _ in speeds]
     assert fixed_to(noise, vs, labels, dt)["verdict"] == "cannot tell"
     assert fixed_to(travel[:1], vs[:1], labels[:1], dt)["verdict"] == "cannot tell"  # one run says nothing
+
+
+def test_limit_cycle_is_the_dominant_oscillation_when_it_holds_a_quarter_of_the_variance():
+    from drakecreep.gap.residuals import OSCILLATION_SHARE, limit_cycle
+
+    dt = 1e-3
+    t = np.arange(3000) * dt
+    rng = np.random.default_rng(0)
+    cycle = 100.0 * np.sin(2 * np.pi * 207.0 * t) + rng.normal(0.0, 5.0, t.size)
+    o = limit_cycle(cycle, dt)
+    assert o is not None and abs(o["freq_Hz"] - 207.0) < 5.0 and o["share"] >= OSCILLATION_SHARE
+    assert limit_cycle(rng.normal(0.0, 5.0, t.size), dt) is None  # noise: no line holds a quarter
+    assert limit_cycle(cycle[:10], dt) is None  # too short to search: nothing to name
