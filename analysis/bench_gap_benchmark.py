@@ -76,11 +76,14 @@ def report(res):
     for r in res["datasets"]:
         a = r.get("audit") or {}
         e = {k: (None if v is None else v["force_rms"]) for k, v in a.items()}
+        low = {k: (None if v is None else v.get("force_lowpass_rms")) for k, v in a.items()}
         f = lambda x: "-" if x is None else f"{x:.2f}"  # noqa: E731
+        below = (f" (below 100 Hz {f(low.get('nominal'))} / {f(low.get('claimed'))} / {f(low.get('true'))})"
+                 if low.get("nominal") is not None else "")  # rows written before the figure have none
         print(f"  {r['seed']} {r['axis']:8s} {(r['withheld'] or ['null'])[0]:20s} SNR {r['snr']:5.1f} "
               f"expected {str(r['expected'] or '-'):19s} claimed {'+'.join(r['claimed']) or '-':32s} "
               f"first passing {str(r['first_passing'] or '-'):19s} audit force % nom {f(e.get('nominal'))} "
-              f"claimed {f(e.get('claimed'))} true {f(e.get('true'))}  {r['seconds']:.0f} s")
+              f"claimed {f(e.get('claimed'))} true {f(e.get('true'))}{below}  {r['seconds']:.0f} s")
 
 
 def main():

@@ -223,6 +223,8 @@ def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     assert row["train_sse"] > 0 and row["train_variance"] > 0
     assert row["uncertain"] == ["table.seal_force"] and set(row["claimed_model"]["fitted"]) == {"table.seal_force"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
+    # beside the scored figure, its part below 100 Hz (docs 3ce), which an encoder-count ripple hardly reaches
+    assert 0 < row["audit"]["nominal"]["force_lowpass_rms"] <= row["audit"]["nominal"]["force_rms"]
     assert row["oscillation"] is None and "audit_oscillation_nepers" not in row  # a stable null: no spectral audit
     # where the diagnosis located what it left unexplained on the held-out runs
     assert row["where"]["force_rms_N"] > 0 and sum(row["where"]["bands"].values()) == pytest.approx(1.0)

@@ -153,6 +153,24 @@ def test_force_error_in_a_mode_band_sees_an_oscillation_there_and_nothing_else(r
         {"force_band_" + f"{lo:.3g}-{hi:.3g}_Hz" for lo, hi in MODE_BANDS_HZ if lo < 0.45 * 250.0}
 
 
+def test_force_error_below_the_cutoff_leaves_out_a_fast_ripple_and_keeps_a_slow_one(run, nominal):
+    """``force_lowpass``: the force residual through the IDIM's 100 Hz low-pass over the whole measured force. A
+    300 Hz ripple the simulation adds (as an encoder-count ripple of a 4 kHz speed loop does) grows ``force`` and
+    hardly ``force_lowpass``; a 10 Hz one grows both alike; and the part below adds to the part above in energy."""
+    t = np.arange(run.n) * run.dt
+    err = drake_replay_errors(nominal, bands=False)
+    assert 0.0 < err["force_lowpass"] < err["force"]
+    ripple = 0.3 * np.linalg.norm(run.force) / math.sqrt(run.n / 2)  # 30 % of the force's RMS as an amplitude
+    fast = drake_replay_errors(dataclasses.replace(nominal, force=nominal.force + ripple * np.sin(2 * np.pi * 300 * t)),
+                               bands=False)
+    slow = drake_replay_errors(dataclasses.replace(nominal, force=nominal.force + ripple * np.sin(2 * np.pi * 10 * t)),
+                               bands=False)
+    assert fast["force"] > err["force"] + 5.0 and fast["force_lowpass"] == pytest.approx(err["force_lowpass"], abs=0.5)
+    assert slow["force_lowpass"] > err["force_lowpass"] + 5.0
+    assert slow["force_lowpass"] == pytest.approx(slow["force"], rel=0.1)
+    assert fast["force_lowpass"] ** 2 <= fast["force"] ** 2
+
+
 @pytest.mark.parametrize("sampled", [False, True], ids=["error_controlled", "sampled"])
 @pytest.mark.parametrize("delay, shift", [(1.0, 1), (0.5, 0), (1.5, 1), (2.0, 2)])
 def test_computation_delay_holds_older_outputs(run, delay, shift, sampled):
