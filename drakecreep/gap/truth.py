@@ -36,7 +36,8 @@ maps them onto the candidates of the diagnosis); this module only simulates them
 * with a candidate in the Drake diagnosis's library (:data:`LIBRARY_EFFECTS`): a strong Stribeck drop,
   asymmetric friction, position-dependent friction (a smooth ``tanh`` ramp, not the library's periodic
   level), a lead error with harmonics (kinematic: the nut follows the screw angle with a periodic error, so
-  it acts through the table's inertia and the spring; it shows on the scale), cogging with harmonics (motor
+  it acts through the table's inertia and the spring, whose force reaches the motor through the error's
+  gearing, ``F (1 + e')``; it shows on the scale), cogging with harmonics (motor
   side), an extra structural mode (a payload on a spring, 10-120 Hz), a control delay of 1-3 samples, a
   bearing defect (a force periodic in screw angle at a *non-integer* order 2.3-3.7: periodic in position,
   with a period that is not a divisor of the lead), a force ripple at a fixed time frequency (6-25 Hz,
@@ -485,12 +486,15 @@ def simulate_batch(jobs):
                 else:
                     fk = p["k"] * stretch + p["c"] * dstretch
                 fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
+                # the chain's force reaches the motor through the lead error's gearing, (1 + e'(x1)): the nut's
+                # travel is x1 + e(x1), so the virtual work of the force on it is fk (1 + e') dx1
+                fk_motor = fk * (1.0 + lead_err_slope(x1)) if has_le else fk
                 th = w_lead * x1
                 extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])
                                                 + p["cg_h2"] * np.sin(2 * p["cg_order"] * th))
                          + p["bd_amplitude_N"] * np.sin(p["bd_order"] * th + p["bd_phase"])
                          + p["tr_amplitude_N"] * np.sin(2 * np.pi * p["tr_freq_Hz"] * t + p["tr_phase"]))
-                a1 = (f_app - fm - fk - extra) / p["m1"]
+                a1 = (f_app - fm - fk_motor - extra) / p["m1"]
                 sg = np.sign(v2)
                 fc = p["Fc_t"] * (1 + sg * p["casym"]) * (1 + p["gamma"] * np.tanh((x2 - p["xc"]) / p["width"]))
                 gz = fc * (1 + (p["Fs_ratio"] - 1) * np.exp(-(v2 / p["vs"]) ** 2))
