@@ -295,3 +295,53 @@ def test_the_shipped_drive_example_is_what_its_script_makes():
         np.testing.assert_allclose(got.u, want.u, rtol=1e-12, atol=1e-9)
     assert shipped.meta.controller.kind == "drakecreep" and shipped.meta.params == rig
     assert shipped.meta.params.disturbance.lead_error_amplitude == 0.0 and mde.LEAD_ERROR > 0
+
+
+def _lowpass_row(seed, category, expected, nominal, nominal_low, ranking, refits_low, oscillation=None):
+    row = _drive_row(seed, category, expected, 5.0 if expected else 0.0, nominal, ranking, [], oscillation)
+    row.update(axis="flexible", test_force_lowpass_nominal_runs=nominal_low, null_test_force_lowpass_runs=refits_low,
+               first_passing=next((c["effect"] for c in ranking if c["passes"]), None))
+    return row
+
+
+def _low(effect, runs, low, passes=False, gain=0.0, transmission=None):
+    return dict(_ranked(effect, runs), test_force_lowpass_runs=low, passes=passes, gain=gain,
+                transmission=transmission)
+
+
+def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
+    """The recount of the first claim on ``force_lowpass`` (docs 3ce): a ripple whose whole force errors hardly
+    move (the count ripple drawn anew) but whose errors below 100 Hz halve on every run is claimed there and not on
+    the whole force; a null's candidate moving below 100 Hz within the refits' spread is not; a lead error decided on
+    the transmission keeps its verdict; rows without the fields are refused in one line."""
+    spec = importlib.util.spec_from_file_location("lcr", ANALYSIS / "lowpass_claim_recount.py")
+    lcr = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(ANALYSIS))
+    try:
+        spec.loader.exec_module(lcr)
+    finally:
+        sys.path.remove(str(ANALYSIS))
+    nominal, low = [30.0, 32.0, 35.0, 31.0, 33.0], [12.0, 14.0, 15.0, 13.0, 12.5]
+    refits = [[12.1, 14.0, 15.1, 12.9, 12.5], [11.9, 14.1, 14.9, 13.0, 12.6]]  # a null of about 1.5 %
+    ripple = _low("force_ripple", [29.5, 32.5, 34.0, 31.5, 32.0], [6.0, 7.5, 7.0, 6.5, 6.0], gain=0.3)
+    row = _lowpass_row(1, "library", "force_ripple", nominal, low, [ripple], refits)
+    x = lcr.recount_row(row)
+    assert x["first_passing"] is None and x["first_passing_lowpass"] == "force_ripple"
+    assert x["null_lowpass"] == pytest.approx(max(abs(1 - sum(v * v for v in r) / sum(v * v for v in low))
+                                                  for r in refits))
+    drift = _low("law_coulomb", [29.0, 33.0, 34.0, 32.0, 32.5], [11.95, 14.05, 14.95, 13.0, 12.45], gain=0.2)
+    null = lcr.recount_row(_lowpass_row(2, "null", None, nominal, low, [drift], refits))
+    assert null["first_passing_lowpass"] is None
+    lead = _low("lead_error", nominal, low, passes=True, gain=0.0, transmission={"passes": True})
+    y = lcr.recount_row(_lowpass_row(3, "library", "lead_error", nominal, low, [lead], refits))
+    assert y["first_passing_lowpass"] == "lead_error" and y["candidates"][0]["kept"]
+    assert lcr.recount_row(dict(row, test_force_lowpass_nominal_runs=None)) is None
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ANALYSIS), str(ANALYSIS.parent)]))
+    (tmp_path / "rows.json").write_text(json.dumps({"datasets": [row]}))
+    out = subprocess.run([sys.executable, str(ANALYSIS / "lowpass_claim_recount.py"), str(tmp_path / "rows.json")],
+                         capture_output=True, text=True, env=env)
+    assert out.returncode == 0 and "below 100 Hz   : top-1 (first claim) 1 / 1" in out.stdout, out.stdout + out.stderr
+    (tmp_path / "old.json").write_text(json.dumps({"datasets": [dict(row, test_force_lowpass_nominal_runs=None)]}))
+    bad = subprocess.run([sys.executable, str(ANALYSIS / "lowpass_claim_recount.py"), str(tmp_path / "old.json")],
+                         capture_output=True, text=True, env=env)
+    assert bad.returncode == 2 and "rows: got no drakecreep row" in bad.stderr and "Traceback" not in bad.stderr

@@ -637,10 +637,15 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
                 "transmission": (c.replay or {}).get("transmission"),
                 "values": dict(c.values),
                 "test_force_runs": ([float(c.test_errors[k]["force"]) for k in labels]
-                                    if all(k in c.test_errors for k in labels) else None)}
+                                    if all(k in c.test_errors for k in labels) else None),
+                # and below 100 Hz, where the speed loop's encoder-count ripple hardly reaches (docs 3ce)
+                "test_force_lowpass_runs": ([float(c.test_errors[k]["force_lowpass"]) for k in labels]
+                                            if all(k in c.test_errors for k in labels) else None)}
                for c in res.candidates]
     row = _row(ds, claimed, ranking, friction=res.params.friction.law, uncertain=list(kw.get("uncertain", DEFAULT_UNCERTAIN)),
                test_force_nominal_runs=[float(res.nominal_test_errors[k]["force"]) for k in labels],
+               test_force_lowpass_nominal_runs=[float(res.nominal_test_errors[k]["force_lowpass"]) for k in labels],
+               null_test_force_lowpass_runs=res.null_test_force_lowpass,
                replay_null=res.replay_null, transmission_null=res.transmission_null,
                null_test_force_runs=res.null_test_force,
                train_sse=res.train_sse, train_variance=res.train_variance,

@@ -132,6 +132,8 @@ __all__ = [
     "check_run",
     "diagnose_drive",
     "fit_drive",
+    "force_test",
+    "passes_on_force",
 ]
 
 #: DriveParams fields the output-error fit may take as uncertain.
@@ -362,6 +364,10 @@ class DriveDiagnosis:
         The force error [%] of each held-out run (in the order of ``nominal_test_errors``) replayed with each of
         those leave-one-out refits (one tuple per training run left out): the run-to-run variation run by run, so
         that other claim statistics can be recounted on a benchmark's rows.
+    null_test_force_lowpass : tuple or None
+        The same with each run's force error below 100 Hz (``force_lowpass`` of
+        :func:`~drakecreep.gap.drake_replay.drake_replay_errors`), for a recount on the part of the force an
+        encoder-count ripple hardly reaches (docs/gap_benchmark.md, 3ce).
     transmission_null : float or None
         The same largest change of the pooled held-out ``transmission`` error energy (the position the screw adds
         between the motor and the table), on runs that all have a linear scale: the shrink a lead error, decided
@@ -406,6 +412,7 @@ class DriveDiagnosis:
     not_ranked: dict = field(default_factory=lambda: dict(NOT_IN_MODEL))
     replay_null: float | None = None
     null_test_force: tuple | None = None
+    null_test_force_lowpass: tuple | None = None
     transmission_null: float | None = None
     train_sse: float | None = None
     train_variance: float | None = None
@@ -520,6 +527,7 @@ class DriveDiagnosis:
             "test_errors": self.test_errors,
             "replay_null": self.replay_null,
             "null_test_force": self.null_test_force,
+            "null_test_force_lowpass": self.null_test_force_lowpass,
             "transmission_null": self.transmission_null,
             "train_sse": self.train_sse,
             "train_variance": self.train_variance,
@@ -1464,25 +1472,27 @@ def _replay_null(train, test, fit, replayer, nominal_errors):
     computed (one training run, or nothing fitted), each refit's held-out force errors [%] run by run (a tuple
     of tuples in the order of ``nominal_errors``; ``None`` with the null), and the same largest change of the
     pooled held-out ``transmission`` error energy (the screw's, runs with a linear scale; ``None`` when a run
-    has none): the shrink a lead error decided on the transmission must beat (:func:`_held_out_on_scale`).
+    has none): the shrink a lead error decided on the transmission must beat (:func:`_held_out_on_scale`); and
+    each refit's held-out ``force_lowpass`` errors run by run, like the force's (a recount's, docs 3ce).
     """
     if len(train) < 2 or fit is None:
-        return None, None, None
+        return None, None, None, None
     labels = list(nominal_errors)
     keys = ("force", "transmission") if all("transmission" in nominal_errors[k] for k in labels) else ("force",)
     e_nom = {key: float(np.sum(_energy(nominal_errors, labels, key))) for key in keys}
     refits = [fit.without(i) for i in range(len(train))]
-    changes, runs = {key: [] for key in keys}, []
+    changes, runs, runs_lowpass = {key: [] for key in keys}, [], []
     for errors in replayer.many_errors([(test, refit) for refit in refits]):
         for key in keys:
             e = float(np.sum(_energy(errors, labels, key)))
             changes[key].append(abs(1.0 - e / e_nom[key]) if e_nom[key] > 0 else 0.0)
         runs.append(tuple(float(errors[k]["force"]) for k in labels))
+        runs_lowpass.append(tuple(float(errors[k]["force_lowpass"]) for k in labels))
     transmission = float(max(changes["transmission"])) if "transmission" in changes else None
-    return float(max(changes["force"])), tuple(runs), transmission
+    return float(max(changes["force"])), tuple(runs), transmission, tuple(runs_lowpass)
 
 
-def _force_test(current_errors, errs, null):
+def force_test(current_errors, errs, null):
     """The held-out force errors ``errs`` against ``current_errors``: the paired gain [points of %], its standard
     error, its Student bar and :func:`~drakecreep.gap.claims.replay_test` with the run-to-run ``null``."""
     labels = list(current_errors)
@@ -1490,6 +1500,16 @@ def _force_test(current_errors, errs, null):
     bar = float(stats.t.ppf(1 - ALPHA, len(labels) - 1) * se)
     rt = replay_test(_energy(current_errors, labels), _energy(errs, labels), 0.0 if null is None else null)
     return gain, se, bar, rt
+
+
+def passes_on_force(train_gain, gain, bar, rt, null):
+    """The held-out force rule of a candidate: a training gain, and a held-out paired gain above its Student ``bar``
+    or a pooled shrink of more than :data:`~drakecreep.gap.claims.POOLED_FACTOR` run-to-run nulls, and
+    ``rt`` (:func:`~drakecreep.gap.claims.replay_test` against the ``null``) passing; nothing passes without a
+    null. Its inputs come from :func:`force_test`."""
+    nulls = rt["shrink"] / null if null else None
+    large = nulls is not None and nulls > POOLED_FACTOR
+    return bool(null is not None and train_gain > 0 and (gain > bar or large) and rt["passes"])
 
 
 def _held_out(name, values, train_gain, test, current, current_errors, replayer, null, transmission_null=None,
@@ -1500,11 +1520,10 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
     if kinematic and name == _KINEMATIC and all("transmission" in current_errors[k] and "transmission" in errs[k]
                                                 for k in current_errors):
         return _held_out_on_scale(name, values, train_gain, current_errors, errs, null, transmission_null)
-    gain, se, bar, rt = _force_test(current_errors, errs, null)
+    gain, se, bar, rt = force_test(current_errors, errs, null)
     n = len(test)
     nulls = rt["shrink"] / null if null else None  # the pooled shrink in run-to-run nulls
-    large = nulls is not None and nulls > POOLED_FACTOR
-    ok = bool(null is not None and train_gain > 0 and (gain > bar or large) and rt["passes"])
+    ok = passes_on_force(train_gain, gain, bar, rt, null)
     student = f"held-out gain {gain:+.3f} <= {bar:.3f} (t quantile x standard error of {n} runs)"
     if ok:
         reason = "passes" if gain > bar else (f"passes on its pooled shrink: {nulls:.1f} run-to-run nulls "
@@ -1538,7 +1557,7 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
     """
     labels = list(current_errors)
     n = len(labels)
-    gain, se, bar, rt = _force_test(current_errors, errs, null)
+    gain, se, bar, rt = force_test(current_errors, errs, null)
     lr = log_ratios([current_errors[k]["transmission"] for k in labels], [errs[k]["transmission"] for k in labels])
     mean, se_t = mean_and_standard_error(lr)
     bar_t = float(stats.t.ppf(1 - ALPHA, n - 1) * se_t)
@@ -1638,14 +1657,15 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     nominal_sims = replay(test, params)
     nominal_errors = _errors_of(test, nominal_sims)
     say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
-    null, null_runs, transmission_null = (_replay_null(train, test, fit, replay, nominal_errors) if names
-                                          else (None, None, None))
+    null, null_runs, transmission_null, null_runs_lowpass = (
+        _replay_null(train, test, fit, replay, nominal_errors) if names else (None, None, None, None))
     kinematic = _on_scale(train) and _on_scale(test)
     if names:
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %")
             + ("" if transmission_null is None else f" (force), {100 * transmission_null:.3g} % (transmission)"))
     known = dict(prior=prior, nominal=params, prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
-                 replay_null=null, null_test_force=null_runs, transmission_null=transmission_null,
+                 replay_null=null, null_test_force=null_runs, null_test_force_lowpass=null_runs_lowpass,
+                 transmission_null=transmission_null,
                  train_sse=None if fit is None else float(fit.residual @ fit.residual),
                  train_variance=None if fit is None else _effective_variance(fit.residual, len(fit.paths)))
 

@@ -181,10 +181,11 @@ def test_a_drakecreep_rows_true_shrink_is_the_truths_values_in_the_nominal_param
     nominal = ds.train[0].meta.params
 
     def diagnosis(train, test, progress=False, **kw):
-        return SimpleNamespace(claimed=(), nominal_test_errors={r.label: {"force": 10.0} for r in test}, candidates=(),
+        return SimpleNamespace(claimed=(), nominal_test_errors={r.label: {"force": 10.0, "force_lowpass": 5.0}
+                                                                for r in test}, candidates=(),
                                params=nominal, nominal=nominal, replay_null=0.01, transmission_null=None,
-                               null_test_force=[], train_sse=1.0, train_variance=1.0, test_errors={}, seconds=0.0,
-                               warnings=(), oscillation=oscillation, where={}, fitted=())
+                               null_test_force=[], null_test_force_lowpass=[], train_sse=1.0, train_variance=1.0,
+                               test_errors={}, seconds=0.0, warnings=(), oscillation=oscillation, where={}, fitted=())
 
     monkeypatch.setattr(drive_fit, "diagnose_drive", diagnosis)
     oscillation = None
@@ -221,6 +222,11 @@ def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     e_nom = np.sum(np.square(nominal))
     assert max(abs(1 - np.sum(np.square(r)) / e_nom) for r in null_runs) == pytest.approx(row["replay_null"], rel=1e-9)
     assert row["train_sse"] > 0 and row["train_variance"] > 0
+    # the same below 100 Hz (docs 3ce), for a recount there: the nominal's, each candidate's and each refit's
+    low = row["test_force_lowpass_nominal_runs"]
+    assert len(low) == len(nominal) and all(0 < a <= b for a, b in zip(low, nominal))
+    assert len(ranked["nut_friction_side"]["test_force_lowpass_runs"]) == len(ds.test)
+    assert [len(r) for r in row["null_test_force_lowpass_runs"]] == [len(r) for r in null_runs]
     assert row["uncertain"] == ["table.seal_force"] and set(row["claimed_model"]["fitted"]) == {"table.seal_force"}
     assert row["audit"]["nominal"]["force_rms"] > 0 and row["true_shrink"] is None
     # beside the scored figure, its part below 100 Hz (docs 3ce), which an encoder-count ripple hardly reaches

@@ -703,6 +703,9 @@ def test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null():
     e_nom = sum(e["force"] ** 2 for e in result.nominal_test_errors.values())
     assert max(abs(1 - sum(f * f for f in r) / e_nom) for r in result.null_test_force) == pytest.approx(
         result.replay_null, rel=1e-9)
+    # and each refit's held-out errors below 100 Hz, the same runs in the same order (a recount's, docs 3ce)
+    assert [len(r) for r in result.null_test_force_lowpass] == [3, 3]
+    assert all(lo <= f for r, q in zip(result.null_test_force, result.null_test_force_lowpass) for f, lo in zip(r, q))
     (lead,) = [c for c in result.candidates if c.name == "lead_error"]
     assert lead.train_gain * result.train_sse / result.train_variance > stats.chi2.ppf(0.999, 3)
     assert result.params.disturbance.lead_error_amplitude == pytest.approx(3e-6, rel=0.1)
