@@ -311,9 +311,9 @@ def _low(effect, runs, low, passes=False, gain=0.0, transmission=None):
 
 def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
     """The recount of the first claim on ``force_lowpass`` (docs 3ce): a ripple whose whole force errors hardly
-    move (the count ripple drawn anew) but whose errors below 100 Hz halve on every run is claimed there and not on
-    the whole force; a null's candidate moving below 100 Hz within the refits' spread is not; a lead error decided on
-    the transmission keeps its verdict; rows without the fields are refused in one line."""
+    move (the count ripple drawn anew; the row's own verdict is no claim) but whose errors below 100 Hz halve on
+    every run is claimed there; a null's candidate moving below 100 Hz within the refits' spread is not; a lead
+    error decided on the transmission keeps its verdict; rows without the fields are refused in one line."""
     spec = importlib.util.spec_from_file_location("lcr", ANALYSIS / "lowpass_claim_recount.py")
     lcr = importlib.util.module_from_spec(spec)
     sys.path.insert(0, str(ANALYSIS))
