@@ -37,6 +37,7 @@ __all__ = ["recount_row", "main"]
 
 
 def _errors(values):
+    """Per-run errors below 100 Hz under the key ``force``, the one :func:`force_test` reads."""
     return {f"run{i}": {"force": float(v)} for i, v in enumerate(values)}
 
 

@@ -474,9 +474,12 @@ def simulate_batch(jobs):
             for i in range(sub):
                 t = (kk + (j * sub + i) / SUBSTEPS) * DT
                 f_app = f_app + (cmd - f_app) * lagc
+                # the nut's travel is x1 + e(x1): its gearing 1 + e'(x1) moves the chain's motor end and, by virtual
+                # work, carries the chain's force back to the motor
+                gearing = 1.0 + lead_err_slope(x1) if has_le else 1.0
                 if has_le:
                     stretch = x1 + lead_err(x1) - x2
-                    dstretch = v1 * (1.0 + lead_err_slope(x1)) - v2
+                    dstretch = v1 * gearing - v2
                 else:
                     stretch, dstretch = x1 - x2, v1 - v2
                 if has_bl:  # a dead zone of +-bl in the chain: no force (and no damping) until the balls bear
@@ -486,15 +489,12 @@ def simulate_batch(jobs):
                 else:
                     fk = p["k"] * stretch + p["c"] * dstretch
                 fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
-                # the chain's force reaches the motor through the lead error's gearing, (1 + e'(x1)): the nut's
-                # travel is x1 + e(x1), so the virtual work of the force on it is fk (1 + e') dx1
-                fk_motor = fk * (1.0 + lead_err_slope(x1)) if has_le else fk
                 th = w_lead * x1
                 extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])
                                                 + p["cg_h2"] * np.sin(2 * p["cg_order"] * th))
                          + p["bd_amplitude_N"] * np.sin(p["bd_order"] * th + p["bd_phase"])
                          + p["tr_amplitude_N"] * np.sin(2 * np.pi * p["tr_freq_Hz"] * t + p["tr_phase"]))
-                a1 = (f_app - fm - fk_motor - extra) / p["m1"]
+                a1 = (f_app - fm - fk * gearing - extra) / p["m1"]
                 sg = np.sign(v2)
                 fc = p["Fc_t"] * (1 + sg * p["casym"]) * (1 + p["gamma"] * np.tanh((x2 - p["xc"]) / p["width"]))
                 gz = fc * (1 + (p["Fs_ratio"] - 1) * np.exp(-(v2 / p["vs"]) ** 2))
