@@ -49,7 +49,7 @@ from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE, applied_force,
-                                   axis_friction, axis_parameters, axis_ripple, lead_error_force, nut_load)
+                                   axis_friction, axis_parameters, axis_ripple, lead_error_drive, nut_load)
 
 __all__ = ["ScreenResult", "Constancy", "constancy", "screen_effect", "screen_delay", "inverse_dynamics_force",
            "NOT_SCREENED", "LINEAR", "SHAPE", "SLOW_SHARE", "MIN_SLIDING"]
@@ -152,7 +152,9 @@ def inverse_dynamics_force(parameters, t, q, dq, ddq, tau=0.0):
     force, ``g(tau) + r - alpha M ddq`` (:func:`~drakecreep.model.axis.nut_load` with the measured
     acceleration, so the force stays affine in the coefficient), and ``tau - g(tau)`` is what a saturating
     drive does not apply of the command (:func:`~drakecreep.model.axis.applied_force`; 0 for a linear drive).
-    A lead error adds the table's inertial force ``m_t e''(q) dq^2`` (:func:`~drakecreep.model.axis.lead_error_force`).
+    A lead error adds the table's inertial force ``m_t e''(q) dq^2`` and the nut's force geared by ``1 + e'(q)``, to
+    first order in the error, with the nut's force from the measured command
+    (:func:`~drakecreep.model.axis.lead_error_drive`: affine in the amplitudes).
     """
     other, friction = _force_parts(parameters, t, q, dq, ddq, tau)
     return other + friction
@@ -167,7 +169,8 @@ def _force_parts(parameters, t, q, dq, ddq, tau=0.0):
     P = dict(zip(AXIS_PARAMETERS, p))
     ripple = axis_ripple(q, t, p)
     applied = applied_force(tau, p)
-    return (P["mass"] * ddq + P["offset"] - ripple - lead_error_force(q, dq, p) + (tau - applied),
+    lead = lead_error_drive(q, dq, ddq, applied + ripple, p)
+    return (P["mass"] * ddq + P["offset"] - ripple + lead + (tau - applied),
             axis_friction(dq, p, q, t, nut_load(applied + ripple, p, acceleration=ddq)))
 
 

@@ -29,9 +29,16 @@ plus a fixed time frequency ``f_r``)::
 
 A lead error moves the nut ``e(x_m)`` ahead of where the screw's angle puts it (:func:`lead_error`: the first
 two harmonics of the ``lead``). On the two-mass axis the spring's motor end is at ``x_m + e(x_m)`` (exact
-kinematics); on the rigid axis the table is at ``x + e(x)``, and the drive must supply the table's extra
-inertial force ``m_t e''(x) v^2`` (``m_t = (1 - motor_mass_fraction) M``; the terms in ``e'`` (about 1 %) are
-left out), a ripple of position whose amplitude grows with the square of the speed.
+kinematics). On the rigid axis the table is at ``x + e(x)`` and moves at ``g v`` with the gearing
+``g = 1 + e'(x)``; the motor side ``m_m = motor_mass_fraction M`` stays at ``x`` (Lagrange's equation of the
+constraint, the rigid limit of the two-mass axis)::
+
+    (m_m + m_t g^2) dv/dt = F + r - m_t g e''(x) v^2 - g (f(g v, x + e, t) + offset)
+
+``m_t = M - m_m``. Two pushes at the lead's period: the table's extra inertial force ``m_t e'' v^2``
+(:func:`lead_error_force`), which grows with the square of the speed, and the nut's force geared by ``g``, which
+at slow speed is mostly friction (``e'`` is 1-3 % for 4-12 um on a 2.5-10 mm lead; 0.4 N at 10 mm/s on the
+benchmark's truths, docs/gap_benchmark.md, 3ce).
 
 With bristles (``bristles=True``, ``bristle_stiffness`` ``sigma0 > 0``) the Coulomb-Stribeck part is the LuGre
 law instead (Canudas de Wit et al. 1995): a bristle deflection ``z`` is appended to the state, and::
@@ -71,7 +78,8 @@ from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
            "set_axis_parameters", "axis_friction", "applied_force", "nut_load", "friction_map", "FRICTION_MAP",
-           "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "POSITION_RIPPLE",
+           "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "lead_error_drive",
+           "POSITION_RIPPLE",
            "axis_ripple"]
 
 #: numeric parameters, in order, with their default values
@@ -325,15 +333,39 @@ def lead_error(x, p):
     return e, d1, d2
 
 
-def lead_error_force(x, v, p):
-    """Force [N] along +x on the RIGID axis from a lead error (:func:`lead_error`): ``-m_t e''(x) v^2``, the table's
-    extra inertial force the drive must supply (``m_t = (1 - motor_mass_fraction) mass``; the terms in ``e'``,
-    about 1 % of the inertia force, are left out)."""
-    e2 = lead_error(x, p)[2]
+def lead_error_force(x, v, p, lead=None):
+    """Force [N] along +x on the RIGID axis from the table's extra inertia under a lead error (:func:`lead_error`):
+    ``-m_t g e''(x) v^2`` with the gearing ``g = 1 + e'(x)`` and ``m_t = (1 - motor_mass_fraction) mass``. The rest
+    of the lead error's push (the nut's force geared by ``g``, the table's inertia ``m_t g^2``) is in the rigid
+    equation of :class:`MeasuredAxis_`; :func:`lead_error_drive` is the whole push to first order in ``e``.
+    ``lead``: :func:`lead_error` at ``x`` if already evaluated."""
+    _, e1, e2 = lead if lead is not None else lead_error(x, p)
     if _off(e2):
         return 0.0
     P = dict(zip(_NAMES, p))
-    return -(1.0 - P["motor_mass_fraction"]) * P["mass"] * e2 * v * v
+    return -(1.0 - P["motor_mass_fraction"]) * P["mass"] * (1.0 + e1) * e2 * v * v
+
+
+def lead_error_drive(x, v, a, drive, p):
+    """Drive force [N] a lead error takes on the RIGID axis for a measured motion ``x, v, a`` [m, m/s, m/s^2] and
+    the applied force ``drive`` [N] (ripple included), to first order in the error ``e`` (arrays or floats)::
+
+        m_t e''(x) v^2 + e'(x) (drive - (m_m - m_t) a)
+
+    The rigid equation of :class:`MeasuredAxis_` expanded in ``e``, with the nut's force ``f + offset`` taken as
+    ``drive - M a`` (its zeroth order): for a measured drive the force is affine in the lead error's amplitudes,
+    as an inverse-dynamics fit wants them (:func:`drakecreep.gap.screen.inverse_dynamics_force`). Left out: the
+    friction's change with the table's speed ``g v``, ``e' v df/dv`` (``Fv e' v`` of the viscous part, a few
+    tenths of a newton on the benchmark's truths), which would tie the amplitudes to the friction's
+    coefficients; and the terms in ``e'^2``.
+    """
+    _, e1, e2 = lead_error(x, p)
+    if _off(e1) and _off(e2):
+        return 0.0
+    P = dict(zip(_NAMES, p))
+    m_m = P["motor_mass_fraction"] * P["mass"]
+    m_t = P["mass"] - m_m
+    return m_t * e2 * v * v + e1 * (drive - (m_m - m_t) * a)
 
 
 #: the position ripple's harmonic amplitudes [N]: ``(cos, sin)`` of its first and second harmonic (a cogging's
@@ -414,9 +446,6 @@ def MeasuredAxis_(T):
         def _p(self, context):
             return context.get_numeric_parameter(0).CopyToVector()
 
-        def _table(self):
-            return 2 if self.flexible else 0
-
         def _masses(self, P):
             """``(m_m, m_t)``: motor side and table (both the whole mass when rigid)."""
             if not self.flexible:
@@ -424,14 +453,25 @@ def MeasuredAxis_(T):
             m_m = P["motor_mass_fraction"] * P["mass"]
             return m_m, P["mass"] - m_m
 
-        def _friction(self, x, p, t, load):
-            """``(friction on the table, [dz/dt] or [])`` under the axial load ``load`` (:meth:`_load`)."""
+        def _table_motion(self, x, p, lead=None):
+            """``(position, speed)`` of the table: the two-mass axis's own; on the rigid axis the nut's,
+            ``(x + e(x), (1 + e'(x)) v)`` (``lead`` = :func:`lead_error` at ``x`` if already evaluated)."""
+            if self.flexible:
+                return x[2], x[3]
+            e, e1, _ = lead if lead is not None else lead_error(x[0], p)
+            if _off(e) and _off(e1):
+                return x[0], x[1]
+            return x[0] + e, x[1] * (1.0 + e1)
+
+        def _friction(self, x, p, t, load, lead=None):
+            """``(friction on the table, [dz/dt] or [])`` under the axial load ``load`` (:meth:`_load`), at the
+            table's position and speed (:meth:`_table_motion`)."""
             P = dict(zip(_NAMES, p))
-            i = self._table()
+            pos, speed = self._table_motion(x, p, lead)
             if not self.bristles:
-                return axis_friction(x[i + 1], p, x[i], t, load), []
-            zdot, f = bristle_rates(x[i + 1], x[-1], p, self._masses(P)[1], load)
-            return _level(P, x[i], t) * f, [zdot]
+                return axis_friction(speed, p, pos, t, load), []
+            zdot, f = bristle_rates(speed, x[-1], p, self._masses(P)[1], load)
+            return _level(P, pos, t) * f, [zdot]
 
         def _load(self, x, P, F, t, p, lead=None):
             """Axial load through the nut [N]: the screw's spring force (two-mass; its motor end at
@@ -442,7 +482,7 @@ def MeasuredAxis_(T):
                 return P["stiffness"] * (x[0] + e - x[2]) + P["damping"] * (x[1] * (1.0 + e1) - x[3])
             if _off(P["load_friction_coefficient"]):
                 return 0.0
-            return nut_load(F + axis_ripple(x[0], t, p), p, friction=self._friction(x, p, t, 0.0)[0])
+            return nut_load(F + axis_ripple(x[0], t, p), p, friction=self._friction(x, p, t, 0.0, lead)[0])
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             x = context.get_continuous_state_vector().CopyToVector()
@@ -450,9 +490,9 @@ def MeasuredAxis_(T):
             P = dict(zip(_NAMES, p))
             F = applied_force(self._force.Eval(context)[0], p)
             t = context.get_time()
-            lead = lead_error(x[0], p) if self.flexible else None
+            lead = lead_error(x[0], p)
             load = self._load(x, P, F, t, p, lead)
-            friction, zdot = self._friction(x, p, t, load)
+            friction, zdot = self._friction(x, p, t, load, lead)
             if self.flexible:
                 m_m, m_t = self._masses(P)
                 # the spring pulls the motor side back through the lead error's gearing, (1 + e'): the work
@@ -461,9 +501,16 @@ def MeasuredAxis_(T):
                 a_m = (F + axis_ripple(x[0], t, p) - load * (1.0 + e1)) / m_m
                 a_t = (load - friction - P["offset"]) / m_t
                 rates = [x[1], a_m, x[3], a_t]
+            elif _off(lead[1]) and _off(lead[2]):
+                rates = [x[1], (F + axis_ripple(x[0], t, p) - friction - P["offset"]) / P["mass"]]
             else:
-                push = F + axis_ripple(x[0], t, p) + lead_error_force(x[0], x[1], p) - friction - P["offset"]
-                rates = [x[1], push / P["mass"]]
+                # the table at x + e(x) moves at g v: Lagrange's equation of the constraint (module docstring)
+                g = 1.0 + lead[1]
+                m_m = P["motor_mass_fraction"] * P["mass"]
+                m_t = P["mass"] - m_m
+                push = (F + axis_ripple(x[0], t, p) + lead_error_force(x[0], x[1], p, lead)
+                        - g * (friction + P["offset"]))
+                rates = [x[1], push / (m_m + m_t * g * g)]
             derivatives.get_mutable_vector().SetFromVector(vector(rates + zdot))
 
         def _calc_motor(self, context, output):
@@ -472,11 +519,7 @@ def MeasuredAxis_(T):
 
         def _calc_table(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
-            if self.flexible:
-                output.SetFromVector(vector([x[2], x[3]]))
-                return
-            e, e1, _ = lead_error(x[0], self._p(context))  # the rigid table follows the nut: x + e(x)
-            output.SetFromVector(vector([x[0] + e, x[1] * (1.0 + e1)]))
+            output.SetFromVector(vector(list(self._table_motion(x, self._p(context)))))
 
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()

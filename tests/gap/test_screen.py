@@ -58,6 +58,32 @@ def test_inverse_dynamics_of_the_true_axis_is_close_to_the_measured_force(asym_r
     assert np.linalg.norm(tau - good) < 0.6 * np.linalg.norm(tau - bad)
 
 
+def test_the_inverse_dynamics_of_a_lead_error_is_the_rigid_axis_to_first_order():
+    """The screen's lead error (:func:`~drakecreep.model.axis.lead_error_drive`, affine in the amplitudes) against the
+    rigid Drake axis's own accelerations at 200 random states: 2.5 mm lead, 11 um error (``e'`` up to 2.7 %),
+    Coulomb friction and an offset (no viscous part: its change with the table's speed is the documented
+    omission). What is left is second order in ``e'``: 0.014 N RMS of the lead error's 8.7 N (0.17 %). The screen's
+    inertia-only form (up to session 74) left 1.0 N RMS (12 %) of it, the geared nut force, unexplained."""
+    from drakecreep.model.axis import MeasuredAxis, set_axis_parameters
+
+    p = dict(mass=60.0, motor_mass_fraction=0.4, coulomb=20.0, offset=2.0, lead_error_cos=10e-6, lead_error_sin=4e-6,
+             lead=2.5e-3)
+    axis = MeasuredAxis(False)
+    ctx = axis.CreateDefaultContext()
+    set_axis_parameters(axis, ctx, **p)
+    rng = np.random.default_rng(1)
+    q, dq, tau = rng.uniform(0, 0.01, 200), rng.uniform(-0.1, 0.1, 200), rng.uniform(-80.0, 80.0, 200)
+    ddq = np.empty(200)
+    for i in range(200):
+        ctx.SetContinuousState([q[i], dq[i]])
+        axis.GetInputPort("force").FixValue(ctx, [tau[i]])
+        ddq[i] = axis.EvalTimeDerivatives(ctx).CopyToVector()[1]
+    t = np.zeros(200)
+    residual = tau - inverse_dynamics_force(p, t, q, dq, ddq, tau)
+    unmodelled = tau - inverse_dynamics_force(dict(p, lead_error_cos=0.0, lead_error_sin=0.0), t, q, dq, ddq, tau)
+    assert np.linalg.norm(residual) < 0.005 * np.linalg.norm(unmodelled)
+
+
 def test_a_time_ripple_is_found_near_its_frequency():
     runs = _runs(dict(BASE, time_ripple_cos=3.0, ripple_frequency=13.0))
     sc = screen_effect(DRAKE_EFFECTS["time_ripple"], runs[:2], runs[2:], BASE)
