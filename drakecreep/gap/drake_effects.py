@@ -154,15 +154,17 @@ DRAKE_EFFECTS = {
                                    signature="force ripple periodic in position (cogging, a bearing)",
                                    bounds={"position_period": (2e-4, 0.05)}),
     # a kinematic lead error, first and second harmonic of the lead (drakecreep.model.axis.lead_error): on a
-    # motor-encoder loop its force is the table's inertia times e''(x) v^2, a position ripple growing with the
-    # square of the speed (the position_ripple candidate, of constant amplitude, cannot serve runs at 5-150 mm/s).
+    # motor-encoder loop its force is the nut's force geared by 1 + e'(x) plus the table's inertia times
+    # e''(x) v^2, a position ripple growing with the square of the speed above a friction-sized floor (the
+    # position_ripple candidate, of constant amplitude, cannot serve runs at 5-150 mm/s).
     # The held-out runs at 5-150 mm/s carry it in proportion to their squared speed, often one or two of five: it
     # may pass by the test over the runs' pieces (piece_test; docs/gap_benchmark.md, 3ag and 3ai).
     # Starts: the periodogram's peaks and twice them (screen); amplitudes up to 0.1 mm, far beyond any screw's
     "lead_error": DrakeEffect("lead_error", LEAD_ERROR + ("lead",),
                               tuple({"lead": x} for x in (2.5e-3, 5e-3, 1e-2, 2e-2)),
                               signature="force ripple periodic in position whose amplitude grows with the square of "
-                                        "the speed (the table's inertia behind a periodic lead error)",
+                                        "the speed above a friction-sized floor (the table's inertia and the nut's "
+                                        "force geared by a periodic lead error)",
                               bounds=dict({n: (-1e-4, 1e-4) for n in LEAD_ERROR}, lead=(1e-3, 0.05)),
                               piece_test=True),
     # a force at a fixed time frequency is there at constant speed as well; runs that share their timing (a
