@@ -164,9 +164,9 @@ DEFAULT_KINDS = ("p_p_cascade",)
 #: is off (seal force, nut preload, viscous: what ``diagnose_drive`` fits by default). Assumption: a user's
 #: catalogue or commissioning values, about 15 % off.
 DECLARED_SPREAD = 0.15
-#: Table travel [m] from the diagram's origin at which the declared chain's stiffness and damping are the
-#: truth's (the shaft's stiffness varies along the screw; the truth's spring does not).
-DECLARED_AT = 0.1
+#: Table position [m] at which a drawn truth's chain has its drawn stiffness and damping (:data:`truth.CHAIN_AT`);
+#: the declared chain is the truth's there and, since session 75, everywhere (both shafts soften along the screw).
+DECLARED_AT = T.CHAIN_AT
 
 
 def category_of(kind, withheld):
@@ -198,8 +198,10 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
       (with the drive's friction law: the diagram has one), its viscous part as ``motor.viscous_damping``;
     * table: ``table.mass = m2 - nut.mass``; its LuGre friction (``Fc``, ``Fs / Fc``, ``vs``, ``sigma0``,
       ``sigma1``, viscous) as the seal force and the friction parameters, no guide coefficient;
-    * axial chain: shaft 4 times stiffer than the truth's spring at :data:`DECLARED_AT`, bearing and nut equal,
-      so that the chain's stiffness and damping there are the truth's;
+    * axial chain: the truth's (:meth:`~drakecreep.gap.truth.Truth.chain`), a fixed-free shaft with its share of
+      the compliance at :data:`DECLARED_AT` (a quarter: 4 times the chain's stiffness) and its nut distance,
+      bearing and nut equal and carrying the damping, so that the chain's stiffness and damping are the truth's
+      at every table position;
     * current-loop lag, force limit, controller gains and periods (``controller_meta``) as the truth's.
 
     Not expressible, so left out: the truth's constant force offset, the motor friction's own law (a ``tanh``
@@ -210,14 +212,18 @@ def declared_params(tr, rng=None, spread=DECLARED_SPREAD):
     ratio = tr.lead / (2 * math.pi)
     inertia = tr.m1 * ratio ** 2
     k, c = tr.k_axial, tr.c_axial
+    share = tr.shaft_share
+    if not 0.0 < share < 1.0:
+        raise ValueError(f"declared_params: the truth's shaft_share must be in (0, 1), got {share}")
     screw = p.screw
-    a = screw.nut_start_distance + DECLARED_AT
-    area = 4.0 * k * a / screw.youngs_modulus  # shaft 4 k at a (fixed-free: E A / a)
+    a = tr.nut_start + tr.chain_at
+    area = k * a / (share * screw.youngs_modulus)  # shaft k / share at a (fixed-free: E A / a)
     d_root = math.sqrt(4.0 * area / math.pi)
-    element = 2.0 / (1.0 / k - 1.0 / (4.0 * k))  # bearing = nut, in series with the shaft: k at a
+    element = 2.0 * k / (1.0 - share)  # bearing = nut, in series with the shaft: k at a
     damping = c * element ** 2 / (2.0 * k ** 2)  # chain damping k^2 (c_b / k_b^2 + c_n / k_n^2) = c at a
     d_nom = d_root + 3e-3
     screw = dataclasses.replace(screw, root_diameter=d_root, nominal_diameter=d_nom, mounting="fixed-free",
+                       nut_start_distance=tr.nut_start,
                        density=0.2 * inertia / (math.pi / 32.0 * screw.length * d_nom ** 4),
                        bearing_stiffness=element, bearing_damping=damping, chain_damping="viscous",
                        seat_joint_stiffness=0.0, seat_joint_damping=0.0)

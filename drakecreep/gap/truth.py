@@ -11,7 +11,10 @@ diagnosis from one that only recognises its own equations. This module is theref
 
 * **two bodies with an axial mode**: a motor-side mass ``m1`` (rotor, coupling and screw reflected to the
   table) and the table ``m2`` on an axial spring ``k, c`` (screw + nut + bearing in series). ``flexible``
-  axes have the mode at 150-300 Hz (the paper rig: about 180 Hz), ``rigid`` axes at 500-700 Hz;
+  axes have the mode at 150-300 Hz (the paper rig: about 180 Hz), ``rigid`` axes at 500-700 Hz, at table
+  position :data:`CHAIN_AT`; the fixed-free shaft, a quarter of the chain's compliance there, softens as the
+  nut moves away from the thrust bearing (:meth:`Truth.chain`; a constant spring until session 75, which the
+  replay's chain did not match away from 0.1 m: docs/gap_benchmark.md, 3cb);
 * **LuGre friction on the table** (bristle state ``z``, ``sigma0``, ``sigma1``, viscous ``Fv``), with a
   small Stribeck rise (``Fs/Fc`` <= 1.05) always present; bearing friction (smooth Coulomb + viscous) on
   the motor side;
@@ -56,8 +59,8 @@ Cross-tests (``tests/gap/test_truth.py``, with the measured differences and the 
 
 * **against the Drake diagram**: the PI cascade on the project's default drive (parameters mapped onto
   the two bodies; no motor drag or nut friction, which the truth does not have; no noise, drift or
-  effect), unloaded, 10 mm/s: motor positions 0.04 um RMS apart against a 1.9 um RMS tracking error,
-  force commands 0.22 N RMS apart against 7.3 N RMS;
+  effect), unloaded, 10 mm/s: motor positions 0.07 um RMS apart (session 75) against a 1.9 um RMS tracking error,
+  force commands 0.21 N RMS apart against 7.3 N RMS;
 * **against the exact rigid replay** (:func:`drakecreep.gap.replay.replay`, the P-P cascade): one stiff
   body, ``Fs = Fc``, stiff bristles: positions 0.2-1.1 um RMS apart against 39-786 um of tracking error.
 """
@@ -108,6 +111,14 @@ WITHHELD = LIBRARY_EFFECTS + NO_CANDIDATE + OUT_OF_LIBRARY
 CONTROLLER_KINDS = ("p_p_cascade", "drakecreep")
 AXES = ("flexible", "rigid")
 
+#: the table position [m] at which a drawn truth's axial chain has its drawn stiffness and damping (``k_axial``,
+#: ``c_axial``; the benchmark's params file matches the chain there, :func:`drakecreep.gap.benchmark.declared_params`)
+CHAIN_AT = 0.1
+#: the shaft's share of a drawn truth's chain compliance at :data:`CHAIN_AT` (thrust bearing and nut the rest)
+SHAFT_SHARE = 0.25
+#: thrust bearing to nut [m] at table position 0 (the params files' default screw, ``ScrewParams``)
+NUT_START = 0.1
+
 DT = 1e-3          # recording and position-loop sample time [s]
 SUBSTEPS = 12      # integration substeps per sample (h = 83 us; a multiple of VEL_DIV)
 GTAU = 35.15       # N/V of the P-P cascade drive (EMPS)
@@ -141,6 +152,9 @@ class Truth:
     drift_sd: float
     effects: dict = field(default_factory=dict)
     gains: dict | None = None  # PI cascade gains {kp, kv, ki, ff, sat}; default from the mass (40 Hz speed loop)
+    shaft_share: float = SHAFT_SHARE  # the shaft's share of the chain's compliance at chain_at (0: a constant spring)
+    chain_at: float = CHAIN_AT  # table position [m] where the chain is k_axial, c_axial
+    nut_start: float = NUT_START  # thrust bearing to nut [m] at table position 0
 
     @property
     def m1(self):
@@ -160,8 +174,24 @@ class Truth:
         mu = self.m1 * self.m2 / self.M
         return 2 * self.zeta_axial * math.sqrt(self.k_axial * mu)
 
+    def chain(self, x):
+        """``(stiffness [N/m], damping [N s/m])`` of the axial chain with the table at ``x`` [m] (floats or arrays).
+
+        Thrust bearing and nut in series with a fixed-free shaft, ``E A / a``, which softens as the nut's distance
+        ``a = nut_start + x`` from the bearing grows; the shaft's share of the compliance is ``shaft_share`` at
+        ``chain_at``, where the chain is ``k_axial``, ``c_axial``. The shaft is undamped, so the damping of the
+        bearing and nut reaches the table as ``c_axial (k / k_axial)^2`` (a chain of elements in series).
+        """
+        return _chain(self.k_axial, self.c_axial, self.shaft_share, self.nut_start, self.nut_start + self.chain_at, x)
+
     def to_dict(self):
         return dataclasses.asdict(self)
+
+
+def _chain(k, c, share, a0, a_ref, x):
+    """:meth:`Truth.chain` from its columns (arrays in :func:`simulate_batch`)."""
+    stiffness = k / ((1.0 - share) + share * np.maximum(a0 + x, 0.0) / a_ref)
+    return stiffness, c * (stiffness / k) ** 2
 
 
 def draw_truth(rng, kind, axis, withheld=()):
@@ -332,6 +362,9 @@ def _columns(jobs):
         put("m2", one(tr.m2 - mp))
         put("k", one(tr.k_axial))
         put("c", one(tr.c_axial))
+        put("shaft_share", one(tr.shaft_share))
+        put("a0", one(tr.nut_start))
+        put("a_ref", one(tr.nut_start + tr.chain_at))
         sh = tr.motor_friction_share
         put("Fc_m", list(sh * tr.Fc * drift))
         put("Fv_m", list(sh * tr.Fv * drift))
@@ -482,12 +515,12 @@ def simulate_batch(jobs):
                     dstretch = v1 * gearing - v2
                 else:
                     stretch, dstretch = x1 - x2, v1 - v2
+                k, c = _chain(p["k"], p["c"], p["shaft_share"], p["a0"], p["a_ref"], x2)
                 if has_bl:  # a dead zone of +-bl in the chain: no force (and no damping) until the balls bear
                     bearing = np.abs(stretch) >= p["bl"]
-                    fk = np.where(bearing, p["k"] * (stretch - np.clip(stretch, -p["bl"], p["bl"]))
-                                  + p["c"] * dstretch, 0.0)
+                    fk = np.where(bearing, k * (stretch - np.clip(stretch, -p["bl"], p["bl"])) + c * dstretch, 0.0)
                 else:
-                    fk = p["k"] * stretch + p["c"] * dstretch
+                    fk = k * stretch + c * dstretch
                 fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
                 th = w_lead * x1
                 extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])

@@ -114,6 +114,11 @@ def test_declared_params_carry_the_truths_effect_free_physics():
         assert p.table.mass + p.nut.mass == pytest.approx(tr.m2, rel=1e-12)
         assert axial_stiffness(p.screw, p.nut, DECLARED_AT) == pytest.approx(tr.k_axial, rel=1e-9)
         assert axial_damping(p.screw, p.nut, DECLARED_AT) == pytest.approx(tr.c_axial, rel=1e-9)
+        for x in (0.0, 0.036, 0.13):  # the runs' travel: the truth's chain is the params file's everywhere
+            k, c = tr.chain(x)
+            assert axial_stiffness(p.screw, p.nut, x) == pytest.approx(k, rel=1e-9)
+            assert axial_damping(p.screw, p.nut, x) == pytest.approx(c, rel=1e-9)
+        assert tr.chain(0.0)[0] > 1.1 * tr.k_axial > 1.1 * tr.chain(0.13)[0]  # it softens along the screw
         load = p.load_case(0)
         share = tr.motor_friction_share
         assert table_friction_levels(p, load)[0] == pytest.approx((1 - share) * tr.Fc, rel=1e-9)
