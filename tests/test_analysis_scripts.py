@@ -345,3 +345,27 @@ def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
     bad = subprocess.run([sys.executable, str(ANALYSIS / "lowpass_claim_recount.py"), str(tmp_path / "old.json")],
                          capture_output=True, text=True, env=env)
     assert bad.returncode == 2 and "rows: got no drakecreep row" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path):
+    """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
+    each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
+    script = str(ANALYSIS / "diagnose_dataset.py")
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    for args, says in ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
+                       (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
+                       (["9014:null:rigid", "--kind", "pi"], "--kind"),
+                       (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json")):
+        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
+        assert r.returncode == 2, (args, r.stderr)
+        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+    spec = importlib.util.spec_from_file_location("dd", script)
+    dd = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dd)
+    row = {"seed": 1205, "withheld": ["lead_error"], "axis": "flexible", "snr": 24.2, "claimed": ["lead_error"],
+           "first_passing": "lead_error", "audit_shrink": 0.9695, "true_shrink": 0.9695, "worse": False,
+           "audit": {"nominal": {"force_rms": 29.88, "force_lowpass_rms": 26.64},
+                     "claimed": {"force_rms": 5.21, "force_lowpass_rms": 3.55}, "true": None}}
+    line = dd.summary(row)
+    assert "claimed ['lead_error']" in line and "29.88 % (< 100 Hz 26.64)" in line and "true -" in line
+    assert "shrink 97.0 %" in line and "worse False" in line

@@ -1,0 +1,74 @@
+"""Diagnose named benchmark datasets with the product path and print each row's verdict and audit.
+
+One benchmark row per dataset (:func:`drakecreep.gap.benchmark.evaluate`, as ``bench_gap_benchmark.py`` makes
+them): what was claimed and first, the audit force error [%] of the nominal, the claimed and the true model (whole
+and below 100 Hz), their shrinks and ``worse``. For development checks of one change on a few datasets (docs/
+gap_benchmark.md, 3cg) and for looking again at spent held-out ones. Seeds of the current held-out set
+(``>= benchmark.HELDOUT_SEEDS``) are refused: they are spent in a pre-registered run only.
+
+Usage: ``PYTHONPATH=. python analysis/diagnose_dataset.py SEED:WITHHELD:AXIS [...] --kind drakecreep
+[--json OUT.json]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a null dataset).
+"""
+
+import argparse
+import json
+import sys
+import time
+
+from drakecreep.errors import InputError
+from drakecreep.files import check_output_file, write_text
+from drakecreep.gap import benchmark as B
+
+__all__ = ["summary", "main"]
+
+
+def summary(row):
+    """The verdict and audit of a benchmark ``row`` as one line of text."""
+    audit = row.get("audit") or {}
+
+    def fig(name):
+        a = audit.get(name)
+        return "-" if not a else f"{a['force_rms']:.2f} % (< 100 Hz {a.get('force_lowpass_rms', float('nan')):.2f})"
+
+    shrink = row.get("audit_shrink")
+    true = row.get("true_shrink")
+    return (f"{row['seed']} {'/'.join(row.get('withheld') or ['null'])} {row.get('axis')} SNR {row.get('snr', 0):.1f}: "
+            f"claimed {row.get('claimed') or 'nothing'} (first {row.get('first_passing')}); audit nominal "
+            f"{fig('nominal')}, claimed {fig('claimed')}, true {fig('true')}; shrink "
+            f"{'-' if shrink is None else f'{100 * shrink:.1f} %'}, true {'-' if true is None else f'{100 * true:.1f} %'}"
+            f"; worse {row.get('worse')}")
+
+
+def main(argv=None):
+    """Parse ``argv``, diagnose each dataset and print its line; the exit status (2 on a bad argument)."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("datasets", nargs="+", metavar="SEED:WITHHELD:AXIS",
+                    help="a dataset: WITHHELD null or a withheld effect, AXIS rigid or flexible")
+    ap.add_argument("--kind", required=True, choices=B.BENCHMARK_KINDS, help="the controller kind")
+    ap.add_argument("--json", help="write the rows here (after each dataset)")
+    a = ap.parse_args(argv)
+    try:
+        specs = [B.dataset_spec(s) for s in a.datasets]
+        for seed, _, _ in specs:
+            if seed >= B.HELDOUT_SEEDS:
+                raise InputError("SEED", seed, f"a seed below {B.HELDOUT_SEEDS} (the current held-out set is spent "
+                                 "in a pre-registered run only)")
+        if a.json:
+            check_output_file(a.json, "--json")
+    except InputError as e:
+        ap.exit(2, f"diagnose_dataset: error: {e}\n")
+    rows = []
+    for seed, withheld, axis in specs:
+        ds = B.generate_dataset(seed, withheld=withheld, kind=a.kind, axis=axis)
+        t0 = time.time()
+        row = B.evaluate(ds)
+        row["seconds"] = time.time() - t0
+        rows.append(row)
+        print(summary(row) + f" ({row['seconds']:.0f} s)", flush=True)
+        if a.json:
+            write_text(a.json, json.dumps({"kind": a.kind, "datasets": rows}, indent=1, default=str))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
