@@ -30,13 +30,14 @@ def summary(row):
         a = audit.get(name)
         return "-" if not a else f"{a['force_rms']:.2f} % (< 100 Hz {a.get('force_lowpass_rms', float('nan')):.2f})"
 
-    shrink = row.get("audit_shrink")
-    true = row.get("true_shrink")
+    def share(key):
+        value = row.get(key)
+        return "-" if value is None else f"{100 * value:.1f} %"
+
     return (f"{row['seed']} {'/'.join(row.get('withheld') or ['null'])} {row.get('axis')} SNR {row.get('snr', 0):.1f}: "
             f"claimed {row.get('claimed') or 'nothing'} (first {row.get('first_passing')}); audit nominal "
-            f"{fig('nominal')}, claimed {fig('claimed')}, true {fig('true')}; shrink "
-            f"{'-' if shrink is None else f'{100 * shrink:.1f} %'}, true {'-' if true is None else f'{100 * true:.1f} %'}"
-            f"; worse {row.get('worse')}")
+            f"{fig('nominal')}, claimed {fig('claimed')}, true {fig('true')}; shrink {share('audit_shrink')}, "
+            f"true {share('true_shrink')}; worse {row.get('worse')}")
 
 
 def main(argv=None):
