@@ -79,8 +79,7 @@ from drakecreep.model.disturbances import cos, sin
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
            "set_axis_parameters", "axis_friction", "applied_force", "nut_load", "friction_map", "FRICTION_MAP",
            "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "lead_error_drive",
-           "POSITION_RIPPLE",
-           "axis_ripple"]
+           "POSITION_RIPPLE", "axis_ripple"]
 
 #: numeric parameters, in order, with their default values
 AXIS_PARAMETERS = {
@@ -357,7 +356,9 @@ def lead_error_drive(x, v, a, drive, p):
     as an inverse-dynamics fit wants them (:func:`drakecreep.gap.screen.inverse_dynamics_force`). Left out: the
     friction's change with the table's speed ``g v``, ``e' v df/dv`` (``Fv e' v`` of the viscous part, a few
     tenths of a newton on the benchmark's truths), which would tie the amplitudes to the friction's
-    coefficients; and the terms in ``e'^2``.
+    coefficients; and the terms in ``e'^2``. Where a position ripple is fitted beside it, ``drive`` carries that
+    ripple's fitted value, so the product ``e' r`` (a few hundredths of the ripple) is not in the screen's
+    regressor columns.
     """
     _, e1, e2 = lead_error(x, p)
     if _off(e1) and _off(e2):
