@@ -356,9 +356,9 @@ def lead_error_drive(x, v, a, drive, p):
     as an inverse-dynamics fit wants them (:func:`drakecreep.gap.screen.inverse_dynamics_force`). Left out: the
     friction's change with the table's speed ``g v``, ``e' v df/dv`` (``Fv e' v`` of the viscous part, a few
     tenths of a newton on the benchmark's truths), which would tie the amplitudes to the friction's
-    coefficients; and the terms in ``e'^2``. Where a position ripple is fitted beside it, ``drive`` carries that
-    ripple's fitted value, so the product ``e' r`` (a few hundredths of the ripple) is not in the screen's
-    regressor columns.
+    coefficients; and the terms in ``e'^2``. Where a ripple's amplitudes are solved beside the error's, the
+    product ``e' r`` (a few hundredths of the ripple) is not in the screen's regressor columns, each taken with
+    the other linear coefficients at 0.
     """
     _, e1, e2 = lead_error(x, p)
     if _off(e1) and _off(e2):
