@@ -76,6 +76,7 @@ from scipy import signal
 
 from drakecreep.errors import InputError
 from drakecreep.gap.measured import ControllerMeta, EMPS_CONTROLLER, MeasuredMeta, MeasuredRun, SensorMeta
+from drakecreep.params import ControllerParams, DriveParams, ScrewParams
 
 __all__ = [
     "LIBRARY_EFFECTS",
@@ -116,8 +117,8 @@ AXES = ("flexible", "rigid")
 CHAIN_AT = 0.1
 #: the shaft's share of a drawn truth's chain compliance at :data:`CHAIN_AT` (thrust bearing and nut the rest)
 SHAFT_SHARE = 0.25
-#: thrust bearing to nut [m] at table position 0 (the params files' default screw, ``ScrewParams``)
-NUT_START = 0.1
+#: thrust bearing to nut [m] at table position 0: the params files' default screw's
+NUT_START = ScrewParams().nut_start_distance
 
 DT = 1e-3          # recording and position-loop sample time [s]
 SUBSTEPS = 12      # integration substeps per sample (h = 83 us; a multiple of VEL_DIV)
@@ -594,8 +595,6 @@ def controller_meta(tr):
     if tr.kind == "p_p_cascade":
         return MeasuredMeta(u_units="V", u_gain=GTAU, controller=EMPS_CONTROLLER, sensors=sensors,
                             source="drakecreep.gap.truth (P-P cascade)")
-    from drakecreep.params import ControllerParams, DriveParams, ScrewParams
-
     g = _controller_gains(tr)
     ctrl = ControllerParams(position_gain=g["kp"], velocity_feedforward=g["ff"], velocity_gain=g["kv"],
                             velocity_integral_gain=g["ki"], velocity_period=DT / VEL_DIV, position_period=DT)

@@ -525,8 +525,9 @@ def MeasuredAxis_(T):
         def _calc_friction(self, context, output):
             x = context.get_continuous_state_vector().CopyToVector()
             p, t = self._p(context), context.get_time()
-            load = self._load(x, dict(zip(_NAMES, p)), applied_force(self._force.Eval(context)[0], p), t, p)
-            output.SetAtIndex(0, self._friction(x, p, t, load)[0])
+            lead = lead_error(x[0], p)
+            load = self._load(x, dict(zip(_NAMES, p)), applied_force(self._force.Eval(context)[0], p), t, p, lead)
+            output.SetAtIndex(0, self._friction(x, p, t, load, lead)[0])
 
     return Impl
 
