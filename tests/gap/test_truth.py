@@ -245,3 +245,31 @@ def test_backlash_is_a_lost_motion_between_motor_and_table():
         gaps.append(np.mean(d[cruise & (v > 0)]) - np.mean(d[cruise & (v < 0)]))
     assert gaps[0] - gaps[1] == pytest.approx(12e-6, rel=0.05)
     assert abs(gaps[1]) < 1e-6
+
+
+def test_a_loop_near_its_stability_limit_is_converged_in_the_substeps(monkeypatch):
+    """The truth's step (``SUBSTEPS`` per sample) against one four times finer, where it matters most: a loop near
+    its stability limit, whose oscillation grows or decays with a few degrees of phase at the axial mode.
+
+    Development dataset 97106042 (flexible, a 3-sample delay; docs/gap_benchmark.md 3ci), the first 1.5 s of its
+    two runs near the thrust bearing: 152 Hz oscillations of 7.4 and 8.2 N RMS at 24 substeps, 7.4 and 9.9 N at 96
+    (the effect-free twin's strongest peaks: 0.9 and 0.6 N, at 23 and 47 Hz). When the current loop's lag was
+    advanced before the kick (the force a substep early), they were 21 and 28 N at 24 substeps, 9.9 and 12.5 N at
+    96, and 41 and 64 N at the 12 substeps the truth then took.
+    """
+    from drakecreep.gap import benchmark as B
+    from drakecreep.gap.residuals import dominant_oscillation
+
+    n = 1500
+    tr, refs, pulses, drift, noise = B._draw(97106042, ("control_delay",), "drakecreep", "flexible", B.N_SAMPLES)
+    job = (tr, refs[:2, :n], pulses[:2, :n], drift[:2], noise[:2, :n], True)
+
+    def rms():
+        runs = T.make_runs(tr, refs[:2, :n], pulses[:2, :n], T.simulate_batch([job])[0])
+        return np.array([dominant_oscillation(r.force, r.dt)["rms"] for r in runs])
+
+    coarse = rms()
+    monkeypatch.setattr(T, "SUBSTEPS", 4 * T.SUBSTEPS)
+    fine = rms()
+    assert np.all(fine > 5.0)  # the oscillation is there
+    np.testing.assert_allclose(coarse, fine, rtol=0.25)
