@@ -4,6 +4,7 @@ its usage instead of starting the long job, and a wrong argument is refused with
 import ast
 import importlib.util
 import json
+import math
 import os
 import subprocess
 import sys
@@ -369,3 +370,23 @@ def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tm
     line = dd.summary(row)
     assert "claimed ['lead_error']" in line and "29.88 % (< 100 Hz 26.64)" in line and "true -" in line
     assert "shrink 97.0 %" in line and "worse False" in line
+
+
+def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line():
+    """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
+    held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
+    frequency is its RMS, and next to nothing an octave away."""
+    script = str(ANALYSIS / "delay_pattern_study.py")
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    for args, says in ((["9014", "--ticks", "8,x"], "--ticks"), (["9014", "--ticks", "-1"], "--ticks"),
+                       (["99000001"], "99000001")):
+        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
+        assert r.returncode == 2, (args, r.stderr)
+        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+    spec = importlib.util.spec_from_file_location("dps", script)
+    dps = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dps)
+    t = np.arange(3000) * 1e-3
+    x = 3.0 * math.sqrt(2.0) * np.sin(2 * math.pi * 150.0 * t)
+    assert abs(dps.band_rms(x, 1e-3, 150.0) - 3.0) < 0.15
+    assert dps.band_rms(x, 1e-3, 300.0) < 0.05
