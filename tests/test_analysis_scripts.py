@@ -348,18 +348,23 @@ def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
     assert bad.returncode == 2 and "rows: got no drakecreep row" in bad.stderr and "Traceback" not in bad.stderr
 
 
+def _refused_in_one_line(script, cases):
+    """Each ``(args, says)`` of ``cases`` run as ``script`` exits 2 with no traceback, ``says`` in its last line."""
+    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+    for args, says in cases:
+        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
+        assert r.returncode == 2, (args, r.stderr)
+        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+
+
 def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path):
     """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
     each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
     script = str(ANALYSIS / "diagnose_dataset.py")
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
-    for args, says in ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
-                       (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
-                       (["9014:null:rigid", "--kind", "pi"], "--kind"),
-                       (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json")):
-        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
-        assert r.returncode == 2, (args, r.stderr)
-        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+    _refused_in_one_line(script, ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
+                                  (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
+                                  (["9014:null:rigid", "--kind", "pi"], "--kind"),
+                                  (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json")))
     spec = importlib.util.spec_from_file_location("dd", script)
     dd = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dd)
@@ -377,12 +382,8 @@ def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line():
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
     frequency is its RMS, and next to nothing an octave away."""
     script = str(ANALYSIS / "delay_pattern_study.py")
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
-    for args, says in ((["9014", "--ticks", "8,x"], "--ticks"), (["9014", "--ticks", "-1"], "--ticks"),
-                       (["99000001"], "99000001")):
-        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
-        assert r.returncode == 2, (args, r.stderr)
-        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+    _refused_in_one_line(script, ((["9014", "--ticks", "8,x"], "--ticks"), (["9014", "--ticks", "-1"], "--ticks"),
+                                  (["99000001"], "99000001")))
     spec = importlib.util.spec_from_file_location("dps", script)
     dps = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dps)
