@@ -65,7 +65,8 @@ Steps:
    delay search runs (it says which delays make the model oscillate there); the other candidates are not fitted.
    A delay that makes the model oscillate there can be claimed on the held-out runs' spectrum: the RMS in the
    band of the measured oscillation, model against measurement, must come closer, run by run, by more than the
-   held-out runs' spread (``_spectral_delay``). Nothing else is claimed, and the uncertain fields are not refitted.
+   held-out runs' spread on the runs that oscillate, and the model must not oscillate on most of those that do
+   not (``_spectral_delay``). Nothing else is claimed, and the uncertain fields are not refitted.
 5. With an effect claimed, the uncertain fields are fitted again on the augmented model, jointly with the
    claimed effects' amplitudes (a missing effect biases them and widens their intervals), except a lead error
    fitted on the screw's transmission, which keeps its amplitudes; ``fitted`` and ``test_errors`` are those of the
@@ -100,8 +101,9 @@ from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, check_travel, drake_replay_errors, replay_drakecreep,
                                          replay_params, rms_force_error)
 from drakecreep.gap.measured import check_split
-from drakecreep.gap.residuals import (dominant_oscillation, limit_cycle, oscillates_at, oscillation_log_errors,
-                                      sustained_oscillation, transmission_position)
+from drakecreep.gap.residuals import (OSCILLATION_SHARE, dominant_oscillation, limit_cycle, oscillates_at,
+                                      oscillation_band_errors, sustained_oscillation,
+                                      transmission_position)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.model.controller import force_limit
 from drakecreep.model.compensators import rigid_inertia
@@ -1232,14 +1234,16 @@ def _claim_on_spectrum(oscillation, candidates, test, params, nominal_sims, nomi
 def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
     """The claim a computation delay can make on runs that oscillate where the model does not: on the spectrum.
 
-    Of the delays that make the model oscillate at the measured frequency on the training runs
-    (``oscillation["reproduced_by"]``), the one whose oscillation's RMS is closest to the measured one's (training
-    runs only) is replayed on the held-out runs. Each held-out run's spectral error is
-    :func:`~drakecreep.gap.residuals.oscillation_log_errors` (``|ln(model / measured)|`` of the RMS in the band
-    around the measured oscillation); the delay passes when the per-run decrease from the fitted model's error
-    exceeds ``t_(1-ALPHA, n-1)`` standard errors of those decreases (the held-out runs' own spread), more than
-    half of the runs improve, and the delayed model oscillates within +-15 % of each run's measured frequency on
-    more than half of them. Needs the run-to-run null as every claim does (None: not claimed).
+    Of the delays that make the model oscillate at the measured frequency on the training runs that oscillate
+    (``oscillation["reproduced_by"]``, :func:`_reproduces`), the one with the least run-by-run band error on the
+    training runs (``band_nepers``: quiet runs included) is replayed on the held-out runs. Each held-out run's
+    spectral error is :func:`~drakecreep.gap.residuals.oscillation_band_errors` (``|ln(model / measured)|`` of the
+    RMS in the band of the run's measured oscillation, or of the training runs' where the run does not
+    oscillate). The delay passes when, over the held-out runs that oscillate (at least two), the per-run decrease
+    from the fitted model's error exceeds ``t_(1-ALPHA, n-1)`` standard errors of those decreases (their own
+    spread), on more than half of them its error is smaller and it oscillates within +-15 % of the measured
+    frequency, and it oscillates on at most half of the held-out runs that do not. Needs the run-to-run null as
+    every claim does (None: not claimed).
 
     ``nominal_sims`` are the fitted model's replays of ``test`` (those of the diagnosis, not replayed again).
 
@@ -1254,41 +1258,64 @@ def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
     rep = oscillation.get("reproduced_by") or []
     if not rep:
         return None, None
-    pick = min(rep, key=lambda r: abs(math.log(r["rms"] / oscillation["rms"])))
+    pick = min(rep, key=lambda r: r.get("band_nepers", abs(math.log(r["rms"] / oscillation["rms"]))))
     values = {pick["path"]: pick["value"]}
     measured = [r.force for r in test]
     dt = test[0].dt
     delay_sims = replay(test, _with(params, values))
-    e0 = oscillation_log_errors(measured, [x.force for x in nominal_sims], dt)
-    e1 = oscillation_log_errors(measured, [x.force for x in delay_sims], dt)
-    gain, se = mean_and_standard_error(e0 - e1)
+    e0 = oscillation_band_errors(measured, [x.force for x in nominal_sims], dt, oscillation["freq_Hz"])
+    e1 = oscillation_band_errors(measured, [x.force for x in delay_sims], dt, oscillation["freq_Hz"])
     n = len(test)
-    bar = float(stats.t.ppf(1 - ALPHA, n - 1) * se)
-    better = int(np.sum(e0 - e1 > 0))
-    same = sum(bool(oscillates_at(x.force, r.dt, dominant_oscillation(r.force, r.dt)["freq_Hz"])[0])
-               for r, x in zip(test, delay_sims))
-    ok = bool(null is not None and gain > bar and 2 * better > n and 2 * same > n)
+    # the held-out runs that oscillate in the measurement: there the delayed model must come closer beyond their
+    # own spread, and on most of them oscillate at their frequency; on the quiet ones it must not oscillate at the
+    # oscillation's frequency on more than half (a delay that oscillates everywhere does not reproduce a pattern)
+    waves = [dominant_oscillation(r.force, r.dt) for r in test]
+    osc = [i for i, w in enumerate(waves) if w["share"] >= OSCILLATION_SHARE]
+    quiet = [i for i in range(n) if i not in osc]
+    gain, se = mean_and_standard_error((e0 - e1)[osc]) if len(osc) > 1 else (float("nan"), float("nan"))
+    bar = float(stats.t.ppf(1 - ALPHA, len(osc) - 1) * se) if len(osc) > 1 else float("nan")
+    better = int(sum(e0[i] - e1[i] > 0 for i in osc))
+    same = sum(bool(oscillates_at(delay_sims[i].force, dt, waves[i]["freq_Hz"])[0]) for i in osc)
+    spurious = sum(bool(oscillates_at(delay_sims[i].force, dt, oscillation["freq_Hz"])[0]) for i in quiet)
+    ok = bool(null is not None and len(osc) > 1 and gain > bar and 2 * better > len(osc) and 2 * same > len(osc)
+              and 2 * spurious <= len(quiet))
     reason = (f"{pick['path']} = {pick['value']:g} oscillates at {pick['freq_Hz']:.0f} Hz on the training runs; on "
-              f"the held-out runs it oscillates at the measured frequency on {same} of {n}, its band error "
-              f"{np.mean(e1):.2f} Np against the fitted model's {np.mean(e0):.2f} Np (decrease {gain:.2f} Np, bar "
-              f"{bar:.2f}, {better} of {n} runs better)"
+              f"the {len(osc)} of {n} held-out runs that oscillate it does so at the measured frequency on {same}, "
+              f"its band error {np.mean(e1[osc]) if osc else float('nan'):.2f} Np against the fitted model's "
+              f"{np.mean(e0[osc]) if osc else float('nan'):.2f} Np (decrease {gain:.2f} Np, bar {bar:.2f}, "
+              f"{better} of {len(osc)} runs better); it oscillates on {spurious} of the {len(quiet)} that do not"
+              + ("" if len(osc) > 1 else "; fewer than two held-out runs oscillate: not claimed")
               + ("" if null is not None else "; no run-to-run null: not claimed"))
     out = {"values": values, "passes": ok, "reason": reason, "nominal_nepers": e0.tolist(),
            "delay_nepers": e1.tolist(), "gain": float(gain), "standard_error": float(se), "threshold": bar,
-           "same_frequency": int(same), "of": n}
+           "same_frequency": int(same), "oscillating": len(osc), "spurious": int(spurious), "of": n}
     oscillation["spectral"] = out
     return out, _errors_of(test, delay_sims)
 
 
 def _reproduces(oscillation, path, value, runs, sims):
     """Append ``{path: value}`` to ``oscillation["reproduced_by"]`` (a list) when its replays ``sims`` of ``runs``
-    oscillate at the measured frequency on more than half of the runs."""
-    hits = [o for ok, o in (oscillates_at(s.force, r.dt, oscillation["freq_Hz"]) for r, s in zip(runs, sims)) if ok]
-    if 2 * len(hits) > len(runs):
+    oscillate at the measured frequency on more than half of the runs that oscillate in the measurement
+    (``oscillation["oscillating"]``; all runs without it), with ``band_nepers``, the mean run-by-run band error
+    (:func:`~drakecreep.gap.residuals.oscillation_band_errors`, quiet runs included: a delay that oscillates
+    everywhere where the measurement oscillates on some runs scores worse than one that oscillates on those).
+
+    Near a loop's stability limit the oscillation comes and goes with the run (the nut's position, the speed), in
+    a converged truth as in the model: at development dataset 97106042's the truth's own delay oscillates on
+    exactly the two runs of four that the measurement does (docs/gap_benchmark.md 3ci)."""
+    flags = oscillation.get("oscillating")
+    if not flags or len(flags) != len(runs):
+        flags = [True] * len(runs)
+    checks = [oscillates_at(s.force, r.dt, oscillation["freq_Hz"]) for r, s in zip(runs, sims)]
+    hits = [o for flag, (ok, o) in zip(flags, checks) if flag and ok]
+    if 2 * len(hits) > sum(flags):
+        band = oscillation_band_errors([r.force for r in runs], [s.force for s in sims], runs[0].dt,
+                                       oscillation["freq_Hz"])
         rep = oscillation["reproduced_by"]
         rep.append({"path": path, "value": float(value), "runs": len(hits),
+                    "quiet_runs_oscillating": sum(1 for flag, (ok, _) in zip(flags, checks) if ok and not flag),
                     "freq_Hz": float(np.median([o["freq_Hz"] for o in hits])),
-                    "rms": float(np.median([o["rms"] for o in hits]))})
+                    "rms": float(np.median([o["rms"] for o in hits])), "band_nepers": float(np.mean(band))})
         rep.sort(key=lambda x: x["value"])
 
 

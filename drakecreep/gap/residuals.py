@@ -53,6 +53,7 @@ __all__ = [
     "sustained_oscillation",
     "oscillates_at",
     "oscillation_log_errors",
+    "oscillation_band_errors",
 ]
 
 #: Frequency bands [Hz] of :func:`frequency_bands` (the last one ends at the Nyquist frequency).
@@ -598,17 +599,18 @@ def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
     dict or None
         None when no record oscillates; otherwise ``freq_Hz`` (median over the oscillating runs), ``rms`` and
         ``model_rms`` (their median RMS in the band, measured and replayed), ``share`` (median), ``runs`` (how
-        many oscillate) and ``of`` (how many were checked).
+        many oscillate), ``of`` (how many were checked) and ``oscillating`` (a bool per run, in order).
     """
-    hits = []
+    hits, flags = [], []
     for o, model in _paired_bands(measured, simulated, dt, f_min):
-        if o["share"] >= OSCILLATION_SHARE and o["rms"] >= OSCILLATION_RATIO * model:
+        flags.append(bool(o["share"] >= OSCILLATION_SHARE and o["rms"] >= OSCILLATION_RATIO * model))
+        if flags[-1]:
             hits.append((o["freq_Hz"], o["rms"], model, o["share"]))
     if not hits:
         return None
     med = np.median(np.array(hits), axis=0)
     return {"freq_Hz": float(med[0]), "rms": float(med[1]), "model_rms": float(med[2]), "share": float(med[3]),
-            "runs": len(hits), "of": len(measured)}
+            "runs": len(hits), "of": len(measured), "oscillating": flags}
 
 
 def oscillates_at(record, dt, freq, f_min=OSCILLATION_MIN_HZ):
@@ -616,6 +618,37 @@ def oscillates_at(record, dt, freq, f_min=OSCILLATION_MIN_HZ):
     ``(bool, its dominant_oscillation)``."""
     o = dominant_oscillation(record, dt, f_min)
     return bool(o["share"] >= OSCILLATION_SHARE and abs(o["freq_Hz"] - freq) <= _OSC_WIDTH * freq), o
+
+
+def oscillation_band_errors(measured, simulated, dt, freq, f_min=OSCILLATION_MIN_HZ):
+    """Run by run, how far each replay is from the measurement in the band of a known oscillation, whether or not
+    the run oscillates: ``|ln(model / measured)|`` of the RMS in the band of +-15 % around the measured record's
+    dominant oscillation where it holds :data:`OSCILLATION_SHARE` of the record's variance, else around ``freq``
+    [Hz] (the oscillation found on other runs). A replay that oscillates on a run that does not, or is quiet on one
+    that oscillates, scores high; one that oscillates where and as strongly as the measurement, about 0.
+
+    Parameters
+    ----------
+    measured, simulated, dt, f_min
+        As :func:`sustained_oscillation`.
+    freq : float
+        The oscillation's frequency [Hz] (e.g. :func:`sustained_oscillation`'s ``freq_Hz``).
+
+    Returns
+    -------
+    numpy.ndarray
+        One error per run [nepers].
+    """
+    if len(measured) != len(simulated):
+        raise InputError("simulated", f"{len(simulated)} records", f"one per measured record ({len(measured)})")
+    out = []
+    for m, s in zip(measured, simulated):
+        o = dominant_oscillation(m, dt, f_min)
+        f0 = o["freq_Hz"] if o["share"] >= OSCILLATION_SHARE else float(freq)
+        band_m, band_s = (_band_rms(*_welch(np.asarray(x, dtype=float), dt), f0) for x in (m, s))
+        tiny = 1e-12 * max(band_m, 1.0)
+        out.append(abs(math.log(max(band_s, tiny) / max(band_m, tiny))))
+    return np.array(out)
 
 
 def oscillation_log_errors(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):

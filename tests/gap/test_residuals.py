@@ -9,6 +9,7 @@ from drakecreep.gap.residuals import (
     dominant_oscillation,
     operating_map,
     oscillates_at,
+    oscillation_band_errors,
     oscillation_log_errors,
     order_spectrum,
     regime_shares,
@@ -183,6 +184,26 @@ def test_sustained_oscillation_only_when_the_replay_lacks_it_and_it_dominates():
     ok, osc = oscillates_at(measured, 1e-3, 150.0)
     assert ok and abs(osc["freq_Hz"] - 160.0) < 4.0
     assert not oscillates_at(measured, 1e-3, 100.0)[0] and not oscillates_at(quiet, 1e-3, 160.0)[0]
+
+
+def test_oscillation_band_errors_score_the_runs_that_do_not_oscillate_too():
+    """Two runs, the first oscillating at 160 Hz, the second quiet: a replay that oscillates on the first only scores
+    about 0 nepers on both, one that oscillates on both is far off on the quiet run (judged in the band of the
+    oscillation found on the other run), a quiet replay is far off on the oscillating one. sustained_oscillation
+    says which run oscillates."""
+    measured, quiet = _oscillating()
+    shifted = quiet + (measured - quiet)[::-1]
+    o = sustained_oscillation([measured, quiet], [quiet, quiet], 1e-3)
+    assert o["runs"] == 1 and o["of"] == 2 and o["oscillating"] == [True, False]
+    f = o["freq_Hz"]
+    same = oscillation_band_errors([measured, quiet], [shifted, quiet[::-1]], 1e-3, f)
+    everywhere = oscillation_band_errors([measured, quiet], [shifted, shifted], 1e-3, f)
+    nowhere = oscillation_band_errors([measured, quiet], [quiet, quiet[::-1]], 1e-3, f)
+    assert np.all(same < 0.2)
+    assert everywhere[0] < 0.2 and everywhere[1] > np.log(10.0)
+    assert nowhere[0] > np.log(10.0) and nowhere[1] < 0.2
+    with pytest.raises(InputError, match="simulated"):
+        oscillation_band_errors([measured], [], 1e-3, f)
 
 
 def test_oscillation_log_errors_compare_the_band_rms_whatever_the_phase():
