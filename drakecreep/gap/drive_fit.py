@@ -1301,7 +1301,7 @@ def _reproduces(oscillation, path, value, runs, sims):
     everywhere where the measurement oscillates on some runs scores worse than one that oscillates on those).
 
     Near a loop's stability limit the oscillation comes and goes with the run (the nut's position, the speed), in
-    a converged truth as in the model: at development dataset 97106042's the truth's own delay oscillates on
+    a converged truth as in the model: on development dataset 97106042 the truth's own delay oscillates on
     exactly the two runs of four that the measurement does (docs/gap_benchmark.md 3ci)."""
     flags = oscillation.get("oscillating")
     if not flags or len(flags) != len(runs):
