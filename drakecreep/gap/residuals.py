@@ -570,14 +570,27 @@ def limit_cycle(record, dt, f_min=OSCILLATION_MIN_HZ):
     return o if o["share"] >= OSCILLATION_SHARE else None
 
 
-def _paired_bands(measured, simulated, dt, f_min):
-    """Per run: the measured record's :func:`dominant_oscillation` and the replay's RMS in its band."""
+def _paired_bands(measured, simulated, dt, f_min, freq=None):
+    """Per run: the measured record's :func:`dominant_oscillation` and the replay's RMS in its band; with ``freq``,
+    a measured record whose dominant oscillation holds less than :data:`OSCILLATION_SHARE` of its variance is
+    taken in the band of ``freq`` instead (its ``rms`` there)."""
     if len(measured) != len(simulated):
         raise InputError("simulated", f"{len(simulated)} records", f"one per measured record ({len(measured)})")
     for m, s in zip(measured, simulated):
         o = dominant_oscillation(m, dt, f_min)
+        if freq is not None and o["share"] < OSCILLATION_SHARE:
+            o = dict(o, freq_Hz=float(freq), rms=_band_rms(*_welch(np.asarray(m, dtype=float), dt), float(freq)))
         f, p, df = _welch(s, dt)
         yield o, _band_rms(f, p, df, o["freq_Hz"])
+
+
+def _log_band_errors(pairs):
+    """``|ln(model / measured)|`` per ``(dominant oscillation, replay's band RMS)`` of :func:`_paired_bands`."""
+    out = []
+    for o, model in pairs:
+        tiny = 1e-12 * max(o["rms"], 1.0)  # a replay with nothing in the band: finite, large
+        out.append(abs(math.log(max(model, tiny) / max(o["rms"], tiny))))
+    return np.array(out)
 
 
 def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
@@ -639,16 +652,7 @@ def oscillation_band_errors(measured, simulated, dt, freq, f_min=OSCILLATION_MIN
     numpy.ndarray
         One error per run [nepers].
     """
-    if len(measured) != len(simulated):
-        raise InputError("simulated", f"{len(simulated)} records", f"one per measured record ({len(measured)})")
-    out = []
-    for m, s in zip(measured, simulated):
-        o = dominant_oscillation(m, dt, f_min)
-        f0 = o["freq_Hz"] if o["share"] >= OSCILLATION_SHARE else float(freq)
-        band_m, band_s = (_band_rms(*_welch(np.asarray(x, dtype=float), dt), f0) for x in (m, s))
-        tiny = 1e-12 * max(band_m, 1.0)
-        out.append(abs(math.log(max(band_s, tiny) / max(band_m, tiny))))
-    return np.array(out)
+    return _log_band_errors(_paired_bands(measured, simulated, dt, f_min, freq))
 
 
 def oscillation_log_errors(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
@@ -669,8 +673,4 @@ def oscillation_log_errors(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
     numpy.ndarray
         One error per run [nepers].
     """
-    out = []
-    for o, model in _paired_bands(measured, simulated, dt, f_min):
-        tiny = 1e-12 * max(o["rms"], 1.0)  # a replay with nothing in the band: finite, large
-        out.append(abs(math.log(max(model, tiny) / max(o["rms"], tiny))))
-    return np.array(out)
+    return _log_band_errors(_paired_bands(measured, simulated, dt, f_min))
