@@ -449,6 +449,15 @@ def simulate_batch(jobs):
     knee_safe = np.where(p["knee"] > 0, p["knee"], 1.0)
     has_cc = bool(np.any(p["cc_k"] != 0) or np.any(p["cc_q"] != 0))
     has_bl = bool(np.any(p["bl"] > 0))
+    # terms that are zero in every column are skipped: the same numbers (a zero term adds +-0), fewer numpy calls
+    has_cg = bool(np.any(p["cg_amplitude_N"] != 0))
+    has_bd = bool(np.any(p["bd_amplitude_N"] != 0))
+    has_tr = bool(np.any(p["tr_amplitude_N"] != 0))
+    has_casym = bool(np.any(p["casym"] != 0))
+    has_gamma = bool(np.any(p["gamma"] != 0))
+    has_mu = bool(np.any(p["mu"] != 0))
+    has_beta = bool(np.any(p["beta"] != 0))
+    has_pl = bool(np.any(p["kpl"] != 0) or np.any(p["cpl"] != 0))
     w_lead = 2 * np.pi / p["lead"]
     v_eps = 1e-4
 
@@ -526,20 +535,33 @@ def simulate_batch(jobs):
                 else:
                     fk = k * stretch + c * dstretch
                 fm = p["Fc_m"] * np.tanh(v1 / v_eps) + p["Fv_m"] * v1 + p["offset"]
-                th = w_lead * x1
-                extra = (p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])
-                                                + p["cg_h2"] * np.sin(2 * p["cg_order"] * th))
-                         + p["bd_amplitude_N"] * np.sin(p["bd_order"] * th + p["bd_phase"])
-                         + p["tr_amplitude_N"] * np.sin(2 * np.pi * p["tr_freq_Hz"] * t + p["tr_phase"]))
-                a1 = (f_app - fm - fk * gearing - extra) / p["m1"]
-                sg = np.sign(v2)
-                fc = p["Fc_t"] * (1 + sg * p["casym"]) * (1 + p["gamma"] * np.tanh((x2 - p["xc"]) / p["width"]))
+                if has_cg or has_bd:
+                    th = w_lead * x1
+                extra = 0.0
+                if has_cg:
+                    extra = p["cg_amplitude_N"] * (np.sin(p["cg_order"] * th + p["cg_phase"])
+                                                   + p["cg_h2"] * np.sin(2 * p["cg_order"] * th))
+                if has_bd:
+                    extra = extra + p["bd_amplitude_N"] * np.sin(p["bd_order"] * th + p["bd_phase"])
+                if has_tr:
+                    extra = extra + p["tr_amplitude_N"] * np.sin(2 * np.pi * p["tr_freq_Hz"] * t + p["tr_phase"])
+                push = f_app - fm - (fk * gearing if has_le else fk)
+                if has_cg or has_bd or has_tr:
+                    push = push - extra
+                a1 = push / p["m1"]
+                if has_casym or has_beta:
+                    sg = np.sign(v2)
+                fc = p["Fc_t"]
+                if has_casym:
+                    fc = fc * (1 + sg * p["casym"])
+                if has_gamma:
+                    fc = fc * (1 + p["gamma"] * np.tanh((x2 - p["xc"]) / p["width"]))
                 gz = fc * (1 + (p["Fs_ratio"] - 1) * np.exp(-(v2 / p["vs"]) ** 2))
                 # the nut's load scales the bristle force (normal-load-scaled LuGre), not the bristles' target
                 # g(v): putting mu |fk| into g made sigma1 dz/dt follow every swing of the axial spring force, a
                 # damping force of order sigma1 mu dfk/dt / sigma0, 15 times the screw's own damper, which
                 # tripled the friction at 80 mm/s (docs/gap_benchmark.md, 3l). Steady sliding is the same.
-                lam = 1.0 + p["mu"] * np.abs(fk) / np.maximum(fc, 1e-9)
+                lam = 1.0 + p["mu"] * np.abs(fk) / np.maximum(fc, 1e-9) if has_mu else 1.0
                 # exact bristle update for v2 held over the substep
                 rate = p["sigma0"] * np.abs(v2) / np.maximum(gz, 1e-9)
                 moving = rate > 0
@@ -547,19 +569,27 @@ def simulate_batch(jobs):
                 z_new = np.where(moving, zss + (z - zss) * np.exp(-rate * h), z)
                 dz = (z_new - z) / h
                 z = z_new
-                ft = lam * (p["sigma0"] * z + p["sigma1"] * dz) + p["Fv_t"] * (1 + sg * p["beta"]) * v2
-                fp = p["kpl"] * (x2 - xp) + p["cpl"] * (v2 - vp)
-                fcc = 0.0
+                fv = p["Fv_t"] * (1 + sg * p["beta"]) if has_beta else p["Fv_t"]
+                bristles = p["sigma0"] * z + p["sigma1"] * dz
+                ft = (lam * bristles if has_mu else bristles) + fv * v2
+                if has_pl:
+                    fp = p["kpl"] * (x2 - xp) + p["cpl"] * (v2 - vp)
                 if has_cc:  # conservative: the same force of position in both directions of motion
                     d = x2 - p["cc_x0"]
                     fcc = p["cc_k"] * d + p["cc_q"] * (d / 0.1) ** 2
-                a2 = (fk - ft - fp - fcc) / p["m2"]
+                pull = fk - ft
+                if has_pl:
+                    pull = pull - fp
+                if has_cc:
+                    pull = pull - fcc
+                a2 = pull / p["m2"]
                 v1 = v1 + h * a1
                 v2 = v2 + h * a2
                 x1 = x1 + h * v1
                 x2 = x2 + h * v2
-                vp = vp + h * fp / mp_safe
-                xp = xp + h * vp
+                if has_pl:
+                    vp = vp + h * fp / mp_safe
+                    xp = xp + h * vp
                 # the current loop's lag advances after the kick: the kick takes the applied force at the substep's
                 # start, as it takes every other force (a semi-implicit Euler step is the leapfrog's kick-drift, its
                 # force at the step's start). Advanced before the kick, the force led by one substep, which near a

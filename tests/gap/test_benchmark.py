@@ -370,7 +370,7 @@ def test_skipped_seeds_are_neither_generated_nor_diagnosed(monkeypatch):
                                                                  "claimed": [], "seconds": 0.0})
     monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
     kw = dict(seed=DEV_SEEDS, kinds=("p_p_cascade",), n_per_effect=2, n_null=3, n_ool=0, n_no_candidate=0,
-              audit=False, tries=4, library=["time_ripple"])  # two time ripples at SNR >= 3 of the first four
+              audit=False, tries=6, library=["time_ripple"], n_samples=1500)  # 1.5 s runs: 9 s, not 26
     whole = run_benchmark(**kw)["datasets"]
     nulls = [r["seed"] for r in whole if not r["withheld"]]
     ripples = [r["seed"] for r in whole if r["withheld"]]
