@@ -6,6 +6,7 @@ import importlib.util
 import json
 import math
 import os
+import pkgutil
 import subprocess
 import sys
 from pathlib import Path
@@ -31,6 +32,40 @@ def _indexes_argv(tree):
     """Whether the module reads ``sys.argv[...]`` itself (a missing argument is then an IndexError)."""
     return any(isinstance(node, ast.Subscript) and isinstance(node.value, ast.Attribute) and node.value.attr == "argv"
                for node in ast.walk(tree))
+
+
+def _in_process(script, args, monkeypatch, capsys, cwd):
+    """``python analysis/SCRIPT ARGS`` run in this process, with no dataset generated, diagnosed or replayed: the
+    exit status, standard output and standard error. (A subprocess spent 2 s importing SciPy and Drake for each
+    refusal; ``test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once`` keeps the
+    command-line path.)"""
+    import drakecreep
+    from drakecreep.gap import benchmark, drake_replay
+
+    # every module of the package imported before the patches, so none binds a patched name for good
+    for info in pkgutil.walk_packages(drakecreep.__path__, "drakecreep."):
+        if not info.name.endswith("__main__"):
+            importlib.import_module(info.name)
+
+    def work(*args, **kwargs):
+        raise AssertionError(f"{script} started the work before refusing {args!r}")
+
+    for module, name in ((benchmark, "generate_dataset"), (benchmark, "evaluate"), (benchmark, "run_benchmark"),
+                         (drake_replay, "replay_drakecreep")):
+        monkeypatch.setattr(module, name, work)
+    monkeypatch.syspath_prepend(str(ANALYSIS))
+    monkeypatch.chdir(cwd)
+    monkeypatch.setattr(sys, "argv", [str(ANALYSIS / script), *args])
+    spec = importlib.util.spec_from_file_location(Path(script).stem, ANALYSIS / script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    capsys.readouterr()
+    try:
+        code = module.main()
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr()
+    return code, out.out, out.err
 
 
 def test_there_are_scripts():
@@ -80,12 +115,9 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_gap_benchmark.py", ("--skip-seeds", "104000"), "--skip-seeds: got (104000,) with --seeds heldout"),
     ("bench_gap_benchmark.py", ("--seeds", "dev", "--skip-seeds", "114003-114000"), "'114003-114000': seeds >= 0"),
 ])
-def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, script, args, field):
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
-    out = subprocess.run([sys.executable, str(ANALYSIS / script), *args], cwd=tmp_path, env=env,
-                         capture_output=True, text=True, timeout=300)
-    assert out.returncode == 2 and "Traceback" not in out.stderr and out.stdout == ""
-    assert field in out.stderr.strip().splitlines()[-1]
+def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, monkeypatch, capsys, script, args, field):
+    code, out, err = _in_process(script, args, monkeypatch, capsys, tmp_path)
+    assert code == 2 and out == "" and field in err.strip().splitlines()[-1]
 
 
 def _drive_row(seed, category, expected, snr, nominal, ranking, claimed, oscillation=None):
@@ -226,16 +258,14 @@ def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monke
     (("--out", "x.json", "--tolerance", "0"), "--tolerance: got 0.0"),
     (("--out", "x.json"), "rows: got"),  # held-out rows: refused
 ])
-def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, args, field):
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+def test_backfill_refuses_bad_options_and_held_out_rows(tmp_path, monkeypatch, capsys, args, field):
     rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
-    out = subprocess.run([sys.executable, str(ANALYSIS / "backfill_training_fit.py"), str(rows), *args], cwd=tmp_path,
-                         env=env, capture_output=True, text=True, timeout=300)
-    assert out.returncode == 2 and "Traceback" not in out.stderr and field in out.stderr.strip().splitlines()[-1]
+    code, _, err = _in_process("backfill_training_fit.py", (str(rows), *args), monkeypatch, capsys, tmp_path)
+    assert code == 2 and field in err.strip().splitlines()[-1]
     assert not (tmp_path / "x.json").exists()
 
 
-def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch):
+def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch, capsys):
     """The true effect's audit shrink of an older drakecreep-kind row: the dataset regenerated from the row's seed
     gives the row's own audit energy again (its claim's values, then the final refit's, a refitted amplitude
     among them), and the true model is the fitted uncertain fields with the truth's effect (not the claim's
@@ -268,14 +298,12 @@ def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch)
     off = dict(row, audit={"nominal": {"energy": nominal}, "claimed": {"energy": 1.01 * claimed}})
     r = dts.true_shrink(off, n_samples=600)
     assert not r["reproduced"] and r["check"] == pytest.approx(1 - 1 / 1.01, abs=1e-9)
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
     rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
     for args, field in ((("--tolerance", "0"), "--tolerance: got 0.0"), (("--samples", "10"), "--samples: got 10"),
                         (("--json", str(tmp_path)), "--json: got"), ((), "rows: cannot read")):
         argv = [str(rows), *args] if args else [str(tmp_path / "none.json")]
-        out = subprocess.run([sys.executable, str(ANALYSIS / "drive_true_shrink.py"), *argv], cwd=tmp_path, env=env,
-                             capture_output=True, text=True, timeout=300)
-        assert out.returncode == 2 and "Traceback" not in out.stderr and field in out.stderr.strip().splitlines()[-1]
+        code, _, err = _in_process("drive_true_shrink.py", argv, monkeypatch, capsys, tmp_path)
+        assert code == 2 and field in err.strip().splitlines()[-1]
 
 
 def test_the_shipped_drive_example_is_what_its_script_makes():
@@ -348,23 +376,24 @@ def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
     assert bad.returncode == 2 and "rows: got no drakecreep row" in bad.stderr and "Traceback" not in bad.stderr
 
 
-def _refused_in_one_line(script, cases):
-    """Each ``(args, says)`` of ``cases`` run as ``script`` exits 2 with no traceback, ``says`` in its last line."""
-    env = dict(os.environ, PYTHONPATH=str(ANALYSIS.parent))
+def _refused_in_one_line(script, cases, monkeypatch, capsys, cwd):
+    """Each ``(args, says)`` of ``cases`` run as ``analysis/SCRIPT`` exits 2 before any work, ``says`` in its last
+    line."""
     for args, says in cases:
-        r = subprocess.run([sys.executable, script, *args], capture_output=True, text=True, env=env, timeout=120)
-        assert r.returncode == 2, (args, r.stderr)
-        assert "Traceback" not in r.stderr and says in r.stderr.strip().splitlines()[-1]
+        code, _, err = _in_process(script, args, monkeypatch, capsys, cwd)
+        assert code == 2, (args, err)
+        assert says in err.strip().splitlines()[-1]
 
 
-def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path):
+def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
     each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
     script = str(ANALYSIS / "diagnose_dataset.py")
-    _refused_in_one_line(script, ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
-                                  (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
-                                  (["9014:null:rigid", "--kind", "pi"], "--kind"),
-                                  (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json")))
+    cases = ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
+             (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
+             (["9014:null:rigid", "--kind", "pi"], "--kind"),
+             (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json"))
+    _refused_in_one_line("diagnose_dataset.py", cases, monkeypatch, capsys, tmp_path)
     spec = importlib.util.spec_from_file_location("dd", script)
     dd = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dd)
@@ -377,13 +406,14 @@ def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tm
     assert "shrink 97.0 %" in line and "worse False" in line
 
 
-def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line():
+def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
     frequency is its RMS, and next to nothing an octave away."""
     script = str(ANALYSIS / "delay_pattern_study.py")
-    _refused_in_one_line(script, ((["9014", "--ticks", "8,x"], "--ticks"), (["9014", "--ticks", "-1"], "--ticks"),
-                                  (["99000001"], "99000001")))
+    _refused_in_one_line("delay_pattern_study.py", ((["9014", "--ticks", "8,x"], "--ticks"),
+                                                    (["9014", "--ticks", "-1"], "--ticks"), (["99000001"], "99000001")),
+                         monkeypatch, capsys, tmp_path)
     spec = importlib.util.spec_from_file_location("dps", script)
     dps = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(dps)
