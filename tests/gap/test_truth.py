@@ -273,3 +273,21 @@ def test_a_loop_near_its_stability_limit_is_converged_in_the_substeps(monkeypatc
     fine = rms()
     assert np.all(fine > 5.0)  # the oscillation is there
     np.testing.assert_allclose(coarse, fine, rtol=0.25)
+
+
+def test_the_terms_left_out_where_they_are_zero_change_no_bit():
+    """``simulate_batch`` leaves out the terms that are zero in every column (2.1 times faster,
+    ``analysis/bench_truth.py``): the null and each withheld effect alone, on either kind and axis, give the same
+    bits on a short out-and-back with a force pulse as every term evaluated."""
+    rng = np.random.default_rng(11)
+    refs = T.out_and_back(0.02, 0.05, n=60, leg=0.025, starts=(0.004, 0.032))[None, :]
+    pulses = np.zeros_like(refs)
+    pulses[0, 20:30] = 15.0
+    for i, withheld in enumerate(((),) + tuple((w,) for w in T.WITHHELD)):
+        tr = T.draw_truth(rng, T.CONTROLLER_KINDS[(i // 2) % 2], T.AXES[i % 2], withheld)
+        drift, noise = T.noise_draws(tr, 1, refs.shape[1], rng)
+        job = [(tr, refs, pulses, drift, noise, True)]
+        fast, every = T.simulate_batch(job)[0], T.simulate_batch(job, skip_zero_terms=False)[0]
+        for key in ("x_motor", "x_table", "u"):
+            np.testing.assert_array_equal(fast[key], every[key], err_msg=f"{withheld} {key}")
+        assert np.ptp(every["u"]) > 0  # the loop acted
