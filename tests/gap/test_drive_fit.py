@@ -220,13 +220,15 @@ def test_a_delay_that_reproduces_the_oscillation_is_claimed_on_the_held_out_spec
     assert "explained by control_delay on the spectrum: the measured force oscillates" in text
 
 
-def test_claims_are_withheld_only_when_most_runs_oscillate():
-    """An oscillation on one run of four (a lead error's force at one speed can look like one) leaves the claims
-    to the held-out test; on three of four, or two of two, they are withheld."""
+def test_claims_are_withheld_when_at_least_two_and_half_the_runs_oscillate():
+    """An oscillation on one run (a lead error's force at one speed can look like one) leaves the claims to the
+    held-out test, of four runs or of two; on two of four (an axial mode unstable only where the nut is far from
+    the bearing), three of four, or two of two, they are withheld."""
     o = {"freq_Hz": 150.0, "rms": 5.0, "model_rms": 0.1, "share": 0.9, "of": 4}
     assert not drive_fit.claims_withheld(None)
-    assert [drive_fit.claims_withheld(dict(o, runs=k)) for k in (1, 2, 3, 4)] == [False, False, True, True]
-    assert drive_fit.claims_withheld(dict(o, runs=2, of=2))
+    assert [drive_fit.claims_withheld(dict(o, runs=k)) for k in (1, 2, 3, 4)] == [False, True, True, True]
+    assert drive_fit.claims_withheld(dict(o, runs=2, of=2)) and not drive_fit.claims_withheld(dict(o, runs=1, of=2))
+    assert not drive_fit.claims_withheld(dict(o, runs=2, of=5)) and drive_fit.claims_withheld(dict(o, runs=3, of=6))
 
 
 def test_a_stribeck_hump_is_found_from_a_params_file_whose_curve_is_flat(monkeypatch):
@@ -915,9 +917,9 @@ def test_a_limit_cycle_is_not_refused_as_a_unit_slip_by_its_inverse_dynamics_mas
 
 def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_picked_run_by_run(monkeypatch):
     """Near a loop's stability limit the measured oscillation comes and goes with the run (docs/gap_benchmark.md
-    3ci). Two of four runs oscillate at 160 Hz: a delay whose model oscillates on those two only reproduces it (it
-    did not when "reproduces" meant more than half of all runs), and is picked over one that oscillates on all four
-    by the run-by-run band error; on held-out runs of the same pattern it is claimed, and the one oscillating
+    3ci). Two of four runs oscillate at 160 Hz (enough to withhold the sample claims since 3cj): a delay whose
+    model oscillates on those two only reproduces it (it did not when "reproduces" meant more than half of all
+    runs), and is picked over one that oscillates on all four by the run-by-run band error; on held-out runs of the same pattern it is claimed, and the one oscillating
     everywhere, alone, is not (it oscillates on both held-out runs that do not)."""
     rng = np.random.default_rng(0)
     t = np.arange(2000) * 1e-3
@@ -931,7 +933,7 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
 
     runs, quiet = records((1, 1, 0, 0)), records((0, 0, 0, 0))
     o = drive_fit.sustained_oscillation([r.force for r in runs], [q.force for q in quiet], 1e-3)
-    assert o["oscillating"] == [True, True, False, False] and not drive_fit.claims_withheld(o)
+    assert o["oscillating"] == [True, True, False, False] and drive_fit.claims_withheld(o)
     o["reproduced_by"] = []
     sims = {4.0: quiet, 8.0: records((1, 1, 1, 1)), 12.0: records((1, 1, 0, 0))}
     for d, s in sims.items():
