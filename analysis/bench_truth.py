@@ -17,6 +17,7 @@ import time
 import numpy as np
 
 from drakecreep.gap import truth as T
+from drakecreep.gap.benchmark import N_AUDIT, N_TEST, N_TRAIN
 
 __all__ = ["main"]
 
@@ -37,9 +38,11 @@ def _cpu(job, repeat, skip):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=8, help="runs per dataset (default %(default)s, the benchmark's)")
+    ap.add_argument("--runs", type=int, default=N_TRAIN + N_TEST + N_AUDIT,
+                    help="runs per dataset (default %(default)s, the benchmark's training, held-out and audit runs)")
     ap.add_argument("--samples", type=int, default=3000, help="samples per run (default %(default)s, 3 s)")
-    ap.add_argument("--repeat", type=int, default=2, help="simulations per case and way; the least is kept")
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="simulations per case and way, the least CPU time kept (default %(default)s)")
     args = ap.parse_args(argv)
     if not 1 <= args.runs <= 64:
         ap.error(f"--runs: got {args.runs}; allowed: an integer in [1, 64]")

@@ -26,7 +26,7 @@ import traceback
 from drakecreep import __version__
 from drakecreep.errors import DrakecreepError, Terminated
 
-__all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "plain"]
+__all__ = ["main", "build_parser", "COMMANDS", "HEARTBEAT", "HEARTBEAT_AFTER", "plain"]
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMANDS = [
@@ -47,6 +47,8 @@ COMMANDS = [
 #: Commands that can take more than ~2 s and report no progress of their own: an elapsed-time bar on stderr
 #: (on a terminal, or with DRAKECREEP_PROGRESS=1).
 HEARTBEAT = ("report", "compensate", "reproduce-paper", "margins", "tune", "critical", "modal", "emps", "simulate")
+#: seconds a job runs before its heartbeat shows: shorter jobs stay silent
+HEARTBEAT_AFTER = 2.0
 
 
 def plain(text):
@@ -111,13 +113,13 @@ def _heartbeat(command):
 
     stop = threading.Event()
     bar = tqdm(desc=f"drakecreep {command}", bar_format="{desc}: {elapsed} elapsed", file=sys.stderr,
-               delay=2.0, mininterval=0.5)
+               delay=HEARTBEAT_AFTER, mininterval=0.5)
 
     start = time.monotonic()
 
     def tick():
         while not stop.wait(0.5):
-            if time.monotonic() - start >= 2.0:  # short jobs stay silent
+            if time.monotonic() - start >= HEARTBEAT_AFTER:  # short jobs stay silent
                 bar.refresh()
 
     thread = threading.Thread(target=tick, daemon=True)

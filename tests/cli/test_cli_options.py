@@ -25,11 +25,12 @@ def test_heartbeat_appears_on_stderr_for_a_long_job_and_not_with_quiet(monkeypat
 
     import drakecreep.cli.hertz as hertz
 
-    def slow(args):
-        time.sleep(3.2)
+    def slow(args):  # a job longer than the heartbeat's wait (2 s in use, 0.2 s here) and three of its ticks
+        time.sleep(1.5)
         return 0
 
     monkeypatch.setattr(cli, "HEARTBEAT", ("hertz",))
+    monkeypatch.setattr(cli, "HEARTBEAT_AFTER", 0.2)
     monkeypatch.setenv("DRAKECREEP_PROGRESS", "1")  # stderr is not a terminal under pytest: force it
     monkeypatch.setattr(hertz, "run", slow)
     assert cli.main(["hertz"]) == 0
