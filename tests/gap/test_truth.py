@@ -276,7 +276,7 @@ def test_a_loop_near_its_stability_limit_is_converged_in_the_substeps(monkeypatc
 
 
 def test_the_terms_left_out_where_they_are_zero_change_no_bit():
-    """``simulate_batch`` leaves out the terms that are zero in every column (2.1 times faster,
+    """``simulate_batch`` leaves out the terms that are zero in every column (about twice as fast,
     ``analysis/bench_truth.py``): the null and each withheld effect alone, on either kind and axis, give the same
     bits on a short out-and-back with a force pulse as every term evaluated."""
     rng = np.random.default_rng(11)
