@@ -60,9 +60,10 @@ Steps:
    null.
 4. **No claim on an oscillating loop**: when training runs carry a sustained oscillation that the fitted model's
    replay does not (:func:`drakecreep.gap.residuals.sustained_oscillation` on at least two and at least half of
-   them: the real loop is unstable, the model is stable), the held-out force error is the oscillation's, whose phase is
-   free, and a gain of a thousandth of a point passes the paired test as easily as the run-to-run null. Only the
-   delay search runs (it says which delays make the model oscillate there); the other candidates are not fitted.
+   them: the real loop is unstable, the model is stable), the held-out force error is the oscillation's, whose
+   phase is free, and a gain of a thousandth of a point passes the paired test as easily as the run-to-run null.
+   Only the delay search runs (it says which delays make the model oscillate there); the other candidates are not
+   fitted.
    A delay that makes the model oscillate there can be claimed on the held-out runs' spectrum: the RMS in the
    band of the measured oscillation, model against measurement, must come closer, run by run, by more than the
    held-out runs' spread on the runs that oscillate, and the model must not oscillate on most of those that do
@@ -389,8 +390,8 @@ class DriveDiagnosis:
         computation delays the delay search tried whose replay oscillates within +-15 % of that frequency
         (``{"path", "value", "freq_Hz", "rms", "runs"}``). Reported as unexplained: a replay sample by sample
         cannot follow an oscillation whose phase is free, so no claim rests on its samples; on at least two and
-        half of the training runs (:func:`claims_withheld`) only the delay search runs, and the one claim possible is a delay
-        on the held-out spectrum (``spectral``, :func:`_spectral_delay`).
+        half of the training runs (:func:`claims_withheld`) only the delay search runs, and the one claim possible
+        is a delay on the held-out spectrum (``spectral``, :func:`_spectral_delay`).
     where : dict
         What the augmented params file still does not explain on the held-out runs, and where
         (:func:`drakecreep.gap.where.locate` of their replays): by regime, frequency band, order of the screw's

@@ -919,8 +919,9 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
     """Near a loop's stability limit the measured oscillation comes and goes with the run (docs/gap_benchmark.md
     3ci). Two of four runs oscillate at 160 Hz (enough to withhold the sample claims since 3cj): a delay whose
     model oscillates on those two only reproduces it (it did not when "reproduces" meant more than half of all
-    runs), and is picked over one that oscillates on all four by the run-by-run band error; on held-out runs of the same pattern it is claimed, and the one oscillating
-    everywhere, alone, is not (it oscillates on both held-out runs that do not)."""
+    runs), and is picked over one that oscillates on all four by the run-by-run band error; on held-out runs of
+    the same pattern it is claimed, and the one oscillating everywhere, alone, is not (it oscillates on both
+    held-out runs that do not)."""
     rng = np.random.default_rng(0)
     t = np.arange(2000) * 1e-3
 
