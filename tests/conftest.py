@@ -32,13 +32,18 @@ def ctrl_c_as_at_a_terminal():
     signal.signal(signal.SIGINT, before)
 
 
-#: the test files that take longest (20-330 s each on one of two cores, session 66's ``--durations=0``), longest
+#: the test files that take longest (10-330 s each on one of two cores, session 77's ``--durations=0``), longest
 #: first: with ``--dist loadfile`` a worker takes whole files in the order collected, and a long file collected in
-#: the middle of the suite (test_drive_fit.py, a third of all the test time) left the other worker idle at the end
-LONGEST_FIRST = ("gap/test_drive_fit.py", "gap/test_benchmark.py", "studies/test_compensation.py",
-                 "gap/test_drake_diagnosis.py", "test_analysis_scripts.py", "report/test_loop_report.py",
-                 "cli/test_diagnose_drakecreep.py", "servo/test_tuning.py", "gap/test_screen.py",
-                 "sim/test_sweep_faults.py", "sim/test_sweep.py", "cli/test_gap_benchmark.py")
+#: the middle of the suite (test_drive_fit.py, a quarter of all the test time) left the other worker idle at the
+#: end; the files of 10-30 s are listed too, so that the last files handed out are the short ones
+LONGEST_FIRST = ("gap/test_drive_fit.py", "gap/test_benchmark.py", "gap/test_drake_diagnosis.py",
+                 "studies/test_compensation.py", "gap/test_screen.py", "test_analysis_scripts.py", "gap/test_truth.py",
+                 "gap/test_drake_replay_drakecreep.py", "report/test_loop_report.py", "servo/test_tuning.py",
+                 "gap/test_drake_replay.py", "cli/test_diagnose_drakecreep.py", "sim/test_baseline.py",
+                 "sim/test_sweep.py", "cli/test_gap_benchmark.py", "cli/test_reproduce_compensate.py", "test_docs.py",
+                 "cli/test_bad_input.py", "studies/test_paper_reproduction.py", "model/test_axis.py",
+                 "servo/test_loops.py", "sim/test_simulation.py", "cli/test_cli_options.py", "cli/test_diagnose.py",
+                 "model/test_nut_friction.py")
 
 
 def pytest_collection_modifyitems(config, items):
