@@ -1290,7 +1290,8 @@ def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
               f"the {len(osc)} of {n} held-out runs that oscillate it does so at the measured frequency on {same}, "
               f"its band error {np.mean(e1[osc]) if osc else float('nan'):.2f} Np against the fitted model's "
               f"{np.mean(e0[osc]) if osc else float('nan'):.2f} Np (decrease {gain:.2f} Np, bar {bar:.2f}, "
-              f"{better} of {len(osc)} runs better); it oscillates on {spurious} of the {len(quiet)} that do not"
+              f"{better} of {len(osc)} runs better); "
+              + (f"it oscillates on {spurious} of the {len(quiet)} that do not" if quiet else "none is quiet")
               + ("" if len(osc) > 1 else "; fewer than two held-out runs oscillate: not claimed")
               + ("" if null is not None else "; no run-to-run null: not claimed"))
     out = {"values": values, "passes": ok, "reason": reason, "nominal_nepers": e0.tolist(),

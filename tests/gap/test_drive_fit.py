@@ -957,3 +957,7 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
     o["reproduced_by"] = [by[8.0]]
     spectral, _ = drive_fit._spectral_delay(o, test, RIG, records((0, 0, 0, 0)), replay, null=0.01)
     assert spectral["values"] == {"controller.computation_delay": 8.0} and not spectral["passes"]
+    assert spectral["reason"].endswith("it oscillates on 2 of the 2 that do not")
+    # held-out runs that all oscillate: the reason says none is quiet (not "0 of the 0")
+    spectral, _ = drive_fit._spectral_delay(o, records((1, 1, 1, 1)), RIG, records((0, 0, 0, 0)), replay, null=0.01)
+    assert spectral["oscillating"] == 4 and spectral["reason"].endswith("none is quiet")
