@@ -34,6 +34,14 @@ def _indexes_argv(tree):
                for node in ast.walk(tree))
 
 
+def _script_module(name):
+    """``analysis/NAME`` loaded as a module (its ``__main__`` block not run)."""
+    spec = importlib.util.spec_from_file_location(Path(name).stem, ANALYSIS / name)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def _in_process(script, args, monkeypatch, capsys, cwd):
     """``python analysis/SCRIPT ARGS`` run in this process, with no dataset generated, diagnosed or replayed: the
     exit status, standard output and standard error. (A subprocess spent 2 s importing SciPy and Drake for each
@@ -56,9 +64,7 @@ def _in_process(script, args, monkeypatch, capsys, cwd):
     monkeypatch.syspath_prepend(str(ANALYSIS))
     monkeypatch.chdir(cwd)
     monkeypatch.setattr(sys, "argv", [str(ANALYSIS / script), *args])
-    spec = importlib.util.spec_from_file_location(Path(script).stem, ANALYSIS / script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = _script_module(script)
     capsys.readouterr()
     try:
         code = module.main()
@@ -135,9 +141,7 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     amounts fails the Student bars on points and on log ratios but passes the sign-flip test; a null's candidate
     that helps two runs of five is claimed by none; a row without per-run errors (written before session 55) is
     skipped."""
-    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
-    dcs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dcs)
+    dcs = _script_module("drive_claim_statistics.py")
     nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
     lead = _ranked("lead_error", [9.9, 11.5, 12.0, 10.8, 14.0])  # gains 0.1-26 points, all positive
     noise = _ranked("force_ripple", [9.0, 11.0, 30.5, 11.5, 40.2])
@@ -172,9 +176,7 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
     (Student bar passed, training gain 0.2 %). ``points_t`` claims the flat curve; with the training chi-square
     test it is out (0.15 against the 5 % quantile of two degrees of freedom, 5.99), and the pooled test alone
     claims the lead error (50 against 11.07 for its five fields)."""
-    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
-    dcs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dcs)
+    dcs = _script_module("drive_claim_statistics.py")
     nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
     lead = dict(_ranked("lead_error", [9.9, 11.5, 12.0, 10.8, 14.0]),
                 values={"disturbance.lead_error_amplitude": 2e-6, "disturbance.lead_error_period": 4e-4,
@@ -201,9 +203,7 @@ def test_drive_claim_statistics_weighs_the_training_gain(tmp_path):
 def test_drive_claim_statistics_lets_a_large_pooled_shrink_stand_for_the_student_bar():
     """Study 3bs's rule: a candidate that fails the Student bar on its per-run gains is claimed when its pooled
     held-out shrink is above 20 run-to-run nulls, and not when it is above the null but below 20 of them."""
-    spec = importlib.util.spec_from_file_location("dcs", ANALYSIS / "drive_claim_statistics.py")
-    dcs = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dcs)
+    dcs = _script_module("drive_claim_statistics.py")
     nominal = [10.0, 12.0, 30.0, 11.0, 40.0]
     lead = _ranked("lead_error", [9.9, 11.5, 12.0, 10.8, 14.0])  # shrink 76 % of the pooled energy
     row = _drive_row(1, "library", "lead_error", 5.0, nominal, [lead], [])
@@ -219,10 +219,7 @@ def test_drive_claim_statistics_lets_a_large_pooled_shrink_stand_for_the_student
 
 
 def _backfill_module():
-    spec = importlib.util.spec_from_file_location("btf", ANALYSIS / "backfill_training_fit.py")
-    btf = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(btf)
-    return btf
+    return _script_module("backfill_training_fit.py")
 
 
 def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
@@ -274,9 +271,7 @@ def test_drive_true_shrink_counts_only_rows_it_reproduces(tmp_path, monkeypatch,
     from drakecreep.gap.drive_fit import _with
 
     monkeypatch.syspath_prepend(str(ANALYSIS))  # its study_cli, as when run from analysis/
-    spec = importlib.util.spec_from_file_location("dts", ANALYSIS / "drive_true_shrink.py")
-    dts = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dts)
+    dts = _script_module("drive_true_shrink.py")
     seed, withheld = DEV_SEEDS + 7, ["lead_error"]
     ds = generate_dataset(seed, withheld=tuple(withheld), kind="drakecreep", axis="rigid", n_samples=600)
     declared = ds.train[0].meta.params
@@ -313,9 +308,7 @@ def test_the_shipped_drive_example_is_what_its_script_makes():
     from drakecreep.data import example_path
     from drakecreep.gap.measured import load_measured
 
-    spec = importlib.util.spec_from_file_location("mde", ANALYSIS / "make_drive_example.py")
-    mde = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mde)
+    mde = _script_module("make_drive_example.py")
     rig, runs = mde.example_runs()
     shipped = load_measured(example_path("drive_lead_error.csv"))
     assert [r.label for r in shipped.runs] == [r.label for r in runs] and len(runs) == len(mde.SPEEDS)
@@ -343,11 +336,9 @@ def test_lowpass_claim_recount_decides_on_the_force_below_100_hz(tmp_path):
     move (the count ripple drawn anew; the row's own verdict is no claim) but whose errors below 100 Hz halve on
     every run is claimed there; a null's candidate moving below 100 Hz within the refits' spread is not; a lead
     error decided on the transmission keeps its verdict; rows without the fields are refused in one line."""
-    spec = importlib.util.spec_from_file_location("lcr", ANALYSIS / "lowpass_claim_recount.py")
-    lcr = importlib.util.module_from_spec(spec)
     sys.path.insert(0, str(ANALYSIS))
     try:
-        spec.loader.exec_module(lcr)
+        lcr = _script_module("lowpass_claim_recount.py")
     finally:
         sys.path.remove(str(ANALYSIS))
     nominal, low = [30.0, 32.0, 35.0, 31.0, 33.0], [12.0, 14.0, 15.0, 13.0, 12.5]
@@ -388,15 +379,12 @@ def _refused_in_one_line(script, cases, monkeypatch, capsys, cwd):
 def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
     each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
-    script = str(ANALYSIS / "diagnose_dataset.py")
     cases = ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
              (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
              (["9014:null:rigid", "--kind", "pi"], "--kind"),
              (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json"))
     _refused_in_one_line("diagnose_dataset.py", cases, monkeypatch, capsys, tmp_path)
-    spec = importlib.util.spec_from_file_location("dd", script)
-    dd = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dd)
+    dd = _script_module("diagnose_dataset.py")
     row = {"seed": 1205, "withheld": ["lead_error"], "axis": "flexible", "snr": 24.2, "claimed": ["lead_error"],
            "first_passing": "lead_error", "audit_shrink": 0.9695, "true_shrink": 0.9695, "worse": False,
            "audit": {"nominal": {"force_rms": 29.88, "force_lowpass_rms": 26.64},
@@ -410,13 +398,10 @@ def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tm
     """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
     frequency is its RMS, and next to nothing an octave away."""
-    script = str(ANALYSIS / "delay_pattern_study.py")
     _refused_in_one_line("delay_pattern_study.py", ((["9014", "--ticks", "8,x"], "--ticks"),
                                                     (["9014", "--ticks", "-1"], "--ticks"), (["99000001"], "99000001")),
                          monkeypatch, capsys, tmp_path)
-    spec = importlib.util.spec_from_file_location("dps", script)
-    dps = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(dps)
+    dps = _script_module("delay_pattern_study.py")
     t = np.arange(3000) * 1e-3
     x = 3.0 * math.sqrt(2.0) * np.sin(2 * math.pi * 150.0 * t)
     assert abs(dps.band_rms(x, 1e-3, 150.0) - 3.0) < 0.15
