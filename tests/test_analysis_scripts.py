@@ -14,8 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from drakecreep.gap.benchmark import HELDOUT_SEEDS
+
 ANALYSIS = Path(__file__).resolve().parents[1] / "analysis"
 SCRIPTS = sorted(p for p in ANALYSIS.glob("*.py") if '__name__ == "__main__"' in p.read_text())
+#: a seed of the current held-out set, which the development scripts refuse
+HELD_OUT = HELDOUT_SEEDS + 1
 
 
 def _parses_arguments(tree):
@@ -380,7 +384,7 @@ def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tm
     """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
     each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
     cases = ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
-             (["99000001:null:rigid", "--kind", "drakecreep"], "99000001"),
+             ([f"{HELD_OUT}:null:rigid", "--kind", "drakecreep"], str(HELD_OUT)),
              (["9014:null:rigid", "--kind", "pi"], "--kind"),
              (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json"))
     _refused_in_one_line("diagnose_dataset.py", cases, monkeypatch, capsys, tmp_path)
@@ -399,7 +403,7 @@ def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tm
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
     frequency is its RMS, and next to nothing an octave away."""
     _refused_in_one_line("delay_pattern_study.py", ((["9014", "--ticks", "8,x"], "--ticks"),
-                                                    (["9014", "--ticks", "-1"], "--ticks"), (["99000001"], "99000001")),
+                                                    (["9014", "--ticks", "-1"], "--ticks"), ([str(HELD_OUT)], str(HELD_OUT))),
                          monkeypatch, capsys, tmp_path)
     dps = _script_module("delay_pattern_study.py")
     t = np.arange(3000) * 1e-3
