@@ -1,20 +1,22 @@
-"""The symbolic fast path: one feed-drive diagram turned into (at most) two ``SymbolicVectorSystem``s.
+"""The symbolic fast path: one feed-drive diagram turned into one ``SymbolicVectorSystem`` (and a hold).
 
 The leaf systems are written once as ``TemplateSystem``s; here the whole diagram is converted with
 ``ToSymbolic()``, its time derivatives, its periodic discrete update and every recorded signal are
 evaluated once as symbolic expressions of ``(t, x_continuous, x_discrete)``, and those expressions
 become Drake's C++ ``SymbolicVectorSystem``s:
 
-* ``plant``: continuous state, input = the discrete state, output = recorded signals + continuous state;
-* ``discrete_update`` + ``sampler``: the periodic update ``g(t, x_c, x_d)`` as a memoryless symbolic
-  system, held by a ``ZeroOrderHold`` with the diagram's period whose state is the discrete state
-  (no feedthrough, so no algebraic loop). Several sampled leaves (controller, compensator on the encoder
-  speed) are fine when they share one period and offset 0: their groups are concatenated. A second
-  timing (a fractional ``controller.computation_delay`` switches the output between samples) is refused
-  with ``NotImplementedError``; :func:`drakecreep.sim.simulation.simulate` says so up front.
+* ``plant``: continuous state, input = the discrete state (and the inputs), output = recorded signals +
+  continuous state + the periodic update ``g(t, x_c, x_d)``;
+* ``sampler``: a ``ZeroOrderHold`` with the diagram's period whose state is the discrete state, sampling ``g``
+  from the plant's output (no feedthrough, so no algebraic loop); the exported output ``signals`` leaves ``g``
+  out. Several sampled leaves (controller, compensator on the encoder speed) are fine when they share one period
+  and offset 0: their groups are concatenated. A second timing (a fractional ``controller.computation_delay``
+  switches the output between samples) is refused with ``NotImplementedError``;
+  :func:`drakecreep.sim.simulation.simulate` says so up front.
 
 Same equations, same state ordering, no Python in the simulation loop (measured about 10x faster end to
-end than the Python leaf systems, see ``analysis/bench_simulation.py``).
+end than the Python leaf systems, see ``analysis/bench_simulation.py``; the update in the plant's output, not a
+system of its own, 1.3-1.4x faster than that with the same bits, ``analysis/bench_compiled.py``).
 
 Signals from outside (a measured reference, an external force): build the feed drive with
 ``ConstantVectorSource`` placeholders (``build_diagram(..., reference=ConstantVectorSource([0, 0]))``) and
@@ -28,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydrake.symbolic import Expression, MakeVectorVariable, Variable
 from pydrake.systems.framework import DiagramBuilder
-from pydrake.systems.primitives import Multiplexer, SymbolicVectorSystem, ZeroOrderHold
+from pydrake.systems.primitives import Demultiplexer, Multiplexer, SymbolicVectorSystem, ZeroOrderHold
 
 __all__ = ["CompiledDrive", "compile_diagram", "symbolic_equations"]
 
@@ -190,45 +192,39 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
     eq = symbolic_equations(feed_drive, inputs, signals)
     nu = len(eq.inputs)
     builder = DiagramBuilder()
-    out = np.concatenate([eq.signals, [Expression(v) for v in eq.xc]])
+    recorded = np.concatenate([eq.signals, [Expression(v) for v in eq.xc]])
+    # the periodic update g(t, x_c, x_d, inputs) is more of the plant's output (its input carries x_d and the
+    # inputs), sampled by a zero-order hold with the diagram's period whose state is the discrete state: at each
+    # tick it samples g evaluated with the state before the tick, and the hold has no feedthrough, so there is no
+    # algebraic loop. (A discrete SymbolicVectorSystem next to continuous states trips a DRAKE_DEMAND in
+    # SymbolicVectorSystem::DoCalcTimeDerivatives in Drake 1.51, which every leaf gets called. Until session 78 g
+    # was a memoryless SymbolicVectorSystem of its own, which SymbolicVectorSystem let have no state: it carried a
+    # constant continuous state, and every derivative evaluation of the diagram then evaluated that system's input,
+    # the plant's whole output and a multiplexer, for its zero derivative. Two thirds of a step's cost; the same
+    # bits, analysis/bench_compiled.py.)
     plant = builder.AddSystem(
         SymbolicVectorSystem(time=eq.time, state=eq.xc, input=np.concatenate([eq.xd, eq.inputs]),
-                             dynamics=eq.derivatives, output=out)
+                             dynamics=eq.derivatives, output=np.concatenate([recorded, eq.update]))
     )
     plant.set_name("plant")
     sampler = None
+    signals_port = plant.get_output_port(0)
     if len(eq.xd):
-        # x_d[k+1] = g(t_k, x_c(t_k), x_d[k]) as a memoryless symbolic system sampled by a zero-order
-        # hold. (A discrete SymbolicVectorSystem next to continuous states trips a DRAKE_DEMAND in
-        # SymbolicVectorSystem::DoCalcTimeDerivatives in Drake 1.51, which every leaf gets called; the hold has the same semantics:
-        # at each tick it samples g evaluated with the state before the tick.)
-        # SymbolicVectorSystem also demands non-empty dynamics, so the memoryless system carries one
-        # constant continuous state (derivative 0; it never changes and costs one error-norm entry).
-        dummy = MakeVectorVariable(len(eq.signals), "signal")
-        constant = Variable("unused_constant_state")
-        update = builder.AddSystem(
-            SymbolicVectorSystem(
-                time=eq.time, state=[constant], input=np.concatenate([dummy, eq.xc, eq.xd, eq.inputs]),
-                dynamics=[Expression(0.0)], output=eq.update,
-            )
-        )
-        update.set_name("discrete_update")
+        split = builder.AddSystem(Demultiplexer([len(recorded), len(eq.xd)]))
+        split.set_name("recorded_and_update")
+        builder.Connect(plant.get_output_port(0), split.get_input_port(0))
         sampler = builder.AddSystem(ZeroOrderHold(eq.period, len(eq.xd)))
         sampler.set_name("sampler")
-        mux = builder.AddSystem(Multiplexer([len(eq.signals) + len(eq.xc), len(eq.xd)] + ([nu] if nu else [])))
-        builder.Connect(plant.get_output_port(0), mux.get_input_port(0))
-        builder.Connect(sampler.get_output_port(), mux.get_input_port(1))
-        builder.Connect(mux.get_output_port(0), update.get_input_port(0))
-        builder.Connect(update.get_output_port(0), sampler.get_input_port())
+        builder.Connect(split.get_output_port(1), sampler.get_input_port())
+        signals_port = split.get_output_port(0)
     if nu:
-        # one exported input feeds the plant (beside the held discrete state) and the discrete update
+        # one exported input feeds the plant beside the held discrete state
         from pydrake.systems.primitives import PassThrough
 
         through = builder.AddSystem(PassThrough(nu))
         through.set_name("inputs")
         builder.ExportInput(through.get_input_port(), "inputs")
         if sampler is not None:
-            builder.Connect(through.get_output_port(), mux.get_input_port(2))
             plant_in = builder.AddSystem(Multiplexer([len(eq.xd), nu]))
             builder.Connect(sampler.get_output_port(), plant_in.get_input_port(0))
             builder.Connect(through.get_output_port(), plant_in.get_input_port(1))
@@ -237,7 +233,7 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
             builder.Connect(through.get_output_port(), plant.get_input_port(0))
     elif sampler is not None:
         builder.Connect(sampler.get_output_port(), plant.get_input_port(0))
-    builder.ExportOutput(plant.get_output_port(0), "signals")
+    builder.ExportOutput(signals_port, "signals")
     diagram = builder.Build()
     diagram.set_name("feed_drive_compiled")
     return CompiledDrive(

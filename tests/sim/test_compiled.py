@@ -67,3 +67,26 @@ def test_a_compiled_diagram_of_some_signals_simulates_them_to_the_same_bits(pape
         compile_diagram(drive, signals=("motor_angle", "speed"))
     with pytest.raises(ValueError, match="signals: got"):
         compile_diagram(drive, signals=("motor_angle", "motor_angle"))
+
+
+def test_the_compiled_diagram_holds_the_model_state_and_updates_it_as_the_leaves(paper):
+    """The compiled diagram's state is the model's, nothing more (the discrete update is part of the plant's output,
+    sampled by the hold), and its periodic update at a state off the start is the leaf systems'."""
+    drive = build_diagram(paper, Scenario(feed=1e-3, duration=0.1))
+    compiled = compile_diagram(drive)
+    ctx = compiled.default_context()
+    eq = compiled.equations
+    assert ctx.num_continuous_states() == len(eq.xc) and ctx.num_discrete_state_groups() == 1
+    leaf = drive.diagram.CreateDefaultContext()
+    rng = np.random.default_rng(3)
+    xc = eq.xc0 + 1e-4 * rng.standard_normal(len(eq.xc))
+    xd = eq.xd0 + 0.1 * rng.standard_normal(len(eq.xd))
+    for c in (ctx, leaf):
+        c.SetTime(0.02)
+        c.SetContinuousState(xc)
+    ctx.SetDiscreteState(0, xd)
+    leaf.SetDiscreteState(0, xd)
+    got = compiled.diagram.EvalUniquePeriodicDiscreteUpdate(ctx).get_vector(0).CopyToVector()
+    expected = drive.diagram.EvalUniquePeriodicDiscreteUpdate(leaf).get_vector(0).CopyToVector()
+    assert np.ptp(expected - xd) > 0  # the update moves the state: the comparison is of an update
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12 * np.max(np.abs(expected)))
