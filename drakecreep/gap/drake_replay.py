@@ -328,7 +328,14 @@ class DrakeReplay:
 
 class _CompiledPP:
     """:class:`PPCascade` (integer delay) as a memoryless ``SymbolicVectorSystem`` update sampled by a
-    ``ZeroOrderHold`` whose state is the controller's discrete state (as :mod:`drakecreep.sim.compiled`).
+    ``ZeroOrderHold`` whose state is the controller's discrete state.
+
+    ``SymbolicVectorSystem`` wants a state (and a discrete one next to continuous states trips a ``DRAKE_DEMAND``
+    in Drake 1.51), so the update carries one constant continuous state, and each derivative evaluation evaluates
+    its input (the reference, the axis's position and the hold) for that state's zero derivative.
+    :mod:`drakecreep.sim.compiled` puts its update in the plant's output instead (session 78, 1.2-1.5x); this
+    replay is the error-controlled cross-check of :class:`SampledReplay`, the diagnosis's path, and keeps its
+    layout.
 
     Exposes ``GetInputPort("x_ref" | "position")`` and ``GetOutputPort("force" | "u")`` like the leaf.
     """
