@@ -198,9 +198,9 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
     # tick it samples g evaluated with the state before the tick, and the hold has no feedthrough, so there is no
     # algebraic loop. (A discrete SymbolicVectorSystem next to continuous states trips a DRAKE_DEMAND in
     # SymbolicVectorSystem::DoCalcTimeDerivatives in Drake 1.51, which every leaf gets called. Until session 78 g
-    # was a memoryless SymbolicVectorSystem of its own, which SymbolicVectorSystem let have no state: it carried a
-    # constant continuous state, and every derivative evaluation of the diagram then evaluated that system's input,
-    # the plant's whole output and a multiplexer, for its zero derivative. Two thirds of a step's cost; the same
+    # was a memoryless SymbolicVectorSystem of its own; SymbolicVectorSystem wants a state, so it carried a constant
+    # continuous one, and every derivative evaluation of the diagram evaluated that system's input, the plant's
+    # whole output through a multiplexer, for its zero derivative: 1.2-1.5x of a simulation's CPU, for the same
     # bits, analysis/bench_compiled.py.)
     plant = builder.AddSystem(
         SymbolicVectorSystem(time=eq.time, state=eq.xc, input=np.concatenate([eq.xd, eq.inputs]),
@@ -218,19 +218,15 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
         builder.Connect(split.get_output_port(1), sampler.get_input_port())
         signals_port = split.get_output_port(0)
     if nu:
-        # one exported input feeds the plant beside the held discrete state
-        from pydrake.systems.primitives import PassThrough
-
-        through = builder.AddSystem(PassThrough(nu))
-        through.set_name("inputs")
-        builder.ExportInput(through.get_input_port(), "inputs")
+        # the exported input feeds the plant beside the held discrete state (the plant alone reads it)
         if sampler is not None:
             plant_in = builder.AddSystem(Multiplexer([len(eq.xd), nu]))
+            plant_in.set_name("held_and_inputs")
             builder.Connect(sampler.get_output_port(), plant_in.get_input_port(0))
-            builder.Connect(through.get_output_port(), plant_in.get_input_port(1))
             builder.Connect(plant_in.get_output_port(0), plant.get_input_port(0))
+            builder.ExportInput(plant_in.get_input_port(1), "inputs")
         else:
-            builder.Connect(through.get_output_port(), plant.get_input_port(0))
+            builder.ExportInput(plant.get_input_port(0), "inputs")
     elif sampler is not None:
         builder.Connect(sampler.get_output_port(), plant.get_input_port(0))
     builder.ExportOutput(signals_port, "signals")
