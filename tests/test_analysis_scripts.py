@@ -402,9 +402,9 @@ def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tm
     """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
     frequency is its RMS, and next to nothing an octave away."""
-    _refused_in_one_line("delay_pattern_study.py", ((["9014", "--ticks", "8,x"], "--ticks"),
-                                                    (["9014", "--ticks", "-1"], "--ticks"), ([str(HELD_OUT)], str(HELD_OUT))),
-                         monkeypatch, capsys, tmp_path)
+    cases = ((["9014", "--ticks", "8,x"], "--ticks"), (["9014", "--ticks", "-1"], "--ticks"),
+             ([str(HELD_OUT)], str(HELD_OUT)))
+    _refused_in_one_line("delay_pattern_study.py", cases, monkeypatch, capsys, tmp_path)
     dps = _script_module("delay_pattern_study.py")
     t = np.arange(3000) * 1e-3
     x = 3.0 * math.sqrt(2.0) * np.sin(2 * math.pi * 150.0 * t)

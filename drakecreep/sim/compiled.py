@@ -3,7 +3,7 @@
 The leaf systems are written once as ``TemplateSystem``s; here the whole diagram is converted with
 ``ToSymbolic()``, its time derivatives, its periodic discrete update and every recorded signal are
 evaluated once as symbolic expressions of ``(t, x_continuous, x_discrete)``, and those expressions
-become Drake's C++ ``SymbolicVectorSystem``s:
+become a Drake C++ ``SymbolicVectorSystem`` and a hold:
 
 * ``plant``: continuous state, input = the discrete state (and the inputs), output = recorded signals +
   continuous state + the periodic update ``g(t, x_c, x_d)``;
@@ -16,7 +16,7 @@ become Drake's C++ ``SymbolicVectorSystem``s:
 
 Same equations, same state ordering, no Python in the simulation loop (measured about 10x faster end to
 end than the Python leaf systems, see ``analysis/bench_simulation.py``; the update in the plant's output, not a
-system of its own, 1.3-1.4x faster than that with the same bits, ``analysis/bench_compiled.py``).
+system of its own, 1.2-1.5x faster than that with the same bits, ``analysis/bench_compiled.py``).
 
 Signals from outside (a measured reference, an external force): build the feed drive with
 ``ConstantVectorSource`` placeholders (``build_diagram(..., reference=ConstantVectorSource([0, 0]))``) and
