@@ -222,10 +222,6 @@ def test_drive_claim_statistics_lets_a_large_pooled_shrink_stand_for_the_student
     assert scores["t_or_pooled_20"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
 
 
-def _backfill_module():
-    return _script_module("backfill_training_fit.py")
-
-
 def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
     """Study 3br's backfill on a small test-rig dataset standing in for a regenerated benchmark one: the nominal
     fit rerun gives the row's held-out errors, so the SSE and variance are written (and give the training
@@ -239,7 +235,7 @@ def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monke
     rig = quick_replay_params(preset("paper"))
     runs = simulated_runs(rig, (0.02, 0.03, 0.025, 0.035), declared=rig, n=400, noise=2.0, seed=5)
     ds = SimpleNamespace(train=runs[:2], test=runs[2:])
-    btf = _backfill_module()
+    btf = _script_module("backfill_training_fit.py")
     monkeypatch.setattr(btf, "generate_dataset", lambda seed, **kw: ds)
     uncertain = ["table.seal_force"]
     params = fit_drive(ds.train, rig, uncertain, _Replayer(0), max_nfev=20)[0]

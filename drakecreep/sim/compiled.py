@@ -177,7 +177,7 @@ def compile_diagram(feed_drive, inputs=(), signals=None):
     signals : sequence of str, optional
         The recorded signals the output port ``signals`` carries, in this order (names of
         ``feed_drive.signal_names``); default all. The plant's output is evaluated at every sample tick (the
-        discrete update reads it) and at every log, so a caller that reads few signals names them: the same
+        hold samples the update from it) and at every log, so a caller that reads few signals names them: the same
         bits, 1.07-1.22 times faster with three than with all 15-17 (``analysis/bench_drive_fit.py``).
 
     Returns
