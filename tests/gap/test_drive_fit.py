@@ -266,6 +266,24 @@ def test_a_stribeck_hump_is_fitted_with_the_friction_level_the_nominal_raised_fo
     assert rms(res.test_errors) < 0.2 * rms(res.nominal_test_errors)
 
 
+def test_a_stribeck_hump_is_fitted_from_the_params_file_levels_where_the_nominal_lowered_the_viscous():
+    """Truth: Fs/Fc 1.8 at 8 mm/s and a viscous coefficient of 1000 N s/m, which the params file declares. Over the
+    training runs (12-30 mm/s) the friction falls with the speed, so the nominal fit lowers the viscous to a few
+    per cent of it and raises the seal force; from those levels the Stribeck fit stops in a minimum that keeps
+    them (held-out runs at 100-120 mm/s replayed worse: not claimed, development check). From the params file's
+    levels, the second start, it finds the truth's curve and viscous and is claimed."""
+    truth = with_value(with_value(with_value(RIG, "friction.static_ratio", 1.8), "friction.stribeck_velocity", 8e-3),
+                       "friction.viscous", 1000.0)
+    declared = with_value(with_value(truth, "friction.static_ratio", 1.03), "friction.stribeck_velocity", 1.2e-3)
+    runs = simulated_runs(truth, (0.012, 0.02, 0.03, 0.016, 0.1, 0.12), declared=declared, n=N, noise=NOISE, seed=720)
+    res = diagnose_drive(runs[:4], runs[4:], uncertain=("table.seal_force", "friction.viscous"), effects=("stribeck",))
+    assert res.nominal.friction.viscous < 0.1 * truth.friction.viscous
+    (c,) = res.candidates
+    assert c.values["friction.viscous"] == pytest.approx(truth.friction.viscous, rel=0.25)
+    assert c.values["friction.static_ratio"] == pytest.approx(1.8, rel=0.05)
+    assert res.claimed == ("stribeck",)
+
+
 def test_a_declared_lead_error_is_replaced_not_added_to():
     """The params file declares 0.5 um at phase 0, the rig has 2 um at -0.7 rad: the candidate fits the error
     about none (a linearisation about the declared one put 1.74 um at 0.54 rad for 2 um at 1.0 rad on a
