@@ -123,8 +123,10 @@ DEV_SEEDS = 1000
 #: (its ``p_p_cascade`` block unused); 97_000_000 held-out run 44's (3by, the ``p_p_cascade`` kind at the current
 #: code) and the ninth ``drakecreep`` run's (3bz), whose unstable delays 97106014 and 97106042 were looked into
 #: after it (3cb); the tenth (3cc, the nut replayed where the run was) 99_000_000's ``drakecreep`` block, and run
-#: 45 (3ch) its ``p_p_cascade`` block; the eleventh ``drakecreep`` run (3ck) uses this one's ``drakecreep`` block.
-HELDOUT_SEEDS = 101_000_000
+#: 45 (3ch) its ``p_p_cascade`` block; the eleventh ``drakecreep`` run (3ck) 101_000_000's ``drakecreep`` block
+#: (its ``p_p_cascade`` block unused), whose Stribeck 101100002 was looked into after it (3cl); the twelfth (3cm, the
+#: Stribeck candidate's second start) uses this one's ``drakecreep`` block.
+HELDOUT_SEEDS = 103_000_000
 #: Runs per dataset: training, held-out (the diagnosis's claim test: ``t_(1-ALPHA, n-1)`` standard errors of
 #: ``n`` per-run ratios, 2.13 for five runs against 2.92 for three, and a standard error over more runs) and
 #: audit (scored only, never seen by the diagnosis).
