@@ -36,7 +36,8 @@ Steps:
 2. **Candidate effects that are parts of the Drake model** (:data:`EFFECTS`): lead error (amplitude and phase
    fitted, fixed to the screw, period a harmonic of the lead), force ripple at a fixed frequency (frequency
    from the peaks of the training residual's spectrum, amplitude and phase fitted), Stribeck weakening (static
-   ratio and Stribeck velocity fitted), the friction law switched (coulomb, stribeck, lugre, gms), the nut's
+   ratio and Stribeck velocity fitted with the uncertain fields, from the nominal's values and from the params
+   file's, the fit of lower training SSE kept), the friction law switched (coulomb, stribeck, lugre, gms), the nut's
    friction moved between the table and the screw, the controller's computation delay (searched over whole
    samples). What ``DriveParams`` cannot express is never ranked (:data:`NOT_IN_MODEL`).
 3. **Claims on held-out runs only**: each candidate, fitted on the training runs, is replayed with fixed
