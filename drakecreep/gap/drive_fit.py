@@ -1445,19 +1445,19 @@ def _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain
     and four Gauss-Newton steps from there end in a minimum that keeps it (10.9 N s/m; training SSE 62.2, 51.5 after
     twelve) and replays a held-out run at 137 mm/s worse than the nominal. From the params file's levels the same
     fit ends at 155 N s/m, training SSE 50.9, every held-out run better (docs/gap_benchmark.md, 3cl)."""
-    paths = ("friction.static_ratio", "friction.stribeck_velocity")
-    paths = paths + tuple(p for p in uncertain if p not in paths)
+    # (never with the curve itself uncertain: the diagnosis then fits it in the nominal and skips this candidate)
+    paths = ("friction.static_ratio", "friction.stribeck_velocity") + tuple(uncertain)
     starts = [(base, base_sims)]
-    levels = {p: get_value(prior, p) for p in uncertain if p not in paths[:2]} if prior is not None else {}
-    if any(v != get_value(base, p) for p, v in levels.items()):
-        other = _with(base, levels)
+    declared = {p: get_value(prior, p) for p in uncertain} if prior is not None else {}
+    if any(v != get_value(base, p) for p, v in declared.items()):
+        other = _with(base, declared)
         starts.append((other, replayer(runs, other)))
     best = None
-    for level, sims in starts:
-        start = level if level.friction.law != "coulomb" else with_value(level, "friction.law", "stribeck")
+    for origin, sims in starts:
+        start = origin if origin.friction.law != "coulomb" else with_value(origin, "friction.law", "stribeck")
         if start.friction.static_ratio <= 1.0:
             start = with_value(start, "friction.static_ratio", 1.2)
-        start = _stribeck_start(runs, level, start, replayer, sims, scale)
+        start = _stribeck_start(runs, origin, start, replayer, sims, scale)
         fitted_params, _, _, sse = fit_drive(runs, start, paths, replayer, max_nfev=min(max_nfev, 4))
         if best is None or sse < best[1]:
             values = {p: get_value(fitted_params, p) for p in paths}
