@@ -641,6 +641,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
+                "start": c.start,  # which start a fit of more than one kept (the Stribeck candidate's)
                 # the lead error on runs with a linear scale is decided on the screw's transmission (its train_gain
                 # is that SSE's, not the force's): the replay test it passed or failed there
                 "transmission": (c.replay or {}).get("transmission"),

@@ -324,7 +324,8 @@ class EffectResult:
     ``gain``, ``standard_error``, ``threshold``: held-out force-error decrease [points of %] and the bar
     it must clear; ``replay``: :func:`drakecreep.gap.claims.replay_test` of the force (with the transmission's under
     ``"transmission"`` for the lead error on runs with a scale, :func:`_held_out_on_scale`); ``claimed``,
-    ``reason``.
+    ``reason``; ``start``: which start the fit kept where it has more than one (the Stribeck candidate's
+    ``"nominal fit"`` or ``"params file"``, :func:`_stribeck_effect`), else ``""``.
     """
 
     name: str
@@ -337,6 +338,7 @@ class EffectResult:
     replay: dict
     passes: bool
     reason: str = ""
+    start: str = ""
 
 
 @dataclass(frozen=True)
@@ -492,7 +494,8 @@ class DriveDiagnosis:
             if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
                 lines.append(f"  {c.name:18s} {c.reason}")
                 continue
-            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}")
+            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}"
+                         + (f" (fitted from the {c.start}'s values)" if c.start else ""))
             if c.passes:
                 lines.append("    fitted " + ", ".join(
                     f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"
@@ -1434,9 +1437,10 @@ def _stribeck_start(runs, base, start, replayer, base_sims, scale):
 
 
 def _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain, prior=None):
-    """The Stribeck candidate's values and training SSE: the static ratio and Stribeck velocity fitted with the
-    ``uncertain`` fields, from the nominal's fitted values and, where they differ, from the params file's
-    (``prior``); the start of each curve by :func:`_stribeck_start`. The fit of lower training SSE is kept.
+    """The Stribeck candidate's values, training SSE and the start it kept (``"nominal fit"`` or ``"params file"``;
+    ``""`` where they are the same): the static ratio and Stribeck velocity fitted with the ``uncertain`` fields,
+    from the nominal's fitted values and, where they differ, from the params file's (``prior``); the start of each
+    curve by :func:`_stribeck_start`. The fit of lower training SSE is kept.
 
     With the levels: the nominal fit has raised them to absorb part of the hump (development seed 1100: held-out
     gain +2.14 points against a bar of 2.17 with the levels fixed, +3.52 against 1.98 with them). From the params
@@ -1447,13 +1451,13 @@ def _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain
     fit ends at 155 N s/m, training SSE 50.9, every held-out run better (docs/gap_benchmark.md, 3cl)."""
     # (never with the curve itself uncertain: the diagnosis then fits it in the nominal and skips this candidate)
     paths = ("friction.static_ratio", "friction.stribeck_velocity") + tuple(uncertain)
-    starts = [(base, base_sims)]
+    starts = [("nominal fit", base, base_sims)]
     declared = {p: get_value(prior, p) for p in uncertain} if prior is not None else {}
     if any(v != get_value(base, p) for p, v in declared.items()):
         other = _with(base, declared)
-        starts.append((other, replayer(runs, other)))
+        starts.append(("params file", other, replayer(runs, other)))
     best = None
-    for origin, sims in starts:
+    for label, origin, sims in starts:
         start = origin if origin.friction.law != "coulomb" else with_value(origin, "friction.law", "stribeck")
         if start.friction.static_ratio <= 1.0:
             start = with_value(start, "friction.static_ratio", 1.2)
@@ -1463,20 +1467,20 @@ def _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain
             values = {p: get_value(fitted_params, p) for p in paths}
             if start.friction.law != base.friction.law:
                 values["friction.law"] = start.friction.law
-            best = values, sse
+            best = values, sse, label if len(starts) > 1 else ""
     return best
 
 
 def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillation=None, uncertain=(),
                 kinematic=False, prior=None):
-    """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain)``
-    (``oscillation``: :func:`_delay_effect`'s; ``uncertain``: the fields the Stribeck candidate refits with its
-    curve; ``kinematic``: every run has a linear scale, and the lead error is fitted on the screw's transmission,
-    :func:`_lead_error_on_scale`; ``prior``: the params file, whose levels are the Stribeck fit's second start,
-    :func:`_stribeck_effect`)."""
-    scale = _force_scale(runs)
+    """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain, start)``
+    (``start``: :attr:`EffectResult.start`; ``oscillation``: :func:`_delay_effect`'s; ``uncertain``: the fields the
+    Stribeck candidate refits with its curve; ``kinematic``: every run has a linear scale, and the lead error is
+    fitted on the screw's transmission, :func:`_lead_error_on_scale`; ``prior``: the params file, whose levels are
+    the Stribeck fit's second start, :func:`_stribeck_effect`)."""
+    scale, start = _force_scale(runs), ""
     if name == _KINEMATIC and kinematic:
-        return _lead_error_on_scale(runs, base, replayer, base_sims)
+        return (*_lead_error_on_scale(runs, base, replayer, base_sims), "")
     if name in _PERIODIC:  # the lead error and the cogging over the lead's harmonics, the ripple at the residual's peaks
         if name == "lead_error":
             grid, trial = [base.screw.lead / k for k in LEAD_HARMONICS], 1e-6
@@ -1486,28 +1490,28 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
             grid, trial = _ripple_frequencies(runs, base_sims), 0.1 * scale
         values, sse = _quadrature_effect(runs, base, _PERIODIC[name], grid, trial, replayer, base_sims, scale)
         if not values:
-            return {}, 0.0
+            return {}, 0.0, ""
         if name in _SECOND:
             values, sse = _second_harmonic(name, runs, base, values, sse, trial, replayer, scale)
     elif name == "stribeck":
-        values, sse = _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain, prior)
+        values, sse, start = _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain, prior)
     elif name.startswith("law_"):
         law = name[4:]
         if law == base.friction.law:
-            return None, 0.0
+            return None, 0.0, ""
         values = {"friction.law": law}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
         sse = float(r @ r)
     elif name == "control_delay":
         if not base.controller.sampled:
-            return None, 0.0  # a continuous controller has no computation delay
+            return None, 0.0, ""  # a continuous controller has no computation delay
         values, sse = _delay_effect(runs, base, replayer, base_sims, scale, oscillation)
     elif name == "asymmetric_friction":
         # both fractions from the symmetric model by the output-error fit (four Jacobian replays of each run per
         # iteration); the levels stay the nominal's: their mean is the symmetric model's in either direction
         paths = tuple(p for p in _ASYMMETRY if p not in uncertain)
         if not paths:
-            return None, 0.0  # already fitted as uncertain
+            return None, 0.0, ""  # already fitted as uncertain
         fitted_params, _, _, sse = fit_drive(runs, base, paths, replayer, max_nfev=min(max_nfev, 4))
         values = {p: get_value(fitted_params, p) for p in paths}
     elif name == "nut_friction_side":
@@ -1516,7 +1520,7 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         sse = float(r @ r)
     else:  # pragma: no cover - names are checked up front
         raise InputError("effects", name, "one of " + ", ".join(EFFECTS))
-    return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0
+    return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0, start
 
 
 def _energy(errors, labels, key="force"):
@@ -1844,14 +1848,14 @@ def _fit_candidate(name, replay, *, train, test, params, base_sims, sse0, max_nf
     failed or None)``. A failure (an integrator that gives up on a fitted value, a value the params refuse: a
     Stribeck fit that left its range failed the whole diagnosis after five minutes) is recorded, never claimed."""
     try:
-        values, train_gain = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
-                                         uncertain, kinematic, prior)
+        values, train_gain, start = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
+                                                uncertain, kinematic, prior)
         if values is None:
             return None, None
         if not values:
             return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, _NOTHING_TO_FIT), None
-        c = _held_out(name, values, train_gain, test, params, nominal_errors, replay, null, transmission_null,
-                      kinematic)
+        c = dataclasses.replace(_held_out(name, values, train_gain, test, params, nominal_errors, replay, null,
+                                          transmission_null, kinematic), start=start)
     except Exception as err:  # noqa: BLE001 - one candidate's failure must not end the diagnosis
         why = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"[:300]
         return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, f"failed ({why})"), why

@@ -141,7 +141,8 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
                      "better)" if fitted and rt.get("log_ratios") else "-",
                      "yes" if c.name in result.claimed else "passes, not claimed" if c.passes else "no",
                      c.reason,
-                     "; ".join(f"{k} = {_with_unit(v, field_unit(prior, k))}" for k, v in c.values.items())])
+                     (f"fitted from the {c.start}'s values: " if c.start else "")
+                     + "; ".join(f"{k} = {_with_unit(v, field_unit(prior, k))}" for k, v in c.values.items())])
     parts.append("<h2>Which effect: the candidates, best held-out gain first</h2>")
     parts.append(table(["effect", "training gain [% of SSE]", "held-out gain [points of %]",
                         "pooled held-out shrink [%] (in run-to-run nulls)", "claimed", "why", "fitted fields"], rows))

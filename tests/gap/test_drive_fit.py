@@ -242,6 +242,7 @@ def test_a_stribeck_hump_is_found_from_a_params_file_whose_curve_is_flat(monkeyp
     assert c.values["friction.static_ratio"] == pytest.approx(1.8, rel=0.05)
     assert c.values["friction.stribeck_velocity"] == pytest.approx(8e-3, rel=0.1)
     assert c.train_gain > 0.9 and c.gain > c.threshold
+    assert c.start == ""  # nothing uncertain: the nominal is the params file, one start
     monkeypatch.setattr(drive_fit, "STRIBECK_STARTS", ())
     (alone,) = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=("stribeck",)).candidates
     assert alone.values["friction.static_ratio"] < 1.2 and alone.train_gain < 0.5
@@ -259,6 +260,7 @@ def test_a_stribeck_hump_is_fitted_with_the_friction_level_the_nominal_raised_fo
     (c,) = res.candidates
     assert c.values["table.seal_force"] < 1.5 * RIG.table.seal_force
     assert res.claimed == ("stribeck",)
+    assert c.start in ("nominal fit", "params file")  # two starts (the seal force was fitted): one is named
     assert res.params.friction.static_ratio == pytest.approx(1.8, rel=0.05)
     assert res.params.friction.stribeck_velocity == pytest.approx(8e-3, rel=0.1)
     assert res.params.table.seal_force == pytest.approx(RIG.table.seal_force, rel=0.1)
@@ -282,6 +284,8 @@ def test_a_stribeck_hump_is_fitted_from_the_params_file_levels_where_the_nominal
     assert c.values["friction.viscous"] == pytest.approx(truth.friction.viscous, rel=0.25)
     assert c.values["friction.static_ratio"] == pytest.approx(1.8, rel=0.05)
     assert res.claimed == ("stribeck",)
+    assert c.start == "params file"
+    assert "(fitted from the params file's values)" in "\n".join(res.summary())
 
 
 def test_a_declared_lead_error_is_replaced_not_added_to():
