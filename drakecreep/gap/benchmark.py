@@ -125,7 +125,9 @@ DEV_SEEDS = 1000
 #: after it (3cb); the tenth (3cc, the nut replayed where the run was) 99_000_000's ``drakecreep`` block, and run
 #: 45 (3ch) its ``p_p_cascade`` block; the eleventh ``drakecreep`` run (3ck) 101_000_000's ``drakecreep`` block
 #: (its ``p_p_cascade`` block unused), whose Stribeck 101100002 was looked into after it (3cl); the twelfth (3cm, the
-#: Stribeck candidate's second start) uses this one's ``drakecreep`` block.
+#: Stribeck candidate's second start) used this one's ``drakecreep`` block, whose time ripple 103108005 was looked into
+#: after it (3cn); held-out run 46 (3co, the ``p_p_cascade`` kind at the converged truth) uses its ``p_p_cascade``
+#: block.
 HELDOUT_SEEDS = 103_000_000
 #: Runs per dataset: training, held-out (the diagnosis's claim test: ``t_(1-ALPHA, n-1)`` standard errors of
 #: ``n`` per-run ratios, 2.13 for five runs against 2.92 for three, and a standard error over more runs) and
