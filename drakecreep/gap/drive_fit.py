@@ -1054,9 +1054,7 @@ def _quadrature_effect(runs, base, paths, grid, trial, replayer, base_sims, scal
     residuals = [residual(runs, s) for s in replayed]
     k = int(np.argmin([float(r @ r) for r in residuals]))
     (g, q1), r1 = optima[k], residuals[k]
-
-    def values_at(q):
-        return quadratures(g, q)
+    values_at = functools.partial(quadratures, g)
 
     def residual_at(q):
         values = values_at(q)
