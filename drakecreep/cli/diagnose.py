@@ -50,11 +50,13 @@ def add_parser(subparsers):
     p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous; add "
                    "loads.constant_force for a constant axial force such as a drive's offset)")
+    # The names are written out, not imported: the parser is built without the libraries behind it (checked
+    # against drake_effects.DRAKE_EFFECTS and drive_fit.EFFECTS by tests/cli/test_diagnose.py).
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
-                   "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind drakecreep runs: "
-                   "lead_error, force_ripple, stribeck, law_coulomb, ...; asymmetric_friction and cogging only "
-                   "when named)")
+                   "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind "
+                   "drakecreep runs: lead_error, force_ripple, stribeck, law_coulomb, law_stribeck, law_lugre, "
+                   "law_gms, nut_friction_side, control_delay; asymmetric_friction and cogging only when named)")
     p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
                    "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "
                    "sticks below the breakaway force, the share of the friction that sticks fitted; slower), "

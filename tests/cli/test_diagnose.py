@@ -134,3 +134,18 @@ def test_nominal_friction_choices(csv_file, capsys):
     with pytest.raises(SystemExit) as exc:
         cli.main(["diagnose", str(csv_file), "--nominal-friction", "coulomb"])
     assert exc.value.code == 2 and "--nominal-friction" in capsys.readouterr().err
+
+
+def test_the_effects_help_names_every_default_candidate_of_both_kinds():
+    """``--effects``' help writes the candidates out (the parser imports no library); it must name what runs."""
+    from drakecreep.gap import drive_fit
+    from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+
+    parser = cli.build_parser()
+    action = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    text = next(a for a in action.choices["diagnose"]._actions if "--effects" in a.option_strings).help
+    p_p, drive = text.split("(default: all ranked ones: ")[1].split("; kind drakecreep runs: ")
+    drive, on_request = drive.split("; ")
+    assert p_p.split(", ") == [*DRAKE_EFFECTS, "control_delay"]
+    assert drive.split(", ") == [n for n in drive_fit.EFFECTS if n not in drive_fit.ON_REQUEST]
+    assert on_request == " and ".join(drive_fit.ON_REQUEST) + " only when named)"
