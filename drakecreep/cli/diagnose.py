@@ -51,7 +51,7 @@ def add_parser(subparsers):
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous; add "
                    "loads.constant_force for a constant axial force such as a drive's offset)")
     # The names are written out, not imported: the parser is built without the libraries behind it (checked
-    # against drake_effects.DRAKE_EFFECTS and drive_fit.EFFECTS by tests/cli/test_diagnose.py).
+    # against drake_effects.DRAKE_EFFECTS and drive_fit.DEFAULT_EFFECTS by tests/cli/test_diagnose.py).
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
                    "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind "

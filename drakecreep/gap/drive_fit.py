@@ -116,6 +116,7 @@ __all__ = [
     "FITTABLE",
     "NOT_BOUNDED",
     "DEFAULT_UNCERTAIN",
+    "DEFAULT_EFFECTS",
     "EFFECTS",
     "NOT_IN_MODEL",
     "ON_REQUEST",
@@ -278,6 +279,8 @@ EFFECTS = {
 #: ``cogging`` (session 58) has not been run on development datasets either: how often it would be claimed on
 #: nulls, or instead of a lead error of the same period, is not known.
 ON_REQUEST = ("asymmetric_friction", "cogging")
+#: The candidates fitted when ``effects`` is not given: :data:`EFFECTS` without :data:`ON_REQUEST`, in order.
+DEFAULT_EFFECTS = tuple(n for n in EFFECTS if n not in ON_REQUEST)
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
 #: replay takes no fractional delay: a fraction adds a second sampling offset), up to 4 ms at a 4 kHz speed loop;
 #: the best is refined by halving the gaps to its neighbours down to one sample.
@@ -709,7 +712,7 @@ def _check_inputs(train, test, uncertain, effects, load_case):
             raise InputError("uncertain", path, f"a field whose params value is above {_lower(path):g}")
         if get_value(prior, path) >= _upper(path):
             raise InputError("uncertain", path, f"a field whose params value is below {_upper(path):g}")
-    names = tuple(n for n in EFFECTS if n not in ON_REQUEST) if effects is None else name_list(effects, "effects")
+    names = DEFAULT_EFFECTS if effects is None else name_list(effects, "effects")
     for n in names:
         if n not in EFFECTS:
             raise InputError("effects", n, NOT_IN_MODEL.get(n, "one of " + ", ".join(EFFECTS)))

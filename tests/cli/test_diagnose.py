@@ -147,5 +147,5 @@ def test_the_effects_help_names_every_default_candidate_of_both_kinds():
     p_p, drive = text.split("(default: all ranked ones: ")[1].split("; kind drakecreep runs: ")
     drive, on_request = drive.split("; ")
     assert p_p.split(", ") == [*DRAKE_EFFECTS, "control_delay"]
-    assert drive.split(", ") == [n for n in drive_fit.EFFECTS if n not in drive_fit.ON_REQUEST]
+    assert drive.split(", ") == list(drive_fit.DEFAULT_EFFECTS)
     assert on_request == " and ".join(drive_fit.ON_REQUEST) + " only when named)"
