@@ -4,10 +4,13 @@ One benchmark row per dataset (:func:`drakecreep.gap.benchmark.evaluate`, as ``b
 them): what was claimed and first, the audit force error [%] of the nominal, the claimed and the true model (whole
 and below 100 Hz), their shrinks and ``worse``. For development checks of one change on a few datasets (docs/
 gap_benchmark.md, 3cg) and for looking again at spent held-out ones. Seeds of the current held-out set
-(``>= benchmark.HELDOUT_SEEDS``) are refused: they are spent in a pre-registered run only.
+(``>= benchmark.HELDOUT_SEEDS``) are refused: they are spent in a pre-registered run only, and a seed of it is
+looked at again only once a run has spent it: ``--spent ROWS.json`` names that run's rows files (what
+``bench_gap_benchmark.py --json`` wrote, ``"complete": true``), and only their seeds are let through.
 
 Usage: ``PYTHONPATH=. python analysis/diagnose_dataset.py SEED:WITHHELD:AXIS [...] --kind drakecreep
-[--json OUT.json]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a null dataset).
+[--json OUT.json] [--spent ROWS.json ...]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a
+null dataset).
 """
 
 import argparse
@@ -18,6 +21,7 @@ import time
 from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap import benchmark as B
+from study_cli import read_rows
 
 __all__ = ["summary", "main"]
 
@@ -47,13 +51,23 @@ def main(argv=None):
                     help="a dataset: WITHHELD null or a withheld effect, AXIS rigid or flexible")
     ap.add_argument("--kind", required=True, choices=B.BENCHMARK_KINDS, help="the controller kind")
     ap.add_argument("--json", help="write the rows here (after each dataset)")
+    ap.add_argument("--spent", nargs="+", metavar="ROWS", default=(),
+                    help="rows files of a complete pre-registered run: its seeds of the current held-out set are "
+                         "let through")
     a = ap.parse_args(argv)
+    spent = set()
+    for path in a.spent:
+        rows = read_rows(ap, "--spent", path)
+        if rows.get("complete") is not True:
+            ap.exit(2, f"diagnose_dataset: error: --spent: {path!r} is not a complete run's rows (\"complete\": "
+                       f"{rows.get('complete')!r}); allowed: the rows of a run that is whole\n")
+        spent.update(int(r["seed"]) for r in rows["datasets"])
     try:
         specs = [B.dataset_spec(s) for s in a.datasets]
         for seed, _, _ in specs:
-            if seed >= B.HELDOUT_SEEDS:
-                raise InputError("SEED", seed, f"a seed below {B.HELDOUT_SEEDS} (the current held-out set is spent "
-                                 "in a pre-registered run only)")
+            if seed >= B.HELDOUT_SEEDS and seed not in spent:
+                raise InputError("SEED", seed, f"a seed below {B.HELDOUT_SEEDS} or one of a complete run's rows "
+                                 "given to --spent (the current held-out set is spent in a pre-registered run only)")
         if a.json:
             check_output_file(a.json, "--json")
     except InputError as e:

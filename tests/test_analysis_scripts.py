@@ -379,11 +379,21 @@ def _refused_in_one_line(script, cases, monkeypatch, capsys, cwd):
 def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/diagnose_dataset.py``: a malformed dataset, a seed of the current held-out set and an unknown kind
     each exit 2 with one line before any dataset is generated; the summary line carries the verdict and audit."""
+    whole, partial = tmp_path / "whole.json", tmp_path / "partial.json"
+    whole.write_text(json.dumps({"complete": True, "datasets": [{"seed": HELD_OUT}]}))
+    partial.write_text(json.dumps({"complete": False, "datasets": [{"seed": HELD_OUT + 1}]}))
     cases = ((["9014:nothing:flexible", "--kind", "drakecreep"], "nothing"),
              ([f"{HELD_OUT}:null:rigid", "--kind", "drakecreep"], str(HELD_OUT)),
+             ([f"{HELD_OUT + 1}:null:rigid", "--kind", "drakecreep", "--spent", str(whole)], str(HELD_OUT + 1)),
+             ([f"{HELD_OUT + 1}:null:rigid", "--kind", "drakecreep", "--spent", str(partial)], "complete"),
+             ([f"{HELD_OUT}:null:rigid", "--kind", "drakecreep", "--spent", str(tmp_path / "no.json")], "--spent"),
              (["9014:null:rigid", "--kind", "pi"], "--kind"),
              (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json"))
     _refused_in_one_line("diagnose_dataset.py", cases, monkeypatch, capsys, tmp_path)
+    # a seed of a complete run's rows is let through: the dataset is generated
+    with pytest.raises(AssertionError, match="started the work"):
+        _in_process("diagnose_dataset.py", [f"{HELD_OUT}:null:rigid", "--kind", "drakecreep", "--spent", str(whole)],
+                    monkeypatch, capsys, tmp_path)
     dd = _script_module("diagnose_dataset.py")
     row = {"seed": 1205, "withheld": ["lead_error"], "axis": "flexible", "snr": 24.2, "claimed": ["lead_error"],
            "first_passing": "lead_error", "audit_shrink": 0.9695, "true_shrink": 0.9695, "worse": False,
