@@ -70,6 +70,9 @@ OSCILLATION_SHARE = 0.25
 OSCILLATION_RATIO = 10.0
 #: Half-width of an oscillation's band, relative to its frequency.
 _OSC_WIDTH = 0.15
+#: Samples per Welch segment of the oscillation measures: their frequency resolution is ``1 / (256 dt)`` (3.9 Hz
+#: at 1 kHz).
+_OSC_SEGMENT = 256
 
 #: Time regimes, in order of precedence.
 REGIMES = ("dwell", "stick", "reversal", "acceleration", "constant_speed")
@@ -515,7 +518,7 @@ def motor_table_split(x_motor, x_table, x_motor_sim, x_table_sim=None):
             "after_screw_share": share, "where": where}
 
 
-def _welch(record, dt, nperseg=256):
+def _welch(record, dt, nperseg=_OSC_SEGMENT):
     r = np.asarray(record, dtype=float)
     f, p = signal.welch(r, fs=1.0 / dt, nperseg=int(min(nperseg, r.size)), detrend="constant")
     return f, p, float(f[1] - f[0])
@@ -612,7 +615,9 @@ def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
     dict or None
         None when no record oscillates; otherwise ``freq_Hz`` (median over the oscillating runs), ``rms`` and
         ``model_rms`` (their median RMS in the band, measured and replayed), ``share`` (median), ``runs`` (how
-        many oscillate), ``of`` (how many were checked) and ``oscillating`` (a bool per run, in order).
+        many oscillate), ``of`` (how many were checked), ``oscillating`` (a bool per run, in order), ``freqs_Hz``
+        (each oscillating run's frequency, in order) and ``resolution_Hz`` (the frequency resolution of the
+        spectra they are read from, that of the shortest record).
     """
     hits, flags = [], []
     for o, model in _paired_bands(measured, simulated, dt, f_min):
@@ -622,8 +627,10 @@ def sustained_oscillation(measured, simulated, dt, f_min=OSCILLATION_MIN_HZ):
     if not hits:
         return None
     med = np.median(np.array(hits), axis=0)
+    shortest = min(np.asarray(m).size for m in measured)
     return {"freq_Hz": float(med[0]), "rms": float(med[1]), "model_rms": float(med[2]), "share": float(med[3]),
-            "runs": len(hits), "of": len(measured), "oscillating": flags}
+            "runs": len(hits), "of": len(measured), "oscillating": flags,
+            "freqs_Hz": [float(h[0]) for h in hits], "resolution_Hz": 1.0 / (dt * min(_OSC_SEGMENT, shortest))}
 
 
 def oscillates_at(record, dt, freq, f_min=OSCILLATION_MIN_HZ):

@@ -947,6 +947,27 @@ def test_a_lead_error_on_a_linear_scale_is_decided_on_the_transmission():
     assert not force_only.passes and "transmission" not in force_only.replay
 
 
+def test_the_delay_tested_on_the_held_out_runs_matches_the_frequency_first_and_the_amplitude_second():
+    """Held-out dataset 105106022 (docs/gap_benchmark.md 3cp): runs oscillating at 250 and 254 Hz, reproduced by 4
+    ticks at 250 Hz (band error 0.889 Np) and 8 ticks at 223 Hz (0.825 Np). The band error alone chose 8; the
+    frequency, which the delay sets, picks 4. Values inside the measured runs' frequencies (widened by a bin) are
+    told apart by the band error; without one inside, the nearest."""
+    def rep(value, freq, band):
+        return {"path": "controller.computation_delay", "value": value, "freq_Hz": freq, "rms": 1.0,
+                "band_nepers": band}
+
+    o = {"freq_Hz": 251.95, "rms": 1.0, "freqs_Hz": [250.0, 253.9], "resolution_Hz": 3.906,
+         "reproduced_by": [rep(4.0, 250.0, 0.889), rep(8.0, 222.66, 0.825)]}
+    assert drive_fit._reproducing_pick(o)["value"] == 4.0
+    o["reproduced_by"] = [rep(4.0, 246.1, 0.9), rep(6.0, 257.8, 0.3), rep(8.0, 222.66, 0.1)]  # both within a bin
+    assert drive_fit._reproducing_pick(o)["value"] == 6.0
+    o["reproduced_by"] = [rep(4.0, 238.0, 0.9), rep(8.0, 222.66, 0.1)]  # neither within: the nearer
+    assert drive_fit._reproducing_pick(o)["value"] == 4.0
+    del o["freqs_Hz"], o["resolution_Hz"]  # an oscillation of before the per-run frequencies: its median, exactly
+    o["reproduced_by"] = [rep(4.0, 251.95, 0.9), rep(8.0, 251.95, 0.1)]
+    assert drive_fit._reproducing_pick(o)["value"] == 8.0
+
+
 def test_a_limit_cycle_is_not_refused_as_a_unit_slip_by_its_inverse_dynamics_mass(monkeypatch):
     """A run whose inverse-dynamics mass is 33 times the params file's is refused as a unit slip, unless its drive
     force is a limit cycle (held-out run 3cc's unstable control delay 99106000: 2229 kg against 67.7 kg, refused

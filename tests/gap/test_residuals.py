@@ -175,6 +175,7 @@ def test_sustained_oscillation_only_when_the_replay_lacks_it_and_it_dominates():
     measured, quiet = _oscillating()
     o = sustained_oscillation([measured, measured], [quiet, quiet], 1e-3)
     assert o["runs"] == o["of"] == 2 and abs(o["freq_Hz"] - 160.0) < 4.0 and o["model_rms"] < 2.0
+    assert o["freqs_Hz"] == [o["freq_Hz"]] * 2 and o["resolution_Hz"] == pytest.approx(1e3 / 256)
     assert sustained_oscillation([measured], [measured[::-1]], 1e-3) is None  # the replay oscillates too
     ripple, _ = _oscillating(freq=23.0, amp=5.0)  # a force ripple: 12.5 of 213 N^2, not a limit cycle
     assert sustained_oscillation([ripple], [quiet], 1e-3) is None
