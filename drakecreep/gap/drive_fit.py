@@ -103,7 +103,7 @@ from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, check_travel, drake_replay_errors, replay_drakecreep,
                                          replay_params, rms_force_error)
 from drakecreep.gap.measured import check_split
-from drakecreep.gap.residuals import (OSCILLATION_SHARE, dominant_oscillation, limit_cycle, oscillates_at,
+from drakecreep.gap.residuals import (OSCILLATION_RATIO, OSCILLATION_SHARE, dominant_oscillation, limit_cycle, oscillates_at,
                                       oscillation_band_errors, sustained_oscillation,
                                       transmission_position)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
@@ -1321,19 +1321,24 @@ def _reproducing_pick(oscillation):
     """Which of the values that reproduce a measured oscillation (``oscillation["reproduced_by"]``, non-empty) is
     tested on the held-out runs: frequency first, amplitude second.
 
-    A value matches the measured frequency when its replays' (``freq_Hz``) lies within the measured oscillating
-    runs' own frequencies (``freqs_Hz``) widened by one bin of their spectra (``resolution_Hz``) on either side;
-    without a match, the values nearest to that range do. Of these, the least run-by-run band error
-    (``band_nepers``) wins.
+    A value whose replays oscillate :data:`~drakecreep.gap.residuals.OSCILLATION_RATIO` times more weakly than the
+    measurement (``rms``) is passed over when another is not: by the detector's own rule the measured runs
+    would still oscillate where that model does not. Of the others, a value matches the measured frequency when its
+    replays' (``freq_Hz``) lies within the measured oscillating runs' own frequencies (``freqs_Hz``) widened by one
+    bin of their spectra (``resolution_Hz``) on either side; without a match, the values nearest to that range do.
+    Of these, the least run-by-run band error (``band_nepers``) wins.
 
     Why frequency first: a limit cycle's frequency is where the loop's phase lag reaches a half turn, which the delay
     sets (each speed-loop tick shifts it); its amplitude is where the loop's gain meets the nonlinearity that
     limits the cycle (the drive's saturation, friction, quantization), which a model matches less well than its
     linear part. The band error alone compares amplitudes in a band of +-15 %, and so cannot tell frequencies 12 %
     apart: on held-out dataset 105106022 (docs/gap_benchmark.md 3cp, 3cq) it chose 8 ticks at 223 Hz (0.825 Np)
-    over the truth's 4 ticks at 250 Hz (0.889 Np) for runs oscillating at 250 and 254 Hz.
+    over the truth's 4 ticks at 250 Hz (0.889 Np) for runs oscillating at 250 and 254 Hz. On 99106002 (3cc) 16
+    ticks oscillated at the measured 312.5 Hz but 31 times more weakly (47 N against 1481 N); the truth's 4 ticks
+    at 304.7 Hz, as strongly.
     """
-    rep = oscillation["reproduced_by"]
+    rep = [r for r in oscillation["reproduced_by"] if OSCILLATION_RATIO * r["rms"] >= oscillation["rms"]] \
+        or oscillation["reproduced_by"]
     freqs = oscillation.get("freqs_Hz") or [oscillation["freq_Hz"]]
     step = float(oscillation.get("resolution_Hz", 0.0))
     lo, hi = min(freqs) - step, max(freqs) + step

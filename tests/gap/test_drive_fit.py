@@ -951,7 +951,8 @@ def test_the_delay_tested_on_the_held_out_runs_matches_the_frequency_first_and_t
     """Held-out dataset 105106022 (docs/gap_benchmark.md 3cp): runs oscillating at 250 and 254 Hz, reproduced by 4
     ticks at 250 Hz (band error 0.889 Np) and 8 ticks at 223 Hz (0.825 Np). The band error alone chose 8; the
     frequency, which the delay sets, picks 4. Values inside the measured runs' frequencies (widened by a bin) are
-    told apart by the band error; without one inside, the nearest."""
+    told apart by the band error; without one inside, the nearest; one ten times weaker than the measurement only
+    when no other is left."""
     def rep(value, freq, band):
         return {"path": "controller.computation_delay", "value": value, "freq_Hz": freq, "rms": 1.0,
                 "band_nepers": band}
@@ -966,6 +967,12 @@ def test_the_delay_tested_on_the_held_out_runs_matches_the_frequency_first_and_t
     del o["freqs_Hz"], o["resolution_Hz"]  # an oscillation of before the per-run frequencies: its median, exactly
     o["reproduced_by"] = [rep(4.0, 251.95, 0.9), rep(8.0, 251.95, 0.1)]
     assert drive_fit._reproducing_pick(o)["value"] == 8.0
+    # 99106002 (3cc): 16 ticks at the measured 312.5 Hz but 31 times weaker than the measurement; 4 ticks as strong
+    o = {"freq_Hz": 312.5, "rms": 1481.0, "freqs_Hz": [312.5] * 4, "resolution_Hz": 3.906,
+         "reproduced_by": [dict(rep(4.0, 304.69, 0.5), rms=1499.0), dict(rep(16.0, 312.5, 0.5), rms=47.0)]}
+    assert drive_fit._reproducing_pick(o)["value"] == 4.0
+    o["reproduced_by"] = o["reproduced_by"][1:]  # the weak one alone is still the one tried
+    assert drive_fit._reproducing_pick(o)["value"] == 16.0
 
 
 def test_a_limit_cycle_is_not_refused_as_a_unit_slip_by_its_inverse_dynamics_mass(monkeypatch):
