@@ -103,8 +103,8 @@ from drakecreep.gap.drake_diagnosis import paired_gain
 from drakecreep.gap.drake_replay import (check_replayable, check_travel, drake_replay_errors, replay_drakecreep,
                                          replay_params, rms_force_error)
 from drakecreep.gap.measured import check_split
-from drakecreep.gap.residuals import (OSCILLATION_RATIO, OSCILLATION_SHARE, dominant_oscillation, limit_cycle, oscillates_at,
-                                      oscillation_band_errors, sustained_oscillation,
+from drakecreep.gap.residuals import (OSCILLATION_RATIO, OSCILLATION_SHARE, dominant_oscillation, limit_cycle,
+                                      oscillates_at, oscillation_band_errors, sustained_oscillation,
                                       transmission_position)
 from drakecreep.gap.where import locate, oscillation_line, where_lines
 from drakecreep.model.controller import force_limit
@@ -1302,8 +1302,13 @@ def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
     spurious = sum(bool(oscillates_at(delay_sims[i].force, dt, oscillation["freq_Hz"])[0]) for i in quiet)
     ok = bool(null is not None and len(osc) > 1 and gain > bar and 2 * better > len(osc) and 2 * same > len(osc)
               and 2 * spurious <= len(quiet))
-    reason = (f"{pick['path']} = {pick['value']:g} oscillates at {pick['freq_Hz']:.0f} Hz on the training runs; on "
-              f"the {len(osc)} of {n} held-out runs that oscillate it does so at the measured frequency on {same}, "
+    others = [r for r in rep if r is not pick]
+    also = ("" if not others else " (picked on the frequency, then the band error, over " + ", ".join(
+        f"{r['value']:g} at {r['freq_Hz']:.0f} Hz, {r['rms']:.3g} N" for r in others)
+        + f"; measured {oscillation['freq_Hz']:.0f} Hz, {oscillation['rms']:.3g} N)")
+    reason = (f"{pick['path']} = {pick['value']:g} oscillates at {pick['freq_Hz']:.0f} Hz on the training runs"
+              f"{also}; on the {len(osc)} of {n} held-out runs that oscillate it does so at the measured frequency "
+              f"on {same}, "
               f"its band error {np.mean(e1[osc]) if osc else float('nan'):.2f} Np against the fitted model's "
               f"{np.mean(e0[osc]) if osc else float('nan'):.2f} Np (decrease {gain:.2f} Np, bar {bar:.2f}, "
               f"{better} of {len(osc)} runs better); "

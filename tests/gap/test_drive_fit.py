@@ -1031,6 +1031,7 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
 
     spectral, errors = drive_fit._spectral_delay(o, test, RIG, records((0, 0, 0, 0)), replay, null=0.01)
     assert spectral["values"] == {"controller.computation_delay": 12.0} and spectral["passes"], spectral["reason"]
+    assert "training runs (picked on the frequency, then the band error, over 8 at 160 Hz" in spectral["reason"]
     assert spectral["oscillating"] == 2 and spectral["same_frequency"] == 2 and errors == {}
     o["reproduced_by"] = [by[8.0]]
     spectral, _ = drive_fit._spectral_delay(o, test, RIG, records((0, 0, 0, 0)), replay, null=0.01)
