@@ -1258,8 +1258,9 @@ def _spectral_delay(oscillation, test, params, nominal_sims, replay, null):
     """The claim a computation delay can make on runs that oscillate where the model does not: on the spectrum.
 
     Of the delays that make the model oscillate at the measured frequency on the training runs that oscillate
-    (``oscillation["reproduced_by"]``, :func:`_reproduces`), the one :func:`_reproducing_pick` picks (frequency
-    first, then the run-by-run band error) is replayed on the held-out runs. Each held-out run's
+    (``oscillation["reproduced_by"]``, :func:`_reproduces`), the one :func:`_reproducing_pick` picks (not ten times
+    weaker than the measurement, then the frequency, then the run-by-run band error) is replayed on the held-out
+    runs. Each held-out run's
     spectral error is :func:`~drakecreep.gap.residuals.oscillation_band_errors` (``|ln(model / measured)|`` of the
     RMS in the band of the run's measured oscillation, or of the training runs' where the run does not
     oscillate). The delay passes when, over the held-out runs that oscillate (at least two), the per-run decrease
