@@ -9,7 +9,7 @@ looked at again only once a run has spent it: ``--spent ROWS.json`` names that r
 ``bench_gap_benchmark.py --json`` wrote, ``"complete": true``), and only their seeds are let through.
 
 Usage: ``PYTHONPATH=. python analysis/diagnose_dataset.py SEED:WITHHELD:AXIS [...] --kind drakecreep
-[--json OUT.json] [--spent ROWS.json ...]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a
+[--json OUT.json] [--spent ROWS.json ...] [--effects control_delay]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a
 null dataset).
 """
 
@@ -21,6 +21,7 @@ import time
 from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap import benchmark as B
+from drakecreep.gap.drive_fit import EFFECTS
 from study_cli import read_rows
 
 __all__ = ["summary", "main"]
@@ -51,6 +52,9 @@ def main(argv=None):
                     help="a dataset: WITHHELD null or a withheld effect, AXIS rigid or flexible")
     ap.add_argument("--kind", required=True, choices=B.BENCHMARK_KINDS, help="the controller kind")
     ap.add_argument("--json", help="write the rows here (after each dataset)")
+    ap.add_argument("--effects", metavar="NAMES",
+                    help="comma-separated candidates to fit (default: the diagnosis's own; drakecreep kind): a study "
+                         "of one candidate, whose fit and held-out test do not depend on the others, runs only it")
     ap.add_argument("--spent", nargs="+", metavar="ROWS", default=(),
                     help="rows files of a complete pre-registered run: its seeds of the current held-out set are "
                          "let through")
@@ -62,8 +66,15 @@ def main(argv=None):
             ap.exit(2, f"diagnose_dataset: error: --spent: {path!r} is not a complete run's rows (\"complete\": "
                        f"{rows.get('complete')!r}); allowed: the rows of a run that is whole\n")
         spent.update(int(r["seed"]) for r in rows["datasets"])
+    effects = None
     try:
         specs = [B.dataset_spec(s) for s in a.datasets]
+        if a.effects is not None:
+            effects = tuple(e.strip() for e in a.effects.split(",") if e.strip())
+            unknown = [e for e in effects if e not in EFFECTS]
+            if a.kind != "drakecreep" or not effects or unknown:
+                raise InputError("--effects", a.effects, ("candidates of the drakecreep kind: " if a.kind ==
+                                 "drakecreep" else "only with --kind drakecreep: ") + ", ".join(EFFECTS))
         for seed, _, _ in specs:
             if seed >= B.HELDOUT_SEEDS and seed not in spent:
                 raise InputError("SEED", seed, f"a seed below {B.HELDOUT_SEEDS} or one of a complete run's rows "
@@ -76,12 +87,13 @@ def main(argv=None):
     for seed, withheld, axis in specs:
         ds = B.generate_dataset(seed, withheld=withheld, kind=a.kind, axis=axis)
         t0 = time.time()
-        row = B.evaluate(ds)
+        row = B.evaluate(ds, effects=effects)
         row["seconds"] = time.time() - t0
         rows.append(row)
         print(summary(row) + f" ({row['seconds']:.0f} s)", flush=True)
         if a.json:
-            write_text(a.json, json.dumps({"kind": a.kind, "datasets": rows}, indent=1, default=str))
+            write_text(a.json, json.dumps({"kind": a.kind, "effects": effects, "datasets": rows}, indent=1,
+                                          default=str))
     return 0
 
 

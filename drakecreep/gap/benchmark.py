@@ -645,6 +645,9 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
                 "start": c.start,  # which start a fit of more than one kept (the Stribeck candidate's)
+                # what a searched candidate saw run by run on the training runs (the delay's: each run's SSE at
+                # each delay tried and its own best delay; docs 3cr)
+                "search": dict(c.search),
                 # the lead error on runs with a linear scale is decided on the screw's transmission (its train_gain
                 # is that SSE's, not the force's): the replay test it passed or failed there
                 "transmission": (c.replay or {}).get("transmission"),

@@ -328,7 +328,9 @@ class EffectResult:
     it must clear; ``replay``: :func:`drakecreep.gap.claims.replay_test` of the force (with the transmission's under
     ``"transmission"`` for the lead error on runs with a scale, :func:`_held_out_on_scale`); ``claimed``,
     ``reason``; ``start``: which start the fit kept where it has more than one (the Stribeck candidate's
-    ``"nominal fit"`` or ``"params file"``, :func:`_stribeck_effect`), else ``""``.
+    ``"nominal fit"`` or ``"params file"``, :func:`_stribeck_effect`), else ``""``; ``search``: what a searched
+    candidate saw on the training runs, run by run (the ``control_delay`` candidate's: :func:`_delay_effect`'s
+    ``record``), else empty.
     """
 
     name: str
@@ -342,6 +344,7 @@ class EffectResult:
     passes: bool
     reason: str = ""
     start: str = ""
+    search: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -1197,7 +1200,7 @@ def _lead_error_on_scale(runs, base, replayer, base_sims):
     return values, 1.0 - sse / sse0
 
 
-def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
+def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None, record=None):
     """The computation delay that replays the training ``runs`` best: ``({path: delay}, sse)``.
 
     A delay is not a small change of a smooth model (each whole sample shifts the command by a step), so it is
@@ -1207,21 +1210,38 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
 
     With ``oscillation`` (the measured runs' :func:`~drakecreep.gap.residuals.sustained_oscillation`), each
     delay whose replay oscillates within +-15 % of its frequency on most runs is appended to its
-    ``reproduced_by`` (no extra replay: the search's own)."""
+    ``reproduced_by`` (no extra replay: the search's own).
+
+    With ``record`` (a dict), what the search saw is kept in it, run by run (no extra replay either): ``declared``
+    (the params file's delay), ``delays`` (every delay tried, the declared one among them, ascending), ``run_sse``
+    (one list per training run: its force SSE at each of ``delays``, in units of the runs' force scale squared) and
+    ``run_best`` (each run's own best delay of those tried). A computation delay is a constant of the controller,
+    so a withheld one should be every run's best; docs/gap_benchmark.md, 3cr, measures that."""
     path = "controller.computation_delay"
     declared = float(base.controller.computation_delay)
     if oscillation is not None:  # searched: an empty list says that no delay tried oscillates there
         oscillation.setdefault("reproduced_by", [])
+
+    def run_sse(sims):
+        return [float(np.sum(((r.force - s.force) / scale) ** 2)) for r, s in zip(runs, sims)]
+
     r0 = _residual(runs, base_sims, scale)
-    tried = {declared: float(r0 @ r0)}
+    by_run, tried = {declared: run_sse(base_sims)}, {declared: float(r0 @ r0)}
 
     def replay(delays):
         delays = sorted({float(d) for d in delays} - set(tried))
         for d, sims in zip(delays, _replay_many(replayer, [(runs, _with(base, {path: d})) for d in delays])):
             r = _residual(runs, sims, scale)
-            tried[d] = float(r @ r)
+            by_run[d], tried[d] = run_sse(sims), float(r @ r)
             if oscillation is not None:
                 _reproduces(oscillation, path, d, runs, sims)
+
+    def kept():
+        if record is not None:
+            delays = sorted(by_run)
+            sse = [[by_run[d][i] for d in delays] for i in range(len(runs))]
+            record.update(declared=declared, delays=delays, run_sse=sse,
+                          run_best=[delays[int(np.argmin(row))] for row in sse])
 
     replay(DELAY_GRID)
     while True:
@@ -1232,6 +1252,7 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None):
                   ([math.ceil(0.5 * (best + min(upper)))] if upper else [])
         new = [d for d in halfway if d not in tried and d != best]
         if not new:
+            kept()
             return {path: best}, tried[best]
         replay(new)
 
@@ -1524,12 +1545,12 @@ def _stribeck_effect(runs, base, replayer, base_sims, scale, max_nfev, uncertain
 
 
 def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillation=None, uncertain=(),
-                kinematic=False, prior=None):
+                kinematic=False, prior=None, record=None):
     """Fit candidate ``name`` on the training ``runs`` on top of ``base``: ``(values, train_gain, start)``
-    (``start``: :attr:`EffectResult.start`; ``oscillation``: :func:`_delay_effect`'s; ``uncertain``: the fields the
-    Stribeck candidate refits with its curve; ``kinematic``: every run has a linear scale, and the lead error is
-    fitted on the screw's transmission, :func:`_lead_error_on_scale`; ``prior``: the params file, whose levels are
-    the Stribeck fit's second start, :func:`_stribeck_effect`)."""
+    (``start``: :attr:`EffectResult.start`; ``oscillation``, ``record``: :func:`_delay_effect`'s; ``uncertain``: the
+    fields the Stribeck candidate refits with its curve; ``kinematic``: every run has a linear scale, and the lead
+    error is fitted on the screw's transmission, :func:`_lead_error_on_scale`; ``prior``: the params file, whose
+    levels are the Stribeck fit's second start, :func:`_stribeck_effect`)."""
     scale, start = _force_scale(runs), ""
     if name == _KINEMATIC and kinematic:
         return (*_lead_error_on_scale(runs, base, replayer, base_sims), "")
@@ -1557,7 +1578,7 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
     elif name == "control_delay":
         if not base.controller.sampled:
             return None, 0.0, ""  # a continuous controller has no computation delay
-        values, sse = _delay_effect(runs, base, replayer, base_sims, scale, oscillation)
+        values, sse = _delay_effect(runs, base, replayer, base_sims, scale, oscillation, record)
     elif name == "asymmetric_friction":
         # both fractions from the symmetric model by the output-error fit (four Jacobian replays of each run per
         # iteration); the levels stay the nominal's: their mean is the symmetric model's in either direction
@@ -1899,15 +1920,16 @@ def _fit_candidate(name, replay, *, train, test, params, base_sims, sse0, max_nf
     """One candidate fitted on the training runs and replayed on the held-out ones: ``(EffectResult or None, why it
     failed or None)``. A failure (an integrator that gives up on a fitted value, a value the params refuse: a
     Stribeck fit that left its range failed the whole diagnosis after five minutes) is recorded, never claimed."""
+    search = {}
     try:
         values, train_gain, start = _fit_effect(name, train, params, replay, base_sims, sse0, max_nfev, oscillation,
-                                                uncertain, kinematic, prior)
+                                                uncertain, kinematic, prior, search)
         if values is None:
             return None, None
         if not values:
-            return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, _NOTHING_TO_FIT), None
+            return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, _NOTHING_TO_FIT, search=search), None
         c = dataclasses.replace(_held_out(name, values, train_gain, test, params, nominal_errors, replay, null,
-                                          transmission_null, kinematic), start=start)
+                                          transmission_null, kinematic), start=start, search=search)
     except Exception as err:  # noqa: BLE001 - one candidate's failure must not end the diagnosis
         why = f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"[:300]
         return EffectResult(name, {}, 0.0, {}, 0.0, 0.0, 0.0, {}, False, f"failed ({why})"), why

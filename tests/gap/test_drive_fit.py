@@ -151,6 +151,25 @@ def test_control_delay_is_found_between_the_grid_points(delay_case):
     assert result.oscillation is None  # a stable loop with a larger delay: no sustained oscillation
 
 
+def test_the_delay_search_keeps_each_training_runs_own_best_delay(delay_case):
+    """The search's own replays, kept run by run (docs 3cr): a withheld delay of 5 samples is every training run's
+    own best, each run's SSE there is its least, and the runs' SSEs add up to the candidate's training gain."""
+    truth, result = delay_case
+    (c,) = [c for c in result.candidates if c.name == "control_delay"]
+    s = c.search
+    assert s["declared"] == 1.0 and s["declared"] in s["delays"] and 5.0 in s["delays"]
+    assert s["delays"] == sorted(s["delays"]) and set(drive_fit.DELAY_GRID) <= set(s["delays"])
+    assert len(s["run_sse"]) == len(s["run_best"]) == 2  # the two training runs
+    assert all(len(row) == len(s["delays"]) for row in s["run_sse"])
+    assert s["run_best"] == [5.0, 5.0]
+    at = lambda d: sum(row[s["delays"].index(d)] for row in s["run_sse"])  # noqa: E731
+    assert c.train_gain == pytest.approx(1.0 - at(5.0) / at(1.0), rel=1e-6)
+    (kept,) = [d for d in result.to_json()["candidates"] if d["name"] == "control_delay"]
+    assert kept["search"]["run_best"] == [5.0, 5.0]
+    # a candidate that is not searched records nothing
+    assert all(not other.search for other in result.candidates if other.name != "control_delay")
+
+
 def test_an_unstable_real_loop_is_reported_by_its_frequency_not_claimed(tmp_path):
     """Truth: a computation delay of 24 samples, past the rig's stability limit (20-24): the measured force
     oscillates at about 30 Hz, and the model (params file 1 sample; the delay grid ends at 16) does not. The
