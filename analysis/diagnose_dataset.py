@@ -83,18 +83,24 @@ def main(argv=None):
             check_output_file(a.json, "--json")
     except InputError as e:
         ap.exit(2, f"diagnose_dataset: error: {e}\n")
-    rows = []
+    rows, failed = [], []
     for seed, withheld, axis in specs:
-        ds = B.generate_dataset(seed, withheld=withheld, kind=a.kind, axis=axis)
         t0 = time.time()
-        row = B.evaluate(ds, effects=effects)
-        row["seconds"] = time.time() - t0
-        rows.append(row)
-        print(summary(row) + f" ({row['seconds']:.0f} s)", flush=True)
+        try:  # one failing dataset is reported and kept, as the benchmark does; the others go on
+            ds = B.generate_dataset(seed, withheld=withheld, kind=a.kind, axis=axis)
+            row = B.evaluate(ds, effects=effects)
+        except Exception as err:  # noqa: BLE001
+            failed.append({"seed": seed, "withheld": list(withheld), "axis": axis,
+                           "error": f"{type(err).__name__}: {err}"})
+            print(f"{seed} {'/'.join(withheld) or 'null'} {axis}: failed ({failed[-1]['error']})", flush=True)
+        else:
+            row["seconds"] = time.time() - t0
+            rows.append(row)
+            print(summary(row) + f" ({row['seconds']:.0f} s)", flush=True)
         if a.json:
-            write_text(a.json, json.dumps({"kind": a.kind, "effects": effects, "datasets": rows}, indent=1,
-                                          default=str))
-    return 0
+            write_text(a.json, json.dumps({"kind": a.kind, "effects": effects, "datasets": rows, "failed": failed},
+                                          indent=1, default=str))
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
