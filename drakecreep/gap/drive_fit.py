@@ -128,7 +128,9 @@ __all__ = [
     "MIN_DRIVE_FORCE",
     "MAX_SAMPLE_PERIODS",
     "MASS_FACTOR",
+    "SATURATED_SHARE",
     "inverse_dynamics_mass",
+    "saturated_share",
     "claims_withheld",
     "FittedParameter",
     "EffectResult",
@@ -200,6 +202,13 @@ MIN_DRIVE_FORCE = 0.01
 #: determined within :data:`MASS_CHECK_STD` relative) may differ from the params file's rigid-body mass at the table
 #: (table, nut, and the rotor, coupling and screw inertia through the lead): positions in m headed mm read 1000 x
 MASS_FACTOR = 10.0
+#: Share of a run's samples at which a drive force ``u x u_gain`` that sits at the drive's force limit (within
+#: :data:`_AT_LIMIT`) marks a saturated command: the axis did not follow it, so the run's inverse-dynamics mass
+#: reads the limit, not the axis, and is no sign of a unit slip (a development dataset of docs 3cr, a truth whose
+#: drive force falls off above 60-160 N, held 2000 N on 39 % of a fast run's samples and read 935 kg against
+#: 61.2 kg; a unit slip puts u far beyond the limit or far below it, never on it)
+SATURATED_SHARE = 0.01
+_AT_LIMIT = 0.999
 MASS_CHECK_STD = 0.1
 #: Longest sample step of a run, in position-loop periods of its params file: a trace sampled more coarsely shows
 #: nothing of the loop (milliseconds headed seconds: 1000 periods, a replay 1000 times the run's length)
@@ -622,7 +631,8 @@ def check_run(run, params=None, load_case=0):
     between :data:`MIN_DRIVE_FORCE` times the params file's Coulomb friction and :data:`MAX_DRIVE_FORCE` times the
     drive's force limit; the run's inverse-dynamics mass (:func:`inverse_dynamics_mass`), where it is determined, is
     within :data:`MASS_FACTOR` of the params file's rigid-body mass at the table, unless its drive force is a limit
-    cycle (:func:`~drakecreep.gap.residuals.limit_cycle`). Its reference moves: on a run
+    cycle (:func:`~drakecreep.gap.residuals.limit_cycle`) or sits at the drive's force limit on at least
+    :data:`SATURATED_SHARE` of the samples (:func:`saturated_share`: a saturated command). Its reference moves: on a run
     that holds one position the friction has nothing to show (a file whose reference was constant ran five minutes
     of fits before a fitted value left its range).
     """
@@ -666,7 +676,7 @@ def check_run(run, params=None, load_case=0):
     # for it (claims_withheld). Held-out run 3cc's control delay 99106000 read 2229 kg against a params file's
     # 67.7 kg, and the refusal ("is the unit of the positions wrong?") ended the dataset before any fit
     if mass is not None and not rigid / MASS_FACTOR <= mass <= rigid * MASS_FACTOR \
-            and limit_cycle(run.force, run.dt) is None:
+            and limit_cycle(run.force, run.dt) is None and saturated_share(run, params) < SATURATED_SHARE:
         raise InputError(f"x_motor (run {run.label})", f"an inverse-dynamics mass of {mass:.4g} kg",
                          f"within a factor of {MASS_FACTOR:g} of the params file's rigid-body mass at the table "
                          f"({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead); is the unit of "
@@ -676,6 +686,12 @@ def check_run(run, params=None, load_case=0):
         raise InputError(f"f_ext (run {run.label})", f"{float(np.max(np.abs(run.f_ext))):.3g} N",
                          f"external forces up to {MAX_EXTERNAL_FORCE:g} x the drive's force limit ({limit:.3g} N: "
                          "the params file's peak torque through the lead); is a unit wrong?")
+
+
+def saturated_share(run, params):
+    """The share of ``run``'s samples whose drive force ``u x u_gain`` sits at the force limit of ``params`` (the
+    cascade's clip, :func:`~drakecreep.model.controller.force_limit`, within 0.1 %)."""
+    return float(np.mean(np.abs(run.u_gain * run.u) >= _AT_LIMIT * force_limit(params)))
 
 
 def inverse_dynamics_mass(run):
@@ -1794,6 +1810,15 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     nominal_sims = replay(test, params)
     nominal_errors = _errors_of(test, nominal_sims)
     say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
+    shares = {r.label: saturated_share(r, prior) for r in (*train, *test)}
+    saturated = {k: v for k, v in shares.items() if v >= SATURATED_SHARE}
+    notes = () if not saturated else (
+            f"the drive force sits at its limit ({force_limit(prior):.4g} N) on "
+            + ", ".join(f"{100 * v:.0f} % of run {k}'s samples" for k, v in saturated.items())
+            + ": the command saturated and the axis fell behind it; the model clips its command alike, but what "
+              "held the axis back (a drive weaker than its params file says, a force the model lacks) is what the "
+              "candidates must explain",)
+    warnings = tuple(warnings) + notes
     null, null_runs, transmission_null, null_runs_lowpass = (
         _replay_null(train, test, fit, replay, nominal_errors) if names else (None, None, None, None))
     kinematic = _on_scale(train) and _on_scale(test)
@@ -1892,7 +1917,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                            for p in _AMPLITUDES.get(name, ()) if get_value(current, p) != 0 and p not in uncertain)
         before = replay.count
         current, fitted, warnings, _ = fit_drive(train, current, uncertain + amplitudes, replay, max_nfev=max_nfev)
-        warnings = tuple(warnings) + tuple(failures)
+        warnings = tuple(warnings) + notes + tuple(failures)
         fitted = tuple(dataclasses.replace(f, prior=float(get_value(prior, f.path))) for f in fitted)
         final_sims = replay(test, current)
         current_errors = _errors_of(test, final_sims)

@@ -1012,6 +1012,41 @@ def test_a_limit_cycle_is_not_refused_as_a_unit_slip_by_its_inverse_dynamics_mas
     drive_fit.check_run(unstable)  # not refused
 
 
+def test_a_saturated_command_is_not_refused_as_a_unit_slip_and_is_warned_of(monkeypatch):
+    """A run whose drive force sits at the cascade's clip on more than 1 % of its samples saturated: the axis fell
+    behind the command, so its inverse-dynamics mass reads the limit (a docs 3cr development dataset: 935 kg
+    against 61.2 kg, refused as "is the unit of the positions wrong?"). Not refused; the diagnosis says so in a
+    warning. Clipped on fewer samples, the mass still refuses it."""
+    from drakecreep.model.compensators import rigid_inertia
+    from drakecreep.model.controller import force_limit
+
+    rigid = rigid_inertia(RIG) * (2.0 * math.pi / RIG.screw.lead) ** 2
+    runs = _runs(RIG)
+    run, real = runs[0], drive_fit.inverse_dynamics_mass
+    monkeypatch.setattr(drive_fit, "inverse_dynamics_mass",
+                        lambda r: 15.0 * rigid if r.label == run.label else real(r))
+    limit = force_limit(RIG) / run.u_gain
+
+    def clipped(k):  # the first k samples at the limit, alternately signed
+        u = run.u.copy()
+        u[:k] = limit * np.where(np.arange(k) % 2, 1.0, -1.0)
+        return dataclasses.replace(run, u=u)
+
+    few = clipped(int(0.005 * run.n))
+    assert drive_fit.saturated_share(few, RIG) < drive_fit.SATURATED_SHARE
+    with pytest.raises(InputError, match="inverse-dynamics mass"):
+        drive_fit.check_run(few)
+    many = clipped(int(0.05 * run.n))
+    assert drive_fit.saturated_share(many, RIG) == pytest.approx(0.05, abs=1e-3)
+    drive_fit.check_run(many)  # not refused
+    result = diagnose_drive([many, *runs[1:2]], runs[2:], uncertain=(), effects=())
+    (w,) = [w for w in result.warnings if "sits at its limit" in w]
+    assert f"5 % of run {many.label}'s samples" in w and f"{force_limit(RIG):.4g} N" in w
+    monkeypatch.undo()  # run r0 unclipped: its own mass
+    clean = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
+    assert not any("sits at its limit" in w for w in clean.warnings)
+
+
 def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_picked_run_by_run(monkeypatch):
     """Near a loop's stability limit the measured oscillation comes and goes with the run (docs/gap_benchmark.md
     3ci). Two of four runs oscillate at 160 Hz (enough to withhold the sample claims since 3cj): a delay whose
