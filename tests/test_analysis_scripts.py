@@ -445,3 +445,31 @@ def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tm
     x = 3.0 * math.sqrt(2.0) * np.sin(2 * math.pi * 150.0 * t)
     assert abs(dps.band_rms(x, 1e-3, 150.0) - 3.0) < 0.15
     assert dps.band_rms(x, 1e-3, 300.0) < 0.05
+
+
+def test_delay_signature_counts_the_runs_that_agree_and_are_helped(tmp_path, monkeypatch, capsys):
+    """``analysis/delay_signature.py``: each run's own best delay against the fitted one (agreement) and its SSE at
+    the fitted delay against the declared one (helped); a row without the record says so; an unreadable rows file
+    is one line and exit 2."""
+    monkeypatch.syspath_prepend(str(ANALYSIS))
+    ds = _script_module("delay_signature.py")
+    search = {"declared": 1.0, "delays": [0.0, 1.0, 4.0, 8.0],
+              "run_sse": [[5.0, 4.0, 3.0, 3.5], [5.0, 4.0, 4.5, 2.0], [5.0, 4.0, 4.2, 6.0]],
+              "run_best": [4.0, 8.0, 1.0]}
+    row = {"seed": 7, "withheld": ["drive_saturation"], "axis": "rigid", "snr": 1.2,
+           "ranking": [{"effect": "force_ripple", "values": {}},
+                       {"effect": "control_delay", "passes": True, "train_gain": 0.04, "search": search,
+                        "values": {"controller.computation_delay": 4.0}}]}
+    s = ds.signature(row)
+    assert s["fitted"] == 4.0 and s["declared"] == 1.0 and s["passes"]
+    assert s["run_gain"] == pytest.approx([0.25, -0.125, -0.05])
+    assert s["agreement"] == pytest.approx(1 / 3) and s["helped"] == pytest.approx(1 / 3)
+    assert "agreement 1/3, helped 1/3" in ds.line(row) and "runs' own best 4, 8, 1" in ds.line(row)
+    bare = dict(row, ranking=[{"effect": "control_delay", "values": {}}])
+    assert ds.signature(bare) is None and ds.line(bare).endswith("no delay search recorded")
+    rows = tmp_path / "rows.json"
+    rows.write_text(json.dumps({"datasets": [row, bare]}))
+    code, out, _ = _in_process("delay_signature.py", [str(rows)], monkeypatch, capsys, tmp_path)
+    assert code == 0 and len(out.splitlines()) == 2
+    _refused_in_one_line("delay_signature.py", (([str(tmp_path / "no.json")], "ROWS.json"),), monkeypatch, capsys,
+                         tmp_path)
