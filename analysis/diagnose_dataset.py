@@ -9,8 +9,9 @@ looked at again only once a run has spent it: ``--spent ROWS.json`` names that r
 ``bench_gap_benchmark.py --json`` wrote, ``"complete": true``), and only their seeds are let through.
 
 Usage: ``PYTHONPATH=. python analysis/diagnose_dataset.py SEED:WITHHELD:AXIS [...] --kind drakecreep
-[--json OUT.json] [--spent ROWS.json ...] [--effects control_delay]`` (e.g. ``9014:control_delay:flexible``; ``WITHHELD`` ``null`` for a
-null dataset).
+[--json OUT.json] [--spent ROWS.json ...] [--effects control_delay]`` (e.g. ``9014:control_delay:flexible``;
+``WITHHELD`` ``null`` for a null dataset). A dataset that fails is one line and a ``failed`` entry in the rows, and
+the others go on (exit status 1).
 """
 
 import argparse

@@ -205,8 +205,8 @@ MASS_FACTOR = 10.0
 #: Share of a run's samples at which a drive force ``u x u_gain`` that sits at the drive's force limit (within
 #: :data:`_AT_LIMIT`) marks a saturated command: the axis did not follow it, so the run's inverse-dynamics mass
 #: reads the limit, not the axis, and is no sign of a unit slip (a development dataset of docs 3cr, a truth whose
-#: drive force falls off above 60-160 N, held 2000 N on 39 % of a fast run's samples and read 935 kg against
-#: 61.2 kg; a unit slip puts u far beyond the limit or far below it, never on it)
+#: drive force falls off above 60-160 N, held the 2000 N clip on 16-45 % of three runs' samples, and one of them
+#: read 935 kg against 61.2 kg; a unit slip puts u far beyond the limit or far below it, never on it)
 SATURATED_SHARE = 0.01
 _AT_LIMIT = 0.999
 MASS_CHECK_STD = 0.1
