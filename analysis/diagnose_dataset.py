@@ -22,7 +22,6 @@ import time
 from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap import benchmark as B
-from drakecreep.gap.drive_fit import EFFECTS
 from study_cli import read_rows
 
 __all__ = ["summary", "main"]
@@ -71,11 +70,9 @@ def main(argv=None):
     try:
         specs = [B.dataset_spec(s) for s in a.datasets]
         if a.effects is not None:
-            effects = tuple(e.strip() for e in a.effects.split(",") if e.strip())
-            unknown = [e for e in effects if e not in EFFECTS]
-            if a.kind != "drakecreep" or not effects or unknown:
-                raise InputError("--effects", a.effects, ("candidates of the drakecreep kind: " if a.kind ==
-                                 "drakecreep" else "only with --kind drakecreep: ") + ", ".join(EFFECTS))
+            if a.kind != "drakecreep":
+                raise InputError("--effects", a.effects, "only with --kind drakecreep")
+            effects = B.check_effects((a.kind,), (e.strip() for e in a.effects.split(",") if e.strip()), "--effects")
         for seed, _, _ in specs:
             if seed >= B.HELDOUT_SEEDS and seed not in spent:
                 raise InputError("SEED", seed, f"a seed below {B.HELDOUT_SEEDS} or one of a complete run's rows "

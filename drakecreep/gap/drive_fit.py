@@ -807,8 +807,13 @@ def _errors_of(runs, sims):
     return {r.label: drake_replay_errors(s, bands=False) for r, s in zip(runs, sims)}
 
 
+def _run_residuals(runs, sims, scale):
+    """Each run's force residual (measured minus replayed) over ``scale``: one array per run."""
+    return [(r.force - s.force) / scale for r, s in zip(runs, sims)]
+
+
 def _residual(runs, sims, scale):
-    return np.concatenate([(r.force - s.force) / scale for r, s in zip(runs, sims)])
+    return np.concatenate(_run_residuals(runs, sims, scale))
 
 
 def _force_scale(runs):
@@ -1237,18 +1242,19 @@ def _delay_effect(runs, base, replayer, base_sims, scale, oscillation=None, reco
     declared = float(base.controller.computation_delay)
     if oscillation is not None:  # searched: an empty list says that no delay tried oscillates there
         oscillation.setdefault("reproduced_by", [])
+    by_run, tried = {}, {}
 
-    def run_sse(sims):
-        return [float(np.sum(((r.force - s.force) / scale) ** 2)) for r, s in zip(runs, sims)]
+    def keep(d, sims):  # the pooled SSE the search compares, and each run's own
+        parts = _run_residuals(runs, sims, scale)
+        r = np.concatenate(parts)
+        by_run[d], tried[d] = [float(p @ p) for p in parts], float(r @ r)
 
-    r0 = _residual(runs, base_sims, scale)
-    by_run, tried = {declared: run_sse(base_sims)}, {declared: float(r0 @ r0)}
+    keep(declared, base_sims)
 
     def replay(delays):
         delays = sorted({float(d) for d in delays} - set(tried))
         for d, sims in zip(delays, _replay_many(replayer, [(runs, _with(base, {path: d})) for d in delays])):
-            r = _residual(runs, sims, scale)
-            by_run[d], tried[d] = run_sse(sims), float(r @ r)
+            keep(d, sims)
             if oscillation is not None:
                 _reproduces(oscillation, path, d, runs, sims)
 
