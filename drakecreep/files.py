@@ -305,6 +305,7 @@ def read_input_text(path, field=None, max_bytes=MAX_INPUT_BYTES):
         If it does not exist.
     """
     field = field or str(path)
+    where = "" if field == str(path) else f"{path}: "  # the message names the file once
     path = check_input_file(path, field, max_bytes)
     try:
         with open(path, "rb") as fh:
@@ -320,10 +321,10 @@ def read_input_text(path, field=None, max_bytes=MAX_INPUT_BYTES):
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as err:
-        raise InputError(field, f"{path}: byte 0x{raw[err.start]:02x} at offset {err.start} is not UTF-8",
+        raise InputError(field, f"{where}byte 0x{raw[err.start]:02x} at offset {err.start} is not UTF-8",
                          "a UTF-8 text file (not binary, not UTF-16)") from None
     if "\x00" in text:
-        raise InputError(field, f"{path}: NUL byte at offset {text.index(chr(0))}", "a UTF-8 text file (not binary)")
+        raise InputError(field, f"{where}NUL byte at offset {text.index(chr(0))}", "a UTF-8 text file (not binary)")
     return text
 
 

@@ -128,6 +128,19 @@ def test_inputs_are_regular_bounded_utf8(tmp_path):
         read_input_text(tmp_path / "u16.yaml")
 
 
+@pytest.mark.parametrize("payload", [b"a: \x00\n", b"a: \xff\n"])
+def test_a_message_names_the_file_once(payload, tmp_path):
+    path = tmp_path / "bin.yaml"
+    path.write_bytes(payload)
+    with pytest.raises(InputError) as named_by_path:
+        read_input_text(path)
+    assert str(named_by_path.value).count("bin.yaml") == 1
+    with pytest.raises(InputError) as named_by_field:
+        read_input_text(path, field="--params")
+    message = str(named_by_field.value)
+    assert message.count("bin.yaml") == 1 and "--params" in message
+
+
 def test_references_are_relative_to_the_referring_file(tmp_path, monkeypatch):
     (tmp_path / "d").mkdir()
     (tmp_path / "d" / "rig.yaml").write_text("x: 1\n")
