@@ -28,9 +28,9 @@ def edge_value(value, unit):
     return value * factor, shown
 
 
-def _nulls(rt):
-    """``"85.7 nulls, "``: a replay test's pooled shrink in run-to-run nulls ("" without a null)."""
-    return f"{rt['shrink'] / rt['threshold']:.1f} nulls, " if rt.get("threshold") else ""
+def _times_null(rt):
+    """``"85.7 × null, "``: a replay test's pooled shrink as a multiple of its run-to-run null ("" without a null)."""
+    return f"{rt['shrink'] / rt['threshold']:.1f} × null, " if rt.get("threshold") else ""
 
 
 def _with_unit(value, unit):
@@ -137,15 +137,15 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
         rt = c.replay or {}
         rows.append([c.name, f"{100 * c.train_gain:+.2f}" if fitted else "-",
                      f"{c.gain:+.3f} (bar {c.threshold:.3f})" if fitted else "-",
-                     f"{100 * rt['shrink']:+.2f} ({_nulls(rt)}{rt['runs_better']} of {len(rt['log_ratios'])} runs "
-                     "better)" if fitted and rt.get("log_ratios") else "-",
+                     f"{100 * rt['shrink']:+.2f} ({_times_null(rt)}{rt['runs_better']} of {len(rt['log_ratios'])} "
+                     "runs better)" if fitted and rt.get("log_ratios") else "-",
                      "yes" if c.name in result.claimed else "passes, not claimed" if c.passes else "no",
                      c.reason,
                      (f"fitted from the {c.start}'s values: " if c.start else "")
                      + "; ".join(f"{k} = {_with_unit(v, field_unit(prior, k))}" for k, v in c.values.items())])
     parts.append("<h2>Which effect: the candidates, best held-out gain first</h2>")
     parts.append(table(["effect", "training gain [% of SSE]", "held-out gain [points of %]",
-                        "pooled held-out shrink [%] (in run-to-run nulls)", "claimed", "why", "fitted fields"], rows))
+                        "pooled held-out shrink [%] (× the run-to-run null)", "claimed", "why", "fitted fields"], rows))
     parts.append("<h2>How far it shrinks (held-out runs, closed-loop replay)</h2>")
     sig = [s for s in ("position", "velocity", "acceleration", "force", "table_position", "transmission")
            if all(s in e for e in result.test_errors.values())]

@@ -71,10 +71,10 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     assert "table.seal_force" in html and "N</td>" in html  # the fitted field with its unit
     assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
     assert html.count("<img") == 3 and "Unexplained: where" in html  # gains, errors by run, one run's residual
-    # each candidate's pooled shrink also in run-to-run nulls (a shrink above 20 of them stands for the bar)
+    # each candidate's pooled shrink also as a multiple of its run-to-run null (above 20 stands for the bar)
     (lead,) = [c for c in result["candidates"] if c["name"] == "lead_error"]
     nulls = lead["replay"]["shrink"] / result["replay_null"]
-    assert f"({nulls:.1f} nulls, " in html
+    assert f"({nulls:.1f} × null, " in html
     scored = result["scored"]["errors_percent"]  # the augmented params replayed, fixed, on the four runs
     assert set(scored) == {"r0", "r1", "r2", "r3"} and "(the augmented params, fixed)" in html
     assert f"<td>r1</td><td>{scored['r1']['position']:.4g}</td><td>{scored['r1']['force']:.4g}</td>" in html
