@@ -49,7 +49,8 @@ def _figures(result):
         fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
         y = np.arange(len(ranked))[::-1]
         ax.barh(y + 0.2, [c.gain for c in ranked], 0.4,
-                label=f"held-out gain (green: passes, over its bar or by a pooled shrink > {POOLED_FACTOR:g} nulls)",
+                label=f"held-out gain (green: passes, over its bar or by a pooled shrink > {POOLED_FACTOR:g} × its "
+                      "null)",
                 color=["tab:green" if c.passes else "tab:gray" for c in ranked])
         ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
                 label="its bar (t quantile x standard error of the per-run gains)")

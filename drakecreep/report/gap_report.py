@@ -176,9 +176,10 @@ def errors_by_run_figure(series):
     width = 0.8 / len(series)
     for k, (name, errors) in enumerate(series):
         ax.bar(x + width * (k - (len(series) - 1) / 2), [errors[lab]["force"] for lab in labels], width, label=name)
-    ax.set_xticks(x, labels, rotation=30, fontsize=8)
+    slanted = len(labels) > 12 or max(len(str(lab)) for lab in labels) > 6  # short labels of a few runs read level
+    ax.set_xticks(x, labels, rotation=30 if slanted else 0, fontsize=8 if slanted else 10)
     ax.set_ylabel("force error [% of ||F||]")
-    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=len(series))
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3 if slanted else -0.12), ncol=len(series))
     return _fig_png(fig), "How far it shrinks: closed-loop replay force error of every held-out run"
 
 
