@@ -176,7 +176,7 @@ def errors_by_run_figure(series):
     width = 0.8 / len(series)
     for k, (name, errors) in enumerate(series):
         ax.bar(x + width * (k - (len(series) - 1) / 2), [errors[lab]["force"] for lab in labels], width, label=name)
-    slanted = len(labels) > 12 or max(len(str(lab)) for lab in labels) > 6  # short labels of a few runs read level
+    slanted = len(labels) > 12 or max((len(str(lab)) for lab in labels), default=0) > 6  # a few short labels: level
     ax.set_xticks(x, labels, rotation=30 if slanted else 0, fontsize=8 if slanted else 10)
     ax.set_ylabel("force error [% of ||F||]")
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.3 if slanted else -0.12), ncol=len(series))
