@@ -719,10 +719,11 @@ def load_measured(csv_path, meta_path=None, dt_rtol=1e-3):
         if name == "run":
             continue
         arrays[name] = values
-        bad = np.flatnonzero(np.isnan(values))
+        bad = np.flatnonzero(~np.isfinite(values))  # an inf is named by its data row too, as a NaN is
         if bad.size:
-            raise InputError(f"{csv_path}: column {name}", f"NaN at data row {bad[0] + 1} ({bad.size} NaN or empty)",
-                             "finite numbers")
+            first = "NaN" if np.isnan(values[bad[0]]) else f"{values[bad[0]]:g}"
+            raise InputError(f"{csv_path}: column {name}",
+                             f"{first} at data row {bad[0] + 1} ({bad.size} NaN, inf or empty)", "finite numbers")
     cols = {"run": signals["run"]} if "run" in signals else {}
     if "run" in cols:
         labels = np.array(cols["run"], dtype=object)

@@ -1094,3 +1094,23 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
     # held-out runs that all oscillate: the reason says none is quiet (not "0 of the 0")
     spectral, _ = drive_fit._spectral_delay(o, records((1, 1, 1, 1)), RIG, records((0, 0, 0, 0)), replay, null=0.01)
     assert spectral["oscillating"] == 4 and spectral["reason"].endswith("none is quiet")
+
+
+def test_runs_whose_mass_contradicts_the_params_file_are_warned_of():
+    """The runs' inverse-dynamics mass against the params file's rigid-body mass at the table: no fitted field or
+    candidate takes a mass, so the candidates fit around a wrong one (a file whose time was stretched twice, read
+    as 4 x the mass, ran to the end and claimed a 152 N force ripple at 1 Hz). Runs whose time is stretched twice
+    (4 x the mass) or whose drive force is a quarter of the axis's (1/4 x) are warned of; the params file's own runs
+    are not."""
+    runs = _runs(RIG)
+    assert drive_fit.mass_warning(runs, RIG) is None
+    rigid = drive_fit.rigid_mass(RIG)
+    for change, above in ((dict(t=2.0), True), (dict(u=0.25), False)):
+        stretched = [dataclasses.replace(r, **{k: v * getattr(r, k) for k, v in change.items()}) for r in runs]
+        ratios = [drive_fit.inverse_dynamics_mass(r) / rigid for r in stretched]
+        assert all(r > drive_fit.MASS_WARNING if above else r < 1.0 / drive_fit.MASS_WARNING for r in ratios), ratios
+        w = drive_fit.mass_warning(stretched, RIG)
+        assert w is not None and f"{min(ratios):.3g}-{max(ratios):.3g} x the params file's rigid-body mass" in w, w
+        assert f"({rigid:.4g} kg" in w and f"{len(runs)} of {len(runs)} runs" in w
+        if above:  # the diagnosis carries it (to its summary, JSON and HTML)
+            assert w in diagnose_drive(stretched[:2], stretched[2:], uncertain=(), effects=()).warnings

@@ -116,6 +116,15 @@ def test_nan(tmp_path):
     assert "x_motor" in err.value.field
 
 
+def test_inf_is_named_by_its_data_row(tmp_path):
+    """An inf cell is named as a NaN is, by the data row a user finds in the file (it was the sample index)."""
+    cols = _rows()
+    cols["u"][5] = -float("inf")
+    with pytest.raises(InputError, match=r"-inf at data row 6 \(1 NaN, inf or empty\)") as err:
+        load_measured(_write(tmp_path, cols))
+    assert err.value.field.endswith("column u")
+
+
 def test_positions_in_the_wrong_unit_are_refused_by_their_speed(tmp_path):
     n, dt = 400, 1e-3
     t = np.arange(n) * dt
