@@ -427,6 +427,10 @@ class DriveDiagnosis:
         One held-out run's measured minus replayed force [N] and motor position [m], fitted and augmented
         (``{"label", "t", "nominal": {"force", "position"}, "augmented": {...}}``, the first held-out run; for the
         report's figure, not in :meth:`to_json`).
+    caveats : tuple of str
+        The warnings that qualify every claim, as they concern the runs as a whole: a saturated command
+        (:func:`saturated_share`), a mass the runs contradict (:func:`mass_warning`). They are among ``warnings``
+        too; the report repeats them beside its answer.
     """
 
     prior: DriveParams
@@ -451,6 +455,7 @@ class DriveDiagnosis:
     oscillation: dict | None = None
     where: dict = field(default_factory=dict)
     residuals: dict | None = field(default=None, repr=False, compare=False)
+    caveats: tuple = ()
 
     def oscillation_lines(self):
         """Lines of text on :attr:`oscillation` (none without one)."""
@@ -550,6 +555,7 @@ class DriveDiagnosis:
             "kind": "drakecreep.drive_diagnosis",
             "fitted": [dataclasses.asdict(f) for f in self.fitted],
             "warnings": list(self.warnings),
+            "caveats": list(self.caveats),
             "prior_test_errors": self.prior_test_errors,
             "nominal_test_errors": self.nominal_test_errors,
             "candidates": [{k: v for k, v in dataclasses.asdict(c).items()} for c in self.candidates],
@@ -1883,6 +1889,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %")
             + ("" if transmission_null is None else f" (force), {100 * transmission_null:.3g} % (transmission)"))
     known = dict(prior=prior, nominal=params, prior_test_errors=prior_errors, nominal_test_errors=nominal_errors,
+                 caveats=notes,
                  replay_null=null, null_test_force=null_runs, null_test_force_lowpass=null_runs_lowpass,
                  transmission_null=transmission_null,
                  train_sse=None if fit is None else float(fit.residual @ fit.residual),

@@ -111,10 +111,11 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
                  + ". The augmented params file is <code>augmented_params.yaml</code> beside this page "
                  "(<code>drakecreep simulate/margins/report --params</code> take it).</p>")
     # the claim's reason when nothing is claimed, what is left unexplained, the hints, a note on the bar (the
-    # headline has the rest)
-    parts.append("<ul>" + "".join(f"<li>{escape(line.strip())}</li>" for line in result.summary()
-                                  if line.startswith(("claimed: nothing", "hint", "unexplained", "explained"))
-                                  or line.strip().startswith("note:")) + "</ul>")
+    # headline has the rest), and the warnings that qualify every claim (a saturated command, a contradicted mass)
+    parts.append("<ul>" + "".join(f"<li class='bad'>{escape(c)}</li>" for c in result.caveats)
+                 + "".join(f"<li>{escape(line.strip())}</li>" for line in result.summary()
+                           if line.startswith(("claimed: nothing", "hint", "unexplained", "explained"))
+                           or line.strip().startswith("note:")) + "</ul>")
     parts.append("<p class='note'>A candidate is claimed only when it lowers the training runs' force error, its "
                  "closed-loop replay of the held-out runs (parameters fixed from the training runs) beats the fitted "
                  "params file by more than the t quantile times the standard error of the per-run gains (or its pooled "

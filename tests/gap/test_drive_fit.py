@@ -1041,6 +1041,7 @@ def test_a_saturated_command_is_not_refused_as_a_unit_slip_and_is_warned_of(monk
     drive_fit.check_run(many)  # not refused
     result = diagnose_drive([many, *runs[1:2]], runs[2:], uncertain=(), effects=())
     (w,) = [w for w in result.warnings if "sits at its limit" in w]
+    assert result.caveats == (w,)  # beside the report's answer too
     assert f"5 % of run {many.label}'s samples" in w and f"{force_limit(RIG):.4g} N" in w
     monkeypatch.undo()  # run r0 unclipped: its own mass
     clean = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
@@ -1096,7 +1097,7 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
     assert spectral["oscillating"] == 4 and spectral["reason"].endswith("none is quiet")
 
 
-def test_runs_whose_mass_contradicts_the_params_file_are_warned_of():
+def test_runs_whose_mass_contradicts_the_params_file_are_warned_of(tmp_path):
     """The runs' inverse-dynamics mass against the params file's rigid-body mass at the table: no fitted field or
     candidate takes a mass, so the candidates fit around a wrong one (a file whose time was stretched twice, read
     as 4 x the mass, ran to the end and claimed a 152 N force ripple at 1 Hz). Runs whose time is stretched twice
@@ -1112,5 +1113,15 @@ def test_runs_whose_mass_contradicts_the_params_file_are_warned_of():
         w = drive_fit.mass_warning(stretched, RIG)
         assert w is not None and f"{min(ratios):.3g}-{max(ratios):.3g} x the params file's rigid-body mass" in w, w
         assert f"({rigid:.4g} kg" in w and f"{len(runs)} of {len(runs)} runs" in w
-        if above:  # the diagnosis carries it (to its summary, JSON and HTML)
-            assert w in diagnose_drive(stretched[:2], stretched[2:], uncertain=(), effects=()).warnings
+        if above:  # the diagnosis carries it to its summary, JSON and HTML, there beside the answer
+            from drakecreep.files import OutputSet
+            from drakecreep.report.drive_report import write_drive_report
+
+            result = diagnose_drive(stretched[:2], stretched[2:], uncertain=(), effects=())
+            assert result.caveats == (w,) and w in result.warnings and result.to_json()["caveats"] == [w]
+            assert f"  warning: {w}" in result.summary()
+            html = write_drive_report(result, OutputSet(tmp_path, "manifest.json").start()).read_text()
+            answer = html[html.index("<h2>Answer</h2>"):html.index("<h2>Fitted params file fields")]
+            assert "inverse-dynamics mass reads" in answer and "class='bad'" in answer
+    clean = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
+    assert clean.caveats == ()
