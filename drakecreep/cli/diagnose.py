@@ -49,7 +49,8 @@ def add_parser(subparsers):
                    "parts: 1, 2)")
     p.add_argument("--uncertain", metavar="PATHS", help="kind drakecreep runs: the params-file values to fit, "
                    "comma separated (default: table.seal_force,nut.preload_torque,friction.viscous; add "
-                   "loads.constant_force for a constant axial force such as a drive's offset)")
+                   "loads.constant_force for a constant axial force such as a drive's offset, table.mass for a "
+                   "workpiece the params file leaves out)")
     # The names are written out, not imported: the parser is built without the libraries behind it (checked
     # against drake_effects.DRAKE_EFFECTS and drive_fit.DEFAULT_EFFECTS by tests/cli/test_diagnose.py).
     p.add_argument("--effects", metavar="NAMES", help="candidate effects, comma separated (default: all ranked "

@@ -1113,6 +1113,8 @@ def test_runs_whose_mass_contradicts_the_params_file_are_warned_of(tmp_path):
         w = drive_fit.mass_warning(stretched, RIG)
         assert w is not None and f"{min(ratios):.3g}-{max(ratios):.3g} x the params file's rigid-body mass" in w, w
         assert f"({rigid:.4g} kg" in w and f"{len(runs)} of {len(runs)} runs" in w
+        assert w.endswith("(fit the mass at the table: add table.mass to --uncertain)")
+        assert "the fitted rigid-body mass" in drive_fit.mass_warning(stretched, RIG, fitted=True)
         if above:  # the diagnosis carries it to its summary, JSON and HTML, there beside the answer
             from drakecreep.files import OutputSet
             from drakecreep.report.drive_report import write_drive_report
@@ -1125,3 +1127,17 @@ def test_runs_whose_mass_contradicts_the_params_file_are_warned_of(tmp_path):
             assert "inverse-dynamics mass reads" in answer and "class='bad'" in answer
     clean = diagnose_drive(runs[:2], runs[2:], uncertain=(), effects=())
     assert clean.caveats == ()
+
+
+def test_the_table_mass_is_fitted_when_marked_uncertain():
+    """A params file that says the table is twice as heavy as the axis that made the runs (a workpiece taken off):
+    ``table.mass`` marked uncertain is fitted by output error to the truth's within its 95 % interval, and the
+    fitted model replays the runs better than the params file. (The shipped example under a params file that says
+    80 kg fits 39.98 kg, interval 39.93-40.03, against the 40 kg that made it; session 85.)"""
+    heavy = with_value(RIG, "table.mass", 2.0 * RIG.table.mass)
+    runs = simulated_runs(RIG, SPEEDS, declared=heavy, n=N, noise=NOISE, seed=300)
+    params, (mass,), _, sse = drive_fit.fit_drive(runs[:2], heavy, ("table.mass",), drive_fit._Replayer(0))
+    assert mass.path == "table.mass" and mass.unit == "kg" and mass.prior == heavy.table.mass
+    assert mass.contains(RIG.table.mass), mass
+    assert mass.upper - mass.lower < 0.2 * RIG.table.mass  # and the interval is informative
+    assert sse < drive_fit.fit_drive(runs[:2], heavy, (), drive_fit._Replayer(0))[3]
