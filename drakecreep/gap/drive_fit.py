@@ -214,10 +214,10 @@ MASS_FACTOR = 10.0
 #: drive force falls off above 60-160 N, held the 2000 N clip on 16-45 % of three runs' samples, and one of them
 #: read 935 kg against 61.2 kg; a unit slip puts u far beyond the limit or far below it, never on it)
 SATURATED_SHARE = 0.01
-#: Factor by which the runs' inverse-dynamics mass may differ from the params file's rigid-body mass at the table
+#: Factor by which the runs' inverse-dynamics mass may differ from the nominal fit's rigid-body mass at the table
 #: before the diagnosis warns (:func:`mass_warning`): 144 runs of 12 benchmark datasets read 0.95-1.34 x their truth's
 #: params file, the example ``drive_lead_error.csv`` 0.93-1.05 x; a time stretched twice (data at 2 ms headed 1 ms)
-#: reads 4 x. No fitted field or candidate takes a mass, so the candidates fit around one that is wrong.
+#: reads 4 x. No candidate takes a mass (nor does the default fit), so the candidates fit around one that is wrong.
 MASS_WARNING = 2.0
 _AT_LIMIT = 0.999
 MASS_CHECK_STD = 0.1
@@ -712,7 +712,7 @@ def saturated_share(run, params):
 
 
 def rigid_mass(params):
-    """The params file's rigid-body mass at the table [kg]: table and nut, with the rotor, coupling and screw inertia
+    """The rigid-body mass at the table [kg] of ``params``: table and nut, with the rotor, coupling and screw inertia
     through the lead (:func:`~drakecreep.model.compensators.rigid_inertia` x (2 pi / lead)^2)."""
     return rigid_inertia(params) * (2.0 * math.pi / params.screw.lead) ** 2
 
@@ -745,8 +745,9 @@ def mass_warning(runs, params, fitted=False):
               and (m := inverse_dynamics_mass(r)) is not None]
     if not ratios or not (min(ratios) > MASS_WARNING or max(ratios) < 1.0 / MASS_WARNING):
         return None
-    return (f"the runs' inverse-dynamics mass reads {min(ratios):.3g}-{max(ratios):.3g} x the "
-            f"{'fitted' if fitted else 'params file' + chr(39) + 's'} rigid-body mass at the table ({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead; "
+    whose = "fitted" if fitted else "params file's"
+    return (f"the runs' inverse-dynamics mass reads {min(ratios):.3g}-{max(ratios):.3g} x the {whose} rigid-body "
+            f"mass at the table ({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead; "
             f"{len(ratios)} of {len(runs)} runs determine it): the params file's masses and inertias, or the unit "
             "of t or u_gain, do not match the runs; no candidate takes a mass, so the candidates fit around it"
             + ("" if fitted else " (fit the mass at the table: add table.mass to --uncertain)"))
