@@ -1098,9 +1098,9 @@ def test_a_delay_reproduces_an_oscillation_on_the_runs_that_oscillate_and_is_pic
 
 
 def test_runs_whose_mass_contradicts_the_params_file_are_warned_of(tmp_path):
-    """The runs' inverse-dynamics mass against the params file's rigid-body mass at the table: no fitted field or
-    candidate takes a mass, so the candidates fit around a wrong one (a file whose time was stretched twice, read
-    as 4 x the mass, ran to the end and claimed a 152 N force ripple at 1 Hz). Runs whose time is stretched twice
+    """The runs' inverse-dynamics mass against the params file's rigid-body mass at the table: no candidate takes a
+    mass, nor does the default fit, so the candidates fit around a wrong one (a file whose time was stretched twice,
+    read as 4 x the mass, ran to the end and claimed a 152 N force ripple at 1 Hz). Runs whose time is stretched twice
     (4 x the mass) or whose drive force is a quarter of the axis's (1/4 x) are warned of; the params file's own runs
     are not."""
     runs = _runs(RIG)
