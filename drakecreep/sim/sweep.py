@@ -86,7 +86,8 @@ def _check_size(n, max_cases, what="the sweep"):
     if n > max_cases:
         digits = len(str(int(n))) if n < 10**4000 else 4000
         raise InputError("axes", f"about 10^{digits - 1} cases" if n >= 10**6 else f"{n} cases",
-                         f"at most {max_cases} cases in {what} (raise the cap with --max-cases / max_cases)")
+                         f"at most {max_cases} {'case' if max_cases == 1 else 'cases'} in {what} (raise the cap "
+                         "with --max-cases / max_cases)")
 
 
 # --------------------------------------------------------------------------- points

@@ -253,6 +253,9 @@ def test_sweep_cap_can_be_raised(tmp_path):
     axes = {"table.mass": list(range(1, 31)), "feed": [1e-3 * k for k in range(1, 11)]}
     with pytest.raises(InputError, match="max-cases"):
         grid(axes, max_cases=100)
+    with pytest.raises(InputError, match="at most 1 case in ") as err:  # not "1 cases"
+        grid(axes, max_cases=1)
+    assert "got '300 cases'" in str(err.value)
     assert len(grid(axes, max_cases=300)) == 300
 
 
