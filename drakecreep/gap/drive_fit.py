@@ -692,8 +692,7 @@ def check_run(run, params=None, load_case=0):
     # a limit cycle of an unstable real loop hides the mass: not a unit slip, and the diagnosis has its own rule
     # for it (claims_withheld). Held-out run 3cc's control delay 99106000 read 2229 kg against a params file's
     # 67.7 kg, and the refusal ("is the unit of the positions wrong?") ended the dataset before any fit
-    if mass is not None and not rigid / MASS_FACTOR <= mass <= rigid * MASS_FACTOR \
-            and limit_cycle(run.force, run.dt) is None and saturated_share(run, params) < SATURATED_SHARE:
+    if mass is not None and not rigid / MASS_FACTOR <= mass <= rigid * MASS_FACTOR and _mass_reads_axis(run, params):
         raise InputError(f"x_motor (run {run.label})", f"an inverse-dynamics mass of {mass:.4g} kg",
                          f"within a factor of {MASS_FACTOR:g} of the params file's rigid-body mass at the table "
                          f"({rigid:.4g} kg: table, nut, rotor, coupling and screw through the lead); is the unit of "
@@ -709,6 +708,13 @@ def saturated_share(run, params):
     """The share of ``run``'s samples whose drive force ``u x u_gain`` sits at the force limit of ``params`` (the
     cascade's clip, :func:`~drakecreep.model.controller.force_limit`, within 0.1 %)."""
     return float(np.mean(np.abs(run.u_gain * run.u) >= _AT_LIMIT * force_limit(params)))
+
+
+def _mass_reads_axis(run, params):
+    """Whether ``run``'s inverse-dynamics mass reads the axis: its drive force is neither a limit cycle
+    (:func:`~drakecreep.gap.residuals.limit_cycle`) nor saturated (:func:`saturated_share` below
+    :data:`SATURATED_SHARE`), either of which makes it read the loop or the limit instead."""
+    return limit_cycle(run.force, run.dt) is None and saturated_share(run, params) < SATURATED_SHARE
 
 
 def rigid_mass(params):
@@ -740,9 +746,7 @@ def mass_warning(runs, params, fitted=False):
         One sentence with the ratio's range, the rigid-body mass and what may be off.
     """
     rigid = rigid_mass(params)
-    ratios = [m / rigid for r in runs
-              if limit_cycle(r.force, r.dt) is None and saturated_share(r, params) < SATURATED_SHARE
-              and (m := inverse_dynamics_mass(r)) is not None]
+    ratios = [m / rigid for r in runs if _mass_reads_axis(r, params) and (m := inverse_dynamics_mass(r)) is not None]
     if not ratios or not (min(ratios) > MASS_WARNING or max(ratios) < 1.0 / MASS_WARNING):
         return None
     whose = "fitted" if fitted else "params file's"
