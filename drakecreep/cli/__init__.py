@@ -91,11 +91,38 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = _NEGATIVE_NUMBER  # before any option is added (argparse checks them with it)
 
     def error(self, message):
-        if message.startswith("argument ") and "; allowed: " in message:
-            # a type of cli._common: 'argument --workers: got '0'; allowed: ...', the refusals' own form without the
-            # word argparse puts before the option
-            message = message[len("argument "):]
-        self.exit(2, f"{self.prog}: error: {message}\n")
+        self.exit(2, f"{self.prog}: error: {_refusal(message)}\n")
+
+
+#: argparse's own refusals of an option's value, and what the option allows
+_ARGPARSE_REFUSALS = [
+    (re.compile(r"invalid int value: (?P<got>.*)"), lambda m: "an integer"),
+    (re.compile(r"invalid float value: (?P<got>.*)"), lambda m: "a number"),
+    (re.compile(r"invalid choice: (?P<got>.*?) \(choose from (?P<allowed>.*)\)"),
+     lambda m: "one of " + m.group("allowed").replace("'", "")),
+    (re.compile(r"expected (?P<n>.+?) arguments?()(?P<got>)"),
+     lambda m: f"{m.group('n')} value{'' if m.group('n').endswith('one') else 's'} after the option"),
+]
+
+
+def _refusal(message):
+    """argparse's error ``message`` in the refusals' own form, ``OPTION: got VALUE; allowed: WHAT``.
+
+    The types of :mod:`drakecreep.cli._common` already say ``got ...; allowed: ...``: only the word ``argument``
+    argparse puts before the option goes. argparse's own refusals of a value (an int or float it cannot read, a
+    choice not listed, an option without its value) are put in that form; any other message is left as it is.
+    """
+    if not message.startswith("argument ") or ": " not in message:
+        return message
+    option, _, rest = message[len("argument "):].partition(": ")
+    if rest.startswith("got ") and "; allowed: " in rest:
+        return f"{option}: {rest}"
+    for pattern, allowed in _ARGPARSE_REFUSALS:
+        m = pattern.fullmatch(rest)
+        if m:
+            got = m.group("got") or "nothing"
+            return f"{option}: got {got}; allowed: {allowed(m)}"
+    return message
 
 
 def _add_common(parser, suppress):

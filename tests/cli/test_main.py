@@ -35,7 +35,14 @@ def test_simulate_text(tmp_path, capsys):
     (["simulate", "--friction", "maxwell"], "--friction"),
     (["simulate", "--params", "/no/such/file.yaml"], "--params: got '/no/such/file.yaml'; allowed: an existing file"),
     (["diagram", "--out", "x.jpg"], "--out"),
-    (["nonsense"], "invalid choice"),
+    (["nonsense"], "drakecreep: error: COMMAND: got 'nonsense'; allowed: one of simulate, params, diagram"),
+    # argparse's own refusals of a value, in the refusals' form: the option, what it got, what it allows
+    (["critical", "--feed", "abc"], "drakecreep critical: error: --feed: got 'abc'; allowed: a number"),
+    (["uncertainty", "--seed", "x"], "drakecreep uncertainty: error: --seed: got 'x'; allowed: an integer"),
+    (["simulate", "--friction", "maxwell"],
+     "--friction: got 'maxwell'; allowed: one of coulomb, stribeck, lugre, gms"),
+    (["simulate", "--feed"], "drakecreep simulate: error: --feed: got nothing; allowed: one value after the option"),
+    (["gap-benchmark", "--kinds"], "--kinds: got nothing; allowed: at least one value after the option"),
     # an option of no command: the command's own parser names itself and where its options are listed
     (["margins", "--speed", "abc"], "drakecreep margins: error: unrecognized arguments: --speed abc "
                                     "(drakecreep margins --help lists the options)"),
@@ -54,6 +61,14 @@ def test_bad_arguments_one_line_exit_2(argv, fragment, capsys, tmp_path):
     err = capsys.readouterr().err
     assert code == 2
     assert fragment in err and len(err.strip().splitlines()) == 1
+
+
+def test_argparse_messages_other_than_a_refused_value_stay_as_they_are():
+    from drakecreep.cli import _refusal
+
+    message = "argument --params: not allowed with argument --preset"
+    assert _refusal(message) == message
+    assert _refusal("the following arguments are required: SPEC.yaml") == "the following arguments are required: SPEC.yaml"
 
 
 def test_bad_parameter_file(tmp_path, capsys):
