@@ -27,7 +27,7 @@ from pathlib import Path
 
 from drakecreep.cli._common import existing_path, names, path_exists, print_json, regular_file, workers
 from drakecreep.errors import InputError, renaming
-from drakecreep.gap.runs import CYCLE_MIN_SAMPLES, HALF_CYCLE_MIN_SAMPLES, load_runs, train_test
+from drakecreep.gap.runs import CYCLE_MIN_TIME, HALF_CYCLE_MIN_TIME, load_runs, min_samples, train_test
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
 from drakecreep.processes import usable_cpus
 
@@ -105,8 +105,9 @@ def run(args):
         runs = load_runs(args.data, args.meta, split=True if own else "half")
         if len(runs) < 3 and not (args.train or args.test):
             # too short, or too few reversals of the reference: say so, not "no training run"
-            what = (f"out-and-back cycles of >= {CYCLE_MIN_SAMPLES} samples" if own
-                    else f"parts between reversals of >= {HALF_CYCLE_MIN_SAMPLES} samples")
+            least = CYCLE_MIN_TIME if own else HALF_CYCLE_MIN_TIME
+            what = (f"{'out-and-back cycle' if own else 'part between reversals'}{'' if len(runs) == 1 else 's'}"
+                    f" of >= {least:g} s ({min_samples(whole, least)} samples)")
             raise InputError(f"DATA {Path(str(args.data)).name}", f"one run of {whole.n} samples "
                              f"({whole.n * whole.dt:.3g} s): {len(runs)} {what}",
                              "at least 3 parts (1 to train, 2 held out): a longer run, or several runs")

@@ -4,14 +4,15 @@
 """
 
 import dataclasses
+import math
 from pathlib import Path
 
 import numpy as np
 
 from drakecreep.errors import InputError
 
-__all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles", "HALF_CYCLE_MIN_SAMPLES",
-           "CYCLE_MIN_SAMPLES"]
+__all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles", "HALF_CYCLE_MIN_TIME",
+           "CYCLE_MIN_TIME", "min_samples"]
 
 
 def _reversals(run):
@@ -22,24 +23,32 @@ def _reversals(run):
     return [int(c) for c in nz[1:][np.diff(s[nz]) != 0]]
 
 
-#: shortest part kept by :func:`split_half_cycles` and by :func:`split_cycles` [samples]
-HALF_CYCLE_MIN_SAMPLES, CYCLE_MIN_SAMPLES = 500, 200
+#: shortest part kept by :func:`split_half_cycles` and by :func:`split_cycles` [s]: a duration, not a count of
+#: samples (500 and 200 samples at 1 kHz until session 86, which cut a run logged every 4 ms into parts of 2 s)
+HALF_CYCLE_MIN_TIME, CYCLE_MIN_TIME = 0.5, 0.2
 
 
-def _cut(run, cuts, min_samples, sep):
+def min_samples(run, duration):
+    """The fewest samples of ``run`` that span ``duration`` seconds (the shortest part a split keeps)."""
+    return int(math.ceil(duration / run.dt - 1e-9))
+
+
+def _cut(run, cuts, duration, sep):
+    least = min_samples(run, duration)
     parts = []
     for a, b in zip(cuts[:-1], cuts[1:]):
-        if b - a >= min_samples:
+        if b - a >= least:
             parts.append(dataclasses.replace(run.slice(a, b), label=f"{run.label}{sep}{len(parts)}"))
     return parts
 
 
-def split_half_cycles(run, min_samples=HALF_CYCLE_MIN_SAMPLES):
-    """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``), at least ``min_samples`` long."""
-    return _cut(run, [0] + _reversals(run) + [run.n], min_samples, "@")
+def split_half_cycles(run, min_time=HALF_CYCLE_MIN_TIME):
+    """Parts of ``run`` between reversals of the reference (label ``<label>@<i>``), at least ``min_time`` seconds
+    long (:func:`min_samples`)."""
+    return _cut(run, [0] + _reversals(run) + [run.n], min_time, "@")
 
 
-def split_cycles(run, cycles_per_run=1, min_samples=CYCLE_MIN_SAMPLES):
+def split_cycles(run, cycles_per_run=1, min_time=CYCLE_MIN_TIME):
     """Split a run at every second change of direction of the reference (one out-and-back cycle per part).
 
     Parameters
@@ -47,15 +56,15 @@ def split_cycles(run, cycles_per_run=1, min_samples=CYCLE_MIN_SAMPLES):
     run : drakecreep.gap.measured.MeasuredRun
     cycles_per_run : int
         Cycles per part.
-    min_samples : int
-        Shorter parts are dropped.
+    min_time : float
+        Parts shorter than this [s] are dropped (:func:`min_samples`).
 
     Returns
     -------
     list of MeasuredRun
         Labelled ``<label>#<i>``.
     """
-    return _cut(run, [0] + _reversals(run)[1::2 * cycles_per_run] + [run.n], min_samples, "#")
+    return _cut(run, [0] + _reversals(run)[1::2 * cycles_per_run] + [run.n], min_time, "#")
 
 
 def load_runs(data, meta=None, split=True):

@@ -36,6 +36,22 @@ def test_split_half_cycles_cuts_every_reversal():
         assert min(forward, backward) < 0.01 * max(forward, backward)
 
 
+@pytest.mark.parametrize("split", [split_cycles, split_half_cycles])
+def test_the_shortest_part_is_a_duration_not_a_count_of_samples(split):
+    """A run logged every 4 ms is cut where the same run logged every 1 ms is (until session 86 the shortest part
+    was 500 or 200 samples, 2 s or 0.8 s at 4 ms: a 4 ms log of EMPS's first 8 s gave 2 parts, the 1 ms log 6)."""
+    run = _three_cycles()
+    slow = MeasuredRun(t=run.t[::4], x_ref=run.x_ref[::4], x_motor=run.x_motor[::4], u=run.u[::4], meta=META,
+                       label="three")
+    fast_parts, slow_parts = split(run), split(slow)
+    assert len(slow_parts) == len(fast_parts) > 0
+    for a, b in zip(fast_parts, slow_parts):
+        assert abs(a.n * a.dt - b.n * b.dt) <= 4 * slow.dt
+    # a part shorter than the duration is dropped at either rate
+    longest = max(p.n * p.dt for p in fast_parts)
+    assert split(run, min_time=1.01 * longest) == [] and split(slow, min_time=1.01 * longest) == []
+
+
 def test_default_train_test_split_keeps_two_held_out_runs():
     from types import SimpleNamespace
 
