@@ -25,6 +25,7 @@ sample by sample: ``u``, ``x_motor``, ``x_table`` and ``force = u_gain u + f_ext
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import functools
 import math
 import os
@@ -41,6 +42,7 @@ from pydrake.trajectories import PiecewisePolynomial
 
 from drakecreep.errors import InputError
 from drakecreep.gap.idim import filtered_derivatives, relative_error
+from drakecreep.gap.measured import at_controller_rate, controller_ticks
 from drakecreep.gap.residuals import classify_regimes, transmission_position
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, MeasuredAxis, MeasuredAxis_, applied_force,
                                    axis_friction, axis_parameters, axis_ripple, has_bristles, lead_error, nut_load)
@@ -56,6 +58,7 @@ __all__ = [
     "MAX_SUBSTEPS",
     "diverged_result",
     "make_replay",
+    "LoggedReplay",
     "DrakeReplayResult",
     "drake_replay",
     "drake_replay_errors",
@@ -90,12 +93,19 @@ def check_replayable(run):
 
         # a params file's max_step or velocity_period of 1e-9 s replayed for days
         check_step_budget(run.meta.params, float(run.t[-1] - run.t[0]))
-    # named by the run: a file holds several, and their sample times may differ
-    if ctrl.kind == "p_p_cascade" and abs(ctrl.sample_time - run.dt) > 1e-6 * run.dt:
-        raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
-                         f"the run's sample time {run.dt:g} s")
+    # named by the run: a file holds several, and their sample times may differ; a log taken every few ticks is
+    # replayed on the controller's tick (make_replay)
+    controller_ticks(run)
     if run.n < 20:
         raise InputError(f"run {run.label}", f"{run.n} samples", "at least 20 samples")
+
+
+def _check_every_tick(run):
+    """Refuse a run logged every few controller ticks: :func:`make_replay` replays it on the controller's tick."""
+    m = controller_ticks(run)
+    if m != 1:
+        raise InputError(f"run {run.label}", f"logged every {m} controller ticks",
+                         "a run logged every tick here (make_replay replays one logged every few on the tick)")
 
 
 def axis_from_idim(params, **extra):
@@ -194,6 +204,7 @@ class DrakeReplay:
         ctrl = run.meta.controller
         if ctrl.kind != "p_p_cascade":
             raise InputError("controller.kind", ctrl.kind, "p_p_cascade (use replay_drakecreep for drakecreep)")
+        _check_every_tick(run)
         if not (isinstance(delay, (int, float)) and math.isfinite(delay) and delay >= 0):
             raise InputError("delay", delay, "a number of samples >= 0")
         self.run, self.flexible, self.delay = run, bool(flexible), float(delay)
@@ -425,6 +436,7 @@ class SampledReplay:
         ctrl = run.meta.controller
         if ctrl.kind != "p_p_cascade":
             raise InputError("controller.kind", ctrl.kind, "p_p_cascade (use replay_drakecreep for drakecreep)")
+        _check_every_tick(run)
         if isinstance(delay, bool) or not (isinstance(delay, (int, float)) and math.isfinite(delay) and delay >= 0):
             raise InputError("delay", delay, "a number of samples >= 0 (fractions allowed)")
         if not (isinstance(rate_step, (int, float)) and 0 < rate_step <= 1):
@@ -692,10 +704,38 @@ def simulate_each(replays, parameters):
 
 def make_replay(run, flexible=False, delay=0.0, quantize=True, free=None, sampled=True):
     """The replay of ``run``: :class:`SampledReplay` (the fast path, whole or fractional delays) when ``sampled``,
-    else :class:`DrakeReplay` (error-controlled integration; the cross-check)."""
+    else :class:`DrakeReplay` (error-controlled integration; the cross-check).
+
+    A run logged every few controller ticks (:func:`~drakecreep.gap.measured.controller_ticks`) is replayed on the
+    controller's tick (:func:`~drakecreep.gap.measured.at_controller_rate`), ``delay`` in ticks, and its result taken
+    at the logged samples (:class:`LoggedReplay`)."""
+    check_replayable(run)
+    tick = at_controller_rate(run)
     if sampled:
-        return SampledReplay(run, flexible=flexible, delay=delay, quantize=quantize, free=free)
-    return DrakeReplay(run, flexible=flexible, delay=delay, quantize=quantize)
+        rep = SampledReplay(tick, flexible=flexible, delay=delay, quantize=quantize, free=free)
+    else:
+        rep = DrakeReplay(tick, flexible=flexible, delay=delay, quantize=quantize)
+    return rep if tick is run else LoggedReplay(run, rep)
+
+
+class LoggedReplay:
+    """A replay of a run logged every ``m`` controller ticks: ``replay`` runs on the controller's tick
+    (:func:`~drakecreep.gap.measured.at_controller_rate` of ``run``), and :meth:`simulate` returns its result at
+    ``run``'s samples. Every other attribute is the tick replay's."""
+
+    def __init__(self, run, replay):
+        self.run, self.replay = run, replay
+        self.ticks = controller_ticks(run)
+
+    def __getattr__(self, name):
+        return getattr(self.replay, name)
+
+    def simulate(self, parameters):
+        """:meth:`SampledReplay.simulate` (or :meth:`DrakeReplay.simulate`) at the run's logged samples."""
+        res = self.replay.simulate(parameters)
+        m = self.ticks
+        return dataclasses.replace(res, run=self.run, x_motor=res.x_motor[::m], x_table=res.x_table[::m],
+                                   u=res.u[::m], force=res.force[::m])
 
 
 def compiled_axis(flexible, initial_state, bristles=False):
@@ -732,7 +772,7 @@ def _on_samples(times, data, t):
 
 def drake_replay(run, parameters, flexible=False, delay=0.0, quantize=True):
     """Build the replay diagram of ``run`` and simulate it once (see :class:`DrakeReplay`)."""
-    return DrakeReplay(run, flexible=flexible, delay=delay, quantize=quantize).simulate(parameters)
+    return make_replay(run, flexible=flexible, delay=delay, quantize=quantize, sampled=False).simulate(parameters)
 
 
 #: time regimes (:func:`drakecreep.gap.residuals.classify_regimes`) whose force error
@@ -794,7 +834,7 @@ def _band_errors(measured, simulated, dt):
     return out
 
 
-def drake_replay_errors(result, cutoff=100.0, order=4, bands=True):
+def drake_replay_errors(result, cutoff=None, order=4, bands=True):
     """Relative errors [%] of position, velocity, acceleration and force (as :func:`drakecreep.gap.replay.replay_errors`).
 
     Velocity and acceleration of the measured and simulated motor positions go through the same IDIM
@@ -892,8 +932,6 @@ def replay_params(run, params=None, quantize=True):
     InputError
         No params, or an encoder count that does not divide the lead into a whole number of counts.
     """
-    import dataclasses
-
     from drakecreep.params import MAX_INT, MIN_ENCODER_COUNTS, DriveParams
 
     if params is None:
@@ -1170,8 +1208,6 @@ def simulated_runs(truth, speeds, *, declared=None, n=500, dt=1e-3, noise=0.0, s
     -------
     list of drakecreep.gap.measured.MeasuredRun
     """
-    import dataclasses
-
     from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
     from drakecreep.gap.truth import out_and_back
 

@@ -42,6 +42,8 @@ __all__ = [
     "IdimSignals",
     "IdimResult",
     "filtered_derivatives",
+    "derivative_cutoff",
+    "DERIVATIVE_CUTOFF",
     "idim_signals",
     "regressor",
     "relative_error",
@@ -69,7 +71,18 @@ def relative_error(y, y_hat):
     return float(100.0 * np.linalg.norm(y - y_hat) / norm)
 
 
-def filtered_derivatives(q, dt, cutoff=100.0, order=4):
+#: The derivatives' low-pass cut-off [Hz] (:func:`derivative_cutoff`): 100 Hz, the EMPS pipeline's at 1 kHz
+DERIVATIVE_CUTOFF = 100.0
+
+
+def derivative_cutoff(dt):
+    """The default cut-off [Hz] of :func:`filtered_derivatives` at sample time ``dt`` [s]: :data:`DERIVATIVE_CUTOFF`,
+    or 80 % of the Nyquist frequency when that is lower (a run logged every 8 ms ends at 62.5 Hz, and its
+    diagnosis stopped at 'cutoff: got 100.0'). 100 Hz down to a sample time of 4 ms."""
+    return min(DERIVATIVE_CUTOFF, 0.4 / dt)
+
+
+def filtered_derivatives(q, dt, cutoff=None, order=4):
     """Zero-phase Butterworth low-pass of ``q`` and its central-difference derivatives.
 
     Parameters
@@ -78,8 +91,8 @@ def filtered_derivatives(q, dt, cutoff=100.0, order=4):
         Position samples [m].
     dt : float
         Sample time [s].
-    cutoff : float
-        Cut-off frequency [Hz], below the Nyquist frequency.
+    cutoff : float, optional
+        Cut-off frequency [Hz], below the Nyquist frequency (default :func:`derivative_cutoff`).
     order : int
         Butterworth order (applied forward and backward: twice the order in amplitude).
 
@@ -89,6 +102,7 @@ def filtered_derivatives(q, dt, cutoff=100.0, order=4):
         ``(q_f, dq, ddq)``.
     """
     nyquist = 0.5 / dt
+    cutoff = derivative_cutoff(dt) if cutoff is None else cutoff
     if not 0 < cutoff < nyquist:
         raise InputError("cutoff", cutoff, f"a frequency in (0, {nyquist:g}) Hz")
     b, a = signal.butter(order, cutoff / nyquist)
@@ -114,7 +128,7 @@ class IdimSignals:
     tau: np.ndarray
 
 
-def idim_signals(run, cutoff=100.0, order=4, decimation=10, border=50, border_stage="sampled",
+def idim_signals(run, cutoff=None, order=4, decimation=10, border=50, border_stage="sampled",
                  filter_force=False, antialias=False):
     """Pre-process a measured run for IDIM (see the module docstring).
 
@@ -123,7 +137,7 @@ def idim_signals(run, cutoff=100.0, order=4, decimation=10, border=50, border_st
     run : drakecreep.gap.measured.MeasuredRun
         The run; ``tau = run.force``.
     cutoff, order : float, int
-        Butterworth low-pass on the position.
+        Butterworth low-pass on the position (cut-off default :func:`derivative_cutoff`).
     decimation : int
         Keep every ``decimation``-th sample.
     border : int
@@ -148,6 +162,7 @@ def idim_signals(run, cutoff=100.0, order=4, decimation=10, border=50, border_st
     if int(border) != border or border < 0:
         raise InputError("border", border, "an integer >= 0")
     decimation, border = int(decimation), int(border)
+    cutoff = derivative_cutoff(run.dt) if cutoff is None else cutoff
     q, dq, ddq = filtered_derivatives(run.x_motor, run.dt, cutoff, order)
     tau = run.force
     if filter_force:

@@ -67,6 +67,8 @@ __all__ = [
     "check_recorded",
     "check_split",
     "controller_gains",
+    "controller_ticks",
+    "at_controller_rate",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -845,6 +847,57 @@ def check_recorded(run):
         # inverse-dynamics mass of 5e-15 kg written to augmented_model.yaml)
         raise InputError(f"u (run {run.label})", f"constant at {float(run.u[0]):g} {run.meta.u_units} throughout",
                          "the drive command the controller gave (a closed loop moves it)")
+
+
+def controller_ticks(run):
+    """Controller ticks per logged sample of a ``p_p_cascade`` run (1 for any other kind, or none).
+
+    A drive often logs its trace every few ticks of its position loop (a 1 ms loop logged every 4 ms). The replay
+    runs the controller on its own tick (:func:`at_controller_rate`) and compares the logged samples.
+
+    Raises
+    ------
+    InputError
+        When the run's sample time is not a whole number of ``controller.sample_time`` (within 1e-6).
+    """
+    ctrl = run.meta.controller
+    if ctrl is None or ctrl.kind != "p_p_cascade":
+        return 1
+    ratio = run.dt / ctrl.sample_time
+    m = int(round(ratio))
+    if m < 1 or abs(run.dt - m * ctrl.sample_time) > 1e-6 * run.dt:
+        raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
+                         f"the run's sample time {run.dt:g} s or a whole fraction of it (the log taken every "
+                         "controller tick, or every few)")
+    return m
+
+
+def at_controller_rate(run):
+    """The run on its controller's tick: ``run`` itself when it is logged every tick (:func:`controller_ticks`).
+
+    Logged every ``m`` ticks, the ticks between two samples take the reference and the positions linear between
+    them (the first-order hold the replay puts on the reference anyway) and ``u`` and ``f_ext`` held; the result
+    has ``(n - 1) m + 1`` samples on a uniform clock, sample ``k m`` at the run's sample ``k``, and its controller's
+    ``sample_time`` is the run's sample time over ``m``. Only the reference, ``f_ext`` and the first samples (the
+    initial state) are read by a replay; its result is taken back at every ``m``-th tick.
+    """
+    m = controller_ticks(run)
+    if m == 1:
+        return run
+    n = (run.n - 1) * m + 1
+    at = np.arange(n) / m
+    logged = np.arange(run.n)
+
+    def linear(a):
+        return None if a is None else np.interp(at, logged, a)
+
+    def held(a):
+        return None if a is None else np.repeat(a, m)[:n]
+
+    ctrl = dataclasses.replace(run.meta.controller, sample_time=run.dt / m)
+    return MeasuredRun(t=run.t[0] + np.arange(n) * (run.dt / m), x_ref=linear(run.x_ref), x_motor=linear(run.x_motor),
+                       x_table=linear(run.x_table), u=held(run.u), f_ext=held(run.f_ext),
+                       meta=dataclasses.replace(run.meta, controller=ctrl), label=run.label, dt_rtol=run.dt_rtol)
 
 
 def controller_gains(run):

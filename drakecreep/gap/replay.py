@@ -284,7 +284,7 @@ def replay(run, model, controller=None, quantize=False, initial_velocity=None, d
                         force_sim=gain * ua + f_ext, delay=delay)
 
 
-def replay_errors(result, derivatives="filtered", cutoff=100.0, order=4):
+def replay_errors(result, derivatives="filtered", cutoff=None, order=4):
     """Relative errors [%] of position, velocity, acceleration and force of a replay.
 
     Parameters

@@ -327,7 +327,8 @@ def frequency_bands(residual, dt, bands=BANDS_HZ, nperseg=1024):
     dt : float
         Sample time [s].
     bands : sequence of (float, float)
-        Band edges [Hz]; ``inf`` means the Nyquist frequency.
+        Band edges [Hz]; ``inf`` means the Nyquist frequency. A band that starts at or above the Nyquist frequency
+        is left out, and one that holds it ends there.
     nperseg : int
         Welch segment length (shortened for short records).
 
@@ -354,6 +355,8 @@ def frequency_bands(residual, dt, bands=BANDS_HZ, nperseg=1024):
     total = float(np.sum(psd) * df)
     rows = []
     for lo, hi in bands:
+        if lo >= f[-1] and rows:  # a band beyond the Nyquist frequency (a log every 4 ms ends at 125 Hz): none
+            continue
         m = (f >= lo) & (f < (hi if math.isfinite(hi) else np.inf))
         e = float(np.sum(psd[m]) * df)
         rows.append({"lo_Hz": float(lo), "hi_Hz": float(min(hi, f[-1])), "share": e / total if total > 0 else 0.0,

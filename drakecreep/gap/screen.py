@@ -48,6 +48,7 @@ from scipy.optimize import least_squares
 from drakecreep.errors import InputError
 from drakecreep.gap.claims import ALPHA, mean_and_standard_error, mean_log_ratio
 from drakecreep.gap.idim import idim_signals
+from drakecreep.gap.measured import controller_ticks
 from drakecreep.model.axis import (AXIS_PARAMETERS, FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE, applied_force,
                                    axis_friction, axis_parameters, axis_ripple, lead_error_drive, nut_load)
 
@@ -578,15 +579,17 @@ def _peak_periods(sig, base, band, count=3):
 
 
 def screen_delay(train, nominal_parameters, *, max_delay=3.0, step=0.05):
-    """Computation delay [samples] that best explains the training runs' inverse dynamics (a scan of the
-    measured drive force delayed by ``0 .. max_delay`` samples); the start of the closed-loop delay search."""
+    """Computation delay [controller ticks: samples of a run logged every tick] that best explains the training
+    runs' inverse dynamics (a scan of the measured drive force delayed by ``0 .. max_delay`` ticks); the start of
+    the closed-loop delay search."""
     base = dict(AXIS_PARAMETERS)
     base.update(nominal_parameters)
+    ticks = [controller_ticks(r) for r in train]
     best, best_err = 0.0, math.inf
     for d in np.arange(0.0, max_delay + 1e-9, step):
         # the centred acceleration at t_k sees the mean of the forces held before and after t_k: an undelayed
         # held force is the measured one shifted by half a sample
-        err = _rms(_errors([_signals(r, d + 0.5) for r in train], base))
+        err = _rms(_errors([_signals(r, d / m + 0.5) for r, m in zip(train, ticks)], base))
         if err < best_err:
             best, best_err = float(d), err
     return best

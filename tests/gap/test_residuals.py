@@ -123,6 +123,18 @@ def test_frequency_bands_find_a_30_hz_residual():
     assert abs(sum(b["share"] for b in out["bands"]) - 1.0) < 1e-9
 
 
+def test_frequency_bands_end_at_the_nyquist_frequency():
+    """A log every 4 ms ends at 125 Hz: the 50-150 Hz band ends there and the one from 150 Hz is left out (session
+    86: a 4 ms EMPS log was reported with '50-125 Hz 3 %, 150-125 Hz 0 %')."""
+    from drakecreep.gap.residuals import frequency_bands
+
+    rng = np.random.default_rng(2)
+    out = frequency_bands(rng.normal(size=2000), 4e-3)
+    assert [(b["lo_Hz"], b["hi_Hz"]) for b in out["bands"]] == [(0.0, 2.0), (2.0, 10.0), (10.0, 50.0), (50.0, 125.0)]
+    assert abs(sum(b["share"] for b in out["bands"]) - 1.0) < 1e-9
+    assert [b["lo_Hz"] for b in frequency_bands(rng.normal(size=2000), 1e-3)["bands"]][-1] == 150.0
+
+
 def test_independence_band_and_lag():
     from drakecreep.gap.residuals import independence
 
