@@ -238,8 +238,8 @@ class Identified:
 
     def summary(self):
         """Lines of text: the fitted values with their intervals, the warnings."""
-        lines = [f"identified ({'two-mass' if self.flexible else 'rigid'} axis, delay {self.delay:g} samples, "
-                 f"{self.n_evaluations} replays at {self.evaluations_per_s:.2f}/s):"]
+        lines = [f"identified ({'two-mass' if self.flexible else 'rigid'} axis, delay {self.delay:g} controller "
+                 f"samples, {self.n_evaluations} replays at {self.evaluations_per_s:.2f}/s):"]
         for name in self.fitted:
             jack = (f" (leave one run out: std {self.jackknife_std[name]:.3g})" if name in self.jackknife_std else "")
             lines.append(f"  {name:24s} {self.parameters[name]:12.5g} +- {self.ci95[name]:.3g} {AXIS_UNITS[name]}"

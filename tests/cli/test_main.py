@@ -68,7 +68,8 @@ def test_argparse_messages_other_than_a_refused_value_stay_as_they_are():
 
     message = "argument --params: not allowed with argument --preset"
     assert _refusal(message) == message
-    assert _refusal("the following arguments are required: SPEC.yaml") == "the following arguments are required: SPEC.yaml"
+    required = "the following arguments are required: SPEC.yaml"
+    assert _refusal(required) == required
 
 
 def test_bad_parameter_file(tmp_path, capsys):
