@@ -125,7 +125,8 @@ _SATURATION_SLACK = 2.0
 #: while the table may hardly move
 _TRAVEL_FACTOR = 100.0
 #: a P-P run's sample time and its controller's ``sample_time`` this far apart are refused on loading, before the gain
-#: fit (a time column in ms or min under a header in s); a smaller mismatch is refused by the replay, run by run
+#: fit (a time column in ms or min under a header in s); within it, a log every few ticks is replayed and any other
+#: mismatch is refused by the replay, run by run (:func:`controller_ticks`)
 _SAMPLE_TIME_FACTOR = 10.0
 #: Largest factor between a declared P-P gain and the one the recorded ``u`` follows (:func:`controller_gains`):
 #: a gain in the wrong unit (per mm/s for per m/s, a mistyped exponent) is off by decades; noise, quantization
@@ -824,8 +825,8 @@ def check_recorded(run):
             # decades apart: the time column in another unit, which the gain fit below blamed on kv (a small
             # mismatch is the replay's to refuse, run by run: drake_replay.check_replayable)
             raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
-                             f"the run's sample time {run.dt:g} s, within a factor of {_SAMPLE_TIME_FACTOR:g} (is the "
-                             "unit of t wrong?)")
+                             f"the run's sample time {run.dt:g} s or a whole fraction of it down to "
+                             f"1/{_SAMPLE_TIME_FACTOR:g} (is the unit of t wrong?)")
         fitted = controller_gains(run)
         if fitted is not None:
             kp, kv, lag, misfit = fitted
