@@ -69,6 +69,8 @@ __all__ = [
     "controller_gains",
     "controller_ticks",
     "at_controller_rate",
+    "on_controller_ticks",
+    "TICK_SHARE",
     "save_measured",
     "load_emps",
     "emps_data_dir",
@@ -859,7 +861,8 @@ def controller_ticks(run):
     Raises
     ------
     InputError
-        When the run's sample time is not a whole number of ``controller.sample_time`` (within 1e-6).
+        When the run's sample time is not a whole number of ``controller.sample_time`` (within 1e-6): a log taken
+        several times a tick is cut to its ticks first (:func:`on_controller_ticks`), any other ratio is refused.
     """
     ctrl = run.meta.controller
     if ctrl is None or ctrl.kind != "p_p_cascade":
@@ -867,10 +870,62 @@ def controller_ticks(run):
     ratio = run.dt / ctrl.sample_time
     m = int(round(ratio))
     if m < 1 or abs(run.dt - m * ctrl.sample_time) > 1e-6 * run.dt:
+        if _samples_per_tick(run) > 1:
+            raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
+                             f"the run's sample time {run.dt:g} s or a whole fraction of it here: a log taken "
+                             "several times a tick goes through on_controller_ticks first (load_runs does)")
         raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
-                         f"the run's sample time {run.dt:g} s or a whole fraction of it (the log taken every "
-                         "controller tick, or every few)")
+                         f"the run's sample time {run.dt:g} s, a whole fraction of it (the log taken every few "
+                         "controller ticks) or a whole multiple of it (the log taken several times a tick)")
     return m
+
+
+def _samples_per_tick(run):
+    """Logged samples per controller tick of a ``p_p_cascade`` run logged several times a tick (``sample_time`` a
+    whole multiple ``k >= 2`` of its sample time, within 1e-6); 1 otherwise."""
+    ctrl = run.meta.controller
+    if ctrl is None or ctrl.kind != "p_p_cascade":
+        return 1
+    k = int(round(ctrl.sample_time / run.dt))
+    return k if k >= 2 and abs(ctrl.sample_time - k * run.dt) <= 1e-6 * ctrl.sample_time else 1
+
+
+#: Least share of the changes of ``u`` (its total variation) that :func:`on_controller_ticks` asks to fall on one
+#: phase of the controller's ticks: a command computed at each tick and held changes there alone
+TICK_SHARE = 0.9
+
+
+def on_controller_ticks(run):
+    """A ``p_p_cascade`` run logged several times per controller tick, at its ticks: every ``k``-th sample.
+
+    ``controller.sample_time`` is ``k`` times the run's sample time (``k >= 2``); the ticks fall where the held
+    command ``u`` changes: of the ``k`` phases, the one that holds most of ``u``'s changes, at least
+    :data:`TICK_SHARE` of them. The samples before the first tick are dropped, and the run keeps its label. A run
+    logged every tick or every few is returned as it is (:func:`controller_ticks`).
+
+    Raises
+    ------
+    InputError
+        When ``u`` changes between ticks as much as at them (a current, not the controller's held command: where
+        the ticks fall cannot be told), or when fewer than two ticks are logged.
+    """
+    k = _samples_per_tick(run)
+    if k == 1:
+        return run
+    du = np.abs(np.diff(np.asarray(run.u, float)))  # du[i - 1]: the change at sample i
+    share = np.array([du[(np.arange(du.size) + 1) % k == o].sum() for o in range(k)])
+    total = float(share.sum())
+    o = int(np.argmax(share))
+    if not total > 0 or share[o] < TICK_SHARE * total:
+        raise InputError(f"u (run {run.label})", f"{100 * share[o] / total if total > 0 else 0:.0f} % of its "
+                         f"changes on one of the {k} samples of a controller tick",
+                         f"a command held between ticks, changing on one phase (at least {100 * TICK_SHARE:.0f} %): "
+                         "a log taken several times a tick is cut to the ticks where u changes")
+    picked = run.slice(o, None)
+    if (picked.n + k - 1) // k < 2:
+        raise InputError(f"run {run.label}", f"{run.n} samples", "at least two controller ticks")
+    kept = {name: None if getattr(picked, name) is None else getattr(picked, name)[::k] for name in _ARRAYS}
+    return MeasuredRun(meta=run.meta, label=run.label, dt_rtol=run.dt_rtol, **kept)
 
 
 def at_controller_rate(run):

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, renaming
 
 __all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles", "HALF_CYCLE_MIN_TIME",
            "CYCLE_MIN_TIME", "min_samples"]
@@ -84,8 +84,10 @@ def load_runs(data, meta=None, split=True):
     Returns
     -------
     list of drakecreep.gap.measured.MeasuredRun
+        A ``p_p_cascade`` run logged several times per controller tick is cut to its ticks
+        (:func:`~drakecreep.gap.measured.on_controller_ticks`).
     """
-    from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured
+    from drakecreep.gap.measured import EMPS_FILES, load_emps, load_measured, on_controller_ticks
 
     if data in EMPS_FILES and meta is not None:  # the benchmark's own metadata: a meta file was ignored unsaid
         raise InputError("meta", str(meta), f"no metadata with the EMPS benchmark's {data} file (its controller, "
@@ -104,7 +106,8 @@ def load_runs(data, meta=None, split=True):
         if not Path(data).exists():
             raise FileNotFoundError(2, "No such file or directory", str(data))
         md = load_measured(data, meta)
-    runs = list(md.runs)
+    # a log taken several times a controller tick: at its ticks (a refusal names the file, as load_measured's do)
+    runs = [renaming(lambda field: f"{Path(str(data)).name}: {field}", on_controller_ticks, r) for r in md.runs]
     if split == "half" and len(runs) == 1:
         runs = split_half_cycles(runs[0])
     elif split and len(runs) == 1:

@@ -65,7 +65,31 @@ def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers
     assert cli.main(["diagnose", str(tmp_path / "every4.csv")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "controller.sample_time (run every4" in err[0] and "got 0.0015" in err[0]
-    assert "the run's sample time 0.004 s or a whole fraction of it" in err[0]
+    assert "the run's sample time 0.004 s, a whole fraction of it" in err[0] and "a whole multiple of it" in err[0]
+
+
+def test_a_log_taken_four_times_a_controller_tick_is_diagnosed_at_its_ticks(tmp_path, capsys):
+    """EMPS's 1 ms loop logged every 0.25 ms from off a tick (positions linear, the command held): the diagnosis
+    keeps the samples at the ticks, where u changes, and fits what the 1 ms log does (the same samples but the
+    first: nominal within 0.2 %, held-out force error 8.952 % against 8.956 %)."""
+    import numpy as np
+    import pandas as pd
+
+    d = pd.read_csv(EXAMPLE, comment="#")
+    t = d["t[ms]"].to_numpy()
+    fast = np.arange(t[0], t[-1] + 1e-9, 0.25)
+    held = np.minimum(np.floor(fast - t[0] + 1e-9).astype(int), t.size - 1)
+    log = pd.DataFrame({"t[ms]": fast, "x_ref[mm]": np.interp(fast, t, d["x_ref[mm]"]),
+                        "x_motor[mm]": np.interp(fast, t, d["x_motor[mm]"]), "u[V]": d["u[V]"].to_numpy()[held],
+                        "f_ext[N]": 0.0}).iloc[3:]
+    log.to_csv(tmp_path / "fast.csv", index=False)
+    (tmp_path / "fast.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
+    opts = ("--effects", "lead_error", "--workers", "1")
+    quick, slow = _diagnose(capsys, tmp_path / "fast.csv", *opts), _diagnose(capsys, EXAMPLE, *opts)
+    for name in ("mass", "viscous", "coulomb"):
+        assert quick["nominal"]["parameters"][name] == pytest.approx(slow["nominal"]["parameters"][name], rel=5e-3)
+    a, b = quick["nominal"]["held_out_force_error_percent"], slow["nominal"]["held_out_force_error_percent"]
+    assert abs(a - b) < 0.1
 
 
 @pytest.mark.parametrize("rows", [300, 1500])

@@ -494,8 +494,9 @@ def test_a_run_that_cannot_be_replayed_is_named_by_its_label():
     meta = MeasuredMeta(u_units="V", u_gain=35.0, controller=ControllerMeta(kp=100.0, kv=200.0, sample_time=0.8e-3))
     run = MeasuredRun(t=t, x_ref=1e-3 * t, x_motor=1e-3 * t, u=np.cos(t), meta=meta, label="b")
     with pytest.raises(InputError, match=r"^controller.sample_time \(run b\): got 0.0008; allowed: the run's sample "
-                                         r"time 0.002 s or a whole fraction of it \(the log taken every controller "
-                                         r"tick, or every few\)$"):
+                                         r"time 0.002 s, a whole fraction of it \(the log taken every few controller "
+                                         r"ticks\) or a whole multiple of it \(the log taken several times a "
+                                         r"tick\)$"):
         check_replayable(run)
     with pytest.raises(InputError, match="^run b: got '10 samples'; allowed: at least 20 samples$"):
         check_replayable(dataclasses.replace(run.slice(0, 10), meta=dataclasses.replace(

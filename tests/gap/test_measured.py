@@ -857,3 +857,46 @@ def test_free_text_of_the_metadata_is_text(tmp_path, key):
         load_measured(_write(tmp_path, meta=dict(META, **{key: ["a", "b"]})))
     assert getattr(load_measured(_write(tmp_path, meta=dict(META, **{key: None}))).meta, key) == ""
     assert getattr(load_measured(_write(tmp_path, meta=dict(META, **{key: 2024}))).meta, key) == "2024"
+
+
+def _fast_log(k=4, offset=3, held=True, n=200):
+    """A P-P run whose 1 ms controller is logged every 1/k ms from ``offset`` samples before a tick: positions
+    linear, ``u`` held over each tick (or, not ``held``, linear between ticks)."""
+    from drakecreep.gap.measured import ControllerMeta, MeasuredMeta, MeasuredRun
+
+    tick = np.arange(n) * 1e-3
+    rng = np.random.default_rng(4)
+    u_tick = np.cumsum(rng.normal(size=n))
+    t = np.arange((n - 1) * k + 1) * (1e-3 / k)
+    u = u_tick[np.minimum(np.floor(t / 1e-3 + 1e-9).astype(int), n - 1)] if held else np.interp(t, tick, u_tick)
+    x = 0.05 * t
+    meta = MeasuredMeta(u_units="V", u_gain=35.0, controller=ControllerMeta(kp=100.0, kv=200.0, sample_time=1e-3))
+    return MeasuredRun(t=t[offset:], x_ref=x[offset:], x_motor=x[offset:], u=u[offset:], meta=meta, label="fast"), \
+        u_tick
+
+
+@pytest.mark.parametrize("offset", [0, 1, 3])
+def test_a_log_taken_several_times_a_tick_is_cut_to_the_ticks_where_u_changes(offset):
+    """The 1 ms controller logged every 0.25 ms, from any phase: the samples kept are the ticks (where the held
+    ``u`` changes), one per millisecond, the label kept; :func:`load_runs` does it on loading."""
+    from drakecreep.gap.measured import controller_ticks, on_controller_ticks
+
+    run, u_tick = _fast_log(offset=offset)
+    with pytest.raises(InputError, match="a log taken several times a tick goes through on_controller_ticks"):
+        controller_ticks(run)
+    ticks = on_controller_ticks(run)
+    first = 1 if offset else 0  # the first whole tick logged
+    assert ticks.label == "fast" and controller_ticks(ticks) == 1
+    assert ticks.dt == pytest.approx(1e-3, rel=1e-9) and ticks.t[0] == pytest.approx(first * 1e-3, abs=1e-12)
+    assert np.array_equal(ticks.u, u_tick[first: first + ticks.n])
+    assert on_controller_ticks(ticks) is ticks
+
+
+def test_a_fast_log_whose_u_changes_between_ticks_is_refused_naming_u():
+    """A ``u`` that changes at every sample (a current, not the held command) does not say where the ticks are."""
+    from drakecreep.gap.measured import on_controller_ticks
+
+    run, _ = _fast_log(held=False)
+    with pytest.raises(InputError, match=r"^u \(run fast\): got '2[0-9] % of its changes on one of the 4 samples of "
+                                         r"a controller tick'; allowed: a command held between ticks"):
+        on_controller_ticks(run)
