@@ -827,8 +827,8 @@ def check_recorded(run):
             # decades apart: the time column in another unit, which the gain fit below blamed on kv (a small
             # mismatch is the replay's to refuse, run by run: drake_replay.check_replayable)
             raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
-                             f"the run's sample time {run.dt:g} s or a whole fraction of it down to "
-                             f"1/{_SAMPLE_TIME_FACTOR:g} (is the unit of t wrong?)")
+                             f"the run's sample time {run.dt:g} s, or a whole fraction or multiple of it within a "
+                             f"factor of {_SAMPLE_TIME_FACTOR:g} (is the unit of t wrong?)")
         fitted = controller_gains(run)
         if fitted is not None:
             kp, kv, lag, misfit = fitted

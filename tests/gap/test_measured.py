@@ -486,7 +486,8 @@ def test_a_time_column_in_another_unit_is_named_by_the_sample_time_not_by_a_gain
     rows["u"] = _law(rows["x_ref"], rows["x_motor"])
     rows["t"] = np.arange(200) * 1.0  # milliseconds under a header that says seconds
     with pytest.raises(InputError, match=r"controller.sample_time \(run run\): got 0.001; allowed: the run's sample "
-                                         r"time 1 s or a whole fraction of it down to 1/10 \(is the unit of t wrong\?\)"):
+                                         r"time 1 s, or a whole fraction or multiple of it within a factor of 10 \(is the "
+                                         r"unit of t wrong\?\)"):
         load_measured(_write(tmp_path, cols=rows))
 
 
