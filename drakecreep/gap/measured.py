@@ -829,7 +829,8 @@ def check_recorded(run):
             raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
                              f"the run's sample time {run.dt:g} s, or a whole fraction or multiple of it within a "
                              f"factor of {_SAMPLE_TIME_FACTOR:g} (is the unit of t wrong?)")
-        fitted = controller_gains(run)
+        # a log taken several times a tick is fitted at its ticks (its u is held between them)
+        fitted = controller_gains(on_controller_ticks(run))
         if fitted is not None:
             kp, kv, lag, misfit = fitted
             for name, got, follows in (("kv", ctrl.kv, kv), ("kp", ctrl.kp, kp)):

@@ -901,3 +901,29 @@ def test_a_fast_log_whose_u_changes_between_ticks_is_refused_naming_u():
     with pytest.raises(InputError, match=r"^u \(run fast\): got '2[0-9] % of its changes on one of the 4 samples of "
                                          r"a controller tick'; allowed: a command held between ticks"):
         on_controller_ticks(run)
+
+
+def test_the_gains_of_a_log_taken_several_times_a_tick_are_checked_at_its_ticks(tmp_path):
+    """The EMPS segment logged every 0.25 ms (positions linear, u held): its gains are fitted at the ticks, where
+    the law holds (no lag, 1.0 % of u left, against 2 samples and 2.7 % on every sample), so the shipped gains
+    pass and a kv per mm/s written for per m/s is still refused."""
+    import dataclasses
+
+    from drakecreep.gap.measured import check_recorded, on_controller_ticks
+
+    run = load_measured(_segment(tmp_path)).run()
+    k = 4
+    fast_t = run.t[0] + np.arange((run.n - 1) * k + 1) * (run.dt / k)
+    tick = np.minimum(np.arange(fast_t.size) // k, run.n - 1)
+    slots = np.arange(fast_t.size) / k
+    fast = MeasuredRun(t=fast_t, x_ref=np.interp(slots, np.arange(run.n), run.x_ref),
+                       x_motor=np.interp(slots, np.arange(run.n), run.x_motor), u=run.u[tick], meta=run.meta,
+                       label="fast")
+    check_recorded(fast)
+    kp, kv, lag, misfit = controller_gains(on_controller_ticks(fast))
+    assert lag == 0 and misfit < 0.015 and kv == pytest.approx(243.45, rel=0.1)
+    assert misfit < 0.5 * controller_gains(fast)[3]
+    wrong = dataclasses.replace(run.meta, controller=dataclasses.replace(run.meta.controller, kv=0.24345))
+    with pytest.raises(InputError) as err:
+        check_recorded(dataclasses.replace(fast, meta=wrong))
+    assert err.value.field == "controller.kv (run fast)" and "kv = " in err.value.allowed
