@@ -5,7 +5,9 @@ Parquet, HDF5 or .mat with a metadata YAML beside it or given with --meta; units
 (t[ms], x_motor[mm], u[V]) are converted. The format is documented in docs/measured_format.md; an example
 ships in drakecreep/data/examples/emps_segment.csv. A single-run file is split at every reversal of the
 reference; by default alternate pairs of parts train and are held out (--train/--test choose). The
-training runs are fitted, the held-out runs only replayed with every parameter fixed.
+training runs are fitted, the held-out runs only replayed with every parameter fixed. A p_p_cascade run may be
+logged every controller tick (controller.sample_time), every few ticks (the controller is replayed on its tick),
+or several times a tick (cut to the ticks, where the held u changes).
 
 Runs of controller kind p_p_cascade are replayed in closed loop through the Drake model (P-P cascade +
 MeasuredAxis, docs/gap_diagnosis.md): the nominal axis is identified on the training runs, every candidate
