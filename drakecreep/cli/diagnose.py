@@ -129,7 +129,9 @@ def run(args):
                          "at least two held-out runs (the claim threshold is their run-to-run spread; "
                          "choose with --train/--test)")
     # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
-    score_runs = load_runs(args.score, None, split=own) if args.score else None
+    # a refusal of the scored file's loading says it is the --score file (a file may be diagnosed and scored alike)
+    score_runs = _in_file("--score ", lambda data: load_runs(data, None, split=own), args.score) if args.score \
+        else None
     kind = "drakecreep" if own else "p_p_cascade"
     for r in score_runs or ():
         _in_file(f"--score {args.score}: ", check_replayable, r)  # which of the two files (both had 'run: got ...')

@@ -921,7 +921,8 @@ def on_controller_ticks(run):
         raise InputError(f"u (run {run.label})", f"{100 * share[o] / total if total > 0 else 0:.0f} % of its "
                          f"changes on one of the {k} samples of a controller tick",
                          f"a command held between ticks, changing on one phase (at least {100 * TICK_SHARE:.0f} %): "
-                         "a log taken several times a tick is cut to the ticks where u changes")
+                         "a log taken several times a tick is cut to the ticks where u changes (or is "
+                         f"controller.sample_time, {run.meta.controller.sample_time:g} s, wrong?)")
     picked = run.slice(o, None)
     if (picked.n + k - 1) // k < 2:
         raise InputError(f"run {run.label}", f"{run.n} samples", "at least two controller ticks")

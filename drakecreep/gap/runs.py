@@ -107,7 +107,7 @@ def load_runs(data, meta=None, split=True):
             raise FileNotFoundError(2, "No such file or directory", str(data))
         md = load_measured(data, meta)
     # a log taken several times a controller tick: at its ticks (a refusal names the file, as load_measured's do)
-    runs = [renaming(lambda field: f"{Path(str(data)).name}: {field}", on_controller_ticks, r) for r in md.runs]
+    runs = [renaming(lambda field: f"{data}: {field}", on_controller_ticks, r) for r in md.runs]
     if split == "half" and len(runs) == 1:
         runs = split_half_cycles(runs[0])
     elif split and len(runs) == 1:

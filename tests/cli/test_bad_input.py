@@ -399,16 +399,24 @@ def test_a_score_file_that_cannot_be_replayed_is_named(tmp_path, capsys):
         f"{row},{'a' if i < 100 else 'b'}\n" for i, row in enumerate(rows[:110])))
     (tmp_path / "sc.yaml").write_text(meta)
     (tmp_path / "ts.csv").write_text(example.read_text())
-    (tmp_path / "ts.yaml").write_text(meta.replace("sample_time: 0.001", "sample_time: 0.002"))
+    # a sample time of 1.5 ticks; one of two ticks whose u changes at every sample (since session 86 a log taken
+    # several times a tick is cut to its ticks, where the held u changes)
+    (tmp_path / "ts.yaml").write_text(meta.replace("sample_time: 0.001", "sample_time: 0.0015"))
+    (tmp_path / "tu.csv").write_text(example.read_text())
+    (tmp_path / "tu.yaml").write_text(meta.replace("sample_time: 0.001", "sample_time: 0.002"))
     for argv, fragment in (
             (["--score", str(tmp_path / "sc.csv")], f"--score {tmp_path / 'sc.csv'}: run b: got '10 samples'; allowed: "
                                                     "at least 20 samples"),
             (["--score", str(tmp_path / "ts.csv")], f"--score {tmp_path / 'ts.csv'}: controller.sample_time (run ts): "
-                                                    "got 0.002; allowed: the run's sample time 0.001 s"),
+                                                    "got 0.0015; allowed: the run's sample time 0.001 s, a whole "
+                                                    "fraction of it"),
+            (["--score", str(tmp_path / "tu.csv")], f"--score {tmp_path / 'tu.csv'}: u (run tu): got "),
             ([], None)):
         data = str(tmp_path / "ts.csv") if not argv else str(example)
         code, _, err = _run(["diagnose", data, "--train", "0", "--test", "1,2"] + argv, capsys, timeout=20)
-        _one_line_exit_2(code, err, fragment or f"{data}: controller.sample_time (run ts@0): got 0.002")
+        _one_line_exit_2(code, err, fragment or f"{data}: controller.sample_time (run ts@0): got 0.0015")
+        if argv and "tu.csv" in argv[1]:
+            assert "(or is controller.sample_time, 0.002 s, wrong?)" in err
 
 @pytest.mark.parametrize("address", ["garbage", "tcp://127.0.0.1:1", "tcp://[::1", ""])
 def test_bad_or_unreachable_scheduler(address, tmp_path, capsys, monkeypatch):
