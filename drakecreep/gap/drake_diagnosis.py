@@ -352,7 +352,7 @@ class DrakeDiagnosis:
                 sc = r.screen
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
-            if math.isnan(r.fit.test_force_error):  # a held-out replay at the fitted values diverged
+            if not math.isfinite(r.fit.test_force_error):  # a held-out replay at the fitted values diverged
                 lines.append(f"  {r.name:20s} held-out replay diverged at its fitted values (not claimed)")
                 continue
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None

@@ -728,6 +728,8 @@ class LoggedReplay:
         self.ticks = controller_ticks(run)
 
     def __getattr__(self, name):
+        if name == "replay":  # not set yet (copy, unpickling): no recursion through __getattr__
+            raise AttributeError(name)
         return getattr(self.replay, name)
 
     def simulate(self, parameters):

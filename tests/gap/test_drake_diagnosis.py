@@ -628,3 +628,24 @@ def test_a_run_both_fitted_and_held_out_or_held_out_twice_is_refused_before_any_
         with pytest.raises(InputError) as err:
             diagnose_drake(train, test, ("stribeck",))
         assert err.value.field == "test" and said in str(err.value.value)
+
+
+def test_a_candidate_whose_held_out_replay_diverged_says_so_instead_of_nan():
+    """A Stribeck fitted to 1.4e8 N on an 8 ms EMPS log (session 86) diverged on a held-out run: its line read
+    'held-out nan %, gain +nan points of %, error xnan'."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap.drake_diagnosis import DrakeDiagnosis, RankedEffect
+
+    fit = SimpleNamespace(name="stribeck", test_force_error=float("nan"), train_force_error=7.0, delay=0.0,
+                          parameters={"stribeck_extra": 1.4e8, "stribeck_velocity": 1.65e-3},
+                          test_errors={"r0": {"force": float("nan")}}, seconds=1.0)
+    ranked = RankedEffect(fit=fit, gain=float("nan"), standard_error=float("nan"), passes=False, effect="stribeck",
+                          log_ratio=float("nan"))
+    diag = DrakeDiagnosis(nominal=None, nominal_test_errors={"r0": {"force": 9.0}}, ranking=(ranked,), claimed=(),
+                          model={"parameters": {"mass": 90.0}, "flexible": False, "delay": 0.0},
+                          test_errors={"r0": {"force": 9.0}}, seconds=0.0, k_se=2.0)
+    (line,) = [x for x in diag.summary() if "stribeck" in x]
+    assert line.split() == ["stribeck", "held-out", "replay", "diverged", "at", "its", "fitted", "values", "(not",
+                            "claimed)"]
+    assert "nan" not in " ".join(diag.summary()).lower()
