@@ -96,8 +96,9 @@ def run(args):
         # allowed (whole runs of the file, as the EMPS protocol replays them), but not a held-out score: said so
         print(f"drakecreep diagnose: note: --score {args.score} is DATA itself: its runs include those the model is "
               "fitted on, so its score is not a held-out one", file=sys.stderr, flush=True)
-    runs = _in_file("", lambda data: load_runs(data, existing_path("--meta", args.meta), split=False), args.data,
-                    {"meta": "--meta"})
+    notes = []
+    runs = _in_file("", lambda data: load_runs(data, existing_path("--meta", args.meta), split=False, notes=notes),
+                    args.data, {"meta": "--meta"})
     own = any(r.meta.controller is not None and r.meta.controller.kind == "drakecreep" for r in runs)
     # one long run is cut: at every reversal for the Drake path (pairs of half cycles train / are held out, so
     # both sets move both ways), into out-and-back cycles for the kind drakecreep branch
@@ -130,8 +131,10 @@ def run(args):
                          "choose with --train/--test)")
     # the Drake path replays whole scored runs (as the EMPS validation protocol); the drakecreep branch its cycles
     # a refusal of the scored file's loading says it is the --score file (a file may be diagnosed and scored alike)
-    score_runs = _in_file("--score ", lambda data: load_runs(data, None, split=own), args.score) if args.score \
-        else None
+    score_runs = _in_file("--score ", lambda data: load_runs(data, None, split=own, notes=notes), args.score) \
+        if args.score else None
+    for line in notes:  # how a log at another rate than the controller's tick is read (a wrong sample_time shows)
+        print(f"drakecreep diagnose: note: {line}", file=sys.stderr, flush=True)
     kind = "drakecreep" if own else "p_p_cascade"
     for r in score_runs or ():
         _in_file(f"--score {args.score}: ", check_replayable, r)  # which of the two files (both had 'run: got ...')

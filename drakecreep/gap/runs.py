@@ -12,7 +12,7 @@ import numpy as np
 from drakecreep.errors import InputError, renaming
 
 __all__ = ["load_runs", "pick", "train_test", "split_half_cycles", "split_cycles", "HALF_CYCLE_MIN_TIME",
-           "CYCLE_MIN_TIME", "min_samples"]
+           "CYCLE_MIN_TIME", "min_samples", "log_rate_notes"]
 
 
 def _reversals(run):
@@ -67,7 +67,33 @@ def split_cycles(run, cycles_per_run=1, min_time=CYCLE_MIN_TIME):
     return _cut(run, [0] + _reversals(run)[1::2 * cycles_per_run] + [run.n], min_time, "#")
 
 
-def load_runs(data, meta=None, split=True):
+def log_rate_notes(data, logged, ticked):
+    """Lines saying how runs logged at another rate than their controller's tick are read: ``logged`` as the file
+    holds them, ``ticked`` after :func:`~drakecreep.gap.measured.on_controller_ticks` (one line per rate and kind).
+
+    A wrong ``controller.sample_time`` that is a whole fraction or multiple of the log's is read so too, so the
+    reading is said rather than done silently (a 1 ms log declared with 0.25 ms replays a loop four times faster).
+    """
+    from drakecreep.gap.measured import controller_ticks
+
+    lines = []
+    for raw, run in zip(logged, ticked):
+        ctrl = raw.meta.controller
+        if run is not raw:
+            line = (f"{data}: logged every {raw.dt:g} s, {int(round(run.dt / raw.dt))} samples per tick of "
+                    f"controller.sample_time {ctrl.sample_time:g} s: cut to its ticks, where the held u changes")
+        elif controller_ticks(run) > 1:
+            line = (f"{data}: logged every {run.dt:g} s, every {controller_ticks(run)} ticks of controller.sample_time "
+                    f"{ctrl.sample_time:g} s: the controller is replayed on its tick, the reference linear between "
+                    "logged samples")
+        else:
+            continue
+        if line not in lines:
+            lines.append(line)
+    return lines
+
+
+def load_runs(data, meta=None, split=True, notes=None):
     """Runs of a data file: EMPS ``.mat`` (or its role name) or CSV + metadata; one run -> cycles.
 
     Parameters
@@ -80,6 +106,8 @@ def load_runs(data, meta=None, split=True):
     split : bool or str
         Split a single-run file into out-and-back cycles (True), into the parts between reversals of the
         reference (``"half"``, :func:`split_half_cycles`), or not at all (False).
+    notes : list, optional
+        Receives :func:`log_rate_notes` of the file's runs.
 
     Returns
     -------
@@ -108,6 +136,8 @@ def load_runs(data, meta=None, split=True):
         md = load_measured(data, meta)
     # a log taken several times a controller tick: at its ticks (a refusal names the file, as load_measured's do)
     runs = [renaming(lambda field: f"{data}: {field}", on_controller_ticks, r) for r in md.runs]
+    if notes is not None:
+        notes.extend(log_rate_notes(data, md.runs, runs))
     if split == "half" and len(runs) == 1:
         runs = split_half_cycles(runs[0])
     elif split and len(runs) == 1:

@@ -53,7 +53,14 @@ def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers
     (tmp_path / "every4.csv").write_text("\n".join(comments + [header] + body[::4]) + "\n")
     (tmp_path / "every4.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
     opts = ("--effects", "lead_error", "--workers", "1")
-    slow, fast = _diagnose(capsys, tmp_path / "every4.csv", *opts), _diagnose(capsys, EXAMPLE, *opts)
+    assert cli.main(["-q", "diagnose", str(tmp_path / "every4.csv"), *opts, "--json"]) == 0
+    said = capsys.readouterr()
+    slow, fast = json.loads(said.out), _diagnose(capsys, EXAMPLE, *opts)
+    # how the log is read is said (a sample_time declared wrong, a whole fraction of the log's, would show here)
+    assert [x for x in said.err.splitlines() if "note:" in x] == [
+        f"drakecreep diagnose: note: {tmp_path / 'every4.csv'}: logged every 0.004 s, every 4 ticks of "
+        "controller.sample_time 0.001 s: the controller is replayed on its tick, the reference linear between "
+        "logged samples"]
     assert slow["train_runs"] == ["every4@0"] and slow["test_runs"] == ["every4@1", "every4@2"]
     for name in ("mass", "viscous", "coulomb"):
         assert slow["nominal"]["parameters"][name] == pytest.approx(fast["nominal"]["parameters"][name], rel=0.03)
@@ -85,7 +92,11 @@ def test_a_log_taken_four_times_a_controller_tick_is_diagnosed_at_its_ticks(tmp_
     log.to_csv(tmp_path / "fast.csv", index=False)
     (tmp_path / "fast.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
     opts = ("--effects", "lead_error", "--workers", "1")
-    quick, slow = _diagnose(capsys, tmp_path / "fast.csv", *opts), _diagnose(capsys, EXAMPLE, *opts)
+    assert cli.main(["-q", "diagnose", str(tmp_path / "fast.csv"), *opts, "--json"]) == 0
+    said = capsys.readouterr()
+    quick, slow = json.loads(said.out), _diagnose(capsys, EXAMPLE, *opts)
+    assert f"note: {tmp_path / 'fast.csv'}: logged every 0.00025 s, 4 samples per tick of controller.sample_time " \
+           "0.001 s: cut to its ticks, where the held u changes" in said.err
     for name in ("mass", "viscous", "coulomb"):
         assert quick["nominal"]["parameters"][name] == pytest.approx(slow["nominal"]["parameters"][name], rel=5e-3)
     a, b = quick["nominal"]["held_out_force_error_percent"], slow["nominal"]["held_out_force_error_percent"]
