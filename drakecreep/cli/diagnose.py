@@ -161,7 +161,7 @@ def run(args):
             if e != "control_delay" and e not in DRAKE_EFFECTS:
                 raise InputError("--effects", e, NOT_RANKED.get(e, "names among " + ", ".join(
                     tuple(DRAKE_EFFECTS) + ("control_delay",))))
-    return _run_drake(args, train, test, score_runs, effects)
+    return _run_drake(args, train, test, score_runs, effects, notes)
 
 
 def _in_file(prefix, check, run, options=None):
@@ -175,7 +175,7 @@ def _say(args):
     return (lambda line: None) if quiet else (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True))
 
 
-def _run_drake(args, train, test, score_runs, effects=None):
+def _run_drake(args, train, test, score_runs, effects=None, notes=()):
     """The product path: :func:`drakecreep.gap.drake_diagnosis.diagnose_drake` on p_p_cascade runs."""
     import json
 
@@ -187,6 +187,8 @@ def _run_drake(args, train, test, score_runs, effects=None):
     say = _say(args)
     outset = OutputSet(args.out, "manifest.json").start() if args.out else None
     extra = {"data": str(args.data), "train_runs": [r.label for r in train], "test_runs": [r.label for r in test]}
+    if notes:
+        extra["log_rate"] = list(notes)
 
     def keep_ranking(nominal, nominal_test, ranking):
         if outset is not None:  # written before the greedy augmentation: a late failure keeps it

@@ -289,7 +289,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
     outset : drakecreep.files.OutputSet, optional
         The output set to write into (its manifest is committed by the caller); default: a new one committed here.
     **extra
-        Keys added to the JSON (``data``, ``train_runs``, ``test_runs``, ``scored``).
+        Keys added to the JSON (``data``, ``train_runs``, ``test_runs``, ``scored``, ``log_rate``: how a log at
+        another rate than the controller's tick was read, shown under the data line).
 
     Returns
     -------
@@ -311,6 +312,8 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
         parts.append(f"<p>Data: <code>{escape(str(extra['data']))}</code>; training runs "
                      f"{escape(', '.join(extra.get('train_runs', [])))}; held-out runs "
                      f"{escape(', '.join(extra.get('test_runs', [])))}. Diagnosis {diagnosis.seconds:.0f} s.</p>")
+    for line in extra.get("log_rate", ()):  # a log at another rate than the controller's tick: how it was read
+        parts.append(f"<p class='note'>{escape(line)}</p>")
     claimed = " + ".join(diagnosis.claimed) or "nothing"
     parts.append(f"<h2>Answer</h2><p class='answer'><b>Claimed: {escape(claimed)}.</b> Held-out force error "
                  f"{rms_force_error(diagnosis.nominal_test_errors):.3f} % (nominal) → "

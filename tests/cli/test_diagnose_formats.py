@@ -61,6 +61,7 @@ def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers
         f"drakecreep diagnose: note: {tmp_path / 'every4.csv'}: logged every 0.004 s, every 4 ticks of "
         "controller.sample_time 0.001 s: the controller is replayed on its tick, the reference linear between "
         "logged samples"]
+    assert slow["log_rate"] == [said.err.split("note: ")[1].strip()] and "log_rate" not in fast
     assert slow["train_runs"] == ["every4@0"] and slow["test_runs"] == ["every4@1", "every4@2"]
     for name in ("mass", "viscous", "coulomb"):
         assert slow["nominal"]["parameters"][name] == pytest.approx(fast["nominal"]["parameters"][name], rel=0.03)
