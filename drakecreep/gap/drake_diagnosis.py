@@ -270,6 +270,11 @@ class RankedEffect:
         return self.fit is None
 
     @property
+    def diverged(self):
+        """True when its held-out replay at the fitted values diverged (a force error that is not finite)."""
+        return self.fit is not None and not math.isfinite(self.fit.test_force_error)
+
+    @property
     def closed_loop_start(self):
         """Where the closed-loop fit started when the screen offered two starts
         (:attr:`~drakecreep.gap.screen.ScreenResult.alternative_start`): ``inverse_dynamics`` (the candidate's own
@@ -352,7 +357,7 @@ class DrakeDiagnosis:
                 sc = r.screen
                 lines.append(f"  {r.name:20s} screened out: {_screen_numbers(sc)} (not fitted in closed loop)")
                 continue
-            if not math.isfinite(r.fit.test_force_error):  # a held-out replay at the fitted values diverged
+            if r.diverged:
                 lines.append(f"  {r.name:20s} held-out replay diverged at its fitted values (not claimed)")
                 continue
             own = getattr(r.screen, "reference_values", None) if r.reference_errors is not None else None

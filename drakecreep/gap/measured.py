@@ -868,9 +868,8 @@ def controller_ticks(run):
     ctrl = run.meta.controller
     if ctrl is None or ctrl.kind != "p_p_cascade":
         return 1
-    ratio = run.dt / ctrl.sample_time
-    m = int(round(ratio))
-    if m < 1 or abs(run.dt - m * ctrl.sample_time) > 1e-6 * run.dt:
+    m = _whole_ratio(run.dt, ctrl.sample_time)
+    if m is None:
         if _samples_per_tick(run) > 1:
             raise InputError(f"controller.sample_time (run {run.label})", ctrl.sample_time,
                              f"the run's sample time {run.dt:g} s or a whole fraction of it here: a log taken "
@@ -887,8 +886,13 @@ def _samples_per_tick(run):
     ctrl = run.meta.controller
     if ctrl is None or ctrl.kind != "p_p_cascade":
         return 1
-    k = int(round(ctrl.sample_time / run.dt))
-    return k if k >= 2 and abs(ctrl.sample_time - k * run.dt) <= 1e-6 * ctrl.sample_time else 1
+    return _whole_ratio(ctrl.sample_time, run.dt) or 1
+
+
+def _whole_ratio(a, b):
+    """``a / b`` when it is a whole number >= 1 within 1e-6 of ``a``, else None."""
+    n = int(round(a / b))
+    return n if n >= 1 and abs(a - n * b) <= 1e-6 * a else None
 
 
 #: Least share of the changes of ``u`` (its total variation) that :func:`on_controller_ticks` asks to fall on one

@@ -389,7 +389,7 @@ def write_drake_report(diagnosis, out_dir, *, residuals=None, title="Sim-to-real
                            for n in names for value, unit in [_edge(n, r.fit.parameters[n])])
         if r.name == "control_delay":
             params = f"delay = {r.fit.delay:.3g} controller samples"
-        if not np.isfinite(r.fit.test_force_error):  # a held-out replay at the fitted values diverged
+        if r.diverged:
             rows.append([r.name, scr, "diverged", "-", "-", "no", params])
             continue
         rows.append([r.name, scr, f"{r.fit.test_force_error:.3f}", f"{r.gain:+.3f}",
