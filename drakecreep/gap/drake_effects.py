@@ -29,7 +29,7 @@ from drakecreep.gap.identify import identify
 from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
-           "score_parameters", "best_start_index", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
+           "peak_drive_force", "STRIBECK_EXTRA_PEAKS", "score_parameters", "best_start_index", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
 
 
 @dataclass(frozen=True)
@@ -311,14 +311,30 @@ def residual_peak_frequency(runs, parameters, *, fmin=0.5, fmax=400.0, delay=0.0
     return float(f[band][np.argmax(total[band])])
 
 
-def physical_bounds(effect, base, fmin=5.0, fmax=300.0):
-    """Bounds that depend on the model being augmented (SI, ``name -> (lo, hi)``).
+#: The Stribeck excess's upper bound in drive-force peaks of the training runs (:func:`physical_bounds`):
+#: accelerating from rest or from a reversal, the axis passes through the Stribeck speed ``v_s``, where the
+#: regularized friction ``(coulomb + extra e^-1) tanh(v_s / v_reg)`` is at least ``extra / e * tanh(2)``
+#: (``v_s >= 2 v_reg``), about 0.35 ``extra``; the drive pushed it through, so ``extra <= e / tanh(2)``, 2.8 times
+#: the largest drive force the runs record. Rounded up to 3.
+STRIBECK_EXTRA_PEAKS = 3.0
+
+
+def peak_drive_force(runs):
+    """The largest ``|u x u_gain|`` [N] over ``runs`` (the drive force the measurements record)."""
+    return max(float(np.max(np.abs(r.force))) for r in runs)
+
+
+def physical_bounds(effect, base, fmin=5.0, fmax=300.0, peak_force=None):
+    """Bounds that depend on the model being augmented or on the data (SI, ``name -> (lo, hi)``).
 
     * ``axial_mode``: stiffness between the values that put the two-mass mode at ``fmin`` and ``fmax`` Hz
       (the issue's 5-300 Hz search; a fit at the upper bound means "no mode below it") and damping up to
       twice the critical damping at ``fmax``; this also keeps the sampled replay's sub-step count bounded;
     * ``stribeck``: Stribeck speed at least twice the friction's regularization speed (below it the Stribeck
-      term and the ``tanh`` regularization are the same shape) and at most 0.1 m/s.
+      term and the ``tanh`` regularization are the same shape) and at most 0.1 m/s; with ``peak_force`` (the
+      training runs' :func:`peak_drive_force`, N), a Stribeck excess at most :data:`STRIBECK_EXTRA_PEAKS` times
+      it. Without that bound a log every 8 ms, whose samples rarely fall near a reversal, fitted the excess on
+      inverse dynamics to 1.4e8 N, and the closed loop started from there diverged.
     """
     out = {}
     if effect.name == "axial_mode":
@@ -329,6 +345,8 @@ def physical_bounds(effect, base, fmin=5.0, fmax=300.0):
         out = {"stiffness": (k[0], k[1]), "damping": (1e-4 * c_hi, c_hi)}
     elif effect.name == "stribeck":
         out = {"stribeck_velocity": (2.0 * base.get("regularization_velocity", 1e-3), 0.1)}
+        if peak_force is not None:
+            out["stribeck_extra"] = (0.0, STRIBECK_EXTRA_PEAKS * peak_force)
     return out
 
 
@@ -381,7 +399,7 @@ def fit_effect(effect, train, test, nominal, *, max_nfev=12, refit=("viscous", "
     uncertain = tuple(n for n in refit if n not in effect.parameters) + effect.parameters
     flexible = effect.flexible or nominal.flexible
     bounds = dict(effect.bounds)
-    bounds.update(physical_bounds(effect, base))
+    bounds.update(physical_bounds(effect, base, peak_force=peak_drive_force(train)))
     replays = [make_replay(r, flexible=flexible, delay=nominal.delay, free=uncertain) for r in train]
     fixeds = []
     for start in starts:

@@ -87,6 +87,8 @@ class ScreenResult:
         :data:`NOT_SCREENED` candidates).
     inside : bool
         The fitted values are inside the effect's bounds.
+    outside : dict
+        The fitted values that are not: ``name -> (value, lo, hi)`` (SI).
     log_ratio, log_ratio_se : float
         Mean and standard error of the per-run ``ln(reference / candidate)`` of the held-out errors: the
         statistic the screen is decided on, as the claim (:func:`drakecreep.gap.drake_diagnosis.paired_log_ratio`).
@@ -121,6 +123,7 @@ class ScreenResult:
     reference_values: dict = field(default_factory=dict)
     alternative_start: dict = field(default_factory=dict)
     reference_alternative: dict = field(default_factory=dict)
+    outside: dict = field(default_factory=dict)
 
     @property
     def error_ratio(self):
@@ -336,10 +339,10 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     starts = [dict(s) for s in effect.starts]
     if effect.name == "time_ripple":
         starts = [{"ripple_frequency": f} for f in _peak_frequencies(whole, base, effect.bounds["ripple_frequency"])]
-    from drakecreep.gap.drake_effects import physical_bounds
+    from drakecreep.gap.drake_effects import peak_drive_force, physical_bounds
 
     bounds = dict(effect.bounds)
-    bounds.update(physical_bounds(effect, base))
+    bounds.update(physical_bounds(effect, base, peak_force=peak_drive_force(train)))
     # a period the samples cannot resolve at the top speed (its frequency v / P above the Nyquist frequency of
     # the screen's signals) is aliased: a "peak" there fits noise at a false period
     nyquist_period = 2.0 * float(np.median(np.diff(whole[0][0]))) * v_top
@@ -375,7 +378,9 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     # points of a slow run's error is not one of a fast run's
     lr, lr_se = mean_log_ratio(nom_test, test_err)
     # the linear parameters are solved unbounded: a value outside the effect's bounds is not that effect
-    inside = all(bounds[n][0] <= best[n] <= bounds[n][1] for n in effect.parameters if n in bounds)
+    outside = {n: (best[n], *bounds[n]) for n in effect.parameters
+               if n in bounds and not bounds[n][0] <= best[n] <= bounds[n][1]}
+    inside = not outside
     const = constancy(tr, best, refit, effect) if effect.run_constancy else None
     ok = inside and lr > k_se * lr_se and (const is None or const.constant)
     start = {n: best[n] for n in effect.parameters}
@@ -394,7 +399,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
         if effect.screen_refits or effect.own_start else ({}, {})
     return ScreenResult(effect.name, start, _rms(train_err), _rms(test_err),
                         _rms(nom_test), gain, se, bool(ok), inside, lr, lr_se, const,
-                        {n: reference[n] for n in effect.screen_refits}, own, reference_own)
+                        {n: reference[n] for n in effect.screen_refits}, own, reference_own, outside)
 
 
 #: parameters that set a candidate's shape, not its size (held at the pooled fit in the constancy test)

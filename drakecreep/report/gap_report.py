@@ -29,6 +29,8 @@ def ranking_json(nominal, nominal_test_errors, ranking):
                                        "log_error_ratio": sc.log_ratio, "log_error_ratio_standard_error": sc.log_ratio_se,
                                        "passes": bool(sc.passes),
                                        "start": sc.start}
+            if getattr(sc, "outside", None):  # fitted values outside the effect's bounds: name -> [value, lo, hi]
+                row["inverse_dynamics"]["outside_bounds"] = {n: list(v) for n, v in sc.outside.items()}
             if getattr(sc, "alternative_start", None):  # the second closed-loop start (ScreenResult)
                 row["inverse_dynamics"]["alternative_start"] = sc.alternative_start
             c = getattr(sc, "constancy", None)

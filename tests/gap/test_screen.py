@@ -7,10 +7,13 @@ import warnings
 import numpy as np
 import pytest
 
-from drakecreep.gap.drake_effects import DRAKE_EFFECTS
+from drakecreep.data import data_dir
+from drakecreep.gap.drake_effects import DRAKE_EFFECTS, STRIBECK_EXTRA_PEAKS, peak_drive_force, physical_bounds
+from drakecreep.gap.drake_diagnosis import _screen_numbers
 from drakecreep.gap.drake_replay import SampledReplay, axis_from_idim
 from drakecreep.gap.idim import PUBLISHED_IDIM
 from drakecreep.gap.measured import load_emps
+from drakecreep.gap.runs import load_runs
 from drakecreep.gap.screen import inverse_dynamics_force, screen_delay, screen_effect
 
 BASE = axis_from_idim(PUBLISHED_IDIM, regularization_velocity=1e-3)
@@ -191,6 +194,37 @@ def test_the_stribeck_candidate_offers_its_own_friction_as_a_second_start():
     assert alt["stribeck_velocity"] == pytest.approx(0.01, rel=0.2)
     assert set(sc.reference_alternative) == {"viscous", "coulomb", "offset"}
     assert sc.reference_values == {}
+
+
+def test_a_stribeck_excess_beyond_what_the_drive_pushed_through_fails_the_screen(tmp_path):
+    """The shipped EMPS example logged every 8 ms: its samples rarely fall near a reversal, and the excess's
+    variable-projection fit on inverse dynamics runs to 1e5-1e6 N (1.4e8 N on the diagnosis's nominal), whose
+    closed-loop replay diverged. Above :data:`STRIBECK_EXTRA_PEAKS` times the training runs' peak drive force
+    the axis could not have been pushed through its Stribeck speed: such a fit is outside the effect's bounds
+    and fails the screen. Every fold of the three half-cycles is checked; the 1 ms file's fit is far below it."""
+    example = data_dir() / "examples" / "emps_segment.csv"
+    lines = example.read_text().splitlines()
+    body = [line for line in lines if not line.startswith("#")]
+    slow = tmp_path / "emps8.csv"
+    slow.write_text("\n".join([body[0]] + body[1::8]) + "\n")
+    (tmp_path / "emps8.yaml").write_text(example.with_suffix(".yaml").read_text())
+    for path in (slow, example):
+        runs = load_runs(path, split="half")
+        assert len(runs) == 3
+        for k in range(3):
+            train, test = [runs[k]], runs[:k] + runs[k + 1:]
+            sc = screen_effect(DRAKE_EFFECTS["stribeck"], train, test, BASE)
+            hi = physical_bounds(DRAKE_EFFECTS["stribeck"], BASE, peak_force=peak_drive_force(train))["stribeck_extra"][1]
+            assert hi == pytest.approx(STRIBECK_EXTRA_PEAKS * max(np.max(np.abs(r.force)) for r in train))
+            if path == slow:
+                assert abs(sc.start["stribeck_extra"]) > hi and not sc.inside and not sc.passes, k
+                assert sc.outside == {"stribeck_extra": (sc.start["stribeck_extra"], 0.0, hi)}
+                # the report names the value and what is allowed, in N
+                why = _screen_numbers(sc)
+                assert f"stribeck_extra {sc.start['stribeck_extra']:.4g} N, allowed 0 to {hi:.4g} N" in why
+            else:
+                # at 1 ms the excess is fitted where the peak bound is far off (it says no Stribeck here either)
+                assert abs(sc.start["stribeck_extra"]) < 0.1 * hi, k
 
 
 def test_a_position_ripple_is_found_at_its_period_by_the_periodogram():
