@@ -433,6 +433,15 @@ def test_diagnose_dataset_keeps_going_past_a_failing_dataset(tmp_path, monkeypat
     assert kept["failed"][0]["seed"] == 1 and "935.3 kg" in kept["failed"][0]["error"]
 
 
+def test_declared_mass_study_refuses_bad_cases_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
+    """``analysis/declared_mass_study.py``: a malformed case, an unknown effect, a factor out of range and a seed of
+    the held-out set each exit 2 with one line before any dataset is generated."""
+    cases = ((["114000:null:flexible"], "SEED:WITHHELD:AXIS"), (["114000:nothing:flexible:0.85"], "nothing"),
+             (["114000:null:flexible:x"], "factor"), (["114000:null:flexible:0"], "factor"),
+             ([f"{HELD_OUT}:null:rigid:1.15"], str(HELD_OUT)))
+    _refused_in_one_line("declared_mass_study.py", cases, monkeypatch, capsys, tmp_path)
+
+
 def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
