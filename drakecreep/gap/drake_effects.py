@@ -29,7 +29,8 @@ from drakecreep.gap.identify import identify
 from drakecreep.model.axis import FRICTION_MAP, LEAD_ERROR, POSITION_RIPPLE
 
 __all__ = ["DrakeEffect", "DRAKE_EFFECTS", "NOT_RANKED", "EffectFit", "fit_effect", "fit_delay", "physical_bounds",
-           "peak_drive_force", "STRIBECK_EXTRA_PEAKS", "score_parameters", "best_start_index", "residual_peak_frequency", "axial_mode_frequency", "effect_regime"]
+           "peak_drive_force", "STRIBECK_EXTRA_PEAKS", "score_parameters", "best_start_index", "residual_peak_frequency",
+           "axial_mode_frequency", "effect_regime"]
 
 
 @dataclass(frozen=True)
@@ -320,7 +321,8 @@ STRIBECK_EXTRA_PEAKS = 3.0
 
 
 def peak_drive_force(runs):
-    """The largest ``|u x u_gain|`` [N] over ``runs`` (the drive force the measurements record)."""
+    """The largest axial force [N] over ``runs``: ``|u x u_gain + f_ext|`` (:attr:`MeasuredRun.force
+    <drakecreep.gap.measured.MeasuredRun.force>`, the force that moved the axis)."""
     return max(float(np.max(np.abs(r.force))) for r in runs)
 
 

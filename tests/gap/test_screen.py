@@ -214,7 +214,8 @@ def test_a_stribeck_excess_beyond_what_the_drive_pushed_through_fails_the_screen
         for k in range(3):
             train, test = [runs[k]], runs[:k] + runs[k + 1:]
             sc = screen_effect(DRAKE_EFFECTS["stribeck"], train, test, BASE)
-            hi = physical_bounds(DRAKE_EFFECTS["stribeck"], BASE, peak_force=peak_drive_force(train))["stribeck_extra"][1]
+            bounds = physical_bounds(DRAKE_EFFECTS["stribeck"], BASE, peak_force=peak_drive_force(train))
+            hi = bounds["stribeck_extra"][1]
             assert hi == pytest.approx(STRIBECK_EXTRA_PEAKS * max(np.max(np.abs(r.force)) for r in train))
             if path == slow:
                 assert abs(sc.start["stribeck_extra"]) > hi and not sc.inside and not sc.passes, k
