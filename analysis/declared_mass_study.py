@@ -18,7 +18,7 @@ import json
 import math
 import sys
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, name_list
 from drakecreep.gap import benchmark as B
 from drakecreep.params import with_value
 
@@ -45,8 +45,9 @@ def case(text):
     return seed, withheld, axis, factor
 
 
-def run_case(seed, withheld, axis, factor, progress=None):
-    """The benchmark row of one dataset whose params file has ``table.mass`` times ``factor``."""
+def run_case(seed, withheld, axis, factor, progress=None, uncertain=None):
+    """The benchmark row of one dataset whose params file has ``table.mass`` times ``factor`` (``uncertain``: the
+    fields the nominal fit takes as uncertain, :func:`drakecreep.gap.benchmark.evaluate`; None its default)."""
     ds = B.generate_datasets([(seed, withheld, "drakecreep", axis)])[0]
     declared = ds.train[0].meta.params
     wrong = with_value(declared, "table.mass", factor * declared.table.mass)
@@ -55,19 +56,29 @@ def run_case(seed, withheld, axis, factor, progress=None):
         return [dataclasses.replace(r, meta=dataclasses.replace(r.meta, params=wrong)) for r in runs]
 
     ds = dataclasses.replace(ds, train=swap(ds.train), test=swap(ds.test), audit=swap(ds.audit))
-    row = B.evaluate(ds, progress=progress)
-    row.update(mass_factor=factor, declared_table_mass=wrong.table.mass, true_table_mass=declared.table.mass)
+    row = B.evaluate(ds, progress=progress, uncertain=uncertain)
+    row.update(mass_factor=factor, declared_table_mass=wrong.table.mass, true_table_mass=declared.table.mass,
+               uncertain=None if uncertain is None else list(uncertain))
     return row
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("cases", nargs="+", type=case, metavar="SEED:WITHHELD:AXIS:FACTOR")
+    ap.add_argument("--uncertain", metavar="PATHS", help="the fields the nominal fit takes as uncertain, comma "
+                    "separated (default: diagnose_drive's), e.g. table.seal_force,nut.preload_torque,"
+                    "friction.viscous,table.mass")
     args = ap.parse_args(argv)
+    uncertain = None
+    if args.uncertain is not None:
+        try:
+            uncertain = B.check_uncertain(("drakecreep",), name_list(args.uncertain.split(","), "--uncertain"))
+        except InputError as e:
+            ap.exit(2, f"{ap.prog}: error: {e}\n")
     failed = 0
     for seed, withheld, axis, factor in args.cases:
         try:
-            row = run_case(seed, withheld, axis, factor,
+            row = run_case(seed, withheld, axis, factor, uncertain=uncertain,
                            progress=lambda line: print(f"[{seed} x{factor}] {line}", file=sys.stderr, flush=True))
         except InputError as e:
             failed += 1

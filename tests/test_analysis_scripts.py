@@ -434,11 +434,14 @@ def test_diagnose_dataset_keeps_going_past_a_failing_dataset(tmp_path, monkeypat
 
 
 def test_declared_mass_study_refuses_bad_cases_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
-    """``analysis/declared_mass_study.py``: a malformed case, an unknown effect, a factor out of range and a seed of
-    the held-out set each exit 2 with one line before any dataset is generated."""
+    """``analysis/declared_mass_study.py``: a malformed case, an unknown effect, a factor out of range, a seed of the
+    held-out set and an uncertain field it cannot fit (or given twice) each exit 2 with one line before any dataset
+    is generated."""
     cases = ((["114000:null:flexible"], "SEED:WITHHELD:AXIS"), (["114000:nothing:flexible:0.85"], "nothing"),
              (["114000:null:flexible:x"], "factor"), (["114000:null:flexible:0"], "factor"),
-             ([f"{HELD_OUT}:null:rigid:1.15"], str(HELD_OUT)))
+             ([f"{HELD_OUT}:null:rigid:1.15"], str(HELD_OUT)),
+             (["114000:null:flexible:0.85", "--uncertain", "table.bogus"], "table.bogus"),
+             (["114000:null:flexible:0.85", "--uncertain", "table.mass,table.mass"], "given twice"))
     _refused_in_one_line("declared_mass_study.py", cases, monkeypatch, capsys, tmp_path)
 
 
