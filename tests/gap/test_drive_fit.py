@@ -605,6 +605,27 @@ def test_augmented_params_file_feeds_simulate_margins_and_report(lead_case, tmp_
     capsys.readouterr()
 
 
+def test_a_claim_made_on_the_params_files_table_mass_says_how_to_check_it(delay_case, lead_case, coulomb_case):
+    """A claim decided on the drive force with ``table.mass`` taken from the params file carries a note (summary,
+    report, JSON) naming the mass and the ``--uncertain`` list that fits it too: a mass 15 % off made development
+    nulls claim a delay or a slow ripple (docs/gap_benchmark.md, 3cu). No note when nothing is claimed, when the
+    mass was fitted, or for a lead error decided on the screw's transmission (runs with a linear scale)."""
+    _, result = delay_case
+    assert result.claimed == ("control_delay",)
+    (note,) = result.mass_note()
+    assert f"control_delay rests on the params file's table.mass ({RIG.table.mass:.4g} kg)" in note
+    assert note.endswith("--uncertain table.seal_force,table.mass")
+    assert "  " + note in result.summary() and result.to_json()["mass_note"] == [note]
+    mass = drive_fit.FittedParameter("table.mass", RIG.table.mass, 0.9 * RIG.table.mass, 1.1 * RIG.table.mass,
+                                     RIG.table.mass, "kg")
+    assert dataclasses.replace(result, fitted=result.fitted + (mass,)).mass_note() == []
+    assert coulomb_case[1].claimed == () and coulomb_case[1].mass_note() == []
+    lead = lead_case[1]
+    assert lead.claimed == ("lead_error",)
+    assert "transmission" in next(c for c in lead.candidates if c.name == "lead_error").replay  # the runs' scale
+    assert lead.mass_note() == []
+
+
 @pytest.fixture
 def no_replay(monkeypatch):
     """Any closed-loop replay fails: the checks must come before the work."""
