@@ -6,8 +6,9 @@ and current loop, and only its friction levels off (``DECLARED_SPREAD``). A user
 fixture or workpiece left out of ``table.mass``, a catalogue inertia. The diagnosis fits the friction levels by
 default (``table.mass`` only with ``--uncertain ...,table.mass``) and warns of a mass only beyond a factor of 2
 (``MASS_WARNING``). This runs the benchmark's own scoring (:func:`drakecreep.gap.benchmark.evaluate`) on
-development datasets with ``table.mass`` multiplied by a factor in every run's params file. One JSON line per
-case: the row's claims, its audit and, for comparison, nothing else changed. Run from the repository root:
+development datasets with ``table.mass`` multiplied by a factor in every run's params file, nothing else changed.
+One JSON line per case: the benchmark row (claims, audit) with the factor and both masses. Run from the repository
+root:
 
     PYTHONPATH=. python analysis/declared_mass_study.py 114000:null:flexible:0.85 114001:null:rigid:1.15
 """
