@@ -720,13 +720,11 @@ def _screen_numbers(sc):
     """Why a candidate was screened out, in a few words."""
     why = (f"held-out inverse-dynamics gain {sc.gain:+.3f} points of %, error x{sc.error_ratio:.3f} "
            f"(log ratio {sc.log_ratio:+.3f}, standard error {sc.log_ratio_se:.3f})")
-    if not getattr(sc, "inside", True):
-        why += "; fitted values outside the effect's bounds"
-        outside = getattr(sc, "outside", {})
-        if outside:
-            unit = {n: "" if AXIS_UNITS.get(n, "-") == "-" else " " + AXIS_UNITS[n] for n in outside}
-            why += " (" + "; ".join(f"{n} {v:.4g}{unit[n]}, allowed {lo:.4g} to {hi:.4g}{unit[n]}"
-                                    for n, (v, lo, hi) in outside.items()) + ")"
+    outside = getattr(sc, "outside", {})  # (ScreenResult.inside is its being empty)
+    if outside:
+        unit = {n: "" if AXIS_UNITS.get(n, "-") == "-" else " " + AXIS_UNITS[n] for n in outside}
+        why += "; fitted values outside the effect's bounds (" + "; ".join(
+            f"{n} {v:.4g}{unit[n]}, allowed {lo:.4g} to {hi:.4g}{unit[n]}" for n, (v, lo, hi) in outside.items()) + ")"
     c = getattr(sc, "constancy", None)
     if c is not None and not c.constant:
         why += (f"; not the same in every training run (chi2 {c.chi2:.1f} on {c.dof} degrees of freedom, "

@@ -508,7 +508,8 @@ class DriveDiagnosis:
         one line (none when nothing is claimed on the force or ``table.mass`` was fitted).
 
         On development data a table mass declared 15 % light or heavy made effect-free runs claim a 3-tick control
-        delay and a 1.65 Hz force ripple, and fitting the mass took both claims away (docs/gap_benchmark.md, 3cu). The note says how to check a claim against it; it changes no claim.
+        delay and a 1.65 Hz force ripple, and fitting the mass took both claims away (docs/gap_benchmark.md, 3cu).
+        The note says how to check a claim against it; it changes no claim.
         """
         paths = [f.path for f in self.fitted]
         # claims decided on the drive force: a lead error on runs with a linear scale is decided on the screw's

@@ -85,10 +85,8 @@ class ScreenResult:
     passes : bool
         ``log_ratio > k_se * log_ratio_se`` and the fitted values inside the effect's bounds (always True for
         :data:`NOT_SCREENED` candidates).
-    inside : bool
-        The fitted values are inside the effect's bounds.
     outside : dict
-        The fitted values that are not: ``name -> (value, lo, hi)`` (SI).
+        The fitted values outside the effect's bounds: ``name -> (value, lo, hi)`` (SI); :attr:`inside` when empty.
     log_ratio, log_ratio_se : float
         Mean and standard error of the per-run ``ln(reference / candidate)`` of the held-out errors: the
         statistic the screen is decided on, as the claim (:func:`drakecreep.gap.drake_diagnosis.paired_log_ratio`).
@@ -116,7 +114,6 @@ class ScreenResult:
     gain: float
     standard_error: float
     passes: bool
-    inside: bool = True
     log_ratio: float = float("nan")
     log_ratio_se: float = float("nan")
     constancy: object = None
@@ -124,6 +121,11 @@ class ScreenResult:
     alternative_start: dict = field(default_factory=dict)
     reference_alternative: dict = field(default_factory=dict)
     outside: dict = field(default_factory=dict)
+
+    @property
+    def inside(self):
+        """The fitted values are inside the effect's bounds (none is in :attr:`outside`)."""
+        return not self.outside
 
     @property
     def error_ratio(self):
@@ -380,9 +382,8 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     # the linear parameters are solved unbounded: a value outside the effect's bounds is not that effect
     outside = {n: (best[n], *bounds[n]) for n in effect.parameters
                if n in bounds and not bounds[n][0] <= best[n] <= bounds[n][1]}
-    inside = not outside
     const = constancy(tr, best, refit, effect) if effect.run_constancy else None
-    ok = inside and lr > k_se * lr_se and (const is None or const.constant)
+    ok = not outside and lr > k_se * lr_se and (const is None or const.constant)
     start = {n: best[n] for n in effect.parameters}
     if effect.shifts_nominal:
         # the nominal friction moved by what the candidate took over of it on inverse dynamics (its closed-loop
@@ -398,7 +399,7 @@ def screen_effect(effect, train, test, nominal_parameters, *, refit=("viscous", 
     own, reference_own = ({**start, **{n: best[n] for n in refit}}, {n: reference[n] for n in refit}) \
         if effect.screen_refits or effect.own_start else ({}, {})
     return ScreenResult(effect.name, start, _rms(train_err), _rms(test_err),
-                        _rms(nom_test), gain, se, bool(ok), inside, lr, lr_se, const,
+                        _rms(nom_test), gain, se, bool(ok), lr, lr_se, const,
                         {n: reference[n] for n in effect.screen_refits}, own, reference_own, outside)
 
 
