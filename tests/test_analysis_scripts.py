@@ -445,6 +445,25 @@ def test_declared_mass_study_refuses_bad_cases_and_held_out_seeds_in_one_line(tm
     _refused_in_one_line("declared_mass_study.py", cases, monkeypatch, capsys, tmp_path)
 
 
+def test_idim_mass_spread_reads_the_rigid_body_mass_of_runs_made_with_the_params_file(tmp_path, monkeypatch, capsys):
+    """``analysis/idim_mass_spread.py``: the shipped drive example, made by the project's diagram with its own params
+    file, reads an inverse-dynamics mass within 20 % of that file's rigid-body mass on every run; a malformed
+    dataset and a seed of the held-out set exit 2 with one line before any dataset is generated."""
+    import types
+
+    from drakecreep.data import example_path
+    from drakecreep.gap.runs import load_runs
+
+    cases = ((["114000:null"], "SEED:WITHHELD:AXIS"), ([f"{HELD_OUT}:null:rigid"], str(HELD_OUT)))
+    _refused_in_one_line("idim_mass_spread.py", cases, monkeypatch, capsys, tmp_path)
+    runs = load_runs(example_path("drive_lead_error.csv"), split=False)
+    row = _script_module("idim_mass_spread.py").spread(
+        types.SimpleNamespace(seed=0, axis="flexible", withheld=(), train=runs, test=(), audit=()))
+    assert row["table_mass_kg"] == runs[0].meta.params.table.mass
+    assert len(row["ratios"]) == len(runs)
+    assert all(r is not None and 0.8 < r < 1.2 for r in row["ratios"]), row["ratios"]
+
+
 def test_delay_pattern_study_refuses_bad_ticks_and_held_out_seeds_in_one_line(tmp_path, monkeypatch, capsys):
     """``analysis/delay_pattern_study.py``: a tick that is not a whole number, a negative one and a seed of the
     held-out set each exit 2 with one line before any dataset is generated; the band RMS of a pure sine at its
