@@ -12,7 +12,7 @@ cores": six runs of the project's own controller (``kind: drakecreep``) simulate
 diagram with a 2 um lead error and a 20 % higher seal force the params file lacks, 2 N of noise on ``u``
 (:func:`drakecreep.gap.drake_replay.simulated_runs`), three training and three held-out, diagnosed by
 :func:`drakecreep.gap.drive_fit.diagnose_drive` (what ``drakecreep diagnose`` runs on such data) with the
-default uncertain fields and every candidate. Every time is printed as wall and as CPU time of this
+default uncertain fields (or ``--uncertain``'s) and every candidate. Every time is printed as wall and as CPU time of this
 process (``time.process_time``; the diagnosis runs in one process, so on an idle machine the two agree, and
 on a shared one the CPU time is the fairer figure), and, against a baseline timed in the same run (one
 closed-loop replay of a run on the params file, the mean over the six), as a multiple of it with the number
@@ -22,7 +22,7 @@ With ``--validate`` it then refits the augmented model on the whole estimation f
 validation file once, parameters fixed (``analysis/emps_drake.py``'s last step): force error target < 6 %.
 
 Run from the repository root: ``PYTHONPATH=. python analysis/bench_diagnose.py [--validate] [--paper-rig]
-[--skip-emps]``
+[--skip-emps] [--uncertain PATHS] [--workers N]``
 """
 
 import argparse
@@ -30,6 +30,8 @@ import importlib.util
 import time
 from pathlib import Path
 
+from drakecreep.errors import InputError, name_list
+from drakecreep.gap.benchmark import check_uncertain
 from drakecreep.gap.drake_diagnosis import diagnose_drake
 from drakecreep.gap.drake_replay import DrakeReplay
 from drakecreep.gap.identify import idim_start
@@ -49,6 +51,9 @@ def main():
                     "the validation file once")
     ap.add_argument("--paper-rig", action="store_true", help="also time a 6-run paper-rig dataset (kind drakecreep)")
     ap.add_argument("--skip-emps", action="store_true", help="skip the EMPS diagnosis")
+    ap.add_argument("--uncertain", metavar="PATHS", help="with --paper-rig: the fields its nominal fit takes as "
+                    "uncertain, comma separated (default: diagnose_drive's), e.g. table.seal_force,"
+                    "nut.preload_torque,friction.viscous,table.mass")
     ap.add_argument("--workers", type=int, default=1, help="processes for the candidates' closed-loop fits "
                     "(default 1; the CPU time printed is this process's only, so compare wall times then)")
     args = ap.parse_args()
@@ -56,13 +61,22 @@ def main():
         ap.error(f"--workers: got {args.workers}; allowed: an integer >= 1")
     if args.skip_emps and not args.paper_rig:
         ap.error("--skip-emps: got it without --paper-rig; allowed: --skip-emps with --paper-rig (else nothing runs)")
+    uncertain = None
+    if args.uncertain is not None:
+        if not args.paper_rig:
+            ap.error(f"--uncertain: got {args.uncertain!r} without --paper-rig; allowed: with --paper-rig (the EMPS "
+                     "diagnosis, kind p_p_cascade, fits its own axis)")
+        try:
+            uncertain = check_uncertain(("drakecreep",), name_list(args.uncertain.split(","), "--uncertain"))
+        except InputError as e:
+            ap.error(str(e))
     if not args.skip_emps:
         emps(args.validate, args.workers)
     if args.paper_rig:
-        paper_rig(args.workers)
+        paper_rig(args.workers, uncertain)
 
 
-def paper_rig(workers=1):
+def paper_rig(workers=1, uncertain=None):
     from drakecreep.gap.drake_replay import simulated_runs
     from drakecreep.gap.drive_fit import diagnose_drive, replay_drakecreep
     from drakecreep.params import preset, with_value
@@ -81,7 +95,8 @@ def paper_rig(workers=1):
         replay_drakecreep(run, declared)
     base_wall, base_cpu = (time.perf_counter() - base_wall) / len(runs), (time.process_time() - base_cpu) / len(runs)
     start, cpu = time.perf_counter(), time.process_time()
-    diag = diagnose_drive(runs[0::2], runs[1::2], workers=workers, progress=lambda line: print(
+    kw = {} if uncertain is None else {"uncertain": tuple(uncertain)}
+    diag = diagnose_drive(runs[0::2], runs[1::2], workers=workers, **kw, progress=lambda line: print(
         f"  [{time.perf_counter() - start:5.0f} s] {line}", flush=True))
     wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     print("\n".join(diag.summary()))

@@ -118,6 +118,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
 @pytest.mark.parametrize("script, args, field", [
     ("bench_diagnose.py", ("--workers", "0", "--paper-rig"), "--workers: got 0"),
     ("bench_diagnose.py", ("--skip-emps",), "--skip-emps: got it without --paper-rig"),
+    ("bench_diagnose.py", ("--uncertain", "table.mass"), "--uncertain: got 'table.mass' without --paper-rig"),
+    ("bench_diagnose.py", ("--paper-rig", "--uncertain", "table.bogus"), "uncertain: got 'table.bogus'"),
     ("bench_replay_drakecreep.py", ("--repeat", "0"), "--repeat: got 0"),
     ("bench_gap_benchmark.py", ("--uncertain", "loads.constant_force"), "uncertain: got 'loads.constant_force'; "
                                                                       "allowed: only with kinds drakecreep alone"),
