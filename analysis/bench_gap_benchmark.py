@@ -29,7 +29,7 @@ from drakecreep.cli._common import names
 from drakecreep.files import write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
-                                      check_effects, check_uncertain, run_benchmark, score_rows)
+                                      check_effects, check_mass_spread, check_uncertain, run_benchmark, score_rows)
 from study_cli import read_rows, seed_list
 
 TARGETS = {"top1_snr3": ">= 90 %", "claims_on_nulls": "<= 5 %", "out_of_library_unexplained": ">= 90 %",
@@ -111,6 +111,9 @@ def main():
                     help="kinds drakecreep alone: the fields its nominal fit takes as uncertain, comma separated "
                          "(default diagnose_drive's: table.seal_force,nut.preload_torque,friction.viscous); a "
                          "development study of another nominal, e.g. with loads.constant_force")
+    ap.add_argument("--mass-spread", type=float, default=0.0, metavar="S",
+                    help="kind drakecreep: each params file's table.mass is the truth's times exp(N(0, S)), e.g. "
+                         "0.15 (a workpiece left out or guessed; each row carries its mass_factor); default 0, exact")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
     ap.add_argument("--skip-seeds", metavar="SEEDS", type=seed_list, default=(),
@@ -145,6 +148,7 @@ def main():
     try:  # run_benchmark's checks, before any dataset is generated
         check_uncertain(args.kinds, uncertain)
         check_effects(args.kinds, effects)
+        check_mass_spread(args.mass_spread, args.kinds, "--mass-spread")
     except InputError as err:
         ap.error(str(err))
     done = []
@@ -152,25 +156,28 @@ def main():
         earlier = read_rows(ap, "--resume", args.resume)
         if earlier.get("seed") != seed:
             raise SystemExit(f"--resume: {args.resume} has seeds from {earlier.get('seed')}; this run's are from {seed}")
+        if float(earlier.get("mass_spread", 0.0)) != args.mass_spread:
+            ap.error(f"--resume: {args.resume!r} was run with --mass-spread {earlier.get('mass_spread', 0.0)}; "
+                     f"allowed: the same --mass-spread (got {args.mass_spread})")
         done = earlier["datasets"]
     t0 = time.perf_counter()
 
     def write(row, rows):
         if args.json:
-            write_text(args.json, json.dumps({"seeds": args.seeds, "seed": seed, "complete": False,
-                                              "datasets": rows}, indent=1, default=str))
+            write_text(args.json, json.dumps({"seeds": args.seeds, "seed": seed, "mass_spread": args.mass_spread,
+                                              "complete": False, "datasets": rows}, indent=1, default=str))
 
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
                         progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library,
-                        uncertain=uncertain, effects=effects, skip=args.skip_seeds)
+                        uncertain=uncertain, effects=effects, skip=args.skip_seeds, mass_spread=args.mass_spread)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, {', '.join(args.kinds)}, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "
           f"effects short of {args.n_per_effect} datasets with SNR >= 3: {res['short'] or 'none'}")
     report(res)
     if args.json:
-        write_text(args.json, json.dumps(dict(res, seeds=args.seeds, seed=seed, complete=True), indent=1,
-                                         default=str))
+        write_text(args.json, json.dumps(dict(res, seeds=args.seeds, seed=seed, mass_spread=args.mass_spread,
+                                              complete=True), indent=1, default=str))
 
 
 if __name__ == "__main__":

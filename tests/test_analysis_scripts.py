@@ -104,6 +104,12 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     (tmp_path / "bad.json").write_text('{"datasets": [1]}')
     bad = _bench("--score", str(tmp_path / "bad.json"), cwd=tmp_path)
     assert bad.returncode == 2 and "--score" in bad.stderr and "Traceback" not in bad.stderr
+    # rows drawn with another --mass-spread are not resumed (their params files declare other masses)
+    (tmp_path / "spread.json").write_text(json.dumps({"seeds": "heldout", "seed": HELDOUT_SEEDS, "mass_spread": 0.15,
+                                                      "datasets": [{"seed": HELDOUT_SEEDS + 3}]}))
+    spread = _bench("--kinds", "drakecreep", "--resume", str(tmp_path / "spread.json"), cwd=tmp_path)
+    assert spread.returncode == 2 and spread.stderr.strip().splitlines()[-1].endswith(
+        "was run with --mass-spread 0.15; allowed: the same --mass-spread (got 0.0)")
     rows = ANALYSIS / "gap_benchmark_drakecreep_heldout3.json"
     data = json.loads(rows.read_text())
     (tmp_path / "a.json").write_text(json.dumps(dict(data, datasets=data["datasets"][:2])))
@@ -125,6 +131,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
                                                                       "allowed: only with kinds drakecreep alone"),
     ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,backlash"), "effects: got 'backlash'"),
     ("bench_gap_benchmark.py", ("--skip-seeds", "104000"), "--skip-seeds: got (104000,) with --seeds heldout"),
+    ("bench_gap_benchmark.py", ("--mass-spread", "0.15"), "--mass-spread: got 0.15; allowed: 0 unless kinds"),
+    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--mass-spread", "0.7"), "--mass-spread: got 0.7"),
     ("bench_gap_benchmark.py", ("--seeds", "dev", "--skip-seeds", "114003-114000"), "'114003-114000': seeds >= 0"),
 ])
 def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, monkeypatch, capsys, script, args, field):

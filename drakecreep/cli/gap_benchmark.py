@@ -30,6 +30,9 @@ def add_parser(subparsers):
     p.add_argument("--samples", type=samples, default=3000, help="samples per run at 1 kHz (default 3000)")
     p.add_argument("--effects", help="comma-separated candidates of the diagnosis of the one kind given (default: "
                                      "all; a subset is for quick checks: the reported figures use all)")
+    p.add_argument("--mass-spread", type=float, default=0.0, metavar="S",
+                   help="kind drakecreep: each params file's table.mass is the truth's times exp(N(0, S)), e.g. "
+                        "0.15 for a workpiece left out or guessed (default 0: the truth's mass)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
@@ -56,15 +59,17 @@ def run(args):
     """Run and print the scores (each dataset takes minutes: its kind's diagnosis fits every candidate)."""
     from drakecreep.errors import InputError
     from drakecreep.gap.benchmark import (DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, check_effects, check_kinds,
-                                          run_benchmark)
+                                          check_mass_spread, run_benchmark)
 
     kinds = DEFAULT_KINDS if args.kinds is None else check_kinds(args.kinds, "--kinds")
     if args.n_per_effect + args.n_null + args.n_ool == 0:
         raise InputError("--n-per-effect/--n-null/--n-ool", 0, "at least one dataset")
     effects = None if args.effects is None else check_effects(kinds, names(args.effects, "--effects"), "--effects")
+    mass_spread = check_mass_spread(args.mass_spread, kinds, "--mass-spread")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
     res = run_benchmark(seed=seed, kinds=kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
-                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects)
+                        n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects,
+                        mass_spread=mass_spread)
     if args.json:
         print_json(res)
         return 0

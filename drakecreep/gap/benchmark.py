@@ -79,6 +79,7 @@ __all__ = [
     "BENCHMARK_KINDS",
     "DEFAULT_KINDS",
     "DECLARED_SPREAD",
+    "MAX_MASS_SPREAD",
     "category_of",
     "expected_of",
     "declared_params",
@@ -96,6 +97,7 @@ __all__ = [
     "evaluate",
     "check_kinds",
     "check_effects",
+    "check_mass_spread",
     "check_uncertain",
     "run_benchmark",
     "score_rows",
@@ -172,6 +174,9 @@ DEFAULT_KINDS = ("p_p_cascade",)
 #: is off (seal force, nut preload, viscous: what ``diagnose_drive`` fits by default). Assumption: a user's
 #: catalogue or commissioning values, about 15 % off.
 DECLARED_SPREAD = 0.15
+#: The largest ``mass_spread`` (:func:`generate_datasets`): a log-normal of 0.5 puts one params file in twenty
+#: off by a factor 2.7, beyond the diagnosis's mass warning (``MASS_WARNING``).
+MAX_MASS_SPREAD = 0.5
 #: Table position [m] at which a drawn truth's chain has its drawn stiffness and damping (:data:`truth.CHAIN_AT`);
 #: the declared chain is the truth's there and, since session 75, everywhere (both shafts soften along the screw).
 DECLARED_AT = T.CHAIN_AT
@@ -263,6 +268,9 @@ class Dataset:
     audit: list
     snr: float = 0.0
     twin_train: list = field(default_factory=list)
+    #: the factor by which the declared params file's ``table.mass`` is off the truth's (``drakecreep`` kind,
+    #: :func:`generate_datasets`' ``mass_spread``; 1.0: exact)
+    mass_factor: float = 1.0
 
     @property
     def kind(self):
@@ -311,7 +319,7 @@ def _draw(seed, withheld, kind, axis, n_samples):
     return tr, refs, pulses, drift, noise
 
 
-def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
+def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24, mass_spread=0.0):
     """Generate datasets in batches (one vectorised truth simulation per ``chunk`` datasets).
 
     Parameters
@@ -322,11 +330,17 @@ def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
         Samples per run.
     chunk : int
         Datasets per batch.
+    mass_spread : float
+        ``drakecreep`` kind: the declared params file's ``table.mass`` is the truth's times ``exp(N(0,
+        mass_spread))``, drawn from the dataset's seed apart from every other draw (a fixture or workpiece the
+        user left out or guessed; :attr:`Dataset.mass_factor`). 0 (the default): the truth's mass, as every
+        benchmark row before session 88. At most :data:`MAX_MASS_SPREAD`.
 
     Returns
     -------
     list of Dataset
     """
+    mass_spread = check_mass_spread(mass_spread)
     out = []
     specs = list(specs)
     for c in range(0, len(specs), chunk):
@@ -340,11 +354,17 @@ def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
         sims = iter(T.simulate_batch(jobs))
         for (sd, w, k, a), (tr, refs, pulses, drift, noise) in zip(part, draws):
             runs = T.make_runs(tr, refs, pulses, next(sims))
+            mass_factor = 1.0
             if k == "drakecreep":  # the params file its user would write, friction levels off by a drawn factor
                 declared = declared_params(tr, np.random.default_rng((sd, 1)))
+                if mass_spread > 0.0:  # its own stream: the friction draws stay those of mass_spread 0
+                    mass_factor = float(np.exp(np.random.default_rng((sd, 2)).normal(0.0, mass_spread)))
+                    declared = dataclasses.replace(declared, table=dataclasses.replace(
+                        declared.table, mass=mass_factor * declared.table.mass))
                 runs = [dataclasses.replace(r, meta=dataclasses.replace(r.meta, params=declared)) for r in runs]
             i, j = N_TRAIN, N_TRAIN + N_TEST
-            ds = Dataset(seed=sd, withheld=tuple(w), truth=tr, train=runs[:i], test=runs[i:j], audit=runs[j:])
+            ds = Dataset(seed=sd, withheld=tuple(w), truth=tr, train=runs[:i], test=runs[i:j], audit=runs[j:],
+                         mass_factor=mass_factor)
             if w:
                 twin = next(sims)
                 ds.twin_train = T.make_runs(tr, refs[:i], pulses[:i], {key: v[:i] for key, v in twin.items()})
@@ -353,7 +373,7 @@ def generate_datasets(specs, n_samples=N_SAMPLES, chunk=24):
     return out
 
 
-def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_samples=N_SAMPLES):
+def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_samples=N_SAMPLES, mass_spread=0.0):
     """Generate one dataset.
 
     Parameters
@@ -366,6 +386,8 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
         Design index.
     n_samples : int
         Samples per run.
+    mass_spread : float
+        The spread of the declared ``table.mass`` (:func:`generate_datasets`; 0: exact).
 
     Returns
     -------
@@ -375,7 +397,7 @@ def generate_dataset(seed, withheld=None, kind=None, axis=None, index=None, n_sa
     withheld = tuple(d[0] if withheld is None else withheld)
     kind = d[1] if kind is None else kind
     axis = d[2] if axis is None else axis
-    return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples)[0]
+    return generate_datasets([(seed, withheld, kind, axis)], n_samples=n_samples, mass_spread=mass_spread)[0]
 
 
 def dataset_spec(text):
@@ -606,7 +628,8 @@ def _row(ds, claimed, ranking, **fields):
             "kind": ds.kind, "axis": ds.axis, "snr": ds.snr, "claimed": claimed,
             "first_passing": next((r["effect"] for r in ranking if r["passes"]), None),
             "top3": [r["effect"] for r in ranking[:3]], "ranking": ranking,
-            "truth": {k: v for k, v in ds.truth.effects.items()}, **fields}
+            "truth": {k: v for k, v in ds.truth.effects.items()},
+            **({"mass_factor": ds.mass_factor} if ds.kind == "drakecreep" else {}), **fields}
 
 
 def _audit_fields(a, claimed):
@@ -893,6 +916,28 @@ def check_effects(kinds, effects, field="effects"):
     return effects
 
 
+def check_mass_spread(mass_spread, kinds=None, field="mass_spread"):
+    """``mass_spread`` as a float, checked for :func:`generate_datasets` and :func:`run_benchmark`.
+
+    Raises
+    ------
+    InputError
+        Unless a finite number in [0, :data:`MAX_MASS_SPREAD`]; or above 0 with ``kinds`` given without
+        ``drakecreep`` (only that kind's datasets come with a params file).
+    """
+    try:
+        value = float(mass_spread)
+    except (TypeError, ValueError):
+        value = math.nan
+    if isinstance(mass_spread, bool) or not 0.0 <= value <= MAX_MASS_SPREAD:
+        raise InputError(field, mass_spread, f"a number in [0, {MAX_MASS_SPREAD}] (the log-normal spread of the "
+                         "declared table mass; 0: exact)")
+    if value > 0.0 and kinds is not None and "drakecreep" not in kinds:
+        raise InputError(field, mass_spread, "0 unless kinds include drakecreep (only its datasets have a params "
+                         "file)")
+    return value
+
+
 def check_uncertain(kinds, uncertain):
     """``uncertain`` as a tuple, checked for :func:`run_benchmark` (None stays None: ``diagnose_drive``'s default).
 
@@ -917,7 +962,7 @@ def check_uncertain(kinds, uncertain):
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
-                  done=(), shard=(0, 1), library=None, uncertain=None, skip=()):
+                  done=(), shard=(0, 1), library=None, uncertain=None, skip=(), mass_spread=0.0):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -946,6 +991,9 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         Seeds of datasets neither generated nor diagnosed, and not counted: a development study's fresh datasets
         beyond the ones an earlier study already looked at (a library effect's next datasets with SNR >= 3 take
         their place, and a null's or an effect's outside the library the next of its kind).
+    mass_spread : float
+        The log-normal spread of the ``drakecreep`` kind's declared ``table.mass`` (:func:`generate_datasets`;
+        default 0: the truth's mass); each row carries its ``mass_factor``.
 
     Returns
     -------
@@ -956,6 +1004,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     """
     kinds = check_kinds(kinds)
     uncertain = check_uncertain(kinds, uncertain)
+    mass_spread = check_mass_spread(mass_spread, kinds)
     effects = check_effects(kinds, effects)
     if (not isinstance(shard, tuple) or len(shard) != 2 or not all(isinstance(x, int) for x in shard)
             or not 0 <= shard[0] < shard[1]):
@@ -992,7 +1041,7 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
         if not part:
             break
         say(f"generating {len(part)} datasets (candidate {pos}/{len(specs)})")
-        for ds in generate_datasets(part, n_samples=n_samples, chunk=chunk):
+        for ds in generate_datasets(part, n_samples=n_samples, chunk=chunk, mass_spread=mass_spread):
             key = (ds.kind, ds.withheld)
             if ds.category == "library":
                 if len(kept.get(key, [])) >= n_per_effect:

@@ -72,7 +72,9 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
                                           (["--effects", "backlash"], "--effects"),
                                           (["--kinds", "drakecreep", "--effects", "position_friction"], "--effects"),
                                           (["--kinds", "drakecreep", "p_p_cascade", "--effects", "stribeck"],
-                                           "one --kinds")])
+                                           "one --kinds"),
+                                          (["--mass-spread", "0.15"], "--mass-spread: got 0.15; allowed: 0 unless"),
+                                          (["--kinds", "drakecreep", "--mass-spread", "-0.1"], "--mass-spread: got")])
 def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv, needle):
     assert cli.main(["gap-benchmark"] + argv) == 2
     err = capsys.readouterr().err
@@ -85,7 +87,9 @@ def test_gap_benchmark_rejects_what_it_cannot_benchmark_before_work(capsys, argv
                                          (["--samples", "99999999999"], "--samples"),
                                          # each null and out-of-library dataset was drawn, diagnosed and scored twice
                                          (["--kinds", "p_p_cascade", "p_p_cascade", "--n-per-effect", "1"], "--kinds"),
-                                         (["--kinds", "drakecreep", "p_p_cascade", "drakecreep"], "--kinds")])
+                                         (["--kinds", "drakecreep", "p_p_cascade", "drakecreep"], "--kinds"),
+                                         (["--kinds", "drakecreep", "--mass-spread", "x"], "--mass-spread"),
+                                         (["--kinds", "drakecreep", "--mass-spread", "0.51"], "--mass-spread")])
 def test_gap_benchmark_refuses_sizes_that_never_end_before_starting(capsys, monkeypatch, argv, field):
     import drakecreep.gap.benchmark as benchmark
 

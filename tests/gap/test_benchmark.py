@@ -202,6 +202,36 @@ def test_a_drakecreep_rows_true_shrink_is_the_truths_values_in_the_nominal_param
     assert "true" not in row["audit"] and row["true_shrink"] is None
 
 
+def test_a_mass_spread_puts_the_declared_table_mass_off_and_nothing_else():
+    """``mass_spread``: the drakecreep kind's params file declares the table mass off by a factor drawn from the
+    seed on its own stream, so the runs and the friction levels declared are those of the exact file; the row says
+    the factor; the p_p_cascade kind, which has no params file, is left as it is; bad spreads are refused."""
+    from drakecreep.gap import benchmark
+
+    exact = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="drakecreep", axis="rigid", n_samples=600)
+    off = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="drakecreep", axis="rigid", n_samples=600,
+                           mass_spread=0.15)
+    assert exact.mass_factor == 1.0 and off.mass_factor != 1.0 and abs(math.log(off.mass_factor)) < 5 * 0.15
+    p0, p1 = exact.train[0].meta.params, off.train[0].meta.params
+    assert p1.table.mass == pytest.approx(off.mass_factor * p0.table.mass, rel=1e-12)
+    assert p1.table.seal_force == p0.table.seal_force and p1.friction.viscous == p0.friction.viscous
+    assert p1.nut.preload_torque == p0.nut.preload_torque and p1.motor.rotor_inertia == p0.motor.rotor_inertia
+    for a, b in zip(exact.train + exact.test + exact.audit, off.train + off.test + off.audit):
+        assert np.array_equal(a.force, b.force) and b.meta.params is p1
+    assert benchmark._row(off, [], [])["mass_factor"] == off.mass_factor
+    again = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="drakecreep", axis="rigid", n_samples=600,
+                             mass_spread=0.15)
+    assert again.mass_factor == off.mass_factor  # drawn from the seed
+    pp = generate_dataset(DEV_SEEDS + 5, withheld=(), kind="p_p_cascade", axis="rigid", n_samples=600,
+                          mass_spread=0.15)
+    assert pp.mass_factor == 1.0 and "mass_factor" not in benchmark._row(pp, [], [])
+    for bad in (-0.1, 0.6, math.nan, "x", True):
+        with pytest.raises(InputError, match="^mass_spread: got .*; allowed: a number in"):
+            benchmark.check_mass_spread(bad)
+    with pytest.raises(InputError, match="allowed: 0 unless kinds include drakecreep"):
+        run_benchmark(kinds=("p_p_cascade",), mass_spread=0.15, n_per_effect=0, n_null=1, n_ool=0)
+
+
 def test_a_drakecreep_dataset_is_diagnosed_by_diagnose_drive_and_audited():
     """One short null of the drakecreep kind (two cheap candidates and one uncertain field, to stay fast: 42 s
     against 100-114 s with the three default fields, session 65): the runs carry the declared params file, the row
