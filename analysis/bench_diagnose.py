@@ -12,8 +12,8 @@ cores": six runs of the project's own controller (``kind: drakecreep``) simulate
 diagram with a 2 um lead error and a 20 % higher seal force the params file lacks, 2 N of noise on ``u``
 (:func:`drakecreep.gap.drake_replay.simulated_runs`), three training and three held-out, diagnosed by
 :func:`drakecreep.gap.drive_fit.diagnose_drive` (what ``drakecreep diagnose`` runs on such data) with the
-default uncertain fields (or ``--uncertain``'s) and every candidate. Every time is printed as wall and as CPU time of this
-process (``time.process_time``; the diagnosis runs in one process, so on an idle machine the two agree, and
+default uncertain fields (or ``--uncertain``'s) and every candidate. Every time is printed as wall and as CPU
+time of this process (``time.process_time``; the diagnosis runs in one process, so on an idle machine the two agree, and
 on a shared one the CPU time is the fairer figure), and, against a baseline timed in the same run (one
 closed-loop replay of a run on the params file, the mean over the six), as a multiple of it with the number
 of replays the diagnosis made: the figure to compare between machines and loads.
