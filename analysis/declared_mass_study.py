@@ -22,6 +22,7 @@ import sys
 from drakecreep.errors import InputError, name_list
 from drakecreep.gap import benchmark as B
 from drakecreep.params import with_value
+from study_cli import dev_spec
 
 __all__ = ["case", "run_case", "main"]
 
@@ -30,10 +31,7 @@ def case(text):
     """``SEED:WITHHELD:AXIS:FACTOR`` (:func:`drakecreep.gap.benchmark.dataset_spec` and a factor 0.1-10 on
     ``table.mass``) -> ``(seed, withheld, axis, factor)``; a development seed only."""
     spec, _, factor = str(text).rpartition(":")
-    try:
-        seed, withheld, axis = B.dataset_spec(spec)
-    except InputError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
+    seed, withheld, axis = dev_spec(spec)
     try:
         factor = float(factor)
     except ValueError:
@@ -41,8 +39,6 @@ def case(text):
     if not 0.1 <= factor <= 10.0:
         raise argparse.ArgumentTypeError(f"factor: got {text.rpartition(':')[2]!r} in {text!r}; allowed: a number "
                                          "0.1-10 after SEED:WITHHELD:AXIS, e.g. 114000:null:flexible:0.85")
-    if seed >= B.HELDOUT_SEEDS:
-        raise argparse.ArgumentTypeError(f"seed: got {seed}; allowed: a development seed below {B.HELDOUT_SEEDS}")
     return seed, withheld, axis, factor
 
 

@@ -16,9 +16,9 @@ import argparse
 import json
 import sys
 
-from drakecreep.errors import InputError
 from drakecreep.gap import benchmark as B
 from drakecreep.gap.drive_fit import inverse_dynamics_mass, rigid_mass
+from study_cli import dev_spec
 
 __all__ = ["spread", "main"]
 
@@ -37,12 +37,7 @@ def spread(ds):
 
 
 def _spec(text):
-    try:
-        seed, withheld, axis = B.dataset_spec(text)
-    except InputError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
-    if seed >= B.HELDOUT_SEEDS:
-        raise argparse.ArgumentTypeError(f"seed: got {seed}; allowed: a development seed below {B.HELDOUT_SEEDS}")
+    seed, withheld, axis = dev_spec(text)
     return seed, withheld, "drakecreep", axis
 
 

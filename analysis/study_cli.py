@@ -81,6 +81,20 @@ def out_and_cases(description, case, metavar, help, argv=None):
     return a.out, a.datasets
 
 
+def dev_spec(text):
+    """An argparse ``type`` reading ``SEED:WITHHELD:AXIS`` (:func:`drakecreep.gap.benchmark.dataset_spec`) into
+    ``(seed, withheld, axis)``, a development seed only (below ``HELDOUT_SEEDS``: those are spent in pre-registered
+    runs alone)."""
+    try:
+        seed, withheld, axis = benchmark.dataset_spec(text)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    if seed >= benchmark.HELDOUT_SEEDS:
+        raise argparse.ArgumentTypeError(f"seed: got {seed}; allowed: a development seed below "
+                                         f"{benchmark.HELDOUT_SEEDS}")
+    return seed, withheld, axis
+
+
 def case_type(effects, axis, example):
     """An argparse ``type`` reading ``SEED:EFFECT`` (``axis`` "none"), ``SEED:EFFECT:AXIS`` ("required") or
     ``SEED:EFFECT[:AXIS]`` ("optional") into a tuple of its texts (a left-out axis None), ``EFFECT`` one of
