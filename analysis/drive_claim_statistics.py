@@ -36,8 +36,20 @@ written, to be decided on rows written after it):
   wrong first claim): the product's rule since (``drive_fit._held_out``; rows written from then on give it as their
   own first claims).
 
-Candidates are taken in the rows' order (by held-out gain), the first that passes is the first claim. Only development rows should inform a change of the rule; held-out rows
-are recounted to report, never to choose.
+Two more take the product's own verdicts from the rows (each candidate's ``passes``, whatever rule the row's code
+used, the lead error decided on the screw's transmission included) and weigh the training gain as an effect size
+(study 3cw, declared in session 89 on the rows then written, to be decided on rows written after it):
+
+* ``product``: the first candidate of the ranking that the row itself passed (a self-check: it must be the row's
+  ``first_passing``);
+* ``product_share_20``: the same, among candidates whose training gain (the relative decrease of the training
+  force SSE, of the screw's transmission SSE for a lead error decided there) is at least
+  :data:`MIN_TRAIN_SHARE`: a cause explains at least a fifth of the training error the params file leaves.
+
+Candidates are taken in the rows' order (by held-out gain), the first that passes is the first claim. Only
+development rows should inform a change of the rule; held-out rows are recounted to report, never to choose
+(3cw's floor was declared with spent held-out rows in view, so those rows cannot decide it: rows written after it
+do).
 
 Run: ``PYTHONPATH=. python analysis/drive_claim_statistics.py ROWS.json [ROWS.json ...]``
 """
@@ -52,7 +64,14 @@ from scipy import stats
 
 from drakecreep.gap.claims import ALPHA, POOLED_FACTOR, log_ratios, mean_and_standard_error, replay_test, sign_flip_p
 
-RULES = ("points_t", "sign_flip", "t_or_sign_flip", "log_ratio_t", "points_t_chi2", "pooled_chi2", "t_or_pooled_20")
+RULES = ("points_t", "sign_flip", "t_or_sign_flip", "log_ratio_t", "points_t_chi2", "pooled_chi2", "t_or_pooled_20",
+         "product", "product_share_20")
+#: product_share_20's floor on a candidate's training gain (study 3cw): declared in session 89 as a round figure
+#: between the training gains of the wrong first claims then written (0.15-8.5 %) and of the right first claims at
+#: SNR >= 3 (44 % and more); chosen having seen those rows, so they cannot test it
+MIN_TRAIN_SHARE = 0.20
+#: the rules that take the row's own verdicts (``passes``) instead of recounting a held-out statistic
+PRODUCT_RULES = ("product", "product_share_20")
 # t_or_pooled_20's factor on the run-to-run null is the product's POOLED_FACTOR (20, declared here in session 60
 # and moved to drakecreep.gap.claims when the rule was adopted)
 #: the rules that need the training fit's SSE and variance (rows from 752729f on)
@@ -114,6 +133,13 @@ def held_out_passes(rule, nominal, candidate):
     raise ValueError(rule)
 
 
+def product_claim(row, floor=0.0):
+    """The first candidate of ``row``'s ranking that the row's own code passed, among those whose training gain is
+    at least ``floor`` (None if none; the rules ``product`` and ``product_share_20``)."""
+    return next((c["effect"] for c in row["ranking"] if c.get("passes") and c.get("train_gain", 0.0) >= floor),
+                None)
+
+
 def first_claims(row):
     """``{rule: first claimed effect or None}`` of one drakecreep-kind row (``None`` for every rule when the row
     lacks the per-run errors or the run-to-run null, as the product then claims nothing; the row's own claim for
@@ -127,12 +153,15 @@ def first_claims(row):
     out = dict.fromkeys(RULES)
     if nominal is None or null is None:
         return out
+    out["product"], out["product_share_20"] = product_claim(row), product_claim(row, MIN_TRAIN_SHARE)
     tested = [(c, replay_test(np.square(nominal), np.square(c["test_force_runs"]), null)) for c in row["ranking"]
               if c.get("test_force_runs") is not None and c.get("train_gain", 0.0) > 0]
     passing = [c for c, rt in tested if rt["passes"]]
     large = {c["effect"] for c, rt in tested if rt["passes"] and rt["shrink"] > POOLED_FACTOR * null}
     trained = [training_passes(row, c) for c in passing]  # one verdict per candidate, for both training rules
     for rule in RULES:
+        if rule in PRODUCT_RULES:
+            continue
         if rule in TRAINING_RULES:
             if None in trained:
                 out[rule] = NOT_AVAILABLE
@@ -143,6 +172,13 @@ def first_claims(row):
         out[rule] = next((c["effect"] for c in pool if held_out_passes(rule, nominal, c["test_force_runs"])
                           or (rule == "t_or_pooled_20" and c["effect"] in large)), None)
     return out
+
+
+def dataset_key(row):
+    """A row's whole content: a resumed shard copies its rows verbatim into its new file, while one seed can carry
+    several different rows (a development study draws several effects on one seed, 3cr; diagnoses one dataset with
+    several params files, 3cu; or at another code, 3cn and 3cv), each a diagnosis of its own."""
+    return json.dumps(row, sort_keys=True)
 
 
 def recount(rows):
@@ -185,8 +221,9 @@ def main(argv=None):
             ap.error(f"rows: got {path!r} ({why}); allowed: a JSON file of gap-benchmark rows (a 'datasets' list)")
     seen, unique = set(), []
     for r in rows:  # a resumed shard's datasets appear in both of its files
-        if r["seed"] not in seen:
-            seen.add(r["seed"])
+        key = dataset_key(r)
+        if key not in seen:
+            seen.add(key)
             unique.append(r)
     table, scores = recount(unique)
     if not table:
@@ -201,6 +238,9 @@ def main(argv=None):
         own = row["claimed"][0] if row["claimed"] else None
         if claims["points_t"] != own:
             print(f"           (the row's own first claim is {own}: the recount of points_t differs)")
+        if claims["product"] != row.get("first_passing", claims["product"]):
+            print(f"           (the row's first passing candidate is {row['first_passing']}: the recount of product "
+                  "differs)")
     for rule in RULES:
         s = scores[rule]
         print(f"{rule:16s} top-1 at SNR >= 3: {s['right']} / {s['library']}; claims on nulls: {s['null_claims']} / "

@@ -166,7 +166,8 @@ def test_drive_claim_statistics_recounts_the_first_claims(tmp_path):
     # (the log ratios, 0.01-1.05, differ as much as the points: a log-ratio bar does not pass it either)
     assert claims == {"points_t": None, "sign_flip": "lead_error", "t_or_sign_flip": "lead_error",
                       "log_ratio_t": None, "points_t_chi2": "n/a", "pooled_chi2": "n/a",  # rows before 752729f
-                      "t_or_pooled_20": "lead_error"}  # its pooled shrink, 76 %, is 76 run-to-run nulls
+                      "t_or_pooled_20": "lead_error",  # its pooled shrink, 76 %, is 76 run-to-run nulls
+                      "product": None, "product_share_20": None}  # the row's own verdicts: none passed
     assert set(dcs.first_claims(rows[1]).values()) == {None}
     assert set(dcs.first_claims(dict(rows[0], replay_null=None)).values()) == {None}  # as the product: no null
     table, scores = dcs.recount(rows)
@@ -230,6 +231,38 @@ def test_drive_claim_statistics_lets_a_large_pooled_shrink_stand_for_the_student
     assert dcs.first_claims(null)["points_t"] is None and dcs.first_claims(null)["t_or_pooled_20"] is None
     _, scores = dcs.recount([row, null])
     assert scores["t_or_pooled_20"] == {"right": 1, "library": 1, "null_claims": 0, "nulls": 1, "wrong": 0}
+
+
+def test_drive_claim_statistics_floors_the_product_verdicts_on_the_training_gain(tmp_path):
+    """Study 3cw's rule: the row's own verdicts in ranking order, among candidates whose training gain is at least
+    a fifth. A stand-in delay that passed with 0.47 % of training gain (run 15's 109101000) is withheld and the
+    true effect ranked below it claimed; a spectrum claim on an oscillating loop is left as the row made it; an
+    exact repeat of a row (a resumed shard's) counts once, another row of the same seed does not."""
+    dcs = _script_module("drive_claim_statistics.py")
+    nominal = [21.3, 42.6, 35.7, 47.4, 47.4]
+    delay = dict(_ranked("control_delay", [21.35, 42.04, 35.22, 45.90, 46.58], train_gain=0.0047), passes=True)
+    ripple = dict(_ranked("force_ripple", [20.0, 40.0, 33.0, 44.0, 45.0], train_gain=0.25), passes=True)
+    low = dict(_ranked("stribeck", [21.0, 42.0, 35.0, 46.0, 46.0], train_gain=0.19), passes=True)
+    stand_in = dict(_drive_row(7, "out_of_library", None, 0.4, nominal, [delay], ["control_delay"]),
+                    first_passing="control_delay", withheld=["asymmetric_friction"])
+    claims = dcs.first_claims(stand_in)
+    assert (claims["product"], claims["product_share_20"]) == ("control_delay", None)
+    assert dcs.MIN_TRAIN_SHARE == 0.20
+    ranked = _drive_row(8, "library", "force_ripple", 3.5, nominal, [delay, low, ripple], ["control_delay"])
+    assert dcs.product_claim(ranked, dcs.MIN_TRAIN_SHARE) == "force_ripple"  # 0.19 is under the floor too
+    assert dcs.product_claim(ranked, 0.19) == "stribeck"
+    spectrum = _drive_row(9, "library", "control_delay", 300.0, nominal, [], ["control_delay"],
+                          oscillation={"freq_Hz": 207.0})
+    assert dcs.first_claims(spectrum)["product_share_20"] == "control_delay"
+    other = dict(stand_in, withheld=["load_friction"])  # another effect drawn on the same seed (3cr)
+    (tmp_path / "a.json").write_text(json.dumps({"datasets": [stand_in, ranked]}))
+    (tmp_path / "b.json").write_text(json.dumps({"datasets": [stand_in, other, spectrum]}))
+    out = subprocess.run([sys.executable, str(ANALYSIS / "drive_claim_statistics.py"), str(tmp_path / "a.json"),
+                          str(tmp_path / "b.json")], capture_output=True, text=True,
+                         env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
+    assert out.returncode == 0, out.stderr
+    assert "product          top-1 at SNR >= 3: 1 / 2; claims on nulls: 0 / 0; wrong first claims: 3" in out.stdout
+    assert "product_share_20 top-1 at SNR >= 3: 2 / 2; claims on nulls: 0 / 0; wrong first claims: 0" in out.stdout
 
 
 def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
