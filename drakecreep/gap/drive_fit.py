@@ -546,8 +546,10 @@ class DriveDiagnosis:
             if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
                 lines.append(f"  {c.name:18s} {c.reason}")
                 continue
+            on = " of the transmission" if "transmission" in c.replay else ""
             lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}"
-                         + (f" (fitted from the {c.start}'s values)" if c.start else ""))
+                         + (f" (fitted from the {c.start}'s values)" if c.start else "")
+                         + (f"; training gain {100 * c.train_gain:.1f} %{on}" if c.values else ""))
             if c.passes:
                 lines.append("    fitted " + ", ".join(
                     f"{k} = {v:.4g} {field_unit(self.prior, k)}" if isinstance(v, float) else f"{k} = {v}"

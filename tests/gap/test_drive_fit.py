@@ -378,6 +378,10 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
     assert best.reason.startswith("passes on the screw's transmission (linear scale)")
     assert result.transmission_null is not None and best.replay["transmission"]["shrink"] > 0.99
     assert best.replay["transmission"]["threshold"] == result.transmission_null
+    # the summary gives each fitted candidate's training gain, for the lead error the transmission's
+    (line,) = [x for x in result.summary() if x.strip().startswith("lead_error ")]
+    assert line.endswith(f"; training gain {100 * best.train_gain:.1f} % of the transmission")
+    assert best.train_gain > 0.9
     # refitted with the lead error in place, the friction level is the true one again (and well determined); the
     # error keeps the amplitude the transmission gave it (the force would refit it from its push: on runs without a
     # scale it does, test_a_dominant_missing_effect_leaves_a_usable_run_to_run_null)
