@@ -484,8 +484,29 @@ def test_declared_mass_study_refuses_bad_cases_and_held_out_seeds_in_one_line(tm
              (["114000:null:flexible:x"], "factor"), (["114000:null:flexible:0"], "factor"),
              ([f"{HELD_OUT}:null:rigid:1.15"], str(HELD_OUT)),
              (["114000:null:flexible:0.85", "--uncertain", "table.bogus"], "table.bogus"),
-             (["114000:null:flexible:0.85", "--uncertain", "table.mass,table.mass"], "given twice"))
+             (["114000:null:flexible:0.85", "--uncertain", "table.mass,table.mass"], "given twice"),
+             (["114000:null:flexible:1.5", "--field", "screw.lead"], "--field"))
     _refused_in_one_line("declared_mass_study.py", cases, monkeypatch, capsys, tmp_path)
+
+
+def test_declared_field_study_scales_the_whole_axial_chain():
+    """3cx's ``--field axial_chain``: the bearing's, the nut's and the shaft's stiffness all times the factor, so
+    the two-mass model's axial stiffness is too (at any nut position), its damping and everything else kept; a
+    single field is scaled alone."""
+    from drakecreep.model.screw import axial_damping, axial_stiffness
+    from drakecreep.params import params_to_dict, preset
+
+    m = _script_module("declared_mass_study.py")
+    p = preset()
+    wrong, declared, true = m.declare(p, "axial_chain", 1.5)
+    assert (true, declared) == (p.screw.bearing_stiffness, pytest.approx(1.5 * p.screw.bearing_stiffness))
+    for x in (0.0, 0.2, 0.45):
+        assert axial_stiffness(wrong.screw, wrong.nut, x) == pytest.approx(1.5 * axial_stiffness(p.screw, p.nut, x))
+        assert axial_damping(wrong.screw, wrong.nut, x) == pytest.approx(axial_damping(p.screw, p.nut, x))
+    changed = {k for k, v in params_to_dict(wrong)["screw"].items() if params_to_dict(p)["screw"][k] != v}
+    assert changed == {"bearing_stiffness", "youngs_modulus"}
+    inertia, declared, true = m.declare(p, "motor.rotor_inertia", 0.85)
+    assert declared == pytest.approx(0.85 * true) and params_to_dict(inertia)["nut"] == params_to_dict(p)["nut"]
 
 
 def test_idim_mass_spread_reads_the_rigid_body_mass_of_runs_made_with_the_params_file(tmp_path, monkeypatch, capsys):
