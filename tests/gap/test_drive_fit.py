@@ -248,6 +248,36 @@ def test_claims_are_withheld_when_at_least_two_and_half_the_runs_oscillate():
     assert [drive_fit.claims_withheld(dict(o, runs=k)) for k in (1, 2, 3, 4)] == [False, True, True, True]
     assert drive_fit.claims_withheld(dict(o, runs=2, of=2)) and not drive_fit.claims_withheld(dict(o, runs=1, of=2))
     assert not drive_fit.claims_withheld(dict(o, runs=2, of=5)) and drive_fit.claims_withheld(dict(o, runs=3, of=6))
+    # the held-out runs count alike (3cy): one training run of four and four held-out runs of five withhold them
+    one = dict(o, runs=1)
+    assert drive_fit.claims_withheld(dict(one, held_out={"runs": 4, "of": 5}))
+    assert not drive_fit.claims_withheld(dict(one, held_out={"runs": 1, "of": 5}))
+    assert not drive_fit.claims_withheld(dict(one, held_out={"runs": 2, "of": 5}))
+    assert drive_fit.claims_withheld(dict(o, runs=2, held_out={"runs": 0, "of": 5}))
+
+
+def test_a_delay_whose_held_out_runs_oscillate_is_claimed_on_the_spectrum_from_one_training_run(monkeypatch):
+    """3cy's case: the unstable truth (24 samples) on one training run of two and on both held-out runs, the other
+    training run from a stable loop. One training run in two is not enough to withhold the claims, both held-out
+    runs are: the delay reproducing the training run's oscillation is claimed on the held-out spectrum. With one
+    held-out run of two oscillating the claims stay sample by sample."""
+    monkeypatch.setattr(drive_fit, "DELAY_GRID", drive_fit.DELAY_GRID + (24, 32))
+    unstable = _runs(with_value(RIG, "controller.computation_delay", 24.0), seed=6)
+    stable = _runs(RIG, seed=6)
+    result = diagnose_drive([unstable[0], stable[1]], unstable[2:], uncertain=("friction.viscous",),
+                            effects=("control_delay",))
+    o = result.oscillation
+    assert (o["runs"], o["of"]) == (1, 2) and (o["held_out"]["runs"], o["held_out"]["of"]) == (2, 2)
+    assert drive_fit.claims_withheld(o) and o["spectral"]["passes"] and result.claimed == ("control_delay",)
+    assert abs(result.params.controller.computation_delay - 24.0) <= 1.0
+    assert not any("fitted on runs that oscillate" in w for w in result.warnings)  # most training runs do not
+    text = "\n".join(result.summary())
+    assert "held-out runs: 2 of 2 oscillate where the model does not" in text
+    assert "claimed: control_delay on the held-out spectrum" in text
+    once = diagnose_drive([unstable[0], stable[1]], [unstable[2], stable[3]], uncertain=("friction.viscous",),
+                          effects=("control_delay",))
+    assert once.oscillation["held_out"]["runs"] == 1 and not drive_fit.claims_withheld(once.oscillation)
+    assert "spectral" not in once.oscillation
 
 
 def test_a_stribeck_hump_is_found_from_a_params_file_whose_curve_is_flat(monkeypatch):
