@@ -265,6 +265,47 @@ def test_drive_claim_statistics_floors_the_product_verdicts_on_the_training_gain
     assert "product_share_20 top-1 at SNR >= 3: 2 / 2; claims on nulls: 0 / 0; wrong first claims: 0" in out.stdout
 
 
+def _spectral_row(seed, e0, e1, osc, same, passes, withheld=("control_delay",), keep_runs=True):
+    dec = [e0[i] - e1[i] for i in osc]
+    sp = {"nominal_nepers": e0, "delay_nepers": e1, "same_frequency": same, "spurious": 0, "passes": passes,
+          "oscillating": len(osc), "gain": float(np.mean(dec)), "of": len(e0)}
+    if keep_runs:
+        sp["oscillating_runs"] = list(osc)
+    return {"seed": seed, "kind": "drakecreep", "withheld": list(withheld), "replay_null": 0.01,
+            "oscillation": {"runs": 3, "of": 4, "spectral": sp}}
+
+
+def test_spectral_claim_recount_reads_the_detectors_criterion_run_by_run(tmp_path):
+    """Study 3cz's recount: run 14's 107106006 (3 of 5 held-out runs oscillating, decreases 7.47, 1.64 and 7.05 Np)
+    fails the product's Student bar and passes the detector's criterion (each of the three within ln 10 of the
+    measurement, the fitted model beyond it); 105106022's (one of two reproduced) fails both; a row without the
+    oscillating runs has them inferred from the largest nominal errors and its gain, or reads n/a."""
+    rec = _script_module("spectral_claim_recount.py")
+    e0, e1 = [0.13, 0.61, 7.59, 3.79, 7.08], [0.21, 0.43, 0.12, 2.15, 0.03]
+    row = _spectral_row(107106006, e0, e1, [2, 3, 4], 2, False)
+    osc = rec.oscillating_runs(row["oscillation"]["spectral"])
+    assert osc == [2, 3, 4]
+    assert (rec.spectral_passes("student", row["oscillation"]["spectral"], osc),
+            rec.spectral_passes("detector", row["oscillation"]["spectral"], osc)) == (False, True)
+    two = _spectral_row(105106022, [5.53, 8.01, 1.54, 2.41, 1.52], [2.62, 0.15, 1.29, 1.05, 1.18], [0, 1], 2,
+                        False, keep_runs=False)
+    assert rec.oscillating_runs(two["oscillation"]["spectral"]) == [0, 1]  # inferred: the two largest, its gain
+    (_, v1, _), (_, v2, _) = rec.recount([row, two])
+    assert v1 == {"student": False, "detector": True} and v2 == {"student": False, "detector": False}
+    assert rec.recount([dict(row, replay_null=None)])[0][1]["detector"] is False  # no null, no claim
+    odd = _spectral_row(1, e0, e1, [2, 3, 4], 2, False, keep_runs=False)
+    odd["oscillation"]["spectral"]["gain"] = 9.0  # no subset of the largest errors gives it
+    assert rec.recount([odd])[0][1] == {"student": "n/a", "detector": "n/a"}
+    (tmp_path / "rows.json").write_text(json.dumps({"datasets": [row, two, row]}))
+    out = subprocess.run([sys.executable, str(ANALYSIS / "spectral_claim_recount.py"), str(tmp_path / "rows.json")],
+                         capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
+    assert out.returncode == 0, out.stderr
+    assert "detector  passes 1 of 2 rows (1 of 2 with a withheld delay)" in out.stdout  # the repeat counts once
+    bad = subprocess.run([sys.executable, str(ANALYSIS / "spectral_claim_recount.py"), str(tmp_path / "nope.json")],
+                         capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(ANALYSIS.parent)))
+    assert bad.returncode == 2 and "rows: got" in bad.stderr and "Traceback" not in bad.stderr
+
+
 def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
     """Study 3br's backfill on a small test-rig dataset standing in for a regenerated benchmark one: the nominal
     fit rerun gives the row's held-out errors, so the SSE and variance are written (and give the training
