@@ -306,6 +306,17 @@ def test_spectral_claim_recount_reads_the_detectors_criterion_run_by_run(tmp_pat
     assert bad.returncode == 2 and "rows: got" in bad.stderr and "Traceback" not in bad.stderr
 
 
+def test_oscillation_share_draws_one_effect_on_consecutive_seeds_of_one_axis():
+    """3cy's probe: ``--effect`` draws that withheld effect alone on seeds SEED to SEED+N-1, ``--axis`` fixes the
+    axis; without them every effect and the nulls on their seed blocks, the axes alternating."""
+    osc = _script_module("oscillation_share.py")
+    assert osc.specs(9000, 3, "drakecreep", "control_delay", "flexible") == [
+        (9000 + j, ("control_delay",), "drakecreep", "flexible") for j in range(3)]
+    every = osc.specs(3000, 2, "drakecreep")
+    assert len(every) == 2 * (len(osc.T.WITHHELD) + 1) and {s[3] for s in every} == {"flexible", "rigid"}
+    assert (3000 + 99 * 1000 + 1, (), "drakecreep", "rigid") in every
+
+
 def test_backfill_writes_the_training_fit_only_where_it_reproduces_the_row(monkeypatch):
     """Study 3br's backfill on a small test-rig dataset standing in for a regenerated benchmark one: the nominal
     fit rerun gives the row's held-out errors, so the SSE and variance are written (and give the training
