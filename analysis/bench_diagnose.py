@@ -30,12 +30,11 @@ import importlib.util
 import time
 from pathlib import Path
 
-from drakecreep.errors import InputError, name_list
-from drakecreep.gap.benchmark import check_uncertain
 from drakecreep.gap.drake_diagnosis import diagnose_drake
 from drakecreep.gap.drake_replay import DrakeReplay
 from drakecreep.gap.identify import idim_start
 from drakecreep.gap.measured import load_emps
+from study_cli import drakecreep_uncertain
 
 
 def _study():
@@ -61,15 +60,10 @@ def main():
         ap.error(f"--workers: got {args.workers}; allowed: an integer >= 1")
     if args.skip_emps and not args.paper_rig:
         ap.error("--skip-emps: got it without --paper-rig; allowed: --skip-emps with --paper-rig (else nothing runs)")
-    uncertain = None
-    if args.uncertain is not None:
-        if not args.paper_rig:
-            ap.error(f"--uncertain: got {args.uncertain!r} without --paper-rig; allowed: with --paper-rig (the EMPS "
-                     "diagnosis, kind p_p_cascade, fits its own axis)")
-        try:
-            uncertain = check_uncertain(("drakecreep",), name_list(args.uncertain.split(","), "--uncertain"))
-        except InputError as e:
-            ap.error(str(e))
+    if args.uncertain is not None and not args.paper_rig:
+        ap.error(f"--uncertain: got {args.uncertain!r} without --paper-rig; allowed: with --paper-rig (the EMPS "
+                 "diagnosis, kind p_p_cascade, fits its own axis)")
+    uncertain = drakecreep_uncertain(ap, args.uncertain)
     if not args.skip_emps:
         emps(args.validate, args.workers)
     if args.paper_rig:

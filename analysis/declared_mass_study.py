@@ -28,10 +28,10 @@ import json
 import math
 import sys
 
-from drakecreep.errors import InputError, name_list
+from drakecreep.errors import InputError
 from drakecreep.gap import benchmark as B
 from drakecreep.params import get_value, with_value
-from study_cli import dev_spec
+from study_cli import dev_spec, drakecreep_uncertain
 
 __all__ = ["FIELDS", "case", "declare", "run_case", "main"]
 
@@ -95,12 +95,7 @@ def main(argv=None):
                     "separated (default: diagnose_drive's), e.g. table.seal_force,nut.preload_torque,"
                     "friction.viscous,table.mass")
     args = ap.parse_args(argv)
-    uncertain = None
-    if args.uncertain is not None:
-        try:
-            uncertain = B.check_uncertain(("drakecreep",), name_list(args.uncertain.split(","), "--uncertain"))
-        except InputError as e:
-            ap.exit(2, f"{ap.prog}: error: {e}\n")
+    uncertain = drakecreep_uncertain(ap, args.uncertain)
     failed = 0
     for seed, withheld, axis, factor in args.cases:
         try:

@@ -55,7 +55,6 @@ Run: ``PYTHONPATH=. python analysis/drive_claim_statistics.py ROWS.json [ROWS.js
 """
 
 import argparse
-import json
 import math
 import sys
 
@@ -63,6 +62,7 @@ import numpy as np
 from scipy import stats
 
 from drakecreep.gap.claims import ALPHA, POOLED_FACTOR, log_ratios, mean_and_standard_error, replay_test, sign_flip_p
+from study_cli import unique_rows
 
 RULES = ("points_t", "sign_flip", "t_or_sign_flip", "log_ratio_t", "points_t_chi2", "pooled_chi2", "t_or_pooled_20",
          "product", "product_share_20")
@@ -174,13 +174,6 @@ def first_claims(row):
     return out
 
 
-def dataset_key(row):
-    """A row's whole content: a resumed shard copies its rows verbatim into its new file, while one seed can carry
-    several different rows (a development study draws several effects on one seed, 3cr; diagnoses one dataset with
-    several params files, 3cu; or at another code, 3cn and 3cv), each a diagnosis of its own."""
-    return json.dumps(row, sort_keys=True)
-
-
 def recount(rows):
     """Per-dataset first claims and per-rule scores (top-1 at SNR >= 3, claims on nulls) of drakecreep rows."""
     table, scores = [], {r: {"right": 0, "library": 0, "null_claims": 0, "nulls": 0, "wrong": 0} for r in RULES}
@@ -207,24 +200,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("rows", nargs="+", help="JSON files written by analysis/bench_gap_benchmark.py --kinds drakecreep")
     args = ap.parse_args(argv)
-    rows = []
-    for path in args.rows:
-        try:
-            with open(path, encoding="utf-8") as f:
-                data = json.load(f)
-            part = list(data["datasets"])
-            if not all(isinstance(r, dict) and "seed" in r and "ranking" in r for r in part):
-                raise ValueError("a dataset without seed or ranking")
-            rows += part
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            why = e.strerror if isinstance(e, OSError) else f"no {e}" if isinstance(e, KeyError) else str(e)
-            ap.error(f"rows: got {path!r} ({why}); allowed: a JSON file of gap-benchmark rows (a 'datasets' list)")
-    seen, unique = set(), []
-    for r in rows:  # a resumed shard's datasets appear in both of its files
-        key = dataset_key(r)
-        if key not in seen:
-            seen.add(key)
-            unique.append(r)
+    unique = unique_rows(ap, args.rows, keys=("seed", "ranking"))
     table, scores = recount(unique)
     if not table:
         print("no drakecreep-kind rows with per-run held-out errors (rows written before session 55 lack them)")

@@ -29,7 +29,6 @@ Run: ``PYTHONPATH=. python analysis/spectral_claim_recount.py ROWS.json [ROWS.js
 """
 
 import argparse
-import json
 import math
 import sys
 
@@ -38,6 +37,7 @@ from scipy import stats
 
 from drakecreep.gap.claims import ALPHA
 from drakecreep.gap.residuals import OSCILLATION_RATIO
+from study_cli import unique_rows
 
 __all__ = ["RULES", "oscillating_runs", "spectral_passes", "recount", "main"]
 
@@ -101,21 +101,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("rows", nargs="+", help="JSON files written by analysis/bench_gap_benchmark.py --kinds drakecreep")
     args = ap.parse_args(argv)
-    rows, seen = [], set()
-    for path in args.rows:
-        try:
-            with open(path, encoding="utf-8") as f:
-                part = list(json.load(f)["datasets"])
-            if not all(isinstance(r, dict) and "seed" in r for r in part):
-                raise ValueError("a dataset without seed")
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            why = e.strerror if isinstance(e, OSError) else f"no {e}" if isinstance(e, KeyError) else str(e)
-            ap.error(f"rows: got {path!r} ({why}); allowed: a JSON file of gap-benchmark rows (a 'datasets' list)")
-        for r in part:  # a resumed shard's rows appear whole in both of its files
-            key = json.dumps(r, sort_keys=True)
-            if key not in seen:
-                seen.add(key)
-                rows.append(r)
+    rows = unique_rows(ap, args.rows)
     table = recount(rows)
     if not table:
         print("no rows with a held-out spectrum test")

@@ -7,7 +7,7 @@ import argparse
 import json
 import sys
 
-from drakecreep.errors import InputError
+from drakecreep.errors import InputError, name_list
 from drakecreep.gap import benchmark
 
 
@@ -27,6 +27,40 @@ def read_rows(ap, option, path, keys=("seed",), writer="--json"):
             or not all(isinstance(r, dict) and all(k in r for k in keys) for r in data["datasets"]):
         ap.error(f"{option}: {path!r} has no list of dataset rows with {', '.join(keys)}; {allowed}")
     return data
+
+
+def unique_rows(ap, paths, keys=("seed",)):
+    """The dataset rows of the rows files ``paths`` (a positional ``rows`` argument of ``ap``), each row once: a
+    resumed shard copies its rows whole into its new file, while one seed can carry several different rows (several
+    effects drawn on it, several params files, another code), each a diagnosis of its own. A file that cannot be
+    read, or whose rows lack ``keys``, is one line of ``ap.error`` (exit 2)."""
+    seen, rows = set(), []
+    for path in paths:
+        try:
+            with open(path, encoding="utf-8") as f:
+                part = list(json.load(f)["datasets"])
+            if not all(isinstance(r, dict) and all(k in r for k in keys) for r in part):
+                raise ValueError(f"a dataset without {' or '.join(keys)}")
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            why = e.strerror if isinstance(e, OSError) else f"no {e}" if isinstance(e, KeyError) else str(e)
+            ap.error(f"rows: got {path!r} ({why}); allowed: a JSON file of gap-benchmark rows (a 'datasets' list)")
+        for r in part:
+            key = json.dumps(r, sort_keys=True)
+            if key not in seen:
+                seen.add(key)
+                rows.append(r)
+    return rows
+
+
+def drakecreep_uncertain(ap, text, option="--uncertain"):
+    """The comma-separated fields ``text`` of ``option`` as the ``drakecreep`` kind's uncertain fields
+    (:func:`drakecreep.gap.benchmark.check_uncertain`), or one line of ``ap.error`` (exit 2); None stays None."""
+    if text is None:
+        return None
+    try:
+        return benchmark.check_uncertain(("drakecreep",), name_list(text.split(","), option))
+    except InputError as e:
+        ap.error(str(e))
 
 
 def shard_main(description, study, score, argv=None):
