@@ -34,3 +34,5 @@ def test_columns_of_words_are_left_aligned_and_figures_right_aligned():
     assert '<td class="text"><b>yes</b></td>' in table(["h", "i"], [("a", "<b>yes</b>")], raw=True)
     assert "<td><b>+1.5</b></td>" in table(["h", "i"], [("a", "<b>+1.5</b>")], raw=True)
     assert table(["h", "i"], [("a", "nanometres")]).count('class="text"') == 2
+    assert table(["h", "i"], [("a", "x0.942 (+0.059 vs 0.381)"), ("b", "\u00d71.5")]).count('class="text"') == 0
+    assert table(["h", "i"], [("a", "xenon")]).count('class="text"') == 2
