@@ -40,28 +40,54 @@ def _with_unit(value, unit):
     return f"{v:.4g}" + ("" if u in ("", "-") else f" {u}")
 
 
-def _figures(result):
-    import matplotlib.pyplot as plt
+def _on_transmission(candidate):
+    """Whether ``candidate`` was decided on the screw's transmission (a lead error on runs with a linear scale,
+    ``drive_fit._held_out_on_scale``), not on its held-out force gain."""
+    return "transmission" in (candidate.replay or {})
 
+
+def _gain_figure(ranked):
+    """Each candidate's held-out force gain beside its bar; green where it passes, hatched where it was decided on
+    the screw's transmission (its force gain may then sit under its bar)."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+
+    fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
+    y = np.arange(len(ranked))[::-1]
+    bars = ax.barh(y + 0.2, [c.gain for c in ranked], 0.4,
+                   label=f"held-out gain (green: passes, over its bar or by a pooled shrink > {POOLED_FACTOR:g} × its "
+                         "null)",
+                   color=["tab:green" if c.passes else "tab:gray" for c in ranked])
+    for bar, c in zip(bars, ranked):
+        if _on_transmission(c):
+            bar.set_hatch("//")
+            bar.set_edgecolor("k")
+    ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
+            label="its bar (t quantile x standard error of the per-run gains)")
+    handles, _ = ax.get_legend_handles_labels()
+    handles[0] = Patch(facecolor="tab:green", label=handles[0].get_label())  # not the first bar's hatch
+    if any(_on_transmission(c) for c in ranked):
+        handles.append(Patch(facecolor="white", edgecolor="k", hatch="//",
+                             label="decided on the screw's transmission (linear scale), not on this force gain"))
+    ax.axvline(0, color="k", lw=0.8)
+    ax.set_yticks(y, [c.name for c in ranked])
+    ax.set_xlabel("held-out force error decrease [points of %]")
+    # under the figure, whose axes and labels the layout fits first (its tight bounding box grows to hold the
+    # legend): inside the axes it hid the last candidates' bars
+    fig.tight_layout()
+    ax.legend(handles=handles, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, 0.0),
+              bbox_transform=fig.transFigure)
+    return fig
+
+
+def _figures(result):
     figs = []
     ranked = [c for c in result.candidates if c.test_errors]
     if ranked:
-        fig, ax = plt.subplots(figsize=(8, 0.45 * len(ranked) + 1.2))
-        y = np.arange(len(ranked))[::-1]
-        ax.barh(y + 0.2, [c.gain for c in ranked], 0.4,
-                label=f"held-out gain (green: passes, over its bar or by a pooled shrink > {POOLED_FACTOR:g} × its "
-                      "null)",
-                color=["tab:green" if c.passes else "tab:gray" for c in ranked])
-        ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
-                label="its bar (t quantile x standard error of the per-run gains)")
-        ax.axvline(0, color="k", lw=0.8)
-        ax.set_yticks(y, [c.name for c in ranked])
-        ax.set_xlabel("held-out force error decrease [points of %]")
-        # under the figure, whose axes and labels the layout fits first (its tight bounding box grows to hold the
-        # legend): inside the axes it hid the last candidates' bars
-        fig.tight_layout()
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=fig.transFigure)
-        figs.append((_fig_png(fig), "Which effect: each fitted candidate's held-out gain against its bar"))
+        caption = "Which effect: each fitted candidate's held-out gain against its bar"
+        if any(_on_transmission(c) for c in ranked):
+            caption += " (hatched: decided on the screw's transmission, the force's gain and bar shown beside it)"
+        figs.append((_fig_png(_gain_figure(ranked)), caption))
     if result.nominal_test_errors:
         figs.append(errors_by_run_figure([
             ("params file", result.prior_test_errors), ("fitted", result.nominal_test_errors),

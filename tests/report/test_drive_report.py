@@ -28,3 +28,28 @@ def test_an_interval_the_runs_do_not_bound_reads_so():
     assert not FittedParameter("table.seal_force", 4.0, 0.0, math.inf, 4.0, "N").bounded()
     assert FittedParameter("loads.constant_force", -2.0, -3.0, -1.0, 0.0, "N").bounded()
     assert not FittedParameter("loads.constant_force", -2.0, -math.inf, -1.0, 0.0, "N").bounded()
+
+
+def test_the_gain_chart_marks_a_lead_error_decided_on_the_transmission():
+    """A lead error claimed on the screw's transmission can sit under its force bar (the shipped example: +7.3
+    against 13.3 points); its bar is hatched and the legend says why, so the green bar under its red one reads."""
+    from types import SimpleNamespace
+
+    import matplotlib.pyplot as plt
+
+    from drakecreep.report.drive_report import _gain_figure
+
+    lead = SimpleNamespace(name="lead_error", gain=7.3, threshold=13.3, passes=True,
+                           replay={"shrink": 0.99, "transmission": {"shrink": 0.999}})
+    ripple = SimpleNamespace(name="force_ripple", gain=-0.02, threshold=0.6, passes=False, replay={"shrink": 0.03})
+    fig = _gain_figure([lead, ripple])
+    ax = fig.axes[0]
+    gains = ax.containers[0]
+    assert [b.get_hatch() for b in gains] == ["//", None]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("transmission" in t for t in labels) and len(labels) == 3
+    assert [h.get_hatch() for h in ax.get_legend().legend_handles] == [None, None, "//"]
+    plt.close(fig)
+    fig = _gain_figure([ripple])
+    assert not any("transmission" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    plt.close(fig)
