@@ -43,8 +43,10 @@ def table(header, rows, *, raw=False):
     cell = (lambda c: str(c)) if raw else (lambda c: escape(str(c)))
     cells = [[cell(c) for c in row] for row in rows]
     words = [j > 0 and _words(col, raw) for j, col in enumerate(_columns(cells, len(header)))]
-    td = (lambda j, tag, text: f'<{tag} class="text">{text}</{tag}>' if j < len(words) and words[j]
-          else f"<{tag}>{text}</{tag}>")
+
+    def td(j, tag, text):
+        return f'<{tag} class="text">{text}</{tag}>' if j < len(words) and words[j] else f"<{tag}>{text}</{tag}>"
+
     out = ["<table><tr>" + "".join(td(j, "th", escape(str(h))) for j, h in enumerate(header)) + "</tr>"]
     for row in cells:
         out.append("<tr>" + "".join(td(j, "td", c) for j, c in enumerate(row)) + "</tr>")
