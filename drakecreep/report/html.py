@@ -55,7 +55,8 @@ def table(header, rows, *, raw=False):
 
 #: A cell read as a figure: it starts with a digit, a sign, a decimal point or a factor's "x" before a digit, or
 #: it is a figure's placeholder (a dash, n/a, nan, inf).
-_FIGURE = re.compile(r"\s*([-+\u2212\u00b1.x\u00d7]?\s*[0-9.]|[-\u2013\u2014]\s*$|n/a\s*$|[-+]?(nan|inf)\b)", re.IGNORECASE)
+_FIGURE = re.compile(r"\s*([-+\u2212\u00b1.x\u00d7]?\s*[0-9.]|[-\u2013\u2014]\s*$|n/a\s*$|[-+]?(nan|inf)\b)",
+                     re.IGNORECASE)
 
 
 def _columns(cells, n):
