@@ -553,7 +553,9 @@ class DriveDiagnosis:
                 lines.append(f"  {c.name:18s} {c.reason}")
                 continue
             on = " of the transmission" if "transmission" in c.replay else ""
-            lines.append(f"  {c.name:18s} held-out gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}"
+            # a lead error decided on the transmission: its force gain and bar are shown, not what decides
+            force = " force" if on else ""
+            lines.append(f"  {c.name:18s} held-out{force} gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}"
                          + (f" (fitted from the {c.start}'s values)" if c.start else "")
                          + (f"; training gain {100 * c.train_gain:.1f} %{on}" if c.values else ""))
             if c.passes:

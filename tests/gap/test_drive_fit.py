@@ -411,6 +411,8 @@ def test_lead_error_is_claimed_and_kept_in_the_params(lead_case):
     # the summary gives each fitted candidate's training gain, for the lead error the transmission's
     (line,) = [x for x in result.summary() if x.strip().startswith("lead_error ")]
     assert line.endswith(f"; training gain {100 * best.train_gain:.1f} % of the transmission")
+    # its force gain is shown, not what decides
+    assert line.strip().startswith(f"lead_error         held-out force gain {best.gain:+.3f} points")
     assert best.train_gain > 0.9
     # refitted with the lead error in place, the friction level is the true one again (and well determined); the
     # error keeps the amplitude the transmission gave it (the force would refit it from its push: on runs without a
