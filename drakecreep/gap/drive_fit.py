@@ -366,6 +366,12 @@ class EffectResult:
     start: str = ""
     search: dict = field(default_factory=dict)
 
+    @property
+    def on_transmission(self):
+        """Whether it was decided on the screw's transmission (a lead error on runs with a linear scale,
+        :func:`_held_out_on_scale`), not on its held-out force gain."""
+        return "transmission" in self.replay
+
 
 @dataclass(frozen=True)
 class DriveDiagnosis:
@@ -521,7 +527,7 @@ class DriveDiagnosis:
         # claims decided on the drive force: a lead error on runs with a linear scale is decided on the screw's
         # transmission, which the table's inertia does not move, and a delay claimed on an oscillation's spectrum
         # is not what a wrong mass stood in for
-        on_force = [c.name for c in self.candidates if c.name in self.claimed and "transmission" not in c.replay]
+        on_force = [c.name for c in self.candidates if c.name in self.claimed and not c.on_transmission]
         if not on_force or "table.mass" in paths or claims_withheld(self.oscillation):
             return []
         return [f"note: the claim of {' + '.join(on_force)} rests on the params file's table.mass "
@@ -552,7 +558,7 @@ class DriveDiagnosis:
             if not c.values and not c.test_errors:  # not fitted, or nothing to fit: no held-out replay
                 lines.append(f"  {c.name:18s} {c.reason}")
                 continue
-            on = " of the transmission" if "transmission" in c.replay else ""
+            on = " of the transmission" if c.on_transmission else ""
             # a lead error decided on the transmission: its force gain and bar are shown, not what decides
             force = " force" if on else ""
             lines.append(f"  {c.name:18s} held-out{force} gain {c.gain:+.3f} points (bar {c.threshold:.3f}): {c.reason}"

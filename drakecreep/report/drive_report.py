@@ -40,12 +40,6 @@ def _with_unit(value, unit):
     return f"{v:.4g}" + ("" if u in ("", "-") else f" {u}")
 
 
-def _on_transmission(candidate):
-    """Whether ``candidate`` was decided on the screw's transmission (a lead error on runs with a linear scale,
-    ``drive_fit._held_out_on_scale``), not on its held-out force gain."""
-    return "transmission" in (candidate.replay or {})
-
-
 def _gain_figure(ranked):
     """Each candidate's held-out force gain beside its bar; green where it passes, hatched where it was decided on
     the screw's transmission (its force gain may then sit under its bar)."""
@@ -59,14 +53,14 @@ def _gain_figure(ranked):
                          "null)",
                    color=["tab:green" if c.passes else "tab:gray" for c in ranked])
     for bar, c in zip(bars, ranked):
-        if _on_transmission(c):
+        if c.on_transmission:
             bar.set_hatch("//")
             bar.set_edgecolor("k")
     ax.barh(y - 0.2, [c.threshold for c in ranked], 0.4, color="tab:red", alpha=0.4,
             label="its bar (t quantile x standard error of the per-run gains)")
     handles, _ = ax.get_legend_handles_labels()
     handles[0] = Patch(facecolor="tab:green", label=handles[0].get_label())  # not the first bar's hatch
-    if any(_on_transmission(c) for c in ranked):
+    if any(c.on_transmission for c in ranked):
         handles.append(Patch(facecolor="white", edgecolor="k", hatch="//",
                              label="decided on the screw's transmission (linear scale), not on this force gain"))
     ax.axvline(0, color="k", lw=0.8)
@@ -85,7 +79,7 @@ def _figures(result):
     ranked = [c for c in result.candidates if c.test_errors]
     if ranked:
         caption = "Which effect: each fitted candidate's held-out gain against its bar"
-        if any(_on_transmission(c) for c in ranked):
+        if any(c.on_transmission for c in ranked):
             caption += " (hatched: decided on the screw's transmission, the force's gain and bar shown beside it)"
         figs.append((_fig_png(_gain_figure(ranked)), caption))
     if result.nominal_test_errors:

@@ -33,15 +33,14 @@ def test_an_interval_the_runs_do_not_bound_reads_so():
 def test_the_gain_chart_marks_a_lead_error_decided_on_the_transmission():
     """A lead error claimed on the screw's transmission can sit under its force bar (the shipped example: +7.3
     against 13.3 points); its bar is hatched and the legend says why, so the green bar under its red one reads."""
-    from types import SimpleNamespace
-
     import matplotlib.pyplot as plt
 
+    from drakecreep.gap.drive_fit import EffectResult
     from drakecreep.report.drive_report import _gain_figure
 
-    lead = SimpleNamespace(name="lead_error", gain=7.3, threshold=13.3, passes=True,
-                           replay={"shrink": 0.99, "transmission": {"shrink": 0.999}})
-    ripple = SimpleNamespace(name="force_ripple", gain=-0.02, threshold=0.6, passes=False, replay={"shrink": 0.03})
+    lead = EffectResult("lead_error", {}, 1.0, {}, 7.3, 4.0, 13.3, {"shrink": 0.99, "transmission": {"shrink": 0.999}},
+                        True)
+    ripple = EffectResult("force_ripple", {}, 0.03, {}, -0.02, 0.2, 0.6, {"shrink": 0.03}, False)
     fig = _gain_figure([lead, ripple])
     ax = fig.axes[0]
     gains = ax.containers[0]
