@@ -519,6 +519,35 @@ class FrictionParams(_Params):
     gms_attraction: float = _q(
         1.0e4, "N/s", 0.0, lo_open=True, doc="GMS: attraction C of a sliding element to its Stribeck share",
     )
+    position_map_0: float = _q(
+        0.0, "-", -0.9, 0.9,
+        doc="friction level along the travel: the table's friction is 1 + m(x) times the law's, m(x) the sum of "
+            "position_map_k tanh((x - c_k) / w) over four steps spread evenly over [position_map_start, "
+            "position_map_end] (drakecreep.model.axis.friction_map); assumption: 0, the paper gives none",
+    )
+    position_map_1: float = _q(0.0, "-", -0.9, 0.9, doc="second step of the friction level along the travel")
+    position_map_2: float = _q(0.0, "-", -0.9, 0.9, doc="third step of the friction level along the travel")
+    position_map_3: float = _q(0.0, "-", -0.9, 0.9, doc="fourth step of the friction level along the travel")
+    position_map_start: float = _q(
+        0.0, "m", -10.0, 10.0, doc="table position where the friction map's travel starts (the level is held beyond it)",
+    )
+    position_map_end: float = _q(
+        1.0, "m", -10.0, 10.0, doc="table position where the friction map's travel ends (> position_map_start)",
+    )
+
+    def _check(self):
+        if not self.position_map_end > self.position_map_start:
+            raise InputError("position_map_end", self.position_map_end,
+                             f"a position > position_map_start ({self.position_map_start} m)")
+        total = sum(abs(a) for a in self.position_map)
+        if total >= 1.0:
+            raise InputError("position_map_0..3", f"magnitudes summing to {total:.3g}",
+                             "magnitudes summing to < 1 (the level 1 + m(x) must stay positive)")
+
+    @property
+    def position_map(self):
+        """The four step amplitudes ``position_map_0`` .. ``_3`` of the friction level along the travel."""
+        return (self.position_map_0, self.position_map_1, self.position_map_2, self.position_map_3)
 
 
 @dataclass(frozen=True)

@@ -990,9 +990,10 @@ def check_travel(run, params, x_origin=None):
 def at_origin(params, x_origin):
     """``params`` with what is fixed to the machine moved from its table position 0 to ``x_origin`` [m] (the
     motor's travel at the replayed diagram's angle 0; the run's first position, where the diagram starts): the
-    phases of what is fixed to the screw and the motor (the lead error, the cogging) and the nut's distance from
-    the thrust bearing (``screw.nut_start_distance + x_origin``), so that the shaft's stiffness is the one where
-    the run was. They belong to the machine, not to the run.
+    phases of what is fixed to the screw and the motor (the lead error, the cogging), the friction map's travel
+    (``friction.position_map_start`` and ``_end`` less ``x_origin``: fixed to the guides) and the nut's distance
+    from the thrust bearing (``screw.nut_start_distance + x_origin``), so that the shaft's stiffness is the one
+    where the run was. They belong to the machine, not to the run.
 
     Replaying a run at 0.094 m of a flexible axis with the nut at ``nut_start_distance`` instead, as before
     session 73, made the chain 14 % stiffer and 31 % more damped than where the run was (development dataset
@@ -1012,6 +1013,12 @@ def at_origin(params, x_origin):
         for harmonic, name in enumerate(phases, start=1):
             value = getattr(d, name) + harmonic * turn
             params = with_value(params, f"disturbance.{name}", math.remainder(value, 2.0 * math.pi))
+    f = params.friction
+    if any(a != 0.0 for a in f.position_map):
+        # moved down, the start goes first, moved up the end: end > start holds between the two steps
+        order = ("position_map_start", "position_map_end")[::1 if x_origin > 0 else -1]
+        for name in order:
+            params = with_value(params, f"friction.{name}", getattr(f, name) - x_origin)
     return with_value(params, "screw.nut_start_distance", params.screw.nut_start_distance + x_origin)
 
 

@@ -160,6 +160,10 @@ FITTABLE = (
 DEFAULT_UNCERTAIN = ("table.seal_force", "nut.preload_torque", "friction.viscous")
 #: The asymmetric friction candidate's fields (signed fractions, FrictionParams' range [-0.9, 0.9]).
 _ASYMMETRY = ("friction.coulomb_asymmetry", "friction.viscous_asymmetry")
+#: The position-dependent friction candidate's fields: the four step amplitudes of the table friction's level along
+#: the travel (:func:`drakecreep.model.nut_table.position_level`, FrictionParams' range [-0.9, 0.9] each), over the
+#: training runs' travel (:func:`_travel`).
+_MAP = tuple(f"friction.position_map_{k}" for k in range(4))
 #: The bounds of a fitted field are its own range in DriveParams (:func:`drakecreep.params.field_range`:
 #: ``static_ratio`` in [1, 10], the asymmetries in [-0.9, 0.9], the friction coefficients in [0, 1], the rest
 #: >= 0). A field is fitted as ``lower + (start - lower) exp(theta)``, theta bounded above where the range ends
@@ -272,7 +276,7 @@ _SECOND = {"lead_error": ("disturbance.lead_error_2_amplitude", "disturbance.lea
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _SECOND["lead_error"][0]),
                "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY,
-               "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0])}
+               "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0]), "position_friction": _MAP}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -291,14 +295,18 @@ EFFECTS = {
                            "steady sliding a Coulomb asymmetry pushes as a constant force offset would",
     "cogging": "a load torque on the motor fixed to its angle (disturbance.cogging_force and cogging_phase, period "
                "the lead over a whole order per revolution, with its second harmonic, cogging_2_force and _2_phase)",
+    "position_friction": "the table's friction level varying smoothly along the travel (friction.position_map_0 .. _3: "
+                         "four steps over the training runs' travel, position_map_start and _end)",
 }
 #: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
 #: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
 #: otherwise and which a drive's current offset or an inclined axis gives; how often it would be claimed on data
 #: with an offset and no asymmetry has not been measured on development datasets (docs/gap_drakecreep_kind.md).
 #: ``cogging`` (session 58) has not been run on development datasets either: how often it would be claimed on
-#: nulls, or instead of a lead error of the same period, is not known.
-ON_REQUEST = ("asymmetric_friction", "cogging")
+#: nulls, or instead of a lead error of the same period, is not known; nor has ``position_friction`` (session 91),
+#: whose four free amplitudes can also take up a friction that drifts over the runs' time (run after run over the
+#: travel) or a load that changes along it.
+ON_REQUEST = ("asymmetric_friction", "cogging", "position_friction")
 #: The candidates fitted when ``effects`` is not given: :data:`EFFECTS` without :data:`ON_REQUEST`, in order.
 DEFAULT_EFFECTS = tuple(n for n in EFFECTS if n not in ON_REQUEST)
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
@@ -307,7 +315,6 @@ DEFAULT_EFFECTS = tuple(n for n in EFFECTS if n not in ON_REQUEST)
 DELAY_GRID = (0, 1, 2, 4, 8, 12, 16)
 #: Effects of issue 16 that DriveParams cannot express: never ranked, with the reason.
 NOT_IN_MODEL = {
-    "position_friction": "no position-dependent friction field in DriveParams",
     "load_friction": "load dependence is fixed by the load case (nut.load_friction_coefficient is fittable as uncertain)",
     "backlash": "no lost-motion field in DriveParams",
     "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
@@ -948,9 +955,20 @@ def _effective_variance(r, n):
 # --------------------------------------------------------------------------- output-error fit
 
 def _with(params, values):
-    """``params`` with ``values`` (path -> number or word) set; NumPy scalars become Python numbers."""
-    for path, v in values.items():
-        params = with_value(params, path, v.item() if isinstance(v, np.generic) else v)
+    """``params`` with ``values`` (path -> number or word) set; NumPy scalars become Python numbers. A value that a
+    check across fields refuses on the way (a friction map's end below a start not yet moved, its amplitudes' sum
+    while another is still the old one) is set again after the others; what no order sets is refused."""
+    pending = [(path, v.item() if isinstance(v, np.generic) else v) for path, v in values.items()]
+    while pending:
+        refused = []
+        for path, v in pending:
+            try:
+                params = with_value(params, path, v)
+            except InputError as err:
+                refused.append((path, v, err))
+        if len(refused) == len(pending):
+            raise refused[0][2]
+        pending = [(path, v) for path, v, _ in refused]
     return params
 
 
@@ -1722,6 +1740,13 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
             return None, 0.0, ""  # already fitted as uncertain
         fitted_params, _, _, sse = fit_drive(runs, base, paths, replayer, max_nfev=min(max_nfev, 4))
         values = {p: get_value(fitted_params, p) for p in paths}
+    elif name == "position_friction":
+        # the four amplitudes from a flat map over the training runs' travel, by the output-error fit (eight
+        # Jacobian replays of each run per iteration); a map the params file declares is replaced, not added to
+        values = _travel(runs, base)
+        flat = _with(base, {**{p: 0.0 for p in _MAP}, **values})
+        fitted_params, _, _, sse = fit_drive(runs, flat, _MAP, replayer, max_nfev=min(max_nfev, 4))
+        values.update({p: get_value(fitted_params, p) for p in _MAP})
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
@@ -1729,6 +1754,16 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
     else:  # pragma: no cover - names are checked up front
         raise InputError("effects", name, "one of " + ", ".join(EFFECTS))
     return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0, start
+
+
+def _travel(runs, params):
+    """The friction map's travel: ``friction.position_map_start`` and ``_end`` [m], the lowest and highest position
+    of the runs in the coordinates of their position feedback (the scale's on a closed loop, else the motor's;
+    :func:`drakecreep.gap.drake_replay.at_origin` moves the map there), at least a millimetre apart."""
+    table = params.controller.position_feedback == "table"
+    x = [r.x_table if table and r.x_table is not None else r.x_motor for r in runs]
+    lo, hi = float(min(np.min(v) for v in x)), float(max(np.max(v) for v in x))
+    return {"friction.position_map_start": lo, "friction.position_map_end": max(hi, lo + 1e-3)}
 
 
 def _energy(errors, labels, key="force"):

@@ -7,7 +7,8 @@ The friction of the lumped mass is the friction the model applies to the table
 (:func:`~drakecreep.model.nut_table.table_friction_levels`): with the ball nut's drag on the screw's rotation
 (``friction.nut_friction_on: screw``, the default since issue 15) that is the guides' share only; the nut's
 drag then acts on the motor side of the spring, where the paper's Fig. 2 mechanism (motor side at a constant
-speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the paper lumps it.
+speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the paper lumps it. A friction map
+(``friction.position_map_*``) scales it by its level where the table is.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from drakecreep.model.friction import FrictionLaw, make_friction_law
-from drakecreep.model.nut_table import moving_mass, table_friction_levels
+from drakecreep.model.nut_table import moving_mass, position_level, table_friction_levels
 from drakecreep.model.screw import axial_damping, axial_stiffness, screw_inertia
 
 __all__ = ["LumpedDrive", "lumped", "axial_mode_frequency"]
@@ -71,6 +72,8 @@ def lumped(params, load_case=0, x=0.0):
 
     check_params(params)
     fc, fs = table_friction_levels(params, params.load_case(load_case))
+    level = float(position_level(params.friction, x))  # the friction map's level where the table is
+    fc, fs = level * fc, level * fs
     law = make_friction_law(params.friction)
     return LumpedDrive(
         stiffness=float(axial_stiffness(params.screw, params.nut, x)),

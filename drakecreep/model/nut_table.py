@@ -20,6 +20,15 @@ its weight (the paper's Table 7 cylinders load the table from above); a lifting 
 unloads the guides, down to zero at ``Fz = -m g`` and lifting the table against the guides' upper
 raceways beyond that (rolling guides carry load in both directions, hence the absolute value).
 The lateral load ``Fy`` loads the guides' side raceways either way: ``|Fy|``.
+
+Along the travel the table's friction (every term of its law) is ``1 + m(x)`` times the law's, ``m`` the smooth
+friction map of ``friction.position_map_*`` (:func:`drakecreep.model.axis.friction_map`, the equation the
+replay axis uses): worn or misaligned stretches of the guides, a seal that drags harder near one end. ``x`` is the
+table's position (a replay moves the map to where its run starts, :func:`drakecreep.gap.drake_replay.at_origin`).
+Where the nut's share acts on the screw (``nut_friction_on: screw``), the map scales the guides' share only.
+The lumped drive of the paper's creep theory takes the map's level where its table is
+(:func:`drakecreep.model.lumped.lumped`); the linear analyses refuse a map (sliding at a constant force is no steady
+state of a level that changes along the travel), as do the plain-Python batch equations and the multibody model.
 """
 
 import math
@@ -29,9 +38,11 @@ from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.model._scalar import vector
+from drakecreep.model.axis import FRICTION_MAP, friction_map
 from drakecreep.model.friction import make_friction_law
 
-__all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels", "friction_split", "table_friction_levels"]
+__all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels", "friction_split", "table_friction_levels",
+           "friction_map_parameters", "position_level"]
 
 
 def moving_mass(params):
@@ -69,6 +80,21 @@ def table_friction_levels(params, load):
     return friction_levels(params, load)
 
 
+def friction_map_parameters(friction):
+    """``friction.position_map_*`` (:class:`~drakecreep.params.FrictionParams`) by the names of
+    :func:`drakecreep.model.axis.friction_map`."""
+    P = dict(zip(FRICTION_MAP, friction.position_map))
+    P["friction_map_start"] = friction.position_map_start
+    P["friction_map_end"] = friction.position_map_end
+    return P
+
+
+def position_level(friction, x):
+    """The table friction's level factor ``1 + m(x)`` at map position ``x`` [m] (any Drake scalar; exactly 1.0
+    without a map)."""
+    return 1.0 + friction_map(friction_map_parameters(friction), x)
+
+
 @TemplateSystem.define("NutTable_", scope=sys.modules[__name__])
 def NutTable_(T):
     class Impl(LeafSystem_[T]):
@@ -89,6 +115,7 @@ def NutTable_(T):
             LeafSystem_[T].__init__(self, converter=converter)
             self.params = params
             self.load = load
+            self.mapped = any(a != 0.0 for a in params.friction.position_map)
             self.law = make_friction_law(params.friction)
             self.mass = moving_mass(params)
             self.fc, self.fs = table_friction_levels(params, load)
@@ -114,15 +141,21 @@ def NutTable_(T):
             x = context.get_continuous_state_vector().CopyToVector()
             return x[0], x[1], x[2:]
 
+        def _force(self, x, v, z):
+            # the law's internal states are normalized by its level, so the map scales its force, not its rates
+            f = self.law.force(v, z, self.fc, self.fs)
+            if self.mapped:
+                f = position_level(self.params.friction, x) * f
+            return f
+
         def friction(self, context):
             """Friction force (N) on the table in this context."""
-            _, v, z = self._split(context)
-            return self.law.force(v, z, self.fc, self.fs)
+            return self._force(*self._split(context))
 
         def DoCalcTimeDerivatives(self, context, derivatives):
-            _, v, z = self._split(context)
+            x, v, z = self._split(context)
             push = self._u_axial_force.Eval(context)[0]
-            accel = (push - self.load.fx - self.law.force(v, z, self.fc, self.fs)) / self.mass
+            accel = (push - self.load.fx - self._force(x, v, z)) / self.mass
             rates = [v, accel] + list(self.law.state_rates(v, z, self.fc, self.fs))
             derivatives.get_mutable_vector().SetFromVector(vector(rates))
 

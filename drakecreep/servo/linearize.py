@@ -142,6 +142,11 @@ def operating_point(params, scenario):
     """
     if params.friction.law == "gms":
         raise InputError("friction.law", "gms", "coulomb, stribeck or lugre (linearization needs a smooth law)")
+    for k, a in enumerate(params.friction.position_map):
+        if a != 0.0:  # its level moves with the table: sliding at a constant force is no steady state of it
+            raise InputError(f"friction.position_map_{k}", a,
+                             "0 for the linear analyses (a friction that changes along the travel has no steady "
+                             "sliding to linearize about; simulate and diagnose take it)")
     params = nut_on_table(params)
     g = params.controller
     v = scenario.feed

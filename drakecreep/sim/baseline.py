@@ -38,6 +38,9 @@ def unsupported(params):
     for name in ("coulomb_asymmetry", "viscous_asymmetry"):
         if getattr(p.friction, name) != 0.0:
             return (f"friction.{name}", getattr(p.friction, name), "0 (the plain-Python equations are symmetric)")
+    for k, a in enumerate(p.friction.position_map):
+        if a != 0.0:
+            return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")
     d = p.disturbance
     if d.has_lead_error or d.has_cogging or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")

@@ -762,3 +762,20 @@ def test_options_that_collect_may_repeat():
                  ["margins", "-v", "-v", "-q", "-q"], ["sweep", "--", "--out"]):
         args, _ = parser.parse_known_args(argv)
         cli._check_no_repeated_options(parser, args, argv)
+
+
+def test_a_friction_map_is_named_by_the_linear_analyses_and_simulated(tmp_path, capsys):
+    """A params file with a friction along the travel (``friction.position_map_*``, an augmented file of the
+    diagnosis's ``position_friction``): margins, tune and report refuse it in one line naming the field, before
+    their work; simulate runs it."""
+    from drakecreep.params import preset, save_params, with_value
+
+    mapped = tmp_path / "mapped.yaml"
+    save_params(with_value(preset("paper"), "friction.position_map_2", 0.3), mapped)
+    for argv in (["margins"], ["tune"], ["report", "--out", str(tmp_path / "r")]):
+        code, _, err = _run(argv + ["--params", str(mapped), "--load-case", "0"], capsys)
+        _one_line_exit_2(code, err, "friction.position_map_2: got 0.3; allowed: 0 for the linear analyses")
+    assert not (tmp_path / "r").exists() or not any((tmp_path / "r").iterdir())  # nothing written
+    code, out, _ = _run(["simulate", "--params", str(mapped), "--load-case", "0", "--duration", "1.1", "--out",
+                         str(tmp_path / "s")], capsys)
+    assert code == 0 and "creep (stick-slip)" in out and (tmp_path / "s" / "metrics.json").exists()

@@ -148,4 +148,5 @@ def test_the_effects_help_names_every_default_candidate_of_both_kinds():
     drive, on_request = drive.split("; ")
     assert p_p.split(", ") == [*DRAKE_EFFECTS, "control_delay"]
     assert drive.split(", ") == list(drive_fit.DEFAULT_EFFECTS)
-    assert on_request == " and ".join(drive_fit.ON_REQUEST) + " only when named)"
+    *first, last = drive_fit.ON_REQUEST
+    assert on_request == ", ".join(first) + " and " + last + " only when named)"

@@ -110,6 +110,32 @@ def test_lead_error_is_fixed_to_the_screw_not_to_the_run():
         with_value(rig, "disturbance.lead_error_phase", 7.0)
 
 
+def test_the_friction_map_is_fixed_to_the_guides_not_to_the_run():
+    """A run that starts at ``x0`` meets the friction map ``x0`` along its travel: its replay is the replay of the
+    same run started at 0 with the map's travel moved back by ``x0``, and differs from the run at 0 with the map as
+    written; the leaf systems replay the map as the compiled diagram does."""
+    from drakecreep.gap.drake_replay import at_origin
+
+    rig = with_value(_rig(), "disturbance.lead_error_amplitude", 0.0)  # the map alone
+    for path, value in (("friction.position_map_0", 0.3), ("friction.position_map_2", -0.25),
+                        ("friction.position_map_start", 0.05), ("friction.position_map_end", 0.09)):
+        rig = with_value(rig, path, value)
+    x0 = 0.0637
+    at0 = _run(rig)
+    moved = dataclasses.replace(at0, x_ref=at0.x_ref + x0, x_motor=at0.x_motor + x0)
+    shifted = _nut_moved(with_value(with_value(rig, "friction.position_map_start", 0.05 - x0),
+                                    "friction.position_map_end", 0.09 - x0), x0)
+    assert at_origin(rig, x0) == shifted
+    assert at_origin(rig, -x0).friction.position_map_end == pytest.approx(0.09 + x0)  # moved up: the end first
+    a = replay_drakecreep(moved, rig)
+    b = replay_drakecreep(at0, shifted)
+    assert np.max(np.abs((a.x_motor - x0) - b.x_motor)) < 1e-12 and np.max(np.abs(a.u - b.u)) < 1e-6
+    plain = replay_drakecreep(at0, rig)
+    assert np.max(np.abs(plain.u - b.u)) > 1.0  # N: the guides' friction at another level
+    leaf = replay_drakecreep(moved, rig, backend="leaf")
+    assert np.max(np.abs(leaf.u - a.u)) < 0.05 * np.max(np.abs(plain.u - b.u))
+
+
 def _started_elsewhere(rig, period, name):
     """A run of ``rig`` at 0, the same run started ``x0`` (three and an eighth periods) along, and ``rig`` with the
     phases of ``name`` (its fundamental 0.4 rad, its second harmonic -1.3 rad in ``rig``) moved to ``x0``."""

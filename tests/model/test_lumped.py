@@ -39,3 +39,17 @@ def test_critical_speed_follows_the_friction_on_the_mass():
 def test_axial_mode_frequency_is_the_two_mass_mode():
     # 73.5 Hz for the paper preset (docs/multibody.md), independent of where the friction sits
     assert axial_mode_frequency(preset("paper")) == pytest.approx(73.5, abs=0.1)
+
+
+def test_the_lumped_mass_carries_the_friction_maps_level_where_the_table_is():
+    """``friction.position_map_*`` scales the table's friction where it is: the lumped drive at ``x`` takes that
+    level (:func:`drakecreep.model.nut_table.position_level`), and without a map it is the law's."""
+    from drakecreep.model.nut_table import position_level
+
+    p = preset("paper")
+    mapped = with_value(with_value(p, "friction.position_map_1", 0.4), "friction.position_map_end", 0.2)
+    for x in (0.0, 0.07, 0.15):
+        level = position_level(mapped.friction, x)
+        assert lumped(mapped, 3, x).coulomb == pytest.approx(level * lumped(p, 3, x).coulomb, rel=1e-12)
+        assert lumped(mapped, 3, x).breakaway == pytest.approx(level * lumped(p, 3, x).breakaway, rel=1e-12)
+    assert position_level(mapped.friction, 0.15) > 1.2 > 0.8 > position_level(mapped.friction, 0.0)

@@ -6,7 +6,9 @@ import pytest
 from drakecreep.params import LoadCase, with_value
 from drakecreep.scenario import Scenario
 from drakecreep.sim.simulation import simulate
-from drakecreep.model.nut_table import NutTable, friction_levels, friction_split, moving_mass, table_friction_levels
+from drakecreep.model.axis import friction_map
+from drakecreep.model.nut_table import (NutTable, friction_levels, friction_split, moving_mass, position_level,
+                                       table_friction_levels)
 
 
 def test_friction_levels_by_hand(paper):
@@ -57,6 +59,67 @@ def test_derivatives_by_hand(paper):
     assert table.GetOutputPort("friction_force").Eval(c)[0] == pytest.approx(friction)
     converted = table.ToAutoDiffXd()
     assert converted.load == load and converted.fc == table.fc
+
+
+def test_the_friction_map_scales_the_tables_friction_where_it_is(paper):
+    """``friction.position_map_*``: the table's friction (every term of its law) is ``1 + m(x)`` times the law's,
+    ``m`` the replay axis's own :func:`~drakecreep.model.axis.friction_map`; its rates are the law's (the bristle
+    state is normalized by the level); float, AutoDiffXd and Expression alike."""
+    from pydrake.symbolic import Expression, Variable
+
+    mapped = paper
+    for path, value in (("friction.position_map_0", 0.2), ("friction.position_map_2", -0.3),
+                        ("friction.position_map_start", -0.05), ("friction.position_map_end", 0.15)):
+        mapped = with_value(mapped, path, value)
+    load = paper.load_case(0)
+    state, push = [0.031, 2e-4, 0.4], [300.0]
+    plain, table = NutTable(paper, load), NutTable(mapped, load)
+    derivs = []
+    for system in (plain, table):
+        c = system.CreateDefaultContext()
+        system.get_input_port(0).FixValue(c, push)
+        c.SetContinuousState(state)
+        derivs.append((system.EvalTimeDerivatives(c).CopyToVector(), system.GetOutputPort("friction_force").Eval(c)[0]))
+    P = {"friction_map_0": 0.2, "friction_map_1": 0.0, "friction_map_2": -0.3, "friction_map_3": 0.0,
+         "friction_map_start": -0.05, "friction_map_end": 0.15}
+    level = 1.0 + friction_map(P, 0.031)
+    assert position_level(mapped.friction, 0.031) == pytest.approx(level) and abs(level - 1.0) > 0.05
+    assert derivs[1][1] == pytest.approx(level * derivs[0][1])
+    mass = moving_mass(paper)
+    assert derivs[1][0][1] == pytest.approx((push[0] - load.fx - level * derivs[0][1]) / mass)
+    assert derivs[1][0][2] == pytest.approx(derivs[0][0][2])  # the bristles' rate: the law's
+    assert position_level(paper.friction, 0.031) == 1.0  # no map: exactly the law
+    # the AutoDiffXd and Expression copies keep the map
+    for converted in (table.ToAutoDiffXd(), table.ToSymbolic()):
+        c = converted.CreateDefaultContext()
+        converted.get_input_port(0).FixValue(c, push)
+        if isinstance(converted.CreateDefaultContext().get_time(), Expression):
+            c.SetContinuousState([Expression(v) for v in state])
+            value = converted.GetOutputPort("friction_force").Eval(c)[0].Evaluate()
+        else:
+            c.SetContinuousState(state)
+            value = converted.GetOutputPort("friction_force").Eval(c)[0].value()
+        assert value == pytest.approx(derivs[1][1])
+    symbolic = table.ToSymbolic()
+    c = symbolic.CreateDefaultContext()
+    symbolic.get_input_port(0).FixValue(c, push)
+    x = Variable("x")
+    c.SetContinuousState([Expression(x), Expression(state[1]), Expression(state[2])])
+    force = symbolic.GetOutputPort("friction_force").Eval(c)[0]
+    assert x in force.GetVariables() and force.Evaluate({x: 0.031}) == pytest.approx(derivs[1][1])
+
+
+def test_a_friction_map_is_checked(paper):
+    """A map whose travel ends before it starts, or whose level could reach 0, is refused naming the field."""
+    from drakecreep.errors import InputError
+
+    with pytest.raises(InputError, match=r"friction.position_map_end: got -1.0; allowed: a position > "):
+        with_value(paper, "friction.position_map_end", -1.0)
+    half = with_value(paper, "friction.position_map_0", 0.6)
+    with pytest.raises(InputError, match=r"friction.position_map_0..3: got 'magnitudes summing to 1.1'"):
+        with_value(half, "friction.position_map_3", -0.5)
+    with pytest.raises(InputError, match=r"friction.position_map_1: got 0.95; allowed: a finite number in \[-0.9"):
+        with_value(paper, "friction.position_map_1", 0.95)
 
 
 @pytest.mark.parametrize("law", ["coulomb", "stribeck", "lugre"])

@@ -192,3 +192,6 @@ def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
     with pytest.raises(InputError) as err:  # the cogging is the two-mass model's too
         build_multibody_diagram(with_value(paper, "disturbance.cogging_2_force", 1.0), scenario, options)
     assert err.value.field == "disturbance.cogging_2_force"
+    with pytest.raises(InputError) as err:  # and the friction map
+        build_multibody_diagram(with_value(paper, "friction.position_map_3", 0.2), scenario, options)
+    assert err.value.field == "friction.position_map_3"

@@ -140,3 +140,13 @@ def test_no_steady_sliding_is_an_input_error(paper):
     p = with_value(with_value(paper, "controller.position_gain", 0.0), "controller.velocity_feedforward", 0.5)
     with pytest.raises(InputError, match="position_gain"):
         lin.operating_point(p, Scenario(feed=1e-3, load_case=3))
+
+
+def test_a_friction_map_is_refused_by_name_before_any_linearization(paper):
+    """A level that changes along the travel has no steady sliding to linearize about: one line naming the field."""
+    from drakecreep.errors import InputError
+
+    mapped = with_value(paper, "friction.position_map_1", 0.25)
+    with pytest.raises(InputError) as err:
+        lin.operating_point(mapped, Scenario(feed=1e-3))
+    assert err.value.field == "friction.position_map_1" and "linear analyses" in str(err.value)

@@ -36,3 +36,5 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
     assert unsupported(short_paper) is None
     asym = with_value(short_paper, "friction.viscous_asymmetry", 0.2)
     assert unsupported(asym) == ("friction.viscous_asymmetry", 0.2, "0 (the plain-Python equations are symmetric)")
+    mapped = with_value(short_paper, "friction.position_map_2", -0.1)  # a friction map: the Drake systems' alone
+    assert unsupported(mapped) == ("friction.position_map_2", -0.1, "0 (the plain-Python equations have no friction map)")
