@@ -368,6 +368,12 @@ class MotorParams(_Params):
         2.0e-4, "s", 0.0, 0.1, doc="closed current loop as a first-order lag; 0 = ideal"
     )
     viscous_damping: float = _q(1.0e-4, "N m s/rad", 0.0, doc="motor and bearing viscous drag")
+    saturation_torque: float = _q(
+        0.0, "N m", 0.0, 1e5,
+        doc="torque above which the drive's torque constant falls off: it applies tau / sqrt(1 + (tau / tau_s)^2) "
+            "of a command tau (drakecreep.model.axis.saturating); 0 = a linear drive; assumption: 0, the paper "
+            "gives none",
+    )
 
     def _check(self):
         tau = self.current_loop_time_constant

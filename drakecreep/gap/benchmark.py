@@ -163,9 +163,9 @@ EXPECTED = {
 #: ``force_ripple`` on the table: the same force below the axial mode. The truth's control delay (1-3 recording
 #: samples, 4-12 speed-loop ticks) is ``controller.computation_delay``'s (session 36). The other library effects
 #: have no ``DriveParams`` field (``drive_fit.NOT_IN_MODEL``), or, asymmetric friction, (since session 58) cogging
-#: and (since session 91) position friction, a candidate fitted only when named (``drive_fit.ON_REQUEST``): for
-#: this kind they are out of library until a development study and a held-out run put their candidate among the
-#: defaults.
+#: and (since session 91) position friction and drive saturation, a candidate fitted only when named
+#: (``drive_fit.ON_REQUEST``): for this kind they are out of library until a development study and a held-out run
+#: put their candidate among the defaults.
 EXPECTED_DRIVE = {"stribeck": "stribeck", "lead_error": "lead_error", "time_ripple": "force_ripple",
                   "control_delay": "control_delay"}
 #: Controller kinds the benchmark diagnoses, each with its product path (``diagnose_drake``, ``diagnose_drive``).

@@ -276,7 +276,8 @@ _SECOND = {"lead_error": ("disturbance.lead_error_2_amplitude", "disturbance.lea
 #: Amplitude fields of the effects that have one (refitted jointly with the uncertain fields after a claim).
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _SECOND["lead_error"][0]),
                "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY,
-               "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0]), "position_friction": _MAP}
+               "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0]), "position_friction": _MAP,
+               "drive_saturation": ("motor.saturation_torque",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -297,6 +298,8 @@ EFFECTS = {
                "the lead over a whole order per revolution, with its second harmonic, cogging_2_force and _2_phase)",
     "position_friction": "the table's friction level varying smoothly along the travel (friction.position_map_0 .. _3: "
                          "four steps over the training runs' travel, position_map_start and _end)",
+    "drive_saturation": "the drive applies less torque than commanded, more so the larger the command (a torque "
+                        "constant that falls off: motor.saturation_torque)",
 }
 #: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
 #: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
@@ -305,8 +308,9 @@ EFFECTS = {
 #: ``cogging`` (session 58) has not been run on development datasets either: how often it would be claimed on
 #: nulls, or instead of a lead error of the same period, is not known; nor has ``position_friction`` (session 91),
 #: whose four free amplitudes can also take up a friction that drifts over the runs' time (run after run over the
-#: travel) or a load that changes along it.
-ON_REQUEST = ("asymmetric_friction", "cogging", "position_friction")
+#: travel) or a load that changes along it; nor has ``drive_saturation`` (session 91), which a table mass declared
+#: too light could also take up (both ask more command for the larger accelerations).
+ON_REQUEST = ("asymmetric_friction", "cogging", "position_friction", "drive_saturation")
 #: The candidates fitted when ``effects`` is not given: :data:`EFFECTS` without :data:`ON_REQUEST`, in order.
 DEFAULT_EFFECTS = tuple(n for n in EFFECTS if n not in ON_REQUEST)
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
@@ -320,7 +324,8 @@ NOT_IN_MODEL = {
     "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
     "quantization": "the sensor resolutions are declared in the run metadata (replayed as declared), not fitted",
     "friction_drift": "no time-dependent friction field in DriveParams",
-    "drive_gain": "u_gain is declared in the run metadata, not a DriveParams field",
+    "drive_gain": "u_gain is declared in the run metadata, not a DriveParams field (its fall-off at large commands is "
+                  "drive_saturation)",
 }
 
 
@@ -1747,6 +1752,8 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         flat = _with(base, {**{p: 0.0 for p in _MAP}, **values})
         fitted_params, _, _, sse = fit_drive(runs, flat, _MAP, replayer, max_nfev=min(max_nfev, 4))
         values.update({p: get_value(fitted_params, p) for p in _MAP})
+    elif name == "drive_saturation":
+        values, sse = _saturation_effect(runs, base, replayer, scale, max_nfev)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
@@ -1754,6 +1761,29 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
     else:  # pragma: no cover - names are checked up front
         raise InputError("effects", name, "one of " + ", ".join(EFFECTS))
     return values, 1.0 - sse / sse0 if sse0 > 0 else 0.0, start
+
+
+#: Saturation torques tried before the fit of the ``drive_saturation`` candidate, in units of the training runs'
+#: largest torque command (the drive's force u_gain u through the lead): from one that bends the largest commands
+#: by 3 % (4 x) to one that halves what they get (0.6 x); the fit refines the best.
+SATURATION_STARTS = (0.6, 1.2, 2.4, 4.0)
+
+
+def _saturation_effect(runs, base, replayer, scale, max_nfev):
+    """The drive's saturation torque (``motor.saturation_torque``) on the training ``runs``: the best of
+    :data:`SATURATION_STARTS` by replayed SSE, refined by the output-error fit. ``(values, sse)``."""
+    ratio = base.screw.lead / (2.0 * math.pi)
+    peak = max(float(np.max(np.abs(r.u))) * r.meta.u_gain for r in runs) * ratio
+    path = "motor.saturation_torque"
+    trials = [_with(base, {path: share * peak}) for share in SATURATION_STARTS]
+    many = getattr(replayer, "many", None)  # the trials at once (in parallel when the replayer has a pool)
+    sims = many([(runs, p) for p in trials]) if many is not None else [replayer(runs, p) for p in trials]
+    sses = [float(r @ r) for r in (_residual(runs, s, scale) for s in sims)]
+    best = trials[int(np.argmin(sses))]
+    fitted_params, _, _, sse = fit_drive(runs, best, (path,), replayer, max_nfev=min(max_nfev, 4))
+    if sse > min(sses):  # the fit's last step did not beat its start
+        fitted_params, sse = best, min(sses)
+    return {path: get_value(fitted_params, path)}, sse
 
 
 def _travel(runs, params):

@@ -77,7 +77,7 @@ from drakecreep.model._scalar import clip, exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
-           "set_axis_parameters", "axis_friction", "applied_force", "nut_load", "friction_map", "FRICTION_MAP",
+           "set_axis_parameters", "axis_friction", "applied_force", "saturating", "unsaturated", "nut_load", "friction_map", "FRICTION_MAP",
            "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "lead_error_drive",
            "POSITION_RIPPLE", "axis_ripple"]
 
@@ -271,13 +271,28 @@ def bristle_rates(v, z, p, table_mass, load=0.0):
 
 
 def applied_force(F, p):
-    """Force [N] the drive applies for the commanded ``F`` [N]: ``F / sqrt(1 + (c F)^2)`` with
+    """Force [N] the drive applies for the commanded ``F`` [N]: :func:`saturating` with
     ``c = inverse_drive_limit`` (a drive-gain nonlinearity: linear for small forces, saturating smoothly at
     ``1 / c``; ``c = 0``, the default, is a linear drive)."""
-    c = dict(zip(_NAMES, p))["inverse_drive_limit"]
+    return saturating(F, dict(zip(_NAMES, p))["inverse_drive_limit"])
+
+
+def saturating(F, c):
+    """``F / sqrt(1 + (c F)^2)``: what a drive whose gain falls off applies for the command ``F`` (any Drake
+    scalar; ``F`` itself for a plain-number ``c`` of 0), a smooth saturation at ``1 / c``; the replay axis's
+    :func:`applied_force` and the project's :class:`~drakecreep.model.motor.Motor` (``motor.saturation_torque``)."""
     if _off(c):
         return F
     return F / (1.0 + (c * F) * (c * F)) ** 0.5
+
+
+def unsaturated(applied, c):
+    """The command whose :func:`saturating` is ``applied`` (a float): ``applied / sqrt(1 - (c applied)^2)``, or an
+    infinite command of its sign where ``|c applied| >= 1`` (beyond the saturation: no command reaches it)."""
+    if c == 0.0:
+        return applied
+    r = c * applied
+    return math.copysign(math.inf, applied) if abs(r) >= 1.0 else applied / math.sqrt(1.0 - r * r)
 
 
 def nut_load(drive, p, friction=None, acceleration=None):

@@ -18,10 +18,11 @@ from dataclasses import dataclass, field
 
 from pydrake.systems.framework import DiagramBuilder
 
+from drakecreep.errors import InputError
 from drakecreep.model.compensators import add_compensation
 from drakecreep.model.controller import CascadeController, force_limit
 from drakecreep.model.disturbances import add_disturbances, cogging_force
-from drakecreep.model.motor import Motor
+from drakecreep.model.motor import Motor, commanded_torque
 from drakecreep.model.nut_friction import add_nut_friction
 from drakecreep.model.reference import FeedReference
 from drakecreep.model.screw import ScrewDrive, axial_stiffness, screw_inertia
@@ -86,9 +87,11 @@ def initial_conditions(params, scenario):
     Returns
     -------
     dict
-        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``command0`` (N, the force command that
-        holds it: ``force0`` plus the cogging's load at ``theta0``, :func:`~drakecreep.model.disturbances.cogging_force`),
-        ``x_ref0`` (m, where the position feedback reads at rest), ``theta_counted0`` (rad).
+        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``torque0`` (N m, the motor torque that
+        holds it: ``force0`` plus the cogging's load at ``theta0``, :func:`~drakecreep.model.disturbances.cogging_force`,
+        through the lead), ``command0`` (N, the force command that makes the drive apply ``torque0``: the same force
+        unless the drive saturates, :func:`~drakecreep.model.motor.commanded_torque`), ``x_ref0`` (m, where the
+        position feedback reads at rest), ``theta_counted0`` (rad).
     """
     load = params.load_case(scenario.load_case)
     ratio = params.screw.lead / (2.0 * math.pi)
@@ -97,10 +100,15 @@ def initial_conditions(params, scenario):
     theta0 = stretch / ratio
     theta_counted = quantize(theta0, encoder_resolution(params.sensors.encoder_counts_per_rev))
     x_ref0 = theta_counted * ratio if params.controller.position_feedback == "motor" else 0.0
-    command0 = force0
+    held = force0
     if params.disturbance.has_cogging:
-        command0 = force0 + float(cogging_force(params.disturbance, theta0 * ratio))
-    return dict(theta0=theta0, force0=force0, command0=command0, x_ref0=x_ref0, theta_counted0=theta_counted)
+        held = force0 + float(cogging_force(params.disturbance, theta0 * ratio))
+    command0 = commanded_torque(params.motor, held * ratio) / ratio
+    if not math.isfinite(command0):
+        raise InputError("motor.saturation_torque", params.motor.saturation_torque,
+                         f"above the {abs(held * ratio):.4g} N m that holds the load case at rest")
+    return dict(theta0=theta0, force0=force0, torque0=held * ratio, command0=command0, x_ref0=x_ref0,
+                theta_counted0=theta_counted)
 
 
 def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, drive=None, reference=None,
@@ -142,8 +150,6 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
     check_scenario(scenario)
     drive = drive or getattr(scenario, "drive", "cascade")
     if drive not in DRIVES:
-        from drakecreep.errors import InputError
-
         raise InputError("drive", drive, "one of " + ", ".join(DRIVES))
     gains = params.controller
     if continuous is not None:
@@ -153,7 +159,7 @@ def build_diagram(params, scenario, *, continuous=None, ideal_sensors=False, dri
 
     builder = DiagramBuilder()
     motor_x0 = [ic["theta0"], 0.0] + (
-        [ic["command0"] * params.screw.lead / (2 * math.pi)] if params.motor.current_loop_time_constant > 0 else []
+        [ic["torque0"]] if params.motor.current_loop_time_constant > 0 else []
     )
     s = {}
     s["reference"] = (FeedReference(scenario.feed, params.simulation.acceleration_time, ic["x_ref0"])

@@ -1,5 +1,9 @@
 """Servo motor: torque command -> torque through a torque limit and the closed current loop; rotor dynamics.
 
+A drive whose torque constant falls off (``motor.saturation_torque`` ``tau_s`` > 0) applies
+``tau / sqrt(1 + (tau / tau_s)^2)`` of the limited command ``tau`` (:func:`applied_torque`,
+:func:`drakecreep.model.axis.saturating`): linear for small torques, saturating smoothly at ``tau_s``.
+
 The rotating inertia is the rotor, the coupling and the screw shaft (passed in as ``load_inertia``),
 so the motor side of the two-mass model lives here; the screw's elastic coupling to the table lives
 in :mod:`drakecreep.model.screw`.
@@ -12,13 +16,30 @@ from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
 from drakecreep.model._scalar import clip, vector
+from drakecreep.model.axis import saturating, unsaturated
 
-__all__ = ["Motor", "Motor_", "motor_inertia"]
+__all__ = ["Motor", "Motor_", "motor_inertia", "applied_torque", "commanded_torque"]
 
 
 def motor_inertia(motor, load_inertia=0.0):
     """Total rotating inertia (kg m^2) on the motor shaft: rotor + coupling + ``load_inertia``."""
     return motor.rotor_inertia + motor.coupling_inertia + load_inertia
+
+
+def _inverse_saturation(motor):
+    return 1.0 / motor.saturation_torque if motor.saturation_torque > 0.0 else 0.0
+
+
+def applied_torque(motor, tau):
+    """Torque [N m] the drive applies for the (limited) command ``tau`` [N m]: ``tau`` itself for a linear drive
+    (``motor.saturation_torque`` 0), else ``tau / sqrt(1 + (tau / tau_s)^2)``; any Drake scalar."""
+    return saturating(tau, _inverse_saturation(motor))
+
+
+def commanded_torque(motor, applied):
+    """The command [N m] whose :func:`applied_torque` is ``applied`` (a float; infinite where it is beyond
+    ``motor.saturation_torque``)."""
+    return unsaturated(applied, _inverse_saturation(motor))
 
 
 @TemplateSystem.define("Motor_", scope=sys.modules[__name__])
@@ -28,7 +49,7 @@ def Motor_(T):
 
         Input ports
         -----------
-        torque_command : 1, N m (saturated at the peak torque)
+        torque_command : 1, N m (limited at the peak torque, then through the drive's saturation)
         load_torque : 1, N m (reaction of the screw on the rotor)
 
         Output ports
@@ -68,7 +89,7 @@ def Motor_(T):
         def _commanded(self, context):
             u = self._u_torque_command.Eval(context)[0]
             limit = self.params.peak_torque
-            return clip(u, -limit, limit)
+            return applied_torque(self.params, clip(u, -limit, limit))
 
         def _torque(self, context, x):
             return x[2] if self.has_lag else self._commanded(context)

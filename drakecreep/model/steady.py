@@ -15,6 +15,7 @@ import math
 
 from drakecreep.model.controller import force_limit
 from drakecreep.model.friction import make_friction_law
+from drakecreep.model.motor import commanded_torque
 from drakecreep.model.nut_table import friction_levels
 from drakecreep.params import with_value
 
@@ -49,7 +50,9 @@ def steady_sliding(params, scenario):
     tuple
         The friction law (:func:`drakecreep.model.friction.make_friction_law`) and its Coulomb and static levels
         [N], the steady friction ``F(v)`` and the screw's force ``Fx + F(v)`` [N], the motor torque [N m] that
-        holds them against the motor's viscous drag, and that torque as a force command at the table [N].
+        holds them against the motor's viscous drag, and the force command at the table [N] that makes the drive
+        apply it (that torque through the lead, unless the drive saturates: then more, infinite beyond
+        ``motor.saturation_torque``, :func:`drakecreep.model.motor.commanded_torque`).
     """
     load = params.load_case(scenario.load_case)
     ratio = params.screw.lead / (2.0 * math.pi)
@@ -58,7 +61,7 @@ def steady_sliding(params, scenario):
     friction = float(law.steady_state_force(scenario.feed, fc, fs))
     spring = load.fx + friction
     torque = spring * ratio + params.motor.viscous_damping * scenario.feed / ratio
-    return (law, fc, fs), friction, spring, torque, torque / ratio
+    return (law, fc, fs), friction, spring, torque, commanded_torque(params.motor, torque) / ratio
 
 
 def sliding_overload(params, scenario):

@@ -445,6 +445,9 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         field = "cogging_force" if d.cogging_force > 0.0 else "cogging_2_force"
         raise InputError(f"disturbance.{field}", getattr(d, field),
                          "0 with the multibody model (the cogging is a two-mass model effect)")
+    if params.motor.saturation_torque > 0.0:
+        raise InputError("motor.saturation_torque", params.motor.saturation_torque,
+                         "0 with the multibody model (the drive's saturation is a two-mass model effect)")
     for k, a in enumerate(params.friction.position_map):
         if a != 0.0:
             raise InputError(f"friction.position_map_{k}", a,

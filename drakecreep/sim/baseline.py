@@ -38,6 +38,9 @@ def unsupported(params):
     for name in ("coulomb_asymmetry", "viscous_asymmetry"):
         if getattr(p.friction, name) != 0.0:
             return (f"friction.{name}", getattr(p.friction, name), "0 (the plain-Python equations are symmetric)")
+    if p.motor.saturation_torque > 0.0:
+        return ("motor.saturation_torque", p.motor.saturation_torque,
+                "0 (the plain-Python equations have a linear drive)")
     for k, a in enumerate(p.friction.position_map):
         if a != 0.0:
             return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")

@@ -16,6 +16,29 @@ def test_starts_in_equilibrium_under_load(paper, continuous):
     assert ic["force0"] == 434.0
 
 
+@pytest.mark.parametrize("continuous", [False, True])
+def test_a_saturating_drive_starts_in_equilibrium_with_the_command_that_holds_the_load(paper, continuous):
+    """With ``motor.saturation_torque`` the controller starts from the larger command whose applied torque holds
+    the load (``command0``), the current loop from that torque (``torque0``); beyond it the load is refused."""
+    import math
+
+    from drakecreep.errors import InputError
+    from drakecreep.params import with_value
+
+    ratio = paper.screw.lead / (2 * math.pi)
+    held = 434.0 * ratio  # N m
+    weak = with_value(paper, "motor.saturation_torque", 1.5 * held)
+    drive = build_diagram(weak, Scenario(feed=1e-3, load_case=3), continuous=continuous)
+    c = drive.diagram.CreateDefaultContext()
+    np.testing.assert_allclose(drive.diagram.EvalTimeDerivatives(c).CopyToVector(), 0.0, atol=1e-9)
+    ic = initial_conditions(weak, Scenario(load_case=3))
+    assert ic["torque0"] == pytest.approx(held)
+    assert ic["command0"] == pytest.approx(434.0 / math.sqrt(1.0 - 1.0 / 1.5 ** 2))
+    with pytest.raises(InputError) as err:
+        initial_conditions(with_value(paper, "motor.saturation_torque", 0.9 * held), Scenario(load_case=3))
+    assert err.value.field == "motor.saturation_torque"
+
+
 @pytest.mark.parametrize("case, fx", [(0, 0.0), (3, 434.0)])
 def test_a_constant_force_adds_to_every_load_case_the_unloaded_one_too(paper, case, fx):
     """``loads.constant_force`` (a drive's offset, an incline) reaches the diagram through ``load_case``: the

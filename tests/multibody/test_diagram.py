@@ -195,3 +195,6 @@ def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
     with pytest.raises(InputError) as err:  # and the friction map
         build_multibody_diagram(with_value(paper, "friction.position_map_3", 0.2), scenario, options)
     assert err.value.field == "friction.position_map_3"
+    with pytest.raises(InputError) as err:  # and the drive's saturation
+        build_multibody_diagram(with_value(paper, "motor.saturation_torque", 2.0), scenario, options)
+    assert err.value.field == "motor.saturation_torque"

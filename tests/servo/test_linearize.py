@@ -19,10 +19,15 @@ def rigid_shaft(stribeck):
     return with_value(stribeck, "screw.youngs_modulus", 2.06e19)
 
 
-@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb"])
+@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb", "lugre, saturating drive"])
 @pytest.mark.parametrize("feed", [1e-3, 0.1e-3])
 def test_operating_point_is_steady_sliding(paper, law, feed):
-    p = with_value(paper, "friction.law", law)
+    p = with_value(paper, "friction.law", law.split(",")[0])
+    if "saturating" in law:  # the command that holds the load is larger than the torque the drive applies
+        from drakecreep.model.steady import nut_on_table, steady_sliding
+
+        held = steady_sliding(nut_on_table(p), Scenario(feed=feed, load_case=3))[3]
+        p = with_value(p, "motor.saturation_torque", 1.2 * held)
     sc = Scenario(feed=feed, load_case=3)
     op = lin.operating_point(p, sc)
     x, xdot = lin.closed_loop_derivatives(p, sc, op)
@@ -36,8 +41,10 @@ def test_operating_point_is_steady_sliding(paper, law, feed):
     assert abs(rates["table.v"]) < 1e-9
     assert abs(rates["controller.integrator"]) < 1e-9 * op.spring_force
     assert abs(rates["motor.tau"]) < 1e-9
-    if law == "lugre":
+    if law.startswith("lugre"):
         assert abs(rates["table.w"]) < 1e-9
+    if "saturating" in law:
+        assert op.controller[0] > 1.5 * op.torque / r  # 1 / sqrt(1 - 1 / 1.2^2) = 1.81
 
 
 def test_operating_point_matches_a_simulation(paper):
