@@ -103,7 +103,7 @@ def initial_conditions(params, scenario):
     held = force0
     if params.disturbance.has_cogging:
         held = force0 + float(cogging_force(params.disturbance, theta0 * ratio))
-    command0 = commanded_torque(params.motor, held * ratio) / ratio
+    command0 = held if params.motor.saturation_torque == 0.0 else commanded_torque(params.motor, held * ratio) / ratio
     if not math.isfinite(command0):
         raise InputError("motor.saturation_torque", params.motor.saturation_torque,
                          f"above the {abs(held * ratio):.4g} N m that holds the load case at rest")
