@@ -72,8 +72,8 @@ def test_an_unknown_kind_is_refused_before_any_work():
 
 def test_the_drakecreep_kind_has_its_own_library():
     """Only Stribeck, lead error, the time ripple and the control delay have a default DriveParams candidate; every
-    other library effect of the truth is out of that kind's library (asymmetric friction, cogging and position
-    friction too: their candidates run only when named), and the specs draw it like one (no SNR selection)."""
+    other library effect of the truth is out of that kind's library (asymmetric friction, cogging, position friction
+    and drive saturation too: their candidates run only when named), and the specs draw it like one (no SNR selection)."""
     from drakecreep.gap.drive_fit import EFFECTS, NOT_IN_MODEL, ON_REQUEST
 
     assert set(EXPECTED_DRIVE.values()) <= set(EFFECTS)
@@ -84,10 +84,11 @@ def test_the_drakecreep_kind_has_its_own_library():
         if e not in EXPECTED_DRIVE:
             assert expected_of("drakecreep", (e,)) is None
     assert {"structural_mode", "backlash"} <= set(NOT_IN_MODEL)
-    assert {"asymmetric_friction", "cogging", "position_friction"} <= set(ON_REQUEST)
+    assert {"asymmetric_friction", "cogging", "position_friction", "drive_saturation"} <= set(ON_REQUEST)
     assert not set(ON_REQUEST) & set(EXPECTED_DRIVE.values())
     assert category_of("drakecreep", ("cogging",)) == "out_of_library"
     assert category_of("drakecreep", ("position_friction",)) == "out_of_library"
+    assert category_of("drakecreep", ("drive_saturation",)) == "out_of_library"
     assert category_of("drakecreep", ("asymmetric_friction",)) == "out_of_library"
     assert "control_delay" not in NOT_IN_MODEL and expected_of("drakecreep", ("control_delay",)) == "control_delay"
     assert category_of("drakecreep", ()) == "null" and category_of("drakecreep", ("load_friction",)) == "out_of_library"
