@@ -24,7 +24,8 @@ training fit's SSE and variance, and these two columns then read ``n/a`` and are
   of the nominal fit's effective residual variance, ``train_gain * train_sse / train_variance``, above the
   ``1 - ALPHA`` quantile of a chi-square of ``k`` degrees of freedom, ``k`` the most fields the candidate can add
   to the nominal (:data:`CANDIDATE_FIELDS`: a lead error's or a cogging's five with the second harmonic, a
-  ripple's three, whether or not the fit used them all; a switch of the law or the nut's side one);
+  ripple's three, whether or not the fit used them all; a friction map's four amplitudes (its travel is the runs'
+  own); a switch of the law or the nut's side, a saturation torque one);
 * ``pooled_chi2``: the training chi-square test and the pooled replay test alone, no bar on the per-run gains.
 
 One more lets a large pooled shrink stand for the Student bar (study 3bs, declared in session 60 on the rows then
@@ -85,7 +86,7 @@ NOT_AVAILABLE = "n/a"
 #: Stribeck candidate's refit of the uncertain fields adds none, they were fitted already)
 CANDIDATE_FIELDS = {"lead_error": 5, "cogging": 5, "force_ripple": 3, "stribeck": 2, "asymmetric_friction": 2,
                     "control_delay": 1, "nut_friction_side": 1, "law_coulomb": 1, "law_stribeck": 1,
-                    "law_lugre": 1, "law_gms": 1}
+                    "law_lugre": 1, "law_gms": 1, "position_friction": 4, "drive_saturation": 1}
 
 
 def training_chi2(row, candidate):
