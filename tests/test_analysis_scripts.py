@@ -39,10 +39,16 @@ def _indexes_argv(tree):
 
 
 def _script_module(name):
-    """``analysis/NAME`` loaded as a module (its ``__main__`` block not run)."""
+    """``analysis/NAME`` loaded as a module (its ``__main__`` block not run), with ``analysis/`` on the path while
+    it imports, as when run from there (its ``study_cli``; the tests that use it passed only after another test
+    had left ``analysis/`` on the path)."""
     spec = importlib.util.spec_from_file_location(Path(name).stem, ANALYSIS / name)
     module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    sys.path.insert(0, str(ANALYSIS))
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(ANALYSIS))
     return module
 
 
