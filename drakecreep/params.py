@@ -535,7 +535,8 @@ class FrictionParams(_Params):
     position_map_2: float = _q(0.0, "-", -0.9, 0.9, doc="third step of the friction level along the travel")
     position_map_3: float = _q(0.0, "-", -0.9, 0.9, doc="fourth step of the friction level along the travel")
     position_map_start: float = _q(
-        0.0, "m", -10.0, 10.0, doc="table position where the friction map's travel starts (the level is held beyond it)",
+        0.0, "m", -10.0, 10.0,
+        doc="table position where the friction map's travel starts (the level is held beyond it)",
     )
     position_map_end: float = _q(
         1.0, "m", -10.0, 10.0, doc="table position where the friction map's travel ends (> position_map_start)",

@@ -163,7 +163,7 @@ def check_feed(params, scenario, option, mm_s):
     the scenario's field in m/s, and blamed the feed for what is mostly the params' load and friction)."""
     import numpy as np  # (not at start-up: every command's --help imports this module)
 
-    from drakecreep.model.steady import nut_on_table, sliding_overload, steady_sliding
+    from drakecreep.model.steady import drive_limit, nut_on_table, sliding_overload, steady_sliding
 
     overload = sliding_overload(params, scenario)
     if overload is not None:
@@ -175,13 +175,12 @@ def check_feed(params, scenario, option, mm_s):
             # not given, 'allowed: a feed the drive can slide at', where none can)
             raise InputError("--load-case", scenario.load_case, f"a load case the drive can hold at some feed: this one "
                              f"takes at least {min(n[0] for n in needs):.4g} N at 1e-4 to 1000 mm/s, beyond the "
-                             f"drive's limit {limit:.4g} N (motor.peak_torque through screw.lead against the params "
-                             "file's load and friction)")
+                             f"drive's limit {limit:.4g} N ({drive_limit(params)[1]} against the params file's load "
+                             "and friction)")
         _, friction, spring, _, _ = steady_sliding(nut_on_table(params), scenario)
         raise InputError(option, mm_s, f"a feed in mm/s the drive can slide at: at load case {scenario.load_case} it "
                          f"takes {force:.4g} N (load {spring - friction:.4g} N, friction {friction:.4g} N, motor drag "
-                         f"{force - spring:.4g} N), beyond the drive's limit {limit:.4g} N (motor.peak_torque through "
-                         "screw.lead)")
+                         f"{force - spring:.4g} N), beyond the drive's limit {limit:.4g} N ({drive_limit(params)[1]})")
 
 
 def feed_from_mm_s(value, option="--feed"):

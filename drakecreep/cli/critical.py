@@ -138,19 +138,20 @@ def run(args):
                                     else f"{v0_sc * 1e3:.4g} mm/s"))
     if overload is not None:
         print(f"creep at v        : no verdict: the drive cannot hold this feed (it takes {overload[0]:.4g} N, beyond "
-              f"its force limit {overload[1]:.4g} N: motor.peak_torque through screw.lead)")
+              f"its force limit {overload[1]:.4g} N: {overload[2]})")
     else:
         print(f"creep at v        : {'yes' if result['creep_predicted'] else 'no'}")
     return 0
 
 
 def _overload(args, params, load_case):
-    """``(force, limit)`` [N] when the parameters' drive cannot slide at ``--feed`` under the load case, else None;
-    not asked with friction overrides (``--fs``, ``--fd``: a what-if of the lumped drive, not of the parameters)."""
+    """``(force, limit)`` [N] and where the limit comes from when the parameters' drive cannot slide at ``--feed``
+    under the load case, else None; not asked with friction overrides (``--fs``, ``--fd``: a what-if of the lumped
+    drive, not of the parameters)."""
     if args.fs is not None or args.fd is not None:
         return None
     from drakecreep.scenario import Scenario
-    from drakecreep.model.steady import sliding_overload
+    from drakecreep.model.steady import drive_limit, sliding_overload
 
     overload = sliding_overload(params, Scenario(feed=args.feed * 1e-3, load_case=load_case))
-    return None if overload is None else (float(overload[0]), float(overload[1]))
+    return None if overload is None else (float(overload[0]), float(overload[1]), drive_limit(params)[1])

@@ -77,7 +77,8 @@ from drakecreep.model._scalar import clip, exp, fabs, tanh, vector
 from drakecreep.model.disturbances import cos, sin
 
 __all__ = ["AXIS_PARAMETERS", "AXIS_UNITS", "MeasuredAxis", "MeasuredAxis_", "axis_parameters",
-           "set_axis_parameters", "axis_friction", "applied_force", "saturating", "unsaturated", "nut_load", "friction_map", "FRICTION_MAP",
+           "set_axis_parameters", "axis_friction", "applied_force", "saturating", "unsaturated", "nut_load",
+           "friction_map", "FRICTION_MAP",
            "bristle_rates", "has_bristles", "LEAD_ERROR", "lead_error", "lead_error_force", "lead_error_drive",
            "POSITION_RIPPLE", "axis_ripple"]
 

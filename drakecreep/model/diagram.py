@@ -87,8 +87,8 @@ def initial_conditions(params, scenario):
     Returns
     -------
     dict
-        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``torque0`` (N m, the motor torque that
-        holds it: ``force0`` plus the cogging's load at ``theta0``, :func:`~drakecreep.model.disturbances.cogging_force`,
+        ``theta0`` (rad), ``force0`` (N, screw force = axial load), ``torque0`` (N m, the motor torque that holds
+        it: ``force0`` plus the cogging's load at ``theta0``, :func:`~drakecreep.model.disturbances.cogging_force`,
         through the lead), ``command0`` (N, the force command that makes the drive apply ``torque0``: the same force
         unless the drive saturates, :func:`~drakecreep.model.motor.commanded_torque`), ``x_ref0`` (m, where the
         position feedback reads at rest), ``theta_counted0`` (rad).

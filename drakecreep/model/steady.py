@@ -15,11 +15,11 @@ import math
 
 from drakecreep.model.controller import force_limit
 from drakecreep.model.friction import make_friction_law
-from drakecreep.model.motor import commanded_torque
+from drakecreep.model.motor import applied_torque, commanded_torque
 from drakecreep.model.nut_table import friction_levels
 from drakecreep.params import with_value
 
-__all__ = ["nut_on_table", "steady_sliding", "sliding_overload"]
+__all__ = ["nut_on_table", "steady_sliding", "sliding_overload", "drive_limit"]
 
 
 def nut_on_table(params):
@@ -67,13 +67,25 @@ def steady_sliding(params, scenario):
 def sliding_overload(params, scenario):
     """``(force, limit)`` [N] when the drive cannot slide steadily at ``scenario``'s feed and load case, else None.
 
-    ``force`` is the command that would hold it sliding: the load's axial force, the friction at that speed and
-    the motor's viscous drag, at the table (the ball nut's friction lumped on the table, :func:`nut_on_table`);
-    ``limit`` is :func:`drakecreep.model.controller.force_limit`. The linear analyses' operating point exists
-    only while ``|force| < limit``. None for the GMS law too, which has no steady sliding to linearize (the
-    operating point says so).
+    ``force`` is what would hold it sliding: the load's axial force, the friction at that speed and the motor's
+    viscous drag, at the table (the ball nut's friction lumped on the table, :func:`nut_on_table`); ``limit`` is
+    the most the drive applies (:func:`drive_limit`). The linear analyses' operating point exists only while
+    ``|force| < limit``. None for the GMS law too, which has no steady sliding to linearize (the operating point
+    says so).
     """
     if params.friction.law == "gms":
         return None
-    force, limit = steady_sliding(nut_on_table(params), scenario)[-1], force_limit(params)
+    torque = steady_sliding(nut_on_table(params), scenario)[3]
+    force, limit = torque * 2.0 * math.pi / params.screw.lead, drive_limit(params)[0]
     return (force, limit) if abs(force) >= limit else None
+
+
+def drive_limit(params):
+    """``(force, source)``: the most the drive applies at the table [N], and where that figure comes from in words:
+    :func:`drakecreep.model.controller.force_limit` (``motor.peak_torque`` through ``screw.lead``), less for a
+    drive that saturates (:func:`drakecreep.model.motor.applied_torque` of the peak torque)."""
+    limit = force_limit(params)
+    if params.motor.saturation_torque == 0.0:
+        return limit, "motor.peak_torque through screw.lead"
+    return (applied_torque(params.motor, params.motor.peak_torque) * 2.0 * math.pi / params.screw.lead,
+            "motor.peak_torque through motor.saturation_torque and screw.lead")

@@ -57,7 +57,7 @@ def check_sliding(params, load_case, feeds, source="the params"):
     [m/s], the loci's (:data:`LOCI`) and the crossings' (:data:`CROSSING_SPEEDS`), its force within the drive's
     limit. A params file whose drive cannot hold its load and friction was refused in the loci, after the loop
     analysis, as 'feed: got 2e-05' (a speed of the feed locus, in m/s)."""
-    from drakecreep.model.steady import sliding_overload
+    from drakecreep.model.steady import drive_limit, sliding_overload
 
     speeds = dict(LOCI)["feed"]
     cases = [(params, v, None) for v in (*feeds, *speeds, *CROSSING_SPEEDS)]
@@ -69,7 +69,7 @@ def check_sliding(params, load_case, feeds, source="the params"):
             force, limit = overload
             where = f"{1e3 * v:.3g} mm/s" + (f" with a table mass of {mass:.3g} kg (the mass locus)" if mass else "")
             raise InputError("params", f"{source}, load case {load_case}: {force:.4g} N to slide at {where}",
-                             f"a drive whose limit {limit:.4g} N (motor.peak_torque through screw.lead) holds it "
+                             f"a drive whose limit {limit:.4g} N ({drive_limit(p)[1]}) holds it "
                              f"sliding at the report's feeds, {lo:.3g} to {hi:.3g} mm/s, and table masses, "
                              f"{dict(LOCI)['mass'][0]:g} to {dict(LOCI)['mass'][-1]:g} kg")
 

@@ -779,3 +779,18 @@ def test_a_friction_map_is_named_by_the_linear_analyses_and_simulated(tmp_path, 
     code, out, _ = _run(["simulate", "--params", str(mapped), "--load-case", "0", "--duration", "1.1", "--out",
                          str(tmp_path / "s")], capsys)
     assert code == 0 and "creep (stick-slip)" in out and (tmp_path / "s" / "metrics.json").exists()
+
+
+def test_a_drive_that_saturates_below_its_load_names_the_saturation(tmp_path, capsys):
+    """A saturation torque under what the friction takes (0.05 N m, 63 N at the table, against 118 N): the drive
+    applies at most that, whatever its peak torque; simulate and critical say so by the field, not by
+    motor.peak_torque alone."""
+    from drakecreep.params import preset, save_params, with_value
+
+    weak = tmp_path / "weak.yaml"
+    save_params(with_value(preset("paper"), "motor.saturation_torque", 0.05), weak)
+    code, _, err = _run(["simulate", "--params", str(weak), "--load-case", "0", "--out", str(tmp_path / "s")], capsys)
+    _one_line_exit_2(code, err, "beyond the drive's limit 62.83 N (motor.peak_torque through motor.saturation_torque "
+                                "and screw.lead against")
+    code, out, _ = _run(["critical", "--params", str(weak), "--load-case", "0", "--feed", "1"], capsys)
+    assert code == 0 and "force limit 62.83 N: motor.peak_torque through motor.saturation_torque" in out

@@ -73,7 +73,8 @@ def test_an_unknown_kind_is_refused_before_any_work():
 def test_the_drakecreep_kind_has_its_own_library():
     """Only Stribeck, lead error, the time ripple and the control delay have a default DriveParams candidate; every
     other library effect of the truth is out of that kind's library (asymmetric friction, cogging, position friction
-    and drive saturation too: their candidates run only when named), and the specs draw it like one (no SNR selection)."""
+    and drive saturation too: their candidates run only when named), and the specs draw it like one (no SNR
+    selection)."""
     from drakecreep.gap.drive_fit import EFFECTS, NOT_IN_MODEL, ON_REQUEST
 
     assert set(EXPECTED_DRIVE.values()) <= set(EFFECTS)

@@ -37,6 +37,7 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
     asym = with_value(short_paper, "friction.viscous_asymmetry", 0.2)
     assert unsupported(asym) == ("friction.viscous_asymmetry", 0.2, "0 (the plain-Python equations are symmetric)")
     mapped = with_value(short_paper, "friction.position_map_2", -0.1)  # a friction map: the Drake systems' alone
-    assert unsupported(mapped) == ("friction.position_map_2", -0.1, "0 (the plain-Python equations have no friction map)")
+    assert unsupported(mapped) == ("friction.position_map_2", -0.1,
+                                   "0 (the plain-Python equations have no friction map)")
     weak = with_value(short_paper, "motor.saturation_torque", 0.5)  # a saturating drive: the Drake systems' alone
     assert unsupported(weak) == ("motor.saturation_torque", 0.5, "0 (the plain-Python equations have a linear drive)")
