@@ -120,6 +120,7 @@ __all__ = [
     "EFFECTS",
     "NOT_IN_MODEL",
     "ON_REQUEST",
+    "ON_REQUEST_WHY",
     "SEPARABILITY",
     "STRIBECK_STARTS",
     "MIN_SAMPLES",
@@ -301,16 +302,23 @@ EFFECTS = {
     "drive_saturation": "the drive applies less torque than commanded, more so the larger the command (a torque "
                         "constant that falls off: motor.saturation_torque)",
 }
-#: Candidates fitted only when named (``effects=``, ``--effects``), not by default: ``asymmetric_friction``'s
-#: Coulomb part is, in sliding, a constant force offset (``a_c Fc`` both ways), which DriveParams cannot express
-#: otherwise and which a drive's current offset or an inclined axis gives; how often it would be claimed on data
-#: with an offset and no asymmetry has not been measured on development datasets (docs/gap_drakecreep_kind.md).
-#: ``cogging`` (session 58) has not been run on development datasets either: how often it would be claimed on
-#: nulls, or instead of a lead error of the same period, is not known; nor has ``position_friction`` (session 91),
-#: whose four free amplitudes can also take up a friction that drifts over the runs' time (run after run over the
-#: travel) or a load that changes along it; nor has ``drive_saturation`` (session 91), which a table mass declared
-#: too light could also take up (both ask more command for the larger accelerations).
-ON_REQUEST = ("asymmetric_friction", "cogging", "position_friction", "drive_saturation")
+#: Candidates fitted only when named (``effects=``, ``--effects``), not by default, and why
+#: (docs/gap_drakecreep_kind.md): ``asymmetric_friction``'s Coulomb part is, in sliding, a constant force offset
+#: (``a_c Fc`` both ways), which DriveParams cannot express otherwise and which a drive's current offset or an
+#: inclined axis gives; ``cogging`` (session 58), ``position_friction`` and ``drive_saturation`` (session 91) have
+#: not been run on development datasets: how often each would be claimed on nulls, or in place of what looks alike,
+#: is not known.
+ON_REQUEST_WHY = {
+    "asymmetric_friction": "in sliding its Coulomb part is a constant force offset; how often it is claimed on runs "
+                           "with an offset and no asymmetry is not measured (--uncertain ...,loads.constant_force "
+                           "fits an offset)",
+    "cogging": "not measured on the benchmark's nulls, nor against a lead error of its period",
+    "position_friction": "not measured on the benchmark's nulls; its four free amplitudes can also take up a friction "
+                         "that drifts from run to run (runs taken one after another along the travel)",
+    "drive_saturation": "not measured on the benchmark's nulls; a table mass declared too light also asks more "
+                        "command for the larger accelerations",
+}
+ON_REQUEST = tuple(ON_REQUEST_WHY)
 #: The candidates fitted when ``effects`` is not given: :data:`EFFECTS` without :data:`ON_REQUEST`, in order.
 DEFAULT_EFFECTS = tuple(n for n in EFFECTS if n not in ON_REQUEST)
 #: Computation delays tried by the ``control_delay`` candidate [velocity-loop samples]: whole samples (the compiled
@@ -504,6 +512,13 @@ class DriveDiagnosis:
                          + spectral["reason"])
         return lines
 
+    @property
+    def not_run(self):
+        """The candidates fitted only when named (:data:`ON_REQUEST`) that this diagnosis did not run, with why
+        they are not defaults (:data:`ON_REQUEST_WHY`)."""
+        ran = {c.name for c in self.candidates}
+        return {n: why for n, why in ON_REQUEST_WHY.items() if n not in ran}
+
     def hints(self):
         """Candidates not run that the unexplained residual points to, as lines of text (none when it points nowhere).
 
@@ -621,6 +636,7 @@ class DriveDiagnosis:
             "train_sse": self.train_sse,
             "train_variance": self.train_variance,
             "not_ranked": dict(self.not_ranked),
+            "not_run": self.not_run,
             "params": params_to_dict(self.params),
             "simulations": self.simulations,
             "seconds": self.seconds,

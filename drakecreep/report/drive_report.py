@@ -185,6 +185,9 @@ def write_drive_report(result, outset, *, title="Sim-to-real gap diagnosis (the 
         parts.append("<h2>An oscillation of the measured runs</h2><ul>"
                      + "".join(f"<li>{escape(line.strip())}</li>" for line in result.oscillation_lines()) + "</ul>")
     parts += where_parts(result.where)
+    if result.not_run:
+        parts.append("<h2>Not run: candidates fitted only when named (--effects)</h2>")
+        parts.append(table(["effect", "why not by default"], [[n, why] for n, why in result.not_run.items()]))
     parts.append("<h2>Never ranked</h2>")
     parts.append(table(["effect", "why"], [[n, why] for n, why in result.not_ranked.items()]))
     for png, caption in _figures(result):

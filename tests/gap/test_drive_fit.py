@@ -133,6 +133,7 @@ def test_asymmetric_friction_is_fitted_claimed_and_kept_only_when_named(asymmetr
     rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
     assert rms(result.test_errors) < 0.3 * rms(result.nominal_test_errors)
     assert "asymmetric_friction" in drive_fit.ON_REQUEST and "asymmetric_friction" not in drive_fit.NOT_IN_MODEL
+    assert list(result.not_run) == ["cogging", "position_friction", "drive_saturation"]  # named: it ran
     # the same runs without the asymmetry: fitted, nothing claimed
     plain = simulated_runs(RIG, SPEEDS + (0.015, 0.04), declared=RIG, n=N, noise=NOISE, seed=500)
     none = diagnose_drive(plain[:2], plain[2:], uncertain=("table.seal_force",), effects=("asymmetric_friction",))
