@@ -556,6 +556,11 @@ class FrictionParams(_Params):
         """The four step amplitudes ``position_map_0`` .. ``_3`` of the friction level along the travel."""
         return (self.position_map_0, self.position_map_1, self.position_map_2, self.position_map_3)
 
+    @property
+    def has_position_map(self):
+        """Whether any step of the friction level along the travel is switched on."""
+        return any(a != 0.0 for a in self.position_map)
+
 
 @dataclass(frozen=True)
 class ControllerParams(_Params):

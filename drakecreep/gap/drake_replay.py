@@ -1014,7 +1014,7 @@ def at_origin(params, x_origin):
             value = getattr(d, name) + harmonic * turn
             params = with_value(params, f"disturbance.{name}", math.remainder(value, 2.0 * math.pi))
     f = params.friction
-    if any(a != 0.0 for a in f.position_map):
+    if f.has_position_map:
         # moved down, the start goes first, moved up the end: end > start holds between the two steps
         order = ("position_map_start", "position_map_end")[::1 if x_origin > 0 else -1]
         for name in order:

@@ -115,7 +115,8 @@ def NutTable_(T):
             LeafSystem_[T].__init__(self, converter=converter)
             self.params = params
             self.load = load
-            self.mapped = any(a != 0.0 for a in params.friction.position_map)
+            # the map's parameters by friction_map's names, built once (None: no map)
+            self._map = friction_map_parameters(params.friction) if params.friction.has_position_map else None
             self.law = make_friction_law(params.friction)
             self.mass = moving_mass(params)
             self.fc, self.fs = table_friction_levels(params, load)
@@ -144,8 +145,8 @@ def NutTable_(T):
         def _force(self, x, v, z):
             # the law's internal states are normalized by its level, so the map scales its force, not its rates
             f = self.law.force(v, z, self.fc, self.fs)
-            if self.mapped:
-                f = position_level(self.params.friction, x) * f
+            if self._map is not None:
+                f = (1.0 + friction_map(self._map, x)) * f
             return f
 
         def friction(self, context):
