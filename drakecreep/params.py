@@ -224,6 +224,8 @@ def _check_stiffness(name, value, off=False):
 #: a 1000 kg table on a 1e9 N/m chain. At 1e9-1e20 N s/m ``margins`` printed 'nan Hz' for the mode it overdamps and,
 #: at 1e20, an open-loop unstable pole the rounding of its -c/m eigenvalue made
 MAX_CHAIN_DAMPING = 1e8
+#: largest lost motion of the screw-nut [m] (``nut.backlash``): a millimetre, fifty times a worn nut's 20 um
+MAX_BACKLASH = 1e-3
 #: largest force [N] of a load (a load case's fx, fy, fz, the constant force) and of a friction level (critical's
 #: --fs, --fd): 1000 t, three decades above a heavy machine axis's thrust. A load case's fz of -1e12 N was
 #: accepted, and simulate reported a table that cannot move (3e9 N of guide friction) as sliding without creep
@@ -448,6 +450,11 @@ class NutParams(_Params):
         0.0, "N/m", 0.0, doc="fixed joints of the nut seat (nut-seat, seat-table) in series with the nut (0 = rigid, off)",
     )
     seat_joint_damping: float = _q(0.0, "N s/m", 0.0, MAX_CHAIN_DAMPING, doc="damping of the nut seat joints")
+    backlash: float = _q(
+        0.0, "m", 0.0, MAX_BACKLASH,
+        doc="axial lost motion of the screw-nut: no force through the chain within +-backlash/2 (0 = a preloaded "
+            "nut; assumption: 4-20 um for a nut without preload or a worn one)",
+    )
 
     def _check(self):
         _check_stiffness("axial_stiffness", self.axial_stiffness)

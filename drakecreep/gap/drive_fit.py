@@ -123,6 +123,8 @@ __all__ = [
     "ON_REQUEST_WHY",
     "SEPARABILITY",
     "STRIBECK_STARTS",
+    "SATURATION_STARTS",
+    "BACKLASH_STARTS",
     "MIN_SAMPLES",
     "MIN_DURATION",
     "MAX_DRIVE_FORCE",
@@ -278,7 +280,7 @@ _SECOND = {"lead_error": ("disturbance.lead_error_2_amplitude", "disturbance.lea
 _AMPLITUDES = {"lead_error": ("disturbance.lead_error_amplitude", _SECOND["lead_error"][0]),
                "force_ripple": ("disturbance.force_ripple",), "asymmetric_friction": _ASYMMETRY,
                "cogging": ("disturbance.cogging_force", _SECOND["cogging"][0]), "position_friction": _MAP,
-               "drive_saturation": ("motor.saturation_torque",)}
+               "drive_saturation": ("motor.saturation_torque",), "backlash": ("nut.backlash",)}
 #: Candidate effects (parts of the Drake model, fields of DriveParams) and what each changes.
 EFFECTS = {
     "lead_error": "kinematic lead error of the screw (disturbance.lead_error_amplitude and _phase, period lead/k, "
@@ -301,12 +303,14 @@ EFFECTS = {
                          "four steps over the training runs' travel, position_map_start and _end)",
     "drive_saturation": "the drive applies less torque than commanded, more so the larger the command (a torque "
                         "constant that falls off: motor.saturation_torque)",
+    "backlash": "lost motion of the screw-nut (nut.backlash): the chain bears no force within +-backlash/2, so the "
+                "motor travels the gap before the table follows where the force through the chain reverses",
 }
 #: Candidates fitted only when named (``effects=``, ``--effects``), not by default, and why
 #: (docs/gap_drakecreep_kind.md): ``asymmetric_friction``'s Coulomb part is, in sliding, a constant force offset
 #: (``a_c Fc`` both ways), which DriveParams cannot express otherwise and which a drive's current offset or an
-#: inclined axis gives; ``cogging`` (session 58), ``position_friction`` and ``drive_saturation`` (session 91) have
-#: not been run on development datasets: how often each would be claimed on nulls, or in place of what looks alike,
+#: inclined axis gives; ``cogging`` (session 58), ``position_friction`` and ``drive_saturation`` (session 91) and
+#: ``backlash`` (session 92) have not been run on development datasets: how often each would be claimed on nulls, or in place of what looks alike,
 #: is not known.
 ON_REQUEST_WHY = {
     "asymmetric_friction": "in sliding its Coulomb part is a constant force offset; how often it is claimed on runs "
@@ -317,6 +321,8 @@ ON_REQUEST_WHY = {
                          "that drifts from run to run (runs taken one after another along the travel)",
     "drive_saturation": "not measured on the benchmark's nulls; a table mass declared too light also asks more "
                         "command for the larger accelerations",
+    "backlash": "not measured on the benchmark's nulls; a lost motion shows only where the chain's force reverses "
+                "(a reversal, a stop against a load), as a friction or a delay there would",
 }
 ON_REQUEST = tuple(ON_REQUEST_WHY)
 #: The candidates fitted when ``effects`` is not given: :data:`EFFECTS` without :data:`ON_REQUEST`, in order.
@@ -328,7 +334,6 @@ DELAY_GRID = (0, 1, 2, 4, 8, 12, 16)
 #: Effects of issue 16 that DriveParams cannot express: never ranked, with the reason.
 NOT_IN_MODEL = {
     "load_friction": "load dependence is fixed by the load case (nut.load_friction_coefficient is fittable as uncertain)",
-    "backlash": "no lost-motion field in DriveParams",
     "structural_mode": "no extra mode in DriveParams; the axial chain's stiffness and damping are fittable as uncertain",
     "quantization": "the sensor resolutions are declared in the run metadata (replayed as declared), not fitted",
     "friction_drift": "no time-dependent friction field in DriveParams",
@@ -1770,6 +1775,8 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
         values.update({p: get_value(fitted_params, p) for p in _MAP})
     elif name == "drive_saturation":
         values, sse = _saturation_effect(runs, base, replayer, scale, max_nfev)
+    elif name == "backlash":
+        values, sse = _backlash_effect(runs, base, replayer, scale, max_nfev)
     elif name == "nut_friction_side":
         values = {"friction.nut_friction_on": "screw" if base.friction.nut_friction_on == "table" else "table"}
         r = _residual(runs, replayer(runs, _with(base, values)), scale)
@@ -1790,9 +1797,27 @@ def _saturation_effect(runs, base, replayer, scale, max_nfev):
     :data:`SATURATION_STARTS` by replayed SSE, refined by the output-error fit. ``(values, sse)``."""
     ratio = base.screw.lead / (2.0 * math.pi)
     peak = max(float(np.max(np.abs(r.u))) * r.meta.u_gain for r in runs) * ratio
-    path = "motor.saturation_torque"
-    trials = [_with(base, {path: share * peak}) for share in SATURATION_STARTS]
-    many = getattr(replayer, "many", None)  # the trials at once (in parallel when the replayer has a pool)
+    return _trial_effect(runs, base, "motor.saturation_torque", [share * peak for share in SATURATION_STARTS],
+                         replayer, scale, max_nfev)
+
+
+#: Lost motions tried before the fit of the ``backlash`` candidate [m]: from a few micrometres (a nut whose preload
+#: has worn off) to 60 um (a badly worn one); the fit refines the best.
+BACKLASH_STARTS = (2e-6, 6e-6, 20e-6, 60e-6)
+
+
+def _backlash_effect(runs, base, replayer, scale, max_nfev):
+    """The nut's lost motion (``nut.backlash``) on the training ``runs``: the best of :data:`BACKLASH_STARTS` by
+    replayed SSE, refined by the output-error fit. ``(values, sse)``."""
+    return _trial_effect(runs, base, "nut.backlash", BACKLASH_STARTS, replayer, scale, max_nfev)
+
+
+def _trial_effect(runs, base, path, starts, replayer, scale, max_nfev):
+    """One field fitted from the best of several trial values: each of ``starts`` replayed on the training ``runs``
+    (at once where the replayer has a pool), the best by SSE refined by the output-error fit, kept only where the
+    fit beats it. ``(values, sse)``."""
+    trials = [_with(base, {path: value}) for value in starts]
+    many = getattr(replayer, "many", None)
     sims = many([(runs, p) for p in trials]) if many is not None else [replayer(runs, p) for p in trials]
     sses = [float(r @ r) for r in (_residual(runs, s, scale) for s in sims)]
     best = trials[int(np.argmin(sses))]

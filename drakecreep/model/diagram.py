@@ -25,7 +25,7 @@ from drakecreep.model.disturbances import add_disturbances, cogging_force
 from drakecreep.model.motor import Motor, commanded_torque
 from drakecreep.model.nut_friction import add_nut_friction
 from drakecreep.model.reference import FeedReference
-from drakecreep.model.screw import ScrewDrive, axial_stiffness, screw_inertia
+from drakecreep.model.screw import ScrewDrive, axial_stiffness, chain_stretch, screw_inertia
 from drakecreep.model.sensors import LinearScale, MotorEncoder, encoder_resolution, quantize
 from drakecreep.model.nut_table import NutTable
 
@@ -96,7 +96,7 @@ def initial_conditions(params, scenario):
     load = params.load_case(scenario.load_case)
     ratio = params.screw.lead / (2.0 * math.pi)
     force0 = load.fx
-    stretch = force0 / axial_stiffness(params.screw, params.nut, 0.0)
+    stretch = chain_stretch(force0, axial_stiffness(params.screw, params.nut, 0.0), params.nut.backlash)
     theta0 = stretch / ratio
     theta_counted = quantize(theta0, encoder_resolution(params.sensors.encoder_counts_per_rev))
     x_ref0 = theta_counted * ratio if params.controller.position_feedback == "motor" else 0.0

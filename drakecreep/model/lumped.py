@@ -8,7 +8,10 @@ The friction of the lumped mass is the friction the model applies to the table
 (``friction.nut_friction_on: screw``, the default since issue 15) that is the guides' share only; the nut's
 drag then acts on the motor side of the spring, where the paper's Fig. 2 mechanism (motor side at a constant
 speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the paper lumps it. A friction map
-(``friction.position_map_*``) scales it by its level where the table is.
+(``friction.position_map_*``) scales it by its level where the table is. A lost motion of the nut
+(``nut.backlash``) is not in it: feeding one way, the chain bears the friction in one direction throughout a
+stick-slip cycle (its force swings between the kinetic and the breakaway level, never through zero), so the gap
+stays closed and the spring the creep theory reads is the chain's stiffness.
 """
 
 from __future__ import annotations

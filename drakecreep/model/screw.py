@@ -25,6 +25,13 @@ Damping model (``screw.chain_damping``): ``"viscous"`` uses the hammer-test coef
 ``c_i = eta_i k_i / (2 pi f)`` with ``f = screw.damping_frequency``, is what the chain uses (a
 frequency-independent loss factor cannot be simulated in the time domain; it is exact at ``f``).
 The fixed joints' coefficients are used as given.
+
+Lost motion (``nut.backlash`` ``b``, 0 for a preloaded nut): the chain bears no force, and no damping, while its
+stretch is within ``+-b / 2``; beyond, the spring acts on the stretch less ``b / 2`` (:func:`chain_force`, a dead
+zone: the balls cross the gap between the flanks of their grooves without load). Under a load the chain's stretch
+is ``F / K + b / 2`` in the load's direction (:func:`chain_stretch`), so a linearization about steady sliding (the
+chain bearing the friction) sees the stiffness ``K``; the lost motion shows where the force through the chain
+reverses.
 """
 
 import math
@@ -32,6 +39,8 @@ import sys
 
 from pydrake.systems.framework import LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
+
+from drakecreep.model._scalar import where
 
 __all__ = [
     "ScrewDrive",
@@ -43,6 +52,8 @@ __all__ = [
     "bearing_element",
     "nut_element",
     "screw_inertia",
+    "chain_force",
+    "chain_stretch",
 ]
 
 
@@ -115,10 +126,28 @@ def screw_inertia(screw):
     return math.pi / 32.0 * screw.density * screw.length * screw.nominal_diameter**4
 
 
+def chain_force(stretch, rate, stiffness, damping, backlash=0.0):
+    """Axial force [N] of the chain at ``stretch`` [m] and stretch ``rate`` [m/s]: ``K s + C ds/dt``, or with a lost
+    motion ``backlash`` [m] (a float) no force within ``+-backlash / 2`` and ``K (s -+ backlash / 2) + C ds/dt``
+    beyond. Any Drake scalar type for ``stretch`` and ``rate`` (``if_then_else`` for Expression)."""
+    if backlash == 0.0:
+        return stiffness * stretch + damping * rate
+    h = 0.5 * backlash
+    bearing = where(stretch > h, stiffness * (stretch - h) + damping * rate, 0.0 * stretch)
+    return where(stretch < -h, stiffness * (stretch + h) + damping * rate, bearing)
+
+
+def chain_stretch(force, stiffness, backlash=0.0):
+    """Stretch [m] at which the chain of ``stiffness`` [N/m] and lost motion ``backlash`` [m] bears a static
+    ``force`` [N]: ``F / K``, plus half the lost motion in the force's direction (the middle of the gap at 0)."""
+    return force / stiffness + math.copysign(0.5 * backlash, force) * (force != 0.0)
+
+
 @TemplateSystem.define("ScrewDrive_", scope=sys.modules[__name__])
 def ScrewDrive_(T):
     class Impl(LeafSystem_[T]):
-        """Spring-damper of the screw between the motor rotation and the table (no state).
+        """Spring-damper of the screw between the motor rotation and the table (no state), with the nut's lost
+        motion (``nut.backlash``, :func:`chain_force`).
 
         Input ports
         -----------
@@ -152,7 +181,7 @@ def ScrewDrive_(T):
             rate = omega * self.ratio - v
             k = axial_stiffness(self.screw, self.nut, x)
             c = axial_damping(self.screw, self.nut, x)
-            return k * stretch + c * rate
+            return chain_force(stretch, rate, k, c, self.nut.backlash)
 
         def _calc_force(self, context, output):
             output.SetAtIndex(0, self.force(context))

@@ -452,6 +452,10 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         if a != 0.0:
             raise InputError(f"friction.position_map_{k}", a,
                              "0 with the multibody model (the friction map is a two-mass model effect)")
+    if params.nut.backlash > 0.0:
+        raise InputError("nut.backlash", params.nut.backlash,
+                         "0 with the multibody model (its ScrewJoint has no lost motion; the backlash is a two-mass "
+                         "model effect)")
     s = {}
 
     def put(name, system):

@@ -10,7 +10,8 @@ twice.
 Operating point (:func:`operating_point`, constructed analytically, checked against the diagram's
 derivatives and against a simulation in the tests): table at the feed speed ``v``, motor at
 ``v / (Ph / 2 pi)``; friction at its steady-state value ``F(v)`` (LuGre: bristle load ``w = g(v)/Fc``);
-the screw stretched to carry ``Fx + F(v)``; the motor torque balancing the screw and its own drag;
+the screw stretched to carry ``Fx + F(v)`` (with a lost motion ``nut.backlash``, its gap closed: the small-signal
+model sees the chain's stiffness, not the gap); the motor torque balancing the screw and its own drag;
 the velocity-loop integrator holding that force; the position error ``(1 - ff) v / kp``.
 
 The friction law enters through its slope at the operating speed: for the static laws (Coulomb,
@@ -45,7 +46,7 @@ from drakecreep.model.diagram import build_diagram, build_plant
 from drakecreep.errors import InputError
 from drakecreep.model.friction import make_friction_law
 from drakecreep.model.motor import motor_inertia
-from drakecreep.model.screw import ScrewDrive, axial_damping, axial_stiffness, screw_inertia
+from drakecreep.model.screw import ScrewDrive, axial_damping, axial_stiffness, chain_stretch, screw_inertia
 from drakecreep.model.nut_table import NutTable, moving_mass
 from drakecreep.model.steady import nut_on_table, steady_sliding
 
@@ -170,14 +171,16 @@ def operating_point(params, scenario):
     x = measured
     for _ in range(50):
         k = float(axial_stiffness(params.screw, params.nut, x))
-        theta = (measured / ratio) if g.position_feedback == "motor" else (x + spring / k) / ratio
-        x_new = measured if g.position_feedback == "table" else theta * ratio - spring / k
+        stretch = chain_stretch(spring, k, params.nut.backlash)
+        theta = (measured / ratio) if g.position_feedback == "motor" else (x + stretch) / ratio
+        x_new = measured if g.position_feedback == "table" else theta * ratio - stretch
         if abs(x_new - x) < 1e-15:
             break
         x = x_new
     k = float(axial_stiffness(params.screw, params.nut, x))
     c = float(axial_damping(params.screw, params.nut, x))
-    theta = measured / ratio if g.position_feedback == "motor" else (x + spring / k) / ratio
+    stretch = chain_stretch(spring, k, params.nut.backlash)  # the chain bears the sliding force: its gap is closed
+    theta = measured / ratio if g.position_feedback == "motor" else (x + stretch) / ratio
     motor = (theta, omega) + ((torque,) if params.motor.current_loop_time_constant > 0 else ())
     table = (x, v) + ((float(law.sliding_level(v, fc, fs)) * math.copysign(1.0, v) / fc,) if law.num_states else ())
     # central difference with a small relative step: truncation ~1e-10, round-off ~1e-10 of C1 here

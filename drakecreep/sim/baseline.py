@@ -44,6 +44,8 @@ def unsupported(params):
     for k, a in enumerate(p.friction.position_map):
         if a != 0.0:
             return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")
+    if p.nut.backlash > 0.0:
+        return ("nut.backlash", p.nut.backlash, "0 (the plain-Python equations have no lost motion)")
     d = p.disturbance
     if d.has_lead_error or d.has_cogging or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")

@@ -8,7 +8,8 @@ from pydrake.systems.primitives import ConstantVectorSource, VectorLogSink
 
 from drakecreep.model.diagram import build_plant
 from drakecreep.params import with_value
-from drakecreep.model.screw import ScrewDrive, axial_damping, axial_stiffness, screw_inertia, shaft_axial_stiffness
+from drakecreep.model.screw import (ScrewDrive, axial_damping, axial_stiffness, chain_force, chain_stretch,
+                                   screw_inertia, shaft_axial_stiffness)
 
 
 def test_stiffness_chain_by_hand(paper):
@@ -47,15 +48,28 @@ def test_force_and_torque_by_hand(paper):
     assert screw.ToAutoDiffXd().screw == paper.screw
 
 
-def test_two_mass_natural_frequency_without_friction(paper):
-    """Friction and damping off: the free vibration is at sqrt(k (1/m1 + 1/m2)) / 2 pi."""
-    p = paper
+def _lossless(p):
+    """``p`` without friction and damping."""
     for path, value in [("table.seal_force", 0.0), ("table.guide_friction_coefficient", 0.0),
                         ("nut.preload_torque", 0.0), ("nut.load_friction_coefficient", 0.0),
                         ("friction.viscous", 0.0), ("friction.law", "coulomb"), ("screw.bearing_damping", 0.0),
                         ("nut.axial_damping", 0.0), ("motor.viscous_damping", 0.0)]:
         p = with_value(p, path, value)
-    plant = build_plant(p)
+    return p
+
+
+def _mode(p):
+    """The two-mass mode [rad/s] ``sqrt(k (1/m1 + 1/m2))``, the chain's stiffness at table position 0."""
+    r = p.screw.lead / (2 * math.pi)
+    m1 = (p.motor.rotor_inertia + p.motor.coupling_inertia + screw_inertia(p.screw)) / r**2
+    m2 = p.table.mass + p.nut.mass
+    return math.sqrt(axial_stiffness(p.screw, p.nut, 0.0) * (1 / m1 + 1 / m2))
+
+
+def _free_vibration_peak(params, table_offset, accuracy):
+    """Peak frequency [Hz] of the table speed over 0.5 s of the plant without torque, started at rest with the
+    table displaced by ``table_offset`` [m] (the frequency, not the amplitude, is checked: ``accuracy``)."""
+    plant = build_plant(params)
     builder = DiagramBuilder()
     builder.AddSystem(plant)
     zero = builder.AddSystem(ConstantVectorSource([0.0]))
@@ -66,19 +80,22 @@ def test_two_mass_natural_frequency_without_friction(paper):
     d = builder.Build()
     ctx = d.CreateDefaultContext()
     x0 = ctx.get_continuous_state_vector().CopyToVector()
-    x0[-2] = 1e-6  # table displaced 1 um: stretches the screw
+    x0[-2] = table_offset
     ctx.SetContinuousState(x0)
     sim = Simulator(d, ctx)
-    sim.get_mutable_integrator().set_target_accuracy(1e-7)  # the frequency, not the amplitude, is checked
+    sim.get_mutable_integrator().set_target_accuracy(accuracy)
     sim.AdvanceTo(0.5)
     v = log.FindLog(ctx).data()[1]
     spectrum = np.abs(np.fft.rfft(v * np.hanning(len(v)), n=8 * len(v)))
-    f_sim = np.fft.rfftfreq(8 * len(v), dt)[np.argmax(spectrum)]
-    r = p.screw.lead / (2 * math.pi)
-    m1 = (p.motor.rotor_inertia + p.motor.coupling_inertia + screw_inertia(p.screw)) / r**2
-    m2 = p.table.mass + p.nut.mass
-    f_expected = math.sqrt(axial_stiffness(p.screw, p.nut, 0.0) * (1 / m1 + 1 / m2)) / (2 * math.pi)
-    assert f_sim == pytest.approx(f_expected, rel=5e-3)
+    return np.fft.rfftfreq(8 * len(v), dt)[np.argmax(spectrum)]
+
+
+def test_two_mass_natural_frequency_without_friction(paper):
+    """Friction and damping off: the free vibration is at sqrt(k (1/m1 + 1/m2)) / 2 pi."""
+    p = paper
+    p = _lossless(p)
+    f_sim = _free_vibration_peak(p, 1e-6, 1e-7)  # table displaced 1 um: stretches the screw
+    assert f_sim == pytest.approx(_mode(p) / (2 * math.pi), rel=5e-3)
 
 
 # --------------------------------------------------------------------------- issue 15: defects 6 and 7
@@ -145,3 +162,58 @@ def test_seat_joints_in_series_by_hand(paper):
     from drakecreep.sim.baseline import BaselineModel
 
     assert BaselineModel(p, Scenario(feed=1e-3)).stiffness(0.0) == pytest.approx((k, c))
+
+
+# --------------------------------------------------------------------------- issue 16: the nut's lost motion
+
+@pytest.mark.parametrize("scalar", ["float", "autodiff", "expression"])
+def test_backlash_is_a_dead_zone_of_the_chain_for_every_scalar_type(paper, scalar):
+    """No force (and no damping) within +-b/2 of the unstretched chain; beyond, the spring on the stretch less b/2."""
+    from pydrake.symbolic import Variable
+
+    b = 10e-6
+    screw = ScrewDrive(with_value(paper, "nut.backlash", b).screw, with_value(paper, "nut.backlash", b).nut)
+    if scalar == "autodiff":
+        screw = screw.ToAutoDiffXd()
+    elif scalar == "expression":
+        screw = screw.ToSymbolic()
+    c = screw.CreateDefaultContext()
+    r = paper.screw.lead / (2 * math.pi)
+    x, v = 1.5e-3, 2e-2
+    k, d = axial_stiffness(paper.screw, paper.nut, x), axial_damping(paper.screw, paper.nut, x)
+    for stretch, expected in [(3e-6, 0.0), (-4.9e-6, 0.0), (8e-6, k * 3e-6 + d * 1e-3), (-12e-6, -k * 7e-6 + d * 1e-3)]:
+        theta = (x + stretch) / r
+        omega = (v + 1e-3) / r
+        if scalar == "expression":  # the force as an Expression of the motor angle, evaluated there
+            th = Variable("theta")
+            screw.get_input_port(0).FixValue(c, np.array([th, omega], dtype=object))
+            screw.get_input_port(1).FixValue(c, np.array([x, v], dtype=object))
+            force = screw.GetOutputPort("axial_force").Eval(c)[0].Evaluate({th: theta})
+        else:
+            screw.get_input_port(0).FixValue(c, [theta, omega])
+            screw.get_input_port(1).FixValue(c, [x, v])
+            out = screw.GetOutputPort("axial_force").Eval(c)[0]
+            force = out.value() if scalar == "autodiff" else out
+        assert force == pytest.approx(expected, rel=1e-9, abs=1e-9)
+
+
+def test_chain_stretch_is_the_inverse_of_the_chain_force():
+    k, c, b = 4.0e7, 500.0, 12e-6
+    for force in (-250.0, -1e-3, 0.0, 1e-3, 80.0):
+        s = chain_stretch(force, k, b)
+        assert chain_force(s, 0.0, k, c, b) == pytest.approx(force, rel=1e-9, abs=1e-12)
+    assert chain_stretch(0.0, k, b) == 0.0  # at rest without a load: the middle of the gap
+    assert chain_stretch(100.0, k, 0.0) == 100.0 / k
+
+
+def test_free_vibration_across_the_gap_has_the_period_of_a_piecewise_linear_oscillator(paper):
+    """Friction, damping and torque off: the relative motion of motor side and table bounces across the gap.
+    Engaged by ``A`` beyond the gap's edge it is half a sine on each side (``pi / w`` each) and crosses the gap
+    ``b`` at the speed ``w A`` it leaves the flank with (``b / (w A)`` each way): the period ``(2 pi + 2 b / A) / w``,
+    ``w`` the linear chain's mode. Without the gap the same start oscillates at ``w / 2 pi``."""
+    p = with_value(_lossless(paper), "screw.youngs_modulus", 2.06e19)  # a chain stiffness fixed along the travel
+    b, A, w = 4e-6, 1e-6, _mode(p)
+    # the table back by A beyond the gap's edge: the chain stretched by A
+    assert _free_vibration_peak(p, -A, 1e-8) == pytest.approx(w / (2 * math.pi), rel=5e-3)
+    loose = with_value(p, "nut.backlash", b)
+    assert _free_vibration_peak(loose, -(0.5 * b + A), 1e-8) == pytest.approx(w / (2 * math.pi + 2 * b / A), rel=5e-3)

@@ -198,3 +198,6 @@ def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
     with pytest.raises(InputError) as err:  # and the drive's saturation
         build_multibody_diagram(with_value(paper, "motor.saturation_torque", 2.0), scenario, options)
     assert err.value.field == "motor.saturation_torque"
+    with pytest.raises(InputError) as err:  # and the nut's lost motion
+        build_multibody_diagram(with_value(paper, "nut.backlash", 8e-6), scenario, options)
+    assert err.value.field == "nut.backlash"

@@ -19,7 +19,7 @@ def rigid_shaft(stribeck):
     return with_value(stribeck, "screw.youngs_modulus", 2.06e19)
 
 
-@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb", "lugre, saturating drive"])
+@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb", "lugre, saturating drive", "stribeck, backlash"])
 @pytest.mark.parametrize("feed", [1e-3, 0.1e-3])
 def test_operating_point_is_steady_sliding(paper, law, feed):
     p = with_value(paper, "friction.law", law.split(",")[0])
@@ -28,6 +28,8 @@ def test_operating_point_is_steady_sliding(paper, law, feed):
 
         held = steady_sliding(nut_on_table(p), Scenario(feed=feed, load_case=3))[3]
         p = with_value(p, "motor.saturation_torque", 1.2 * held)
+    if "backlash" in law:  # the chain bears the sliding force across its closed gap
+        p = with_value(p, "nut.backlash", 10e-6)
     sc = Scenario(feed=feed, load_case=3)
     op = lin.operating_point(p, sc)
     x, xdot = lin.closed_loop_derivatives(p, sc, op)
@@ -45,6 +47,10 @@ def test_operating_point_is_steady_sliding(paper, law, feed):
         assert abs(rates["table.w"]) < 1e-9
     if "saturating" in law:
         assert op.controller[0] > 1.5 * op.torque / r  # 1 / sqrt(1 - 1 / 1.2^2) = 1.81
+    if "backlash" in law:  # the chain is stretched half the lost motion further than without it
+        closed = lin.operating_point(with_value(p, "nut.backlash", 0.0), sc)
+        stretch = (op.motor[0] * r - op.table[0]) - (closed.motor[0] * r - closed.table[0])
+        assert stretch == pytest.approx(5e-6, rel=1e-6)
 
 
 def test_operating_point_matches_a_simulation(paper):

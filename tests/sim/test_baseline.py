@@ -41,3 +41,5 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
                                    "0 (the plain-Python equations have no friction map)")
     weak = with_value(short_paper, "motor.saturation_torque", 0.5)  # a saturating drive: the Drake systems' alone
     assert unsupported(weak) == ("motor.saturation_torque", 0.5, "0 (the plain-Python equations have a linear drive)")
+    loose = with_value(short_paper, "nut.backlash", 8e-6)  # a lost motion: the Drake systems' alone
+    assert unsupported(loose) == ("nut.backlash", 8e-6, "0 (the plain-Python equations have no lost motion)")
