@@ -468,6 +468,13 @@ class TableParams(_Params):
     mass: float = _q(40.0, "kg", MIN_TABLE_MASS, 1e5, doc="table, nut seat and sliders")
     guide_friction_coefficient: float = _q(0.003, "-", 0.0, 1.0, doc="rolling guides, per N of normal load")
     seal_force: float = _q(4.0, "N", 0.0, doc="seal and wiper drag of the slider blocks")
+    mode_mass_share: float = _q(
+        0.0, "-", 0.0, 0.9,
+        doc="share of the moving mass on a structural mode of its own (a workpiece and fixture, the carriage's upper "
+            "structure): 0 = a rigid table, off",
+    )
+    mode_frequency: float = _q(100.0, "Hz", 0.1, 1e4, doc="the structural mode's natural frequency on the table")
+    mode_damping_ratio: float = _q(0.03, "-", 0.0, 10.0, doc="the structural mode's damping ratio (assumed 1-5 %)")
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ def add_parser(subparsers):
 
 def run(args):
     """Build, analyse, print."""
-    from drakecreep.multibody import build_multibody, modal_analysis, two_mass_axial_frequency
+    from drakecreep.multibody import build_multibody, modal_analysis, not_in_multibody, two_mass_axial_frequency
 
     if not 2 <= args.segments <= 400:
         raise InputError("--segments", args.segments, "an integer in [2, 400]")
@@ -70,6 +70,7 @@ def run(args):
         out = result.to_dict()
         out["table_position_mm"] = args.table_position
         out["two_mass_axial_frequency_Hz"] = two_mass
+        out["not_in_model"] = [{"field": f, "value": v, "what": w} for f, v, w in not_in_multibody(params)]
         if written:
             out["figures"] = [str(p) for p in written]
         print_json(out)
@@ -83,6 +84,8 @@ def run(args):
         share = 100.0 * m.shares[m.label]
         flag = f"yes: {two_mass:.2f} Hz" if m.two_mass else "no"
         print(f"{i:>4}  {m.frequency:>9.2f}  {m.damping_ratio:>7.4f}  {m.label:<16}  {share:>4.0f}%  {flag}")
+    for field, value, what in not_in_multibody(params):
+        print(f"not in this model: {field} {value:g}: {what}")
     if written:
         print("wrote " + ", ".join(str(p) for p in written))
     if any(m.damping_ratio > 1.0 for m in result.modes):

@@ -11,7 +11,9 @@ speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the pape
 (``friction.position_map_*``) scales it by its level where the table is. A lost motion of the nut
 (``nut.backlash``) is not in it: feeding one way, the chain bears the friction in one direction throughout a
 stick-slip cycle (its force swings between the kinetic and the breakaway level, never through zero), so the gap
-stays closed and the spring the creep theory reads is the chain's stiffness.
+stays closed and the spring the creep theory reads is the chain's stiffness. A structural mode on the table
+(``table.mode_mass_share``) is not in it either: its mass is in the lumped mass, moving with the table (right where
+the mode is well above the stick-slip frequency; where it is not, simulate the diagram).
 """
 
 from __future__ import annotations

@@ -29,6 +29,15 @@ Where the nut's share acts on the screw (``nut_friction_on: screw``), the map sc
 The lumped drive of the paper's creep theory takes the map's level where its table is
 (:func:`drakecreep.model.lumped.lumped`); the linear analyses refuse a map (sliding at a constant force is no steady
 state of a level that changes along the travel), as do the plain-Python batch equations and the multibody model.
+
+A structural mode on the table (``table.mode_mass_share`` ``s`` > 0): a share ``s`` of the moving mass (a workpiece
+and its fixture, the carriage's upper structure) sits on a spring and damper of its own, ``table.mode_frequency``
+``f`` and ``table.mode_damping_ratio`` ``zeta`` (:func:`structural_mode`); the rest, ``(1 - s) M``, carries the nut
+and the friction. The table's state gains the mode's deflection ``d = x_mode - x`` and its rate (0 at rest and in
+steady sliding, so the linear analyses' operating point has them at 0), and ``d``'s spring and damper push the
+table. The guides still carry the whole weight. The lumped drive of the creep theory keeps the whole mass on its
+spring (the mode well above the stick-slip frequency moves with the table); the plain-Python batch equations and
+the multibody model refuse it.
 """
 
 import math
@@ -42,12 +51,23 @@ from drakecreep.model.axis import FRICTION_MAP, friction_map
 from drakecreep.model.friction import make_friction_law
 
 __all__ = ["NutTable", "NutTable_", "moving_mass", "friction_levels", "friction_split", "table_friction_levels",
-           "friction_map_parameters", "position_level"]
+           "friction_map_parameters", "position_level", "structural_mode"]
 
 
 def moving_mass(params):
     """Translating mass (kg): table plus nut."""
     return params.table.mass + params.nut.mass
+
+
+def structural_mode(params):
+    """The table's structural mode as ``(mass kg, stiffness N/m, damping N s/m)``: ``m = s M`` (``M`` the moving
+    mass), ``k = m (2 pi f)^2``, ``c = 2 zeta m 2 pi f``; None without one (``table.mode_mass_share`` 0)."""
+    t = params.table
+    if t.mode_mass_share == 0.0:
+        return None
+    m = t.mode_mass_share * moving_mass(params)
+    w = 2.0 * math.pi * t.mode_frequency
+    return m, m * w * w, 2.0 * t.mode_damping_ratio * m * w
 
 
 def friction_levels(params, load):
@@ -98,7 +118,8 @@ def position_level(friction, x):
 @TemplateSystem.define("NutTable_", scope=sys.modules[__name__])
 def NutTable_(T):
     class Impl(LeafSystem_[T]):
-        """Table mass with friction; state ``[x, v, z...]`` (``z``: the friction law's internal states).
+        """Table mass with friction; state ``[x, v, z..., d, dd]`` (``z``: the friction law's internal states;
+        ``d``, ``dd``: the deflection of the structural mode's mass from the table and its rate, with one).
 
         Input ports
         -----------
@@ -118,15 +139,15 @@ def NutTable_(T):
             # the map's parameters by friction_map's names, built once (None: no map)
             self._map = friction_map_parameters(params.friction) if params.friction.has_position_map else None
             self.law = make_friction_law(params.friction)
-            self.mass = moving_mass(params)
+            self.mode = structural_mode(params)
+            self.mass = moving_mass(params) - (self.mode[0] if self.mode else 0.0)
             self.fc, self.fs = table_friction_levels(params, load)
-            n = 2 + self.law.num_states
+            self._nz = self.law.num_states
+            n = 2 + self._nz + (2 if self.mode else 0)
             self.initial_state = [0.0] * n if initial_state is None else list(initial_state)
             if len(self.initial_state) != n:
                 raise ValueError(f"NutTable initial_state must have {n} entries")
-            self.DeclareContinuousState(
-                BasicVector_[T](self.initial_state), num_q=1, num_v=1, num_z=self.law.num_states
-            )
+            self.DeclareContinuousState(BasicVector_[T](self.initial_state), num_q=1, num_v=1, num_z=n - 2)
             self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
             state_only = {self.xc_ticket()}
             self.DeclareVectorOutputPort("table_state", 2, self._calc_state, prerequisites_of_calc=state_only)
@@ -140,7 +161,7 @@ def NutTable_(T):
 
         def _split(self, context):
             x = context.get_continuous_state_vector().CopyToVector()
-            return x[0], x[1], x[2:]
+            return x[0], x[1], x[2:2 + self._nz]
 
         def _force(self, x, v, z):
             # the law's internal states are normalized by its level, so the map scales its force, not its rates
@@ -155,9 +176,16 @@ def NutTable_(T):
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             x, v, z = self._split(context)
-            push = self._u_axial_force.Eval(context)[0]
-            accel = (push - self.load.fx - self._force(x, v, z)) / self.mass
-            rates = [v, accel] + list(self.law.state_rates(v, z, self.fc, self.fs))
+            push = self._u_axial_force.Eval(context)[0] - self.load.fx - self._force(x, v, z)
+            if self.mode is None:
+                accel, mode_rates = push / self.mass, []
+            else:  # the mode's mass pulls the table by its deflection d = x_mode - x; d'' = its acceleration - the table's
+                m, k, c = self.mode
+                d, dd = context.get_continuous_state_vector().CopyToVector()[2 + self._nz:]
+                pull = k * d + c * dd
+                accel = (push + pull) / self.mass
+                mode_rates = [dd, -pull / m - accel]
+            rates = [v, accel] + list(self.law.state_rates(v, z, self.fc, self.fs)) + mode_rates
             derivatives.get_mutable_vector().SetFromVector(vector(rates))
 
         def _calc_state(self, context, output):

@@ -30,7 +30,7 @@ from drakecreep.model.screw import screw_inertia
 from drakecreep.multibody.plant import BodyGroup
 
 __all__ = ["Mode", "ModalResult", "LABELS", "RIGID_BODY_HZ", "STEP_ROUNDOFF", "static_equilibrium",
-           "linearize_mechanics", "modal_analysis", "two_mass_axial_frequency"]
+           "linearize_mechanics", "modal_analysis", "two_mass_axial_frequency", "not_in_multibody"]
 
 #: (body group, motion) -> label; motion is "tx".."tz" (translation) or "rx".."rz" (rotation about an axis)
 LABELS = {
@@ -293,3 +293,17 @@ def two_mass_axial_frequency(params, table_position=0.0):
     ratio = params.screw.lead / (2.0 * math.pi)
     inertia = motor_inertia(params.motor, screw_inertia(params.screw))
     return math.sqrt(drive.stiffness * (1.0 / drive.mass + ratio**2 / inertia)) / (2.0 * math.pi)
+
+
+def not_in_multibody(params):
+    """The two-mass model's fields of ``params`` the multibody modes leave out, as ``(field, value, what)``: a
+    structural mode on the table (``table.mode_mass_share``) and the nut's lost motion (``nut.backlash``; the
+    modes are those of the closed gap)."""
+    out = []
+    if params.table.mode_mass_share > 0.0:
+        out.append(("table.mode_mass_share", params.table.mode_mass_share,
+                    f"a structural mode on the table at {params.table.mode_frequency:g} Hz (the two-mass model's; "
+                    "margins shows it in the loop)"))
+    if params.nut.backlash > 0.0:
+        out.append(("nut.backlash", params.nut.backlash, "the nut's lost motion (these are the closed gap's modes)"))
+    return out

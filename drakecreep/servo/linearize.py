@@ -183,6 +183,7 @@ def operating_point(params, scenario):
     theta = measured / ratio if g.position_feedback == "motor" else (x + stretch) / ratio
     motor = (theta, omega) + ((torque,) if params.motor.current_loop_time_constant > 0 else ())
     table = (x, v) + ((float(law.sliding_level(v, fc, fs)) * math.copysign(1.0, v) / fc,) if law.num_states else ())
+    table += (0.0, 0.0) if params.table.mode_mass_share > 0.0 else ()  # the structural mode's deflection: none
     # central difference with a small relative step: truncation ~1e-10, round-off ~1e-10 of C1 here
     c1 = float(friction_slope(lambda s: law.steady_state_force(s, fc, fs), v, step=1e-5 * abs(v)))
     return OperatingPoint(
@@ -224,13 +225,19 @@ def _state_names(params, with_controller=True):
     law = make_friction_law(params.friction)
     names = ["controller.integrator"] if with_controller else []
     names += ["motor.theta", "motor.omega"] + (["motor.tau"] if params.motor.current_loop_time_constant > 0 else [])
-    names += ["table.x", "table.v"] + (["table.w"] if law.num_states else [])
-    return names
+    return names + _table_state_names(params, law)
+
+
+def _table_state_names(params, law):
+    """The table's states: position, speed, the friction law's (``w``) and the structural mode's."""
+    return (["table.x", "table.v"] + (["table.w"] if law.num_states else [])
+            + (["table.mode_deflection", "table.mode_rate"] if params.table.mode_mass_share > 0.0 else []))
 
 
 def _diagram_state_names(feed_drive):
     """State names in the diagram's order (subsystems in the order the diagram holds them)."""
-    known = {"controller": ["integrator"], "motor": ["theta", "omega", "tau"], "table": ["x", "v", "w"]}
+    table = _table_state_names(feed_drive.params, make_friction_law(feed_drive.params.friction))
+    known = {"controller": ["integrator"], "motor": ["theta", "omega", "tau"], "table": [n[6:] for n in table]}
     context = feed_drive.diagram.CreateDefaultContext()
     names = []
     for system in feed_drive.diagram.GetSystems():
@@ -407,7 +414,7 @@ def linearize_mechanism(params, scenario, op=None):
     law = make_friction_law(params.friction)
     return control.ss(A, B, C, D, inputs=["motor_angle", "motor_speed"],
                       outputs=["table_position", "table_speed", "spring_force", "friction_force"],
-                      states=["table.x", "table.v"] + (["table.w"] if law.num_states else []), name="mechanism")
+                      states=_table_state_names(params, law), name="mechanism")
 
 
 def two_mass_model(params, scenario, op=None):

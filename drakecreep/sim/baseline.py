@@ -46,6 +46,9 @@ def unsupported(params):
             return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")
     if p.nut.backlash > 0.0:
         return ("nut.backlash", p.nut.backlash, "0 (the plain-Python equations have no lost motion)")
+    if p.table.mode_mass_share > 0.0:
+        return ("table.mode_mass_share", p.table.mode_mass_share,
+                "0 (the plain-Python equations have a rigid table)")
     d = p.disturbance
     if d.has_lead_error or d.has_cogging or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")

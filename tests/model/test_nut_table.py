@@ -133,3 +133,33 @@ def test_friction_dissipates_energy_over_a_run(short_paper, law):
     fc, _ = table_friction_levels(p, p.load_case(3))
     travel = r.signals["table_position"][-1] - r.signals["table_position"][0]
     assert energy > 0.5 * fc * travel
+
+
+# --------------------------------------------------------------------------- issue 16: a structural mode on the table
+
+def test_a_structural_mode_on_the_table_has_the_modes_of_the_two_mass_chain(paper):
+    """Friction and damping off, the motor side held: the table ``(1 - s) M`` on the chain ``k`` and the mode's mass
+    ``s M`` on its spring ``s M (2 pi f)^2`` vibrate at the eigenfrequencies of that two-degree-of-freedom chain
+    (the mechanism's AutoDiff linearization); the mode's deflection is 0 in steady sliding."""
+    from drakecreep.model.screw import axial_stiffness
+    from drakecreep.servo import linearize as lin
+
+    p = paper
+    for path, value in [("table.seal_force", 0.0), ("table.guide_friction_coefficient", 0.0),
+                        ("nut.preload_torque", 0.0), ("nut.load_friction_coefficient", 0.0),
+                        ("friction.viscous", 0.0), ("friction.law", "coulomb"), ("screw.bearing_damping", 0.0),
+                        ("nut.axial_damping", 0.0), ("table.mode_mass_share", 0.3), ("table.mode_frequency", 40.0),
+                        ("table.mode_damping_ratio", 0.0)]:
+        p = with_value(p, path, value)
+    sc = Scenario(feed=1e-3)
+    op = lin.operating_point(p, sc)
+    mech = lin.linearize_mechanism(p, sc, op)
+    assert mech.state_labels == ["table.x", "table.v", "table.mode_deflection", "table.mode_rate"]
+    M = moving_mass(p)
+    m_mode, k_mode = 0.3 * M, 0.3 * M * (2 * math.pi * 40.0) ** 2
+    k = axial_stiffness(p.screw, p.nut, op.table[0])
+    stiffness = np.array([[k + k_mode, -k_mode], [-k_mode, k_mode]])
+    expected = np.sort(np.sqrt(np.linalg.eigvals(np.linalg.solve(np.diag([M - m_mode, m_mode]), stiffness))))
+    got = np.sort(np.abs(np.linalg.eigvals(mech.A)))[::2]
+    assert got == pytest.approx(expected, rel=1e-4)
+    assert NutTable(with_value(p, "table.mode_mass_share", 0.0), LoadCase()).num_continuous_states() == 2

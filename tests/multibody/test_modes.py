@@ -192,3 +192,12 @@ def test_two_axial_segments_keep_the_axial_mode_of_a_fine_screw(paper):
         c = min(m.frequency for m in coarse.modes if m.label == label)
         f = min(m.frequency for m in fine.modes if m.label == label)
         assert c == pytest.approx(f, rel=tol), (label, c, f)
+
+
+def test_the_two_mass_models_own_effects_are_named_as_not_in_the_multibody_modes(paper):
+    """A structural mode on the table and the nut's lost motion are the two-mass model's: the modes say so."""
+    from drakecreep.multibody import not_in_multibody
+
+    assert not_in_multibody(paper) == []
+    p = with_value(with_value(paper, "table.mode_mass_share", 0.25), "nut.backlash", 6e-6)
+    assert [(f, v) for f, v, _ in not_in_multibody(p)] == [("table.mode_mass_share", 0.25), ("nut.backlash", 6e-6)]

@@ -19,7 +19,8 @@ def rigid_shaft(stribeck):
     return with_value(stribeck, "screw.youngs_modulus", 2.06e19)
 
 
-@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb", "lugre, saturating drive", "stribeck, backlash"])
+@pytest.mark.parametrize("law", ["lugre", "stribeck", "coulomb", "lugre, saturating drive", "stribeck, backlash",
+                                 "lugre, structural mode"])
 @pytest.mark.parametrize("feed", [1e-3, 0.1e-3])
 def test_operating_point_is_steady_sliding(paper, law, feed):
     p = with_value(paper, "friction.law", law.split(",")[0])
@@ -30,6 +31,8 @@ def test_operating_point_is_steady_sliding(paper, law, feed):
         p = with_value(p, "motor.saturation_torque", 1.2 * held)
     if "backlash" in law:  # the chain bears the sliding force across its closed gap
         p = with_value(p, "nut.backlash", 10e-6)
+    if "structural mode" in law:  # a third of the moving mass on a 40 Hz mode: at rest on the table when sliding
+        p = with_value(with_value(p, "table.mode_mass_share", 0.3), "table.mode_frequency", 40.0)
     sc = Scenario(feed=feed, load_case=3)
     op = lin.operating_point(p, sc)
     x, xdot = lin.closed_loop_derivatives(p, sc, op)
@@ -45,6 +48,8 @@ def test_operating_point_is_steady_sliding(paper, law, feed):
     assert abs(rates["motor.tau"]) < 1e-9
     if law.startswith("lugre"):
         assert abs(rates["table.w"]) < 1e-9
+    if "structural mode" in law:
+        assert abs(rates["table.mode_deflection"]) < 1e-15 and abs(rates["table.mode_rate"]) < 1e-9
     if "saturating" in law:
         assert op.controller[0] > 1.5 * op.torque / r  # 1 / sqrt(1 - 1 / 1.2^2) = 1.81
     if "backlash" in law:  # the chain is stretched half the lost motion further than without it

@@ -43,3 +43,5 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
     assert unsupported(weak) == ("motor.saturation_torque", 0.5, "0 (the plain-Python equations have a linear drive)")
     loose = with_value(short_paper, "nut.backlash", 8e-6)  # a lost motion: the Drake systems' alone
     assert unsupported(loose) == ("nut.backlash", 8e-6, "0 (the plain-Python equations have no lost motion)")
+    modal = with_value(short_paper, "table.mode_mass_share", 0.2)  # a structural mode: the Drake systems' alone
+    assert unsupported(modal) == ("table.mode_mass_share", 0.2, "0 (the plain-Python equations have a rigid table)")
