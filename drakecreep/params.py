@@ -555,6 +555,11 @@ class FrictionParams(_Params):
     position_map_end: float = _q(
         1.0, "m", -10.0, 10.0, doc="table position where the friction map's travel ends (> position_map_start)",
     )
+    time_drift: float = _q(
+        0.0, "1/s", -1.0, 1.0,
+        doc="the table's friction level changes by this share of itself per second from the start of a run, "
+            "1 + time_drift t, floored at 0 (a warm-up: < 0 as the grease warms); assumption: 0, the paper gives none",
+    )
 
     def _check(self):
         if not self.position_map_end > self.position_map_start:

@@ -135,8 +135,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_replay_drakecreep.py", ("--repeat", "0"), "--repeat: got 0"),
     ("bench_gap_benchmark.py", ("--uncertain", "loads.constant_force"), "uncertain: got 'loads.constant_force'; "
                                                                       "allowed: only with kinds drakecreep alone"),
-    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,friction_drift"),
-     "effects: got 'friction_drift'"),
+    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,drive_gain"),
+     "effects: got 'drive_gain'"),
     ("bench_gap_benchmark.py", ("--skip-seeds", "104000"), "--skip-seeds: got (104000,) with --seeds heldout"),
     ("bench_gap_benchmark.py", ("--mass-spread", "0.15"), "--mass-spread: got 0.15; allowed: 0 unless kinds"),
     ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--mass-spread", "0.7"), "--mass-spread: got 0.7"),

@@ -13,7 +13,8 @@ speed) absorbs it. With ``nut_friction_on: table`` it is everything, as the pape
 stick-slip cycle (its force swings between the kinetic and the breakaway level, never through zero), so the gap
 stays closed and the spring the creep theory reads is the chain's stiffness. A structural mode on the table
 (``table.mode_mass_share``) is not in it either: its mass is in the lumped mass, moving with the table (right where
-the mode is well above the stick-slip frequency; where it is not, simulate the diagram).
+the mode is well above the stick-slip frequency; where it is not, simulate the diagram). A friction drift over
+time (``friction.time_drift``) is taken at its start (level 1).
 """
 
 from __future__ import annotations

@@ -30,6 +30,11 @@ The lumped drive of the paper's creep theory takes the map's level where its tab
 (:func:`drakecreep.model.lumped.lumped`); the linear analyses refuse a map (sliding at a constant force is no steady
 state of a level that changes along the travel), as do the plain-Python batch equations and the multibody model.
 
+Over a run the table's friction can drift (``friction.time_drift`` ``r`` [1/s], a warm-up of the guides' grease): its
+level is ``max(1 + r t, 0)`` times the law's, ``t`` the time since the run started (the replay axis's
+``friction_drift``). The linear analyses refuse it (no steady sliding), as do the plain-Python batch equations and
+the multibody model; the lumped drive of the creep theory takes the level at the start.
+
 A structural mode on the table (``table.mode_mass_share`` ``s`` > 0): a share ``s`` of the moving mass (a workpiece
 and its fixture, the carriage's upper structure) sits on a spring and damper of its own, ``table.mode_frequency``
 ``f`` and ``table.mode_damping_ratio`` ``zeta`` (:func:`structural_mode`); the rest, ``(1 - s) M``, carries the nut
@@ -46,7 +51,7 @@ import sys
 from pydrake.systems.framework import BasicVector_, LeafSystem_
 from pydrake.systems.scalar_conversion import TemplateSystem
 
-from drakecreep.model._scalar import vector
+from drakecreep.model._scalar import smax, vector
 from drakecreep.model.axis import FRICTION_MAP, friction_map
 from drakecreep.model.friction import make_friction_law
 
@@ -138,6 +143,7 @@ def NutTable_(T):
             self.load = load
             # the map's parameters by friction_map's names, built once (None: no map)
             self._map = friction_map_parameters(params.friction) if params.friction.has_position_map else None
+            self.drift = params.friction.time_drift
             self.law = make_friction_law(params.friction)
             self.mode = structural_mode(params)
             self.mass = moving_mass(params) - (self.mode[0] if self.mode else 0.0)
@@ -151,7 +157,8 @@ def NutTable_(T):
             self._u_axial_force = self.DeclareVectorInputPort("axial_force", 1)
             state_only = {self.xc_ticket()}
             self.DeclareVectorOutputPort("table_state", 2, self._calc_state, prerequisites_of_calc=state_only)
-            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction, prerequisites_of_calc=state_only)
+            timed = state_only | ({self.time_ticket()} if self.drift != 0.0 else set())  # a drift reads the time
+            self.DeclareVectorOutputPort("friction_force", 1, self._calc_friction, prerequisites_of_calc=timed)
             self.DeclareVectorOutputPort(
                 "friction_state", self.law.num_states, self._calc_z, prerequisites_of_calc=state_only
             )
@@ -163,20 +170,23 @@ def NutTable_(T):
             x = context.get_continuous_state_vector().CopyToVector()
             return x[0], x[1], x[2:2 + self._nz]
 
-        def _force(self, x, v, z):
-            # the law's internal states are normalized by its level, so the map scales its force, not its rates
+        def _force(self, x, v, z, t):
+            # the law's internal states are normalized by its level, so the map and the drift scale its force, not
+            # its rates
             f = self.law.force(v, z, self.fc, self.fs)
             if self._map is not None:
                 f = (1.0 + friction_map(self._map, x)) * f
+            if self.drift != 0.0:
+                f = smax(1.0 + self.drift * t, 0.0) * f
             return f
 
         def friction(self, context):
             """Friction force (N) on the table in this context."""
-            return self._force(*self._split(context))
+            return self._force(*self._split(context), context.get_time())
 
         def DoCalcTimeDerivatives(self, context, derivatives):
             x, v, z = self._split(context)
-            push = self._u_axial_force.Eval(context)[0] - self.load.fx - self._force(x, v, z)
+            push = self._u_axial_force.Eval(context)[0] - self.load.fx - self._force(x, v, z, context.get_time())
             if self.mode is None:
                 accel, mode_rates = push / self.mass, []
             else:  # the mode's mass pulls the table by its deflection d = x_mode - x; d'' = its acceleration - the table's

@@ -456,6 +456,9 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
         raise InputError("nut.backlash", params.nut.backlash,
                          "0 with the multibody model (its ScrewJoint has no lost motion; the backlash is a two-mass "
                          "model effect)")
+    if params.friction.time_drift != 0.0:
+        raise InputError("friction.time_drift", params.friction.time_drift,
+                         "0 with the multibody model (the friction drift is a two-mass model effect)")
     if params.table.mode_mass_share > 0.0:
         raise InputError("table.mode_mass_share", params.table.mode_mass_share,
                          "0 with the multibody model (its table is one rigid body; the structural mode is a two-mass "

@@ -148,6 +148,10 @@ def operating_point(params, scenario):
             raise InputError(f"friction.position_map_{k}", a,
                              "0 for the linear analyses (a friction that changes along the travel has no steady "
                              "sliding to linearize about; simulate and diagnose take it)")
+    if params.friction.time_drift != 0.0:  # its level moves with time: no steady sliding either
+        raise InputError("friction.time_drift", params.friction.time_drift,
+                         "0 for the linear analyses (a friction that drifts over time has no steady sliding to "
+                         "linearize about; simulate and diagnose take it)")
     params = nut_on_table(params)
     g = params.controller
     v = scenario.feed

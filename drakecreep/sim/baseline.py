@@ -46,6 +46,8 @@ def unsupported(params):
             return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")
     if p.nut.backlash > 0.0:
         return ("nut.backlash", p.nut.backlash, "0 (the plain-Python equations have no lost motion)")
+    if p.friction.time_drift != 0.0:
+        return ("friction.time_drift", p.friction.time_drift, "0 (the plain-Python equations have no friction drift)")
     if p.table.mode_mass_share > 0.0:
         return ("table.mode_mass_share", p.table.mode_mass_share,
                 "0 (the plain-Python equations have a rigid table)")

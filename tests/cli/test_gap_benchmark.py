@@ -70,7 +70,7 @@ def test_gap_benchmark_rejects_short_runs_before_work(capsys):
 @pytest.mark.parametrize("argv, needle", [(["--kinds", "pid"], "--kinds: got 'pid'; allowed: one of p_p_cascade"),
                                           (["--effects", "gremlins"], "--effects"),
                                           (["--effects", "backlash"], "--effects"),
-                                          (["--kinds", "drakecreep", "--effects", "friction_drift"], "--effects"),
+                                          (["--kinds", "drakecreep", "--effects", "drive_gain"], "--effects"),
                                           (["--kinds", "drakecreep", "p_p_cascade", "--effects", "stribeck"],
                                            "one --kinds"),
                                           (["--mass-spread", "0.15"], "--mass-spread: got 0.15; allowed: 0 unless"),

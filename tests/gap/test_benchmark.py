@@ -84,9 +84,9 @@ def test_the_drakecreep_kind_has_its_own_library():
         assert category_of("p_p_cascade", (e,)) == "library" and expected_of("p_p_cascade", (e,)) == EXPECTED[e]
         if e not in EXPECTED_DRIVE:
             assert expected_of("drakecreep", (e,)) is None
-    assert {"friction_drift", "drive_gain"} <= set(NOT_IN_MODEL)
+    assert {"quantization", "drive_gain"} <= set(NOT_IN_MODEL)
     assert {"asymmetric_friction", "cogging", "position_friction", "drive_saturation", "backlash",
-            "structural_mode"} <= set(ON_REQUEST)
+            "structural_mode", "friction_drift"} <= set(ON_REQUEST)
     assert not set(ON_REQUEST) & set(EXPECTED_DRIVE.values())
     assert category_of("drakecreep", ("cogging",)) == "out_of_library"
     assert category_of("drakecreep", ("position_friction",)) == "out_of_library"

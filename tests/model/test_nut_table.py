@@ -163,3 +163,27 @@ def test_a_structural_mode_on_the_table_has_the_modes_of_the_two_mass_chain(pape
     got = np.sort(np.abs(np.linalg.eigvals(mech.A)))[::2]
     assert got == pytest.approx(expected, rel=1e-4)
     assert NutTable(with_value(p, "table.mode_mass_share", 0.0), LoadCase()).num_continuous_states() == 2
+
+
+@pytest.mark.parametrize("scalar", ["float", "autodiff"])
+def test_a_friction_drift_scales_the_tables_friction_with_the_time_of_the_run(paper, scalar):
+    """``friction.time_drift`` r: the table's friction is ``max(1 + r t, 0)`` times the law's at time t (the friction
+    port reads the time: a cached value would keep the start's)."""
+    drifting = NutTable(with_value(paper, "friction.time_drift", -0.25), LoadCase())
+    plain = NutTable(paper, LoadCase())
+    if scalar == "autodiff":
+        drifting, plain = drifting.ToAutoDiffXd(), plain.ToAutoDiffXd()
+    value = (lambda f: f.value()) if scalar == "autodiff" else (lambda f: f)
+    forces = []
+    for system in (drifting, plain):
+        c = system.CreateDefaultContext()
+        state = c.get_continuous_state_vector().CopyToVector()
+        state[1] = 0.01  # sliding at 10 mm/s
+        c.SetContinuousState(state)
+        out = []
+        for t in (0.0, 2.0, 6.0):
+            c.SetTime(t)
+            out.append(value(system.GetOutputPort("friction_force").Eval(c)[0]))
+        forces.append(out)
+    (d0, d2, d6), (p0, p2, p6) = forces
+    assert p0 > 0 and (d0, d2, d6) == pytest.approx((p0, 0.5 * p2, 0.0), rel=1e-12, abs=1e-12)

@@ -204,3 +204,6 @@ def test_force_ripple_acts_on_the_table_along_x(paper, compiled):
     with pytest.raises(InputError) as err:  # and the table's structural mode
         build_multibody_diagram(with_value(paper, "table.mode_mass_share", 0.2), scenario, options)
     assert err.value.field == "table.mode_mass_share"
+    with pytest.raises(InputError) as err:  # and a friction drift over time
+        build_multibody_diagram(with_value(paper, "friction.time_drift", -0.1), scenario, options)
+    assert err.value.field == "friction.time_drift"

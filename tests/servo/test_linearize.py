@@ -168,3 +168,6 @@ def test_a_friction_map_is_refused_by_name_before_any_linearization(paper):
     with pytest.raises(InputError) as err:
         lin.operating_point(mapped, Scenario(feed=1e-3))
     assert err.value.field == "friction.position_map_1" and "linear analyses" in str(err.value)
+    with pytest.raises(InputError) as err:  # nor one that drifts over time
+        lin.operating_point(with_value(paper, "friction.time_drift", -0.1), Scenario(feed=1e-3))
+    assert err.value.field == "friction.time_drift" and "linear analyses" in str(err.value)

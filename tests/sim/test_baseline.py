@@ -45,3 +45,5 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
     assert unsupported(loose) == ("nut.backlash", 8e-6, "0 (the plain-Python equations have no lost motion)")
     modal = with_value(short_paper, "table.mode_mass_share", 0.2)  # a structural mode: the Drake systems' alone
     assert unsupported(modal) == ("table.mode_mass_share", 0.2, "0 (the plain-Python equations have a rigid table)")
+    warm = with_value(short_paper, "friction.time_drift", -0.1)  # a friction drift: the Drake systems' alone
+    assert unsupported(warm) == ("friction.time_drift", -0.1, "0 (the plain-Python equations have no friction drift)")
