@@ -59,8 +59,8 @@ def add_parser(subparsers):
                    "ones: stribeck, asymmetric_friction, load_friction, position_friction, position_ripple, "
                    "lead_error, time_ripple, thermal_drift, drive_saturation, axial_mode, control_delay; kind "
                    "drakecreep runs: lead_error, force_ripple, stribeck, law_coulomb, law_stribeck, law_lugre, "
-                   "law_gms, nut_friction_side, control_delay; asymmetric_friction, cogging, position_friction and "
-                   "drive_saturation only when named)")
+                   "law_gms, nut_friction_side, control_delay; asymmetric_friction, cogging, position_friction, "
+                   "drive_saturation, backlash, structural_mode and friction_drift only when named)")
     p.add_argument("--nominal-friction", choices=("regularized", "lugre", "auto"), help="p_p_cascade runs: friction law "
                    "of the nominal axis: regularized Coulomb (default; creeps under any force), lugre (bristles: "
                    "sticks below the breakaway force, the share of the friction that sticks fitted; slower), "
