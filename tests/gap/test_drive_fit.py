@@ -607,6 +607,8 @@ def test_a_structural_mode_named_is_found_fitted_claimed_and_kept_in_the_params(
     plain = simulated_runs(RIG, speeds, declared=RIG, n=N, noise=NOISE, seed=1500)
     none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("structural_mode",))
     assert none.claimed == () and [c.name for c in none.candidates] == ["structural_mode"]
+    lo, hi = drive_fit.MODE_BAND  # the fit of a mode the runs do not have stays near the search band
+    assert lo / 1.5 <= none.candidates[0].values["table.mode_frequency"] <= hi * 1.5
 
 
 def test_a_friction_drift_named_is_fitted_claimed_and_kept_in_the_params():
