@@ -72,7 +72,8 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     assert "disturbance.lead_error_amplitude = " in html and " um" in html  # a lead error in um at the edge
     assert html.count("<img") == 3 and "Unexplained: where" in html  # gains, errors by run, one run's residual
     # the candidates fitted only when named that did not run, with why they are not defaults
-    assert list(result["not_run"]) == ["asymmetric_friction", "cogging", "position_friction", "drive_saturation"]
+    assert list(result["not_run"]) == ["asymmetric_friction", "cogging", "position_friction", "drive_saturation",
+                                       "backlash", "structural_mode", "friction_drift"]
     assert "<h2>Not run: candidates fitted only when named (--effects)</h2>" in html
     assert "<td>drive_saturation</td><td class=\"text\">not measured on the benchmark" in html
     # each candidate's pooled shrink also as a multiple of its run-to-run null (above 20 stands for the bar)
