@@ -100,7 +100,7 @@ def plot_bode(analysis, path):
     if math.isfinite(res):
         for ax in (axm, axp):
             ax.axvline(res, color="C2", ls=":", lw=1)
-        axm.text(res, axm.get_ylim()[1], f" screw axial mode {res:.3g} Hz", color="C2", va="top", fontsize=8)
+        axm.text(res, axm.get_ylim()[1], f" first mechanical resonance {res:.3g} Hz", color="C2", va="top", fontsize=8)
     axm.set_ylabel("|L| (dB)")
     axp.set_ylabel("phase of L (deg)")
     axp.set_xlabel("frequency (Hz)")
