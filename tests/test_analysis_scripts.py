@@ -133,6 +133,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_diagnose.py", ("--uncertain", "table.mass"), "--uncertain: got 'table.mass' without --paper-rig"),
     ("bench_diagnose.py", ("--paper-rig", "--uncertain", "table.bogus"), "uncertain: got 'table.bogus'"),
     ("bench_replay_drakecreep.py", ("--repeat", "0"), "--repeat: got 0"),
+    ("drive_named_candidates.py", ("cogging",), "NAME: got 'cogging'; allowed: one of backlash"),
+    ("drive_named_candidates.py", ("--seed", "-3"), "--seed: got -3; allowed: an integer >= 0"),
     ("bench_gap_benchmark.py", ("--uncertain", "loads.constant_force"), "uncertain: got 'loads.constant_force'; "
                                                                       "allowed: only with kinds drakecreep alone"),
     ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--effects", "lead_error,drive_gain"),
