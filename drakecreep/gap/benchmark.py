@@ -671,6 +671,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     ranking = [{"effect": c.name, "gain": float(c.gain), "standard_error": float(c.standard_error),
                 "threshold": float(c.threshold), "passes": bool(c.passes), "reason": c.reason,
                 "train_gain": float(c.train_gain),
+                "improves": bool(c.improves),  # beyond its held-out bars, whatever its training gain (3cw's floor)
                 "start": c.start,  # which start a fit of more than one kept (the Stribeck candidate's)
                 # what a searched candidate saw run by run on the training runs (the delay's: each run's SSE at
                 # each delay tried and its own best delay; docs 3cr)

@@ -248,6 +248,14 @@ MASS_CHECK_STD = 0.1
 #: Longest sample step of a run, in position-loop periods of its params file: a trace sampled more coarsely shows
 #: nothing of the loop (milliseconds headed seconds: 1000 periods, a replay 1000 times the run's length)
 MAX_SAMPLE_PERIODS = 10.0
+#: Smallest training gain of a claimed cause: the share of the training force error (of the screw's transmission
+#: error, for a lead error decided there) the candidate removes. A candidate that improves the held-out replay
+#: beyond its bars with less is listed as improving the replay, not claimed as the cause. The held-out bars come from
+#: the runs; this is how large an effect must be to be named the gap's cause (docs/gap_benchmark.md, 3cw: the wrong
+#: first claims on rows of every run had 0.15-8.5 %, the right ones at SNR >= 3 44 % and more; declared there on
+#: those rows and adopted on rows written after). A delay claimed on an oscillation's spectrum has no training gain
+#: and is not held to it.
+MIN_TRAIN_SHARE = 0.20
 #: Finite-difference step of the fit in log(value - lower bound), and the fitted range (a factor e^4 each way).
 _STEP = 0.1
 _BOUND = 4.0
@@ -399,7 +407,8 @@ class EffectResult:
     ``reason``; ``start``: which start the fit kept where it has more than one (the Stribeck candidate's
     ``"nominal fit"`` or ``"params file"``, :func:`_stribeck_effect`), else ``""``; ``search``: what a searched
     candidate saw on the training runs, run by run (the ``control_delay`` candidate's: :func:`_delay_effect`'s
-    ``record``), else empty.
+    ``record``), else empty; ``improves``: it improves the held-out replay beyond its bars (``passes`` asks, besides,
+    a training gain of :data:`MIN_TRAIN_SHARE`: a cause explains that share of the training error).
     """
 
     name: str
@@ -414,6 +423,7 @@ class EffectResult:
     reason: str = ""
     start: str = ""
     search: dict = field(default_factory=dict)
+    improves: bool = False
 
     @property
     def on_transmission(self):
@@ -592,6 +602,12 @@ class DriveDiagnosis:
                 "the moving mass (table, fixture, workpiece) is known to a few per cent, check the claim with "
                 "--uncertain " + ",".join(paths + ["table.mass"])]
 
+    @property
+    def under_floor(self):
+        """The candidates that improve the held-out replay beyond their bars but remove less than
+        :data:`MIN_TRAIN_SHARE` of the training error, so are not claimed (their reason says so)."""
+        return tuple(c for c in self.candidates if c.improves and not c.passes)
+
     def summary(self):
         """Lines of text (units labelled)."""
         lines = [f"held-out force error: params file {rms_force_error(self.prior_test_errors):.3f} %, "
@@ -633,6 +649,10 @@ class DriveDiagnosis:
         elif claims_withheld(self.oscillation):
             lines.append("claimed: nothing (withheld: the measured runs oscillate and the model does not, so the "
                          "held-out force error is the oscillation's)")
+        elif self.under_floor:
+            lines.append(f"claimed: nothing ({' + '.join(c.name for c in self.under_floor)} improves the held-out "
+                         f"replay, but removes under {100 * MIN_TRAIN_SHARE:.0f} % of the training error: not the "
+                         "cause of the gap)")
         else:
             lines.append("claimed: nothing (no candidate improves the held-out replay beyond the runs' spread)")
         lines += ["  " + line for line in self.mass_note()]
@@ -1468,7 +1488,7 @@ def _claim_on_spectrum(oscillation, candidates, test, params, nominal_sims, nomi
     say(f"{_OSCILLATION_EFFECT} on the spectrum: {spectral['reason']}")
     if not spectral["passes"]:
         return candidates, [], params, nominal_errors
-    candidates = [dataclasses.replace(c, values=dict(spectral["values"]), passes=True,
+    candidates = [dataclasses.replace(c, values=dict(spectral["values"]), passes=True, improves=True,
                                       reason="claimed on the spectrum: " + spectral["reason"])
                   if c.name == _OSCILLATION_EFFECT else c for c in candidates]
     current = _with(params, spectral["values"])
@@ -1972,11 +1992,14 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
     gain, se, bar, rt = force_test(current_errors, errs, null)
     n = len(test)
     nulls = rt["shrink"] / null if null else None  # the pooled shrink in run-to-run nulls
-    ok = passes_on_force(train_gain, gain, bar, rt, null)
+    improves = passes_on_force(train_gain, gain, bar, rt, null)
+    ok = improves and train_gain >= MIN_TRAIN_SHARE
     student = f"held-out gain {gain:+.3f} <= {bar:.3f} (t quantile x standard error of {n} runs)"
     if ok:
         reason = "passes" if gain > bar else (f"passes on its pooled shrink: {nulls:.1f} run-to-run nulls "
                                               f"(> {POOLED_FACTOR:g}), the gain under its bar")
+    elif improves:
+        reason = _under_floor(train_gain)
     elif train_gain <= 0:
         reason = "no gain on the training runs"
     elif null is None:
@@ -1988,7 +2011,13 @@ def _held_out(name, values, train_gain, test, current, current_errors, replayer,
     else:  # under the bar, and a pooled shrink of at most POOLED_FACTOR nulls
         reason = student + (f", pooled shrink {nulls:.1f} run-to-run nulls (<= {POOLED_FACTOR:g})" if nulls else "")
     return EffectResult(name=name, values=dict(values), train_gain=float(train_gain), test_errors=errs, gain=gain,
-                        standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason)
+                        standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason, improves=improves)
+
+
+def _under_floor(train_gain, of=""):
+    """The reason of a candidate that improves the held-out replay and explains too little to be the cause."""
+    return (f"improves the held-out replay, but removes {100 * train_gain:.1f} % of the training error{of} (under "
+            f"the {100 * MIN_TRAIN_SHARE:.0f} % a cause must explain): not claimed")
 
 
 def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, transmission_null):
@@ -2014,8 +2043,9 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
                        0.0 if transmission_null is None else transmission_null)
     rt["transmission"] = rt_t
     force_ok = null is not None and rt["shrink"] >= -null
-    ok = bool(transmission_null is not None and null is not None and train_gain > 0 and mean > bar_t
-              and rt_t["passes"] and force_ok)
+    improves = bool(transmission_null is not None and null is not None and train_gain > 0 and mean > bar_t
+                    and rt_t["passes"] and force_ok)
+    ok = improves and train_gain >= MIN_TRAIN_SHARE
     seen = (f"held-out transmission error {math.exp(mean):.3g} times smaller (mean log ratio {mean:.3f}, bar "
             f"{bar_t:.3f}), pooled shrink {100 * rt_t['shrink']:.1f} % (run-to-run null "
             + ("n/a" if transmission_null is None else f"{100 * transmission_null:.3g} %")
@@ -2024,6 +2054,8 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
              + ("n/a" if null is None else f"{100 * null:.2f} %") + ")")
     if ok:
         reason = f"passes on the screw's transmission (linear scale): {seen}; {force}"
+    elif improves:
+        reason = f"{_under_floor(train_gain, ' of the transmission')}: {seen}"
     elif train_gain <= 0:
         reason = "no lead error beyond the transmission's noise on the training runs"
     elif null is None or transmission_null is None:
@@ -2033,7 +2065,7 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
     else:
         reason = f"the force gets worse: {force}; {seen}"
     return EffectResult(name=name, values=dict(values), train_gain=float(train_gain), test_errors=errs, gain=gain,
-                        standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason)
+                        standard_error=se, threshold=bar, replay=rt, passes=ok, reason=reason, improves=improves)
 
 
 def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0, max_nfev=20,

@@ -39,7 +39,7 @@ def test_the_gain_chart_marks_a_lead_error_decided_on_the_transmission():
     from drakecreep.report.drive_report import _gain_figure
 
     lead = EffectResult("lead_error", {}, 1.0, {}, 7.3, 4.0, 13.3, {"shrink": 0.99, "transmission": {"shrink": 0.999}},
-                        True)
+                        True, improves=True)
     ripple = EffectResult("force_ripple", {}, 0.03, {}, -0.02, 0.2, 0.6, {"shrink": 0.03}, False)
     fig = _gain_figure([lead, ripple])
     ax = fig.axes[0]
@@ -51,4 +51,23 @@ def test_the_gain_chart_marks_a_lead_error_decided_on_the_transmission():
     plt.close(fig)
     fig = _gain_figure([ripple])
     assert not any("transmission" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    plt.close(fig)
+
+
+def test_the_gain_chart_tells_a_candidate_under_the_training_gain_floor_apart():
+    """A candidate that improves the held-out replay beyond its bars but explains under MIN_TRAIN_SHARE of the
+    training error (3cw) is neither green (claimed) nor grey (no held-out improvement): olive, with its legend."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgba
+
+    from drakecreep.gap.drive_fit import EffectResult
+    from drakecreep.report.drive_report import _gain_figure
+
+    delay = EffectResult("control_delay", {}, 0.05, {}, 0.68, 0.2, 0.54, {"shrink": 0.04}, False, improves=True)
+    stribeck = EffectResult("stribeck", {}, 0.6, {}, 3.0, 0.4, 1.0, {"shrink": 0.5}, True, improves=True)
+    fig = _gain_figure([stribeck, delay])
+    ax = fig.axes[0]
+    assert [b.get_facecolor() for b in ax.containers[0]] == [to_rgba("tab:green"), to_rgba("tab:olive")]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[2] == "improves the replay, but removes under 20 % of the training error: not claimed"
     plt.close(fig)
