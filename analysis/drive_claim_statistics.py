@@ -83,10 +83,11 @@ NOT_AVAILABLE = "n/a"
 
 #: The most fields each candidate of ``diagnose_drive`` adds to the nominal: the degrees of freedom of its training
 #: chi-square test (fixed per candidate, so that the test does not hang on which harmonics a fit kept; the
-#: Stribeck candidate's refit of the uncertain fields adds none, they were fitted already)
+#: Stribeck and friction-drift candidates' refit of the uncertain fields adds none, they were fitted already)
 CANDIDATE_FIELDS = {"lead_error": 5, "cogging": 5, "force_ripple": 3, "stribeck": 2, "asymmetric_friction": 2,
                     "control_delay": 1, "nut_friction_side": 1, "law_coulomb": 1, "law_stribeck": 1,
-                    "law_lugre": 1, "law_gms": 1, "position_friction": 4, "drive_saturation": 1}
+                    "law_lugre": 1, "law_gms": 1, "position_friction": 4, "drive_saturation": 1, "backlash": 1,
+                    "structural_mode": 3, "friction_drift": 1}
 
 
 def training_chi2(row, candidate):

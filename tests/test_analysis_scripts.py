@@ -493,7 +493,7 @@ def test_diagnose_dataset_refuses_bad_datasets_and_held_out_seeds_in_one_line(tm
              ([f"{HELD_OUT}:null:rigid", "--kind", "drakecreep", "--spent", str(tmp_path / "no.json")], "--spent"),
              (["9014:null:rigid", "--kind", "pi"], "--kind"),
              (["9014:null:rigid", "--kind", "drakecreep", "--json", "/proc/x.json"], "--json"),
-             (["9014:null:rigid", "--kind", "drakecreep", "--effects", "control_delay,backlash"], "--effects"),
+             (["9014:null:rigid", "--kind", "drakecreep", "--effects", "control_delay,drive_gain"], "--effects"),
              (["9014:null:rigid", "--kind", "drakecreep", "--effects", ","], "--effects"),
              (["9014:null:rigid", "--kind", "p_p_cascade", "--effects", "control_delay"], "--effects"))
     _refused_in_one_line("diagnose_dataset.py", cases, monkeypatch, capsys, tmp_path)
