@@ -12,7 +12,7 @@ uncertain, the one candidate named:
 
 Each case prints the fitted fields with their 95 % intervals, the held-out force error of the fitted params file and
 of the augmented one, and what the same diagnosis claims on the runs without the effect (the same noise). The seeds
-are those of ``tests/gap/test_drive_fit.py``; ``--seed`` draws other noise (a figure the tests never saw).
+are those of ``tests/gap/test_drive_fit_on_request.py``; ``--seed`` draws other noise (a figure the tests never saw).
 
 Usage: ``PYTHONPATH=. python analysis/drive_named_candidates.py [NAME ...] [--seed N]``
 """
