@@ -20,6 +20,26 @@ NOISE = 2.0  # N, white, on u
 RIG = quick_replay_params(preset("paper"))
 
 
+def _rms(errors):
+    """RMS over runs of the force error [%] of a diagnosis's per-run errors."""
+    return np.sqrt(np.mean([e["force"] ** 2 for e in errors.values()]))
+
+
+def _with_and_without(truth, effect, seed, declared=RIG):
+    """``effect`` named alone on six runs of ``truth`` (three training, three held out; ``declared`` the params
+    file) and on the same runs of the rig without it (the same noise): the two diagnoses. The one without claims
+    nothing and fits the candidate alone."""
+    speeds = SPEEDS + (0.015, 0.04)
+    out = []
+    for rig in (truth, RIG):
+        runs = simulated_runs(rig, speeds, declared=declared, n=N, noise=NOISE, seed=seed)
+        out.append(diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=(effect,)))
+    result, none = out
+    assert effect in drive_fit.ON_REQUEST and effect not in drive_fit.NOT_IN_MODEL
+    assert none.claimed == () and [c.name for c in none.candidates] == [effect]
+    return result, none
+
+
 def test_a_position_dependent_friction_named_is_fitted_claimed_and_kept_in_the_params():
     """The guides' friction 35 % lower at one end of a 75 mm travel and 38 % higher at the other (two steps of the
     map over [0, 80] mm, which the fit does not know: it spreads its own four over the training runs' travel),
@@ -45,8 +65,7 @@ def test_a_position_dependent_friction_named_is_fitted_claimed_and_kept_in_the_p
         return table_friction_levels(p, LoadCase())[0] * position_level(p.friction, x)
 
     np.testing.assert_allclose(force(result.params), force(truth), rtol=0.05)
-    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-    assert rms(result.test_errors) < 0.15 * rms(result.nominal_test_errors)
+    assert _rms(result.test_errors) < 0.15 * _rms(result.nominal_test_errors)
     plain = simulated_runs(RIG, speeds, declared=RIG, n=N, noise=NOISE, seed=700, origins=origins)
     none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("position_friction",))
     assert none.claimed == () and [c.name for c in none.candidates] == ["position_friction"]
@@ -56,18 +75,11 @@ def test_a_saturating_drive_named_is_fitted_claimed_and_kept_in_the_params():
     """A drive whose torque constant falls off above 1 N m (1257 N at the table: its largest commands, 0.5-1.5 kN,
     get 8-36 % less), which the params file lacks: ``drive_saturation`` recovers it within 1 %, the held-out force
     error falls to the noise's; on the same runs without it nothing is claimed. Not a default candidate."""
-    speeds = SPEEDS + (0.015, 0.04)
-    truth = with_value(RIG, "motor.saturation_torque", 1.0)
-    runs = simulated_runs(truth, speeds, declared=RIG, n=N, noise=NOISE, seed=900)
-    result = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=("drive_saturation",))
-    assert result.claimed == ("drive_saturation",) and "drive_saturation" in drive_fit.ON_REQUEST
+    result, _ = _with_and_without(with_value(RIG, "motor.saturation_torque", 1.0), "drive_saturation", 900)
+    assert result.claimed == ("drive_saturation",)
     assert result.params.motor.saturation_torque == pytest.approx(1.0, rel=0.01)
     assert {p.path: p for p in result.fitted}["motor.saturation_torque"].contains(1.0)
-    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-    assert rms(result.test_errors) < 0.1 * rms(result.nominal_test_errors)
-    plain = simulated_runs(RIG, speeds, declared=RIG, n=N, noise=NOISE, seed=900)
-    none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("drive_saturation",))
-    assert none.claimed == () and [c.name for c in none.candidates] == ["drive_saturation"]
+    assert _rms(result.test_errors) < 0.1 * _rms(result.nominal_test_errors)
 
 
 def test_a_backlash_named_is_fitted_claimed_and_kept_in_the_params():
@@ -75,19 +87,11 @@ def test_a_backlash_named_is_fitted_claimed_and_kept_in_the_params():
     reversal before the table follows): ``backlash`` recovers it within 5 % and its interval holds it, the held-out
     force error falls below half the nominal's; on the same runs without it nothing is claimed. Not a default
     candidate."""
-    speeds = SPEEDS + (0.015, 0.04)
-    truth = with_value(RIG, "nut.backlash", 8e-6)
-    runs = simulated_runs(truth, speeds, declared=RIG, n=N, noise=NOISE, seed=1200)
-    result = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=("backlash",))
-    assert result.claimed == ("backlash",) and "backlash" in drive_fit.ON_REQUEST
-    assert "backlash" not in drive_fit.NOT_IN_MODEL
+    result, _ = _with_and_without(with_value(RIG, "nut.backlash", 8e-6), "backlash", 1200)
+    assert result.claimed == ("backlash",)
     assert result.params.nut.backlash == pytest.approx(8e-6, rel=0.05)
     assert {p.path: p for p in result.fitted}["nut.backlash"].contains(8e-6)
-    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-    assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
-    plain = simulated_runs(RIG, speeds, declared=RIG, n=N, noise=NOISE, seed=1200)
-    none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("backlash",))
-    assert none.claimed == () and [c.name for c in none.candidates] == ["backlash"]
+    assert _rms(result.test_errors) < 0.5 * _rms(result.nominal_test_errors)
 
 
 def test_a_structural_mode_named_is_found_fitted_claimed_and_kept_in_the_params():
@@ -95,19 +99,12 @@ def test_a_structural_mode_named_is_found_fitted_claimed_and_kept_in_the_params(
     ``structural_mode`` finds its frequency within 5 % over the 5-300 Hz search and its share within 10 %, the
     held-out force error falls below half the nominal's; on the same runs without it nothing is claimed. Not a
     default candidate."""
-    speeds = SPEEDS + (0.015, 0.04)
     truth = with_value(with_value(RIG, "table.mode_mass_share", 0.25), "table.mode_frequency", 60.0)
-    runs = simulated_runs(truth, speeds, declared=RIG, n=N, noise=NOISE, seed=1500)
-    result = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=("structural_mode",))
-    assert result.claimed == ("structural_mode",) and "structural_mode" in drive_fit.ON_REQUEST
-    assert "structural_mode" not in drive_fit.NOT_IN_MODEL
+    result, none = _with_and_without(truth, "structural_mode", 1500)
+    assert result.claimed == ("structural_mode",)
     assert result.params.table.mode_frequency == pytest.approx(60.0, rel=0.05)
     assert result.params.table.mode_mass_share == pytest.approx(0.25, rel=0.1)
-    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-    assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
-    plain = simulated_runs(RIG, speeds, declared=RIG, n=N, noise=NOISE, seed=1500)
-    none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("structural_mode",))
-    assert none.claimed == () and [c.name for c in none.candidates] == ["structural_mode"]
+    assert _rms(result.test_errors) < 0.5 * _rms(result.nominal_test_errors)
     lo, hi = drive_fit.MODE_BAND  # the fit of a mode the runs do not have stays near the search band
     assert lo / 1.5 <= none.candidates[0].values["table.mode_frequency"] <= hi * 1.5
 
@@ -117,18 +114,10 @@ def test_a_friction_drift_named_is_fitted_claimed_and_kept_in_the_params():
     is 15 % high: ``friction_drift``, fitted with the seal force from both the nominal's and the file's values,
     recovers both inside their intervals, and the held-out force error falls below half the nominal's; on the same
     runs without a drift nothing is claimed. Not a default candidate."""
-    speeds = SPEEDS + (0.015, 0.04)
     declared = with_value(RIG, "table.seal_force", 1.15 * RIG.table.seal_force)
-    truth = with_value(RIG, "friction.time_drift", -0.3)
-    runs = simulated_runs(truth, speeds, declared=declared, n=N, noise=NOISE, seed=1800)
-    result = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=("friction_drift",))
-    assert result.claimed == ("friction_drift",) and "friction_drift" in drive_fit.ON_REQUEST
-    assert "friction_drift" not in drive_fit.NOT_IN_MODEL
+    result, _ = _with_and_without(with_value(RIG, "friction.time_drift", -0.3), "friction_drift", 1800, declared)
+    assert result.claimed == ("friction_drift",)
     fitted = {p.path: p for p in result.fitted}
     assert fitted["friction.time_drift"].contains(-0.3) and fitted["table.seal_force"].contains(RIG.table.seal_force)
     assert result.params.friction.time_drift == pytest.approx(-0.3, rel=0.05)
-    rms = lambda errs: np.sqrt(np.mean([e["force"] ** 2 for e in errs.values()]))  # noqa: E731
-    assert rms(result.test_errors) < 0.5 * rms(result.nominal_test_errors)
-    plain = simulated_runs(RIG, speeds, declared=declared, n=N, noise=NOISE, seed=1800)
-    none = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=("friction_drift",))
-    assert none.claimed == () and [c.name for c in none.candidates] == ["friction_drift"]
+    assert _rms(result.test_errors) < 0.5 * _rms(result.nominal_test_errors)
