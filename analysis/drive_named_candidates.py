@@ -14,7 +14,10 @@ Each case prints the fitted fields with their 95 % intervals, the held-out force
 of the augmented one, and what the same diagnosis claims on the runs without the effect (the same noise). The seeds
 are those of ``tests/gap/test_drive_fit_on_request.py``; ``--seed`` draws other noise (a figure the tests never saw).
 
-Usage: ``PYTHONPATH=. python analysis/drive_named_candidates.py [NAME ...] [--seed N]``
+With ``--together`` every case names all three candidates, so each must win against the other two (which one is
+claimed first, and what the others do).
+
+Usage: ``PYTHONPATH=. python analysis/drive_named_candidates.py [NAME ...] [--seed N] [--together]``
 """
 
 import argparse
@@ -45,6 +48,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("names", nargs="*", metavar="NAME", help="cases to run (default all: " + ", ".join(CASES) + ")")
     ap.add_argument("--seed", type=int, help="noise seed of every case (default: the tests' own, per case)")
+    ap.add_argument("--together", action="store_true", help="name all three candidates in every case")
     args = ap.parse_args(argv)
     for name in args.names:
         if name not in CASES:
@@ -58,9 +62,10 @@ def main(argv=None):
         declared = _set(rig, declared_fields)
         t0 = time.perf_counter()
         runs = simulated_runs(_set(rig, truth_fields), SPEEDS, declared=declared, n=500, noise=2.0, seed=seed)
-        res = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=(name,))
+        effects = tuple(CASES) if args.together else (name,)
+        res = diagnose_drive(runs[:3], runs[3:], uncertain=("table.seal_force",), effects=effects)
         plain = simulated_runs(rig, SPEEDS, declared=declared, n=500, noise=2.0, seed=seed)
-        null = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=(name,))
+        null = diagnose_drive(plain[:3], plain[3:], uncertain=("table.seal_force",), effects=effects)
         truth = ", ".join(f"{p} = {v:g}" for p, v in {**truth_fields, "table.seal_force": rig.table.seal_force}.items())
         print(f"{name} (seed {seed}; truth {truth}):")
         print(f"  claimed: {' + '.join(res.claimed) or 'nothing'}; held-out force error "
@@ -70,9 +75,12 @@ def main(argv=None):
         for path in truth_fields:
             if path not in {p.path for p in res.fitted}:
                 print(f"  {path} = {get_value(res.params, path):.4g} (searched, no interval)")
-        c = null.candidates[0]
-        print(f"  without the effect: claimed {' + '.join(null.claimed) or 'nothing'} (training gain "
-              f"{100 * c.train_gain:+.1f} %, {c.reason}); {time.perf_counter() - t0:.0f} s")
+        if args.together:
+            for c in res.candidates:
+                print(f"  {c.name}: training gain {100 * c.train_gain:+.1f} %, {c.reason}")
+        gains = ", ".join(f"{c.name} {100 * c.train_gain:+.1f} %" for c in null.candidates)
+        print(f"  without the effect: claimed {' + '.join(null.claimed) or 'nothing'} (training gains {gains}); "
+              f"{time.perf_counter() - t0:.0f} s")
     return 0
 
 
