@@ -85,7 +85,7 @@ def run(args):
         flag = f"yes: {two_mass:.2f} Hz" if m.two_mass else "no"
         print(f"{i:>4}  {m.frequency:>9.2f}  {m.damping_ratio:>7.4f}  {m.label:<16}  {share:>4.0f}%  {flag}")
     for field, value, what in not_in_multibody(params):
-        print(f"not in this model: {field} {value:g}: {what}")
+        print(f"not in this model: {field}: {what}")
     if written:
         print("wrote " + ", ".join(str(p) for p in written))
     if any(m.damping_ratio > 1.0 for m in result.modes):

@@ -296,14 +296,16 @@ def two_mass_axial_frequency(params, table_position=0.0):
 
 
 def not_in_multibody(params):
-    """The two-mass model's fields of ``params`` the multibody modes leave out, as ``(field, value, what)``: a
+    """The two-mass model's fields of ``params`` the multibody modes leave out, as ``(field, value SI, what: in words,
+    the value in its edge unit)``: a
     structural mode on the table (``table.mode_mass_share``) and the nut's lost motion (``nut.backlash``; the
     modes are those of the closed gap)."""
     out = []
     if params.table.mode_mass_share > 0.0:
         out.append(("table.mode_mass_share", params.table.mode_mass_share,
-                    f"a structural mode on the table at {params.table.mode_frequency:g} Hz (the two-mass model's; "
-                    "margins shows it in the loop)"))
+                    f"{params.table.mode_mass_share:g} of the moving mass on a structural mode of the table at "
+                    f"{params.table.mode_frequency:g} Hz (the two-mass model's; margins shows it in the loop)"))
     if params.nut.backlash > 0.0:
-        out.append(("nut.backlash", params.nut.backlash, "the nut's lost motion (these are the closed gap's modes)"))
+        out.append(("nut.backlash", params.nut.backlash,
+                    f"the nut's lost motion, {1e6 * params.nut.backlash:.3g} um (these are the closed gap's modes)"))
     return out
