@@ -1820,7 +1820,7 @@ def _fit_effect(name, runs, base, replayer, base_sims, sse0, max_nfev, oscillati
     elif name == "drive_saturation":
         values, sse = _saturation_effect(runs, base, replayer, scale, max_nfev)
     elif name == "backlash":
-        values, sse = _backlash_effect(runs, base, replayer, scale, max_nfev)
+        values, sse = _trial_effect(runs, base, "nut.backlash", BACKLASH_STARTS, replayer, scale, max_nfev)
     elif name == "structural_mode":
         values, sse = _mode_effect(runs, base, replayer, scale, max_nfev)
     elif name == "friction_drift":
@@ -1849,15 +1849,9 @@ def _saturation_effect(runs, base, replayer, scale, max_nfev):
                          replayer, scale, max_nfev)
 
 
-#: Lost motions tried before the fit of the ``backlash`` candidate [m]: from a few micrometres (a nut whose preload
-#: has worn off) to 60 um (a badly worn one); the fit refines the best.
+#: Lost motions tried before the fit of the ``backlash`` candidate [m] (``nut.backlash``, :func:`_trial_effect`): from
+#: a few micrometres (a nut whose preload has worn off) to 60 um (a badly worn one); the fit refines the best.
 BACKLASH_STARTS = (2e-6, 6e-6, 20e-6, 60e-6)
-
-
-def _backlash_effect(runs, base, replayer, scale, max_nfev):
-    """The nut's lost motion (``nut.backlash``) on the training ``runs``: the best of :data:`BACKLASH_STARTS` by
-    replayed SSE, refined by the output-error fit. ``(values, sse)``."""
-    return _trial_effect(runs, base, "nut.backlash", BACKLASH_STARTS, replayer, scale, max_nfev)
 
 
 def _drift_effect(runs, base, replayer, max_nfev, uncertain, prior):

@@ -166,8 +166,8 @@ def NutTable_(T):
         def _construct_copy(self, other, converter=None):
             Impl._construct(self, other.params, other.load, initial_state=other.initial_state, converter=converter)
 
-        def _split(self, context):
-            x = context.get_continuous_state_vector().CopyToVector()
+        def _split(self, context, state=None):
+            x = context.get_continuous_state_vector().CopyToVector() if state is None else state
             return x[0], x[1], x[2:2 + self._nz]
 
         def _force(self, x, v, z, t):
@@ -185,13 +185,14 @@ def NutTable_(T):
             return self._force(*self._split(context), context.get_time())
 
         def DoCalcTimeDerivatives(self, context, derivatives):
-            x, v, z = self._split(context)
+            state = context.get_continuous_state_vector().CopyToVector()  # read once: the leaf backend's hot path
+            x, v, z = self._split(context, state)
             push = self._u_axial_force.Eval(context)[0] - self.load.fx - self._force(x, v, z, context.get_time())
             if self.mode is None:
                 accel, mode_rates = push / self.mass, []
             else:  # the mode's mass pulls the table by its deflection d = x_mode - x; d'' = its acceleration - the table's
                 m, k, c = self.mode
-                d, dd = context.get_continuous_state_vector().CopyToVector()[2 + self._nz:]
+                d, dd = state[2 + self._nz:]
                 pull = k * d + c * dd
                 accel = (push + pull) / self.mass
                 mode_rates = [dd, -pull / m - accel]
