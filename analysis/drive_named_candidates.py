@@ -11,8 +11,9 @@ uncertain, the one candidate named:
   params file whose seal force is 15 % high.
 
 Each case prints the fitted fields with their 95 % intervals, the held-out force error of the fitted params file and
-of the augmented one, and what the same diagnosis claims on the runs without the effect (the same noise). The seeds
-are those of ``tests/gap/test_drive_fit_on_request.py``; ``--seed`` draws other noise (a figure the tests never saw).
+of the augmented one, and what the same diagnosis claims on the runs without the effect (the same noise). The cases'
+seeds are those of ``tests/gap/test_drive_fit_on_request.py`` (which checks the nulls on one other dataset, every
+candidate named); ``--seed`` draws other noise (a figure the tests never saw).
 
 With ``--together`` every case names all three candidates, so each must win against the other two (which one is
 claimed first, and what the others do).

@@ -1,4 +1,6 @@
+import contextlib
 import importlib.util
+import io
 import json
 
 import pytest
@@ -13,6 +15,20 @@ EXAMPLE = example_path("emps_segment.csv")  # t[ms], x[mm], u[V]
 def _diagnose(capsys, *args):
     assert cli.main(["-q", "diagnose", *map(str, args), "--json"]) == 0
     return json.loads(capsys.readouterr().out)
+
+
+#: the options of the log-rate tests' diagnoses
+LOG_RATE_OPTIONS = ("--effects", "lead_error", "--workers", "1")
+
+
+@pytest.fixture(scope="module")
+def example_at_its_rate():
+    """The shipped example (logged every controller tick) diagnosed with :data:`LOG_RATE_OPTIONS`: what both
+    log-rate tests compare with (once for the module: a diagnosis is 10-15 s)."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli.main(["-q", "diagnose", str(EXAMPLE), *LOG_RATE_OPTIONS, "--json"]) == 0
+    return json.loads(out.getvalue())
 
 
 def test_csv_in_mm_and_ms_gives_the_si_result(tmp_path, capsys):
@@ -42,7 +58,8 @@ def test_bad_run_selection_names_the_option(capsys):
     assert len(err) == 1 and err[0].startswith("drakecreep diagnose: error: --test: got 'r9'")
 
 
-def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers_tick(tmp_path, capsys):
+def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers_tick(tmp_path, capsys,
+                                                                                      example_at_its_rate):
     """EMPS's 1 ms P-P loop logged every 4 ms (``sample_time: 0.001`` kept): the replay runs the controller on its
     1 ms tick with the reference linear between logged samples, and compares the logged samples. Until session 86
     it was refused ('allowed: the run's sample time 0.004 s'). The nominal fitted on the 4 ms log is the 1 ms log's
@@ -52,10 +69,9 @@ def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers
     body = [x for x in lines if not x.startswith("#")][1:]
     (tmp_path / "every4.csv").write_text("\n".join(comments + [header] + body[::4]) + "\n")
     (tmp_path / "every4.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
-    opts = ("--effects", "lead_error", "--workers", "1")
-    assert cli.main(["-q", "diagnose", str(tmp_path / "every4.csv"), *opts, "--json"]) == 0
+    assert cli.main(["-q", "diagnose", str(tmp_path / "every4.csv"), *LOG_RATE_OPTIONS, "--json"]) == 0
     said = capsys.readouterr()
-    slow, fast = json.loads(said.out), _diagnose(capsys, EXAMPLE, *opts)
+    slow, fast = json.loads(said.out), example_at_its_rate
     # how the log is read is said (a sample_time declared wrong, a whole fraction of the log's, would show here)
     assert [x for x in said.err.splitlines() if "note:" in x] == [
         f"drakecreep diagnose: note: {tmp_path / 'every4.csv'}: logged every 0.004 s, every 4 ticks of "
@@ -76,7 +92,7 @@ def test_a_log_taken_every_four_controller_ticks_is_diagnosed_on_the_controllers
     assert "the run's sample time 0.004 s, a whole fraction of it" in err[0] and "a whole multiple of it" in err[0]
 
 
-def test_a_log_taken_four_times_a_controller_tick_is_diagnosed_at_its_ticks(tmp_path, capsys):
+def test_a_log_taken_four_times_a_controller_tick_is_diagnosed_at_its_ticks(tmp_path, capsys, example_at_its_rate):
     """EMPS's 1 ms loop logged every 0.25 ms from off a tick (positions linear, the command held): the diagnosis
     keeps the samples at the ticks, where u changes, and fits what the 1 ms log does (the same samples but the
     first: nominal within 0.2 %, held-out force error 8.952 % against 8.956 %)."""
@@ -92,10 +108,9 @@ def test_a_log_taken_four_times_a_controller_tick_is_diagnosed_at_its_ticks(tmp_
                         "f_ext[N]": 0.0}).iloc[3:]
     log.to_csv(tmp_path / "fast.csv", index=False)
     (tmp_path / "fast.yaml").write_text(EXAMPLE.with_suffix(".yaml").read_text())
-    opts = ("--effects", "lead_error", "--workers", "1")
-    assert cli.main(["-q", "diagnose", str(tmp_path / "fast.csv"), *opts, "--json"]) == 0
+    assert cli.main(["-q", "diagnose", str(tmp_path / "fast.csv"), *LOG_RATE_OPTIONS, "--json"]) == 0
     said = capsys.readouterr()
-    quick, slow = json.loads(said.out), _diagnose(capsys, EXAMPLE, *opts)
+    quick, slow = json.loads(said.out), example_at_its_rate
     assert f"note: {tmp_path / 'fast.csv'}: logged every 0.00025 s, 4 samples per tick of controller.sample_time " \
            "0.001 s: cut to its ticks, where the held u changes" in said.err
     for name in ("mass", "viscous", "coulomb"):

@@ -555,13 +555,20 @@ def test_switch_candidates_find_the_nut_drag_on_the_screw():
     assert refit and int(refit.group(1)) > 0 and int(refit.group(2)) == result.simulations, lines
 
 
-def test_replays_in_worker_processes_give_the_same_diagnosis():
-    """Over a pool the candidates are fitted at once, each in a thread (their replays interleave in the pool): the
-    same fits, gains, candidate order and replay count as one after the other in this process."""
+@pytest.fixture(scope="module")
+def switch_case():
+    """Runs of the rig without an effect, three switch candidates and a short nominal fit, diagnosed in this process
+    one candidate after the other: what the pooled and the resumed diagnoses must give."""
     runs = _runs(RIG, seed=3)
     kwargs = dict(uncertain=("table.seal_force",), effects=("law_coulomb", "nut_friction_side", "law_gms"), max_nfev=2)
+    return runs, kwargs, diagnose_drive(runs[:2], runs[2:], **kwargs)
+
+
+def test_replays_in_worker_processes_give_the_same_diagnosis(switch_case):
+    """Over a pool the candidates are fitted at once, each in a thread (their replays interleave in the pool): the
+    same fits, gains, candidate order and replay count as one after the other in this process."""
+    runs, kwargs, serial = switch_case
     lines = []
-    serial = diagnose_drive(runs[:2], runs[2:], **kwargs)
     pooled = diagnose_drive(runs[:2], runs[2:], workers=2, progress=lines.append, **kwargs)
     assert pooled.fitted == serial.fitted and pooled.claimed == serial.claimed
     assert pooled.simulations == serial.simulations
@@ -573,6 +580,41 @@ def test_replays_in_worker_processes_give_the_same_diagnosis():
     assert len(said) == 3 and all(line.endswith("; 4 replays)") for line in said), said
     with pytest.raises(InputError, match="workers"):
         diagnose_drive(runs[:2], runs[2:], workers=0, **kwargs)
+
+
+def test_a_diagnosis_stopped_after_a_candidate_resumes_from_its_checkpoint_with_the_same_result(
+        switch_case, tmp_path, monkeypatch):
+    """``checkpoint``: a diagnosis stopped (here by its ``on_stage``) after its nominal fit and one candidate
+    replays, resumed, only what was left, and returns the uninterrupted result; a finished one is read whole."""
+    runs, kwargs, whole = switch_case
+
+    class Stop(Exception):
+        pass
+
+    def stop_after_a_candidate(stage, partial):
+        if stage == "candidate":
+            raise Stop(partial.simulations)
+
+    path = tmp_path / "diagnosis.pkl"
+    with pytest.raises(Stop) as stopped:
+        diagnose_drive(runs[:2], runs[2:], on_stage=stop_after_a_candidate, checkpoint=path, **kwargs)
+    done_before = stopped.value.args[0]  # the nominal fit, its null and one candidate
+    assert 0 < done_before < whole.simulations
+
+    replays, original = [], drive_fit.replay_drakecreep
+    monkeypatch.setattr(drive_fit, "replay_drakecreep", lambda *a, **k: replays.append(1) or original(*a, **k))
+    lines = []
+    resumed = diagnose_drive(runs[:2], runs[2:], checkpoint=path, progress=lines.append, **kwargs)
+    assert lines[0].startswith(f"resumed from {path}: nominal, ")
+    assert len(replays) == whole.simulations - done_before and resumed.simulations == whole.simulations
+    assert resumed.fitted == whole.fitted and resumed.claimed == whole.claimed and resumed.params == whole.params
+    assert [(c.name, c.gain, c.threshold, c.values) for c in resumed.candidates] == [
+        (c.name, c.gain, c.threshold, c.values) for c in whole.candidates]
+    assert resumed.warnings == whole.warnings and resumed.replay_null == whole.replay_null
+    assert resumed.nominal_test_errors == whole.nominal_test_errors and resumed.test_errors == whole.test_errors
+    replays.clear()
+    assert diagnose_drive(runs[:2], runs[2:], checkpoint=path, **kwargs).to_json() == resumed.to_json()
+    assert replays == []
 
 
 def test_pooled_replays_are_handed_out_longest_first_and_returned_in_order(monkeypatch):
