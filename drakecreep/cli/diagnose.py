@@ -33,7 +33,10 @@ from drakecreep.gap.runs import CYCLE_MIN_TIME, HALF_CYCLE_MIN_TIME, load_runs, 
 from drakecreep.gap.runs import pick  # noqa: F401 (re-exported: the library side)
 from drakecreep.processes import usable_cpus
 
-__all__ = ["add_parser", "run", "load_runs", "pick"]
+__all__ = ["add_parser", "run", "load_runs", "pick", "CHECKPOINT"]
+
+#: the file in ``--out`` where a ``kind: drakecreep`` diagnosis keeps its finished steps until its manifest is written
+CHECKPOINT = "checkpoint.pkl"
 
 
 def add_parser(subparsers):
@@ -69,7 +72,8 @@ def add_parser(subparsers):
                    "fixed) on this file")
     p.add_argument("--out", metavar="DIR", help="write ranking.json, diagnosis.html, diagnosis.json and "
                    "augmented_model.yaml here (kind drakecreep runs: augmented_params.yaml for simulate/margins/"
-                   "report --params, diagnosis.html, diagnosis.json, summary.txt)")
+                   "report --params, diagnosis.html, diagnosis.json, summary.txt; a run stopped or failed keeps its "
+                   f"finished steps in {CHECKPOINT}, and the same command resumes there)")
     p.add_argument("--workers", type=workers, metavar="N", default=usable_cpus(),
                    help=f"processes for the closed-loop replays (p_p_cascade: the candidates' fits, and as many "
                         f"threads in each for the runs of one evaluation; drakecreep: the runs, Jacobian columns and "
@@ -251,7 +255,10 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     file (``nominal_params.yaml``) as soon as the nominal fit ends, and ``ranking.json`` (the candidates so
     far, ``"stage"`` and ``"complete": false``) after each candidate and once the claims are decided, so that a
     failure or a stop late in the run (the refit with the claims takes a third of it) keeps them; at the end
-    ``ranking.json`` is the final ranking (``"stage": "final"``, ``"complete": true``).
+    ``ranking.json`` is the final ranking (``"stage": "final"``, ``"complete": true``). The diagnosis's finished
+    steps (the nominal fit and its null, each candidate, the result) are kept in ``--out``'s :data:`CHECKPOINT`
+    until the manifest is written: the same command (same runs, options and code) run again after a stop or a
+    failure resumes from them, with the result an uninterrupted run gives.
     """
     import json
 
@@ -269,6 +276,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
     if getattr(args, "effects", None):
         kwargs["effects"] = names(args.effects, "--effects")
     outset = OutputSet(args.out, "manifest.json").start() if args.out else None
+    steps = None if outset is None else outset.dir / CHECKPOINT
     extra = {"data": str(args.data), "train_runs": [r.label for r in train], "test_runs": [r.label for r in test]}
 
     def keep(stage, partial):  # written atomically as the run goes: a late failure keeps them
@@ -282,12 +290,15 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         outset.write_text("ranking.json", json.dumps(body, indent=1) + "\n")
 
     try:
-        result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep, **kwargs)
+        result = diagnose_drive(train, test, progress=not args.quiet, workers=args.workers, on_stage=keep,
+                                checkpoint=steps, **kwargs)
     except BaseException as err:  # a failure or a stop (Ctrl-C): say what is kept, then the one-line error as always
         if isinstance(err, InputError) and err.field in ("uncertain", "effects"):  # checked before any work
             raise err.renamed(f"--{err.field}") from None  # the option, not the parameter
         if outset is not None and outset.files:
             say(f"kept {' and '.join(sorted(outset.files))} in {outset.dir} (no manifest: the run did not finish)")
+        if steps is not None and steps.exists():
+            say(f"the finished steps are kept in {steps}: the same command resumes from them")
         raise
     payload = result.to_json()
     lines = list(result.summary())
@@ -306,6 +317,7 @@ def _run_drakecreep_kind(args, train, test, score_runs):
         keep("final", result)
         outset.commit({"kind": "drakecreep.drive_diagnosis", "claimed": list(result.claimed),
                        "html": "diagnosis.html"})
+        steps.unlink(missing_ok=True)  # the run is whole in its manifest
         say(f"wrote {outset.dir}/diagnosis.html, augmented_params.yaml, diagnosis.json, summary.txt, "
             "nominal_params.yaml and ranking.json")
     if args.json:

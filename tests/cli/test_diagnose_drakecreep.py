@@ -97,7 +97,9 @@ def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, 
     """A step after the candidates that fails (here the location of what is left, made to raise): the run exits 1
     with one line, no manifest claims a complete run, and the folder keeps the fitted params file and the ranking
     of the candidates (the issue: a failure late in the pipeline keeps what was computed). A candidate that fails
-    (here the delay search) no longer ends the run: it is listed as failed, the others are ranked."""
+    (here the delay search) no longer ends the run: it is listed as failed, the others are ranked. The same command
+    run again, the failure mended, resumes from the finished steps: it replays nothing more (no claim, so the
+    nominal's held-out replays are the final model's) and writes the whole folder."""
     from drakecreep.gap import drive_fit
 
     def broken(*args, **kwargs):
@@ -106,16 +108,20 @@ def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, 
     def lost(*args, **kwargs):
         raise RuntimeError("the location broke")
 
+    locate = drive_fit.locate
     monkeypatch.setattr(drive_fit, "_delay_effect", broken)
     monkeypatch.setattr(drive_fit, "locate", lost)
     path, _ = own_csv
     out = tmp_path / "diag"
-    code = cli.main(["diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3", "--uncertain",
-                     "table.seal_force", "--effects", "nut_friction_side,control_delay", "--out", str(out)])
+    command = ["diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3", "--uncertain", "table.seal_force",
+               "--effects", "nut_friction_side,control_delay", "--out", str(out)]
+    code = cli.main(command)
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and "the location broke" in err[-1] and "Traceback" not in "\n".join(err)
     assert any("nominal_params.yaml" in line for line in err)  # the progress says where it is kept
-    assert "kept nominal_params.yaml and ranking.json in" in err[-2]
+    assert "kept nominal_params.yaml and ranking.json in" in err[-3]
+    assert err[-2].endswith(f"the finished steps are kept in {out / 'checkpoint.pkl'}: the same command resumes "
+                            "from them")
     assert not (out / "manifest.json").exists()
     assert load_params(out / "nominal_params.yaml").table.seal_force > 0
     ranking = json.loads((out / "ranking.json").read_text())
@@ -125,6 +131,17 @@ def test_a_late_failure_keeps_the_fitted_params_and_the_ranking_so_far(own_csv, 
     assert delay["reason"] == "failed (RuntimeError: the delay search broke)"
     assert any("control_delay failed (RuntimeError: the delay search broke)" in w for w in ranking["warnings"])
     assert ranking["replay_null"] is not None and ranking["train_runs"] == ["r0", "r1"]
+
+    monkeypatch.setattr(drive_fit, "locate", locate)
+    replays, original = [], drive_fit.replay_drakecreep
+    monkeypatch.setattr(drive_fit, "replay_drakecreep", lambda *a, **k: replays.append(1) or original(*a, **k))
+    assert cli.main(command) == 0
+    err = capsys.readouterr().err
+    assert "resumed from " in err and replays == []
+    assert (out / "manifest.json").exists() and not (out / "checkpoint.pkl").exists()
+    final = json.loads((out / "ranking.json").read_text())
+    assert final["complete"] is True and final["replay_null"] == ranking["replay_null"]
+    assert [c["name"] for c in final["candidates"]] == [c["name"] for c in ranking["candidates"]]
 
 
 def test_uncertain_is_refused_for_p_p_cascade_runs(capsys):
