@@ -2132,7 +2132,8 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
             return checkpoint.get("result")
         if checkpoint.resumed:
             say(f"resumed from {checkpoint.path}: " + ", ".join(
-                step if isinstance(step, str) else step[1] for step in checkpoint.resumed))
+                "the nominal fit and its null" if step == "nominal" else f"candidate {step[1]}"
+                for step in checkpoint.resumed))
     if workers == 1:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case),
                                say, t0, on_stage, checkpoint)

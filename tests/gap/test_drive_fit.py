@@ -605,7 +605,7 @@ def test_a_diagnosis_stopped_after_a_candidate_resumes_from_its_checkpoint_with_
     monkeypatch.setattr(drive_fit, "replay_drakecreep", lambda *a, **k: replays.append(1) or original(*a, **k))
     lines = []
     resumed = diagnose_drive(runs[:2], runs[2:], checkpoint=path, progress=lines.append, **kwargs)
-    assert lines[0].startswith(f"resumed from {path}: nominal, ")
+    assert lines[0].startswith(f"resumed from {path}: the nominal fit and its null, candidate ")
     assert len(replays) == whole.simulations - done_before and resumed.simulations == whole.simulations
     assert resumed.fitted == whole.fitted and resumed.claimed == whole.claimed and resumed.params == whole.params
     assert [(c.name, c.gain, c.threshold, c.values) for c in resumed.candidates] == [
