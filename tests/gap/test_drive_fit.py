@@ -9,6 +9,7 @@ loop, so that a 0.5 s run replays in well under a second.
 import dataclasses
 import json
 import math
+import os
 import re
 from types import SimpleNamespace
 
@@ -320,6 +321,10 @@ def test_a_stribeck_hump_is_fitted_with_the_friction_level_the_nominal_raised_fo
     assert rms(res.test_errors) < 0.2 * rms(res.nominal_test_errors)
 
 
+@pytest.mark.skipif(not os.environ.get("DRAKECREEP_SLOW"),
+                    reason="564 replays (about 50 s, the suite's slowest test); the two starts of the Stribeck fit "
+                           "are checked by test_a_stribeck_hump_is_fitted_with_the_friction_level_the_nominal_raised_"
+                           "for_it; set DRAKECREEP_SLOW=1")
 def test_a_stribeck_hump_is_fitted_from_the_params_file_levels_where_the_nominal_lowered_the_viscous():
     """Truth: Fs/Fc 1.8 at 8 mm/s and a viscous coefficient of 1000 N s/m, which the params file declares. Over the
     training runs (12-30 mm/s) the friction falls with the speed, so the nominal fit lowers the viscous to a few
@@ -538,14 +543,30 @@ def test_a_fitted_map_replaces_a_declared_one_whatever_the_order_of_its_fields()
     assert err.value.field == "friction.position_map_0..3"
 
 
-def test_switch_candidates_find_the_nut_drag_on_the_screw():
-    """The friction-law and nut-side candidates set a word, not a number (they once failed on it)."""
+def test_switch_candidates_find_the_nut_drag_on_the_screw(monkeypatch):
+    """The friction-law and nut-side candidates set a word, not a number (they once failed on it). A candidate that
+    fails beside them (here a Drake integrator that gives up; in the field a fitted value its params refused) is
+    recorded as failed, said in the warnings, never claimed, and the others go on: it ended the whole diagnosis
+    after minutes of work once."""
     truth = with_value(RIG, "friction.nut_friction_on", "screw")
     runs = simulated_runs(truth, SPEEDS + (0.022, 0.032), declared=RIG, n=N, noise=NOISE, seed=900)
+    fit_effect = drive_fit._fit_effect
+
+    def failing(name, *args, **kwargs):
+        if name == "force_ripple":
+            raise RuntimeError("Error control wants to select step smaller than minimum allowed (1e-14)\nmore")
+        return fit_effect(name, *args, **kwargs)
+
+    monkeypatch.setattr(drive_fit, "_fit_effect", failing)
     lines = []
     result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",),
-                            effects=("nut_friction_side", "law_coulomb"), progress=lines.append)
+                            effects=("force_ripple", "nut_friction_side", "law_coulomb"), progress=lines.append)
     assert result.claimed == ("nut_friction_side",)
+    (failed,) = [c for c in result.candidates if c.name == "force_ripple"]
+    assert not failed.passes and failed.reason == ("failed (RuntimeError: Error control wants to select step smaller "
+                                                   "than minimum allowed (1e-14))")
+    assert any(w.startswith("force_ripple failed (RuntimeError") for w in result.warnings)
+    assert any("force_ripple" in line and "failed (RuntimeError" in line for line in result.summary())
     assert result.params.friction.nut_friction_on == "screw" and result.params.friction.law == RIG.friction.law
     # the progress says where the replays go: each switch's (one replay of every training and held-out run)
     # and the refit's, whose line ends with the diagnosis's total
@@ -991,29 +1012,6 @@ def test_a_pooled_shrink_of_many_run_to_run_nulls_stands_for_the_student_bar():
     assert not _held_out(nominal, lead, None).passes
     # a gain above the bar passes as before
     assert _held_out([20.0, 21.0, 19.0], [10.0, 11.0, 9.5], 0.5).reason == "passes"
-
-
-def test_a_candidate_that_fails_is_recorded_and_the_others_go_on(monkeypatch):
-    """One candidate's failure (here a Drake integrator that gives up; in the field a fitted value its params
-    refused) ended the whole diagnosis after minutes of work. Now the candidate is recorded as failed, said in the
-    warnings, never claimed, and the lead error the runs carry is still found and claimed."""
-    truth = with_value(RIG, "disturbance.lead_error_amplitude", 2e-6)
-    runs = _runs(truth, seed=2)
-    fit_effect = drive_fit._fit_effect
-
-    def failing(name, *args, **kwargs):
-        if name == "force_ripple":
-            raise RuntimeError("Error control wants to select step smaller than minimum allowed (1e-14)\nmore")
-        return fit_effect(name, *args, **kwargs)
-
-    monkeypatch.setattr(drive_fit, "_fit_effect", failing)
-    result = diagnose_drive(runs[:2], runs[2:], uncertain=("table.seal_force",), effects=("force_ripple", "lead_error"))
-    (failed,) = [c for c in result.candidates if c.name == "force_ripple"]
-    assert not failed.passes and failed.reason == ("failed (RuntimeError: Error control wants to select step smaller "
-                                                   "than minimum allowed (1e-14))")
-    assert any(w.startswith("force_ripple failed (RuntimeError") for w in result.warnings)
-    assert result.claimed == ("lead_error",)
-    assert any("force_ripple" in line and "failed (RuntimeError" in line for line in result.summary())
 
 
 @pytest.mark.parametrize("kwargs, message", [
