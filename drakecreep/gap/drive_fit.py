@@ -2098,8 +2098,8 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         result) as they end (:class:`drakecreep.gap.checkpoint.Checkpoint`): a call with the same runs, params,
         fields, effects, ``load_case`` and ``max_nfev`` on the same package code resumes from them, so a diagnosis
         stopped or killed loses only the step it was in. The result is the one an uninterrupted call returns
-        (``seconds`` adds the earlier calls' time up to their last kept step). A file of other inputs or code is
-        not read, and is overwritten.
+        (``seconds`` counts the earlier call's time to the end of its nominal fit and null, not its candidates').
+        A file of other inputs or code is not read, and is overwritten.
 
     Returns
     -------
