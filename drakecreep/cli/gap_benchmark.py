@@ -4,6 +4,8 @@ declared params file for drakecreep), scored on audit runs it never sees."""
 
 import sys
 
+import json
+
 from drakecreep.cli._common import integer_in, names, print_json
 
 __all__ = ["add_parser", "run"]
@@ -33,6 +35,11 @@ def add_parser(subparsers):
     p.add_argument("--mass-spread", type=float, default=0.0, metavar="S",
                    help="kind drakecreep: each params file's table.mass is the truth's times exp(N(0, S)), e.g. "
                         "0.15 for a workpiece left out or guessed (default 0: the truth's mass)")
+    p.add_argument("--out", metavar="DIR",
+                   help="keep the run here: rows.json after every dataset, each drakecreep diagnosis's finished "
+                        "steps in checkpoints/, and at the end results.json and manifest.json; the same command "
+                        "run again with this folder resumes where a stop or a kill left it (other settings are "
+                        "refused)")
     p.add_argument("--json", action="store_true", help="print JSON (scores and per-dataset rows)")
     p.set_defaults(func=run)
     return p
@@ -55,9 +62,42 @@ def samples(text):
     return integer_in(text, 600, MAX_SAMPLES)
 
 
+#: the file of ``--out`` that holds the rows as they come (and the settings they were run with)
+ROWS = "rows.json"
+
+
+def _earlier_rows(out, settings):
+    """The rows a run with the same ``settings`` left in ``out`` (none without a rows file); a folder holding a run
+    of other settings, or a rows file that cannot be read, is refused naming ``--out``."""
+    import json
+
+    from drakecreep.errors import InputError
+    from drakecreep.files import read_input_text
+
+    path = out / ROWS
+    if not path.exists():
+        return []
+    try:
+        earlier = json.loads(read_input_text(path, "--out"))
+        rows, before = earlier["datasets"], earlier["settings"]
+        if not isinstance(rows, list) or not isinstance(before, dict):
+            raise TypeError
+    except InputError:
+        raise
+    except (ValueError, KeyError, TypeError):
+        raise InputError("--out", str(out), f"a folder whose {ROWS} is one this command wrote, or another "
+                                            "folder") from None
+    if before != settings:
+        other = ", ".join(f"{k} {before.get(k)!r}" for k in settings if before.get(k) != settings[k])
+        raise InputError("--out", str(out), f"a folder of a run with the same settings (it holds one with {other}), "
+                                            "or another folder")
+    return rows
+
+
 def run(args):
     """Run and print the scores (each dataset takes minutes: its kind's diagnosis fits every candidate)."""
     from drakecreep.errors import InputError
+    from drakecreep.files import OutputSet, check_output_dir, to_jsonable, write_json
     from drakecreep.gap.benchmark import (DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, check_effects, check_kinds,
                                           check_mass_spread, run_benchmark)
 
@@ -67,9 +107,33 @@ def run(args):
     effects = None if args.effects is None else check_effects(kinds, names(args.effects, "--effects"), "--effects")
     mass_spread = check_mass_spread(args.mass_spread, kinds, "--mass-spread")
     seed = HELDOUT_SEEDS if args.seeds == "heldout" else DEV_SEEDS
+    settings = {"seeds": args.seeds, "kinds": list(kinds), "n_per_effect": args.n_per_effect, "n_null": args.n_null,
+                "n_ool": args.n_ool, "samples": args.samples, "effects": None if effects is None else list(effects),
+                "mass_spread": mass_spread}
+    out, done, keep = None, [], None  # without --out: nothing kept, the rows only in the answer
+    if args.out is not None:
+        out = check_output_dir(args.out)
+        done = _earlier_rows(out, settings)
+        if done and not args.quiet:
+            print(f"[gap-benchmark] resuming the run in {out}: {len(done)} datasets diagnosed in it", file=sys.stderr)
+
+        def write_rows(row, rows):  # after every dataset, atomically: a stop or a kill keeps the rows so far
+            write_json(out / ROWS, {"settings": settings, "complete": False, "datasets": rows}, indent=1)
+
+        keep = write_rows
+
     res = run_benchmark(seed=seed, kinds=kinds, n_per_effect=args.n_per_effect, n_null=args.n_null,
                         n_ool=args.n_ool, progress=not args.quiet, n_samples=args.samples, effects=effects,
-                        mass_spread=mass_spread)
+                        mass_spread=mass_spread, done=done, on_row=keep,
+                        checkpoints=None if out is None else out / "checkpoints")
+    if out is not None:
+        with OutputSet(out, "manifest.json") as files:
+            files.write_text(ROWS, json.dumps(to_jsonable({"settings": settings, "complete": True,
+                                                           "datasets": res["datasets"]}), indent=1) + "\n")
+            files.write_text("results.json", json.dumps(to_jsonable(dict(res, settings=settings)), indent=1) + "\n")
+            files.commit({"kind": "drakecreep.gap_benchmark", "datasets": len(res["datasets"])})
+        if not args.quiet:
+            print(f"[gap-benchmark] wrote {out}/results.json, {ROWS} and manifest.json", file=sys.stderr)
     if args.json:
         print_json(res)
         return 0

@@ -6,10 +6,12 @@ from drakecreep import cli
 from drakecreep.errors import InputError
 
 
-def test_gap_benchmark_json_on_one_short_null(capsys):
-    """One short null through the product diagnosis (one candidate, to stay fast)."""
-    assert cli.main(["gap-benchmark", "--seeds", "dev", "--n-per-effect", "0", "--effects", "position_ripple",
-                     "--n-null", "1", "--n-ool", "0", "--samples", "600", "--json"]) == 0
+def test_gap_benchmark_json_on_one_short_null(capsys, tmp_path):
+    """One short null through the product diagnosis (one candidate, to stay fast), kept in ``--out``: the same
+    command again resumes from its rows (nothing diagnosed again), other settings in that folder are refused."""
+    command = ["gap-benchmark", "--seeds", "dev", "--n-per-effect", "0", "--effects", "position_ripple",
+               "--n-null", "1", "--n-ool", "0", "--samples", "600", "--json", "--out", str(tmp_path / "run")]
+    assert cli.main(command) == 0
     captured = capsys.readouterr()
     data = json.loads(captured.out)
     assert data["scores"]["n_datasets"] == 1
@@ -21,6 +23,23 @@ def test_gap_benchmark_json_on_one_short_null(capsys):
     # second null for these until session 64)
     assert row["audit_shrink"] == 0.0 and row["audit"]["claimed"] == row["audit"]["nominal"]
     assert "[gap-benchmark] 1/1 seed" in captured.err
+    # the folder: the rows with their settings, the results, a manifest; the checkpoints' folder empty again
+    kept = json.loads((tmp_path / "run" / "rows.json").read_text())
+    assert kept["complete"] is True and kept["datasets"] == data["datasets"] and kept["settings"]["n_null"] == 1
+    assert json.loads((tmp_path / "run" / "results.json").read_text())["scores"] == data["scores"]
+    assert (tmp_path / "run" / "manifest.json").exists() and not any((tmp_path / "run" / "checkpoints").iterdir())
+    assert cli.main(command) == 0
+    again = capsys.readouterr()
+    assert json.loads(again.out)["datasets"] == data["datasets"]
+    assert "1 datasets diagnosed in it" in again.err and "diagnosed in the earlier run" in again.err
+    command[command.index("--n-null") + 1] = "2"
+    assert cli.main(command) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"drakecreep gap-benchmark: error: --out: got '{tmp_path / 'run'}'")
+    assert "a run with the same settings (it holds one with n_null 1)" in err[0]
+    (tmp_path / "run" / "rows.json").write_text("{not json")
+    assert cli.main(command) == 2
+    assert "rows.json is one this command wrote" in capsys.readouterr().err
 
 
 def test_gap_benchmark_rejects_bad_arguments(capsys):
