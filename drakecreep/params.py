@@ -52,6 +52,7 @@ __all__ = [
     "get_value",
     "field_unit",
     "field_range",
+    "two_mass_effects",
 ]
 
 #: most YAML aliases (``*name``) one file may use: parameter files need none; a few hundred is generous,
@@ -975,6 +976,37 @@ def field_range(params, path):
     side is open-ended (the validation's own range: a value outside it is refused by :func:`with_value`)."""
     meta = _field(params, path).metadata
     return meta.get("lo"), meta.get("hi")
+
+
+def two_mass_effects(params):
+    """The effects ``params`` switches on that only the two-mass Drake diagram has (the drive's ``Motor``,
+    ``ScrewDrive``, ``NutTable``; not the plain-Python baseline, not the multibody diagram): one list, so that the
+    next such effect is added in one place.
+
+    Returns
+    -------
+    list of (str, float, str)
+        ``(field, value, what)`` in a fixed order, the first field of each effect that is set: the lead error, the
+        cogging, the drive's saturation, the friction map, the nut's lost motion, the friction drift, the
+        structural mode on the table (``what`` in words).
+    """
+    d, out = params.disturbance, []
+    groups = (("the lead error", (("disturbance.lead_error_amplitude", d.lead_error_amplitude),
+                                  ("disturbance.lead_error_2_amplitude", d.lead_error_2_amplitude))),
+              ("the cogging", (("disturbance.cogging_force", d.cogging_force),
+                               ("disturbance.cogging_2_force", d.cogging_2_force))),
+              ("the drive's saturation", (("motor.saturation_torque", params.motor.saturation_torque),)),
+              ("the friction map", tuple((f"friction.position_map_{k}", a)
+                                         for k, a in enumerate(params.friction.position_map))),
+              ("the nut's lost motion", (("nut.backlash", params.nut.backlash),)),
+              ("the friction drift", (("friction.time_drift", params.friction.time_drift),)),
+              ("the structural mode on the table", (("table.mode_mass_share", params.table.mode_mass_share),)))
+    for what, fields in groups:
+        for path, value in fields:
+            if value != 0.0:
+                out.append((path, value, what))
+                break
+    return out
 
 
 def check_params(params, field="params"):

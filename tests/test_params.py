@@ -298,3 +298,19 @@ def test_load_params_names_a_path_that_is_no_path(path):
 
     with pytest.raises(InputError, match=r"^path: got .*; allowed: a file path"):
         load_params(path)
+
+
+def test_two_mass_effects_name_the_first_field_of_each_effect_switched_on():
+    """One list of the effects only the two-mass diagram has (the baseline and the multibody diagram refuse them by
+    it): none on the paper rig, each effect once by its first field set, in a fixed order."""
+    from drakecreep.params import two_mass_effects
+
+    p = preset("paper")
+    assert two_mass_effects(p) == []
+    for path, value in (("friction.time_drift", -0.1), ("disturbance.cogging_2_force", 1.0),
+                        ("friction.position_map_2", 0.1), ("friction.position_map_3", -0.2), ("nut.backlash", 8e-6)):
+        p = with_value(p, path, value)
+    assert two_mass_effects(p) == [("disturbance.cogging_2_force", 1.0, "the cogging"),
+                                   ("friction.position_map_2", 0.1, "the friction map"),
+                                   ("nut.backlash", 8e-6, "the nut's lost motion"),
+                                   ("friction.time_drift", -0.1, "the friction drift")]

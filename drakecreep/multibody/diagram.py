@@ -69,6 +69,7 @@ from drakecreep.model.nut_table import table_friction_levels
 from drakecreep.model.reference import FeedReference
 from drakecreep.model.sensors import LinearScale, MotorEncoder, encoder_resolution, quantize
 from drakecreep.multibody.plant import build_multibody
+from drakecreep.params import two_mass_effects
 
 __all__ = ["MultibodyOptions", "MultibodyFeedDrive", "build_multibody_diagram", "loaded_equilibrium",
            "DEFAULT_SEGMENTS", "INTEGRATORS"]
@@ -79,6 +80,11 @@ INTEGRATORS = ("velocity_implicit_euler", "implicit_euler", "radau3", "runge_kut
 #: screw segments of a closed-loop run (modal convergence: 0.8 % at N = 6 with the fixed joints of
 #: Table 1, 1.1 % with rigid joints, against N = 24; docs/multibody.md)
 DEFAULT_SEGMENTS = 6
+#: why the multibody plant has no such effect, where it is not only that the effect is the two-mass model's
+#: (:func:`drakecreep.params.two_mass_effects`)
+_WHY_NOT = {"the lead error": "its ScrewJoint has an exact lead; ",
+            "the nut's lost motion": "its ScrewJoint has no lost motion; ",
+            "the structural mode on the table": "its table is one rigid body; "}
 
 
 @dataclass(frozen=True)
@@ -434,35 +440,9 @@ def _add_controls(builder, add, coords, *, params, scenario, gains, load, ideal_
     (system, port): output port}`` of the recorded signals, or with ``open_loop`` the key
     ``"torque_command_in"`` (the torque limit's input) instead of the signals.
     """
-    if params.disturbance.has_lead_error:
-        d = params.disturbance
-        field = "lead_error_amplitude" if d.lead_error_amplitude > 0.0 else "lead_error_2_amplitude"
-        raise InputError(f"disturbance.{field}", getattr(d, field),
-                         "0 with the multibody model (its ScrewJoint has an exact lead; the lead error is a "
-                         "two-mass model effect)")
-    if params.disturbance.has_cogging:
-        d = params.disturbance
-        field = "cogging_force" if d.cogging_force > 0.0 else "cogging_2_force"
-        raise InputError(f"disturbance.{field}", getattr(d, field),
-                         "0 with the multibody model (the cogging is a two-mass model effect)")
-    if params.motor.saturation_torque > 0.0:
-        raise InputError("motor.saturation_torque", params.motor.saturation_torque,
-                         "0 with the multibody model (the drive's saturation is a two-mass model effect)")
-    for k, a in enumerate(params.friction.position_map):
-        if a != 0.0:
-            raise InputError(f"friction.position_map_{k}", a,
-                             "0 with the multibody model (the friction map is a two-mass model effect)")
-    if params.nut.backlash > 0.0:
-        raise InputError("nut.backlash", params.nut.backlash,
-                         "0 with the multibody model (its ScrewJoint has no lost motion; the backlash is a two-mass "
-                         "model effect)")
-    if params.friction.time_drift != 0.0:
-        raise InputError("friction.time_drift", params.friction.time_drift,
-                         "0 with the multibody model (the friction drift is a two-mass model effect)")
-    if params.table.mode_mass_share > 0.0:
-        raise InputError("table.mode_mass_share", params.table.mode_mass_share,
-                         "0 with the multibody model (its table is one rigid body; the structural mode is a two-mass "
-                         "model effect)")
+    for path, value, what in two_mass_effects(params):  # the first of them, by name
+        raise InputError(path, value, f"0 with the multibody model ({_WHY_NOT.get(what, '')}{what} is a two-mass "
+                                      "model effect)")
     s = {}
 
     def put(name, system):

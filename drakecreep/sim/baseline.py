@@ -22,6 +22,7 @@ from scipy.integrate import solve_ivp
 from drakecreep.model.diagram import initial_conditions
 from drakecreep.model.nut_friction import nut_friction_params
 from drakecreep.model.screw import bearing_element, nut_element
+from drakecreep.params import two_mass_effects
 
 __all__ = ["BaselineModel", "simulate_baseline", "unsupported"]
 
@@ -38,19 +39,9 @@ def unsupported(params):
     for name in ("coulomb_asymmetry", "viscous_asymmetry"):
         if getattr(p.friction, name) != 0.0:
             return (f"friction.{name}", getattr(p.friction, name), "0 (the plain-Python equations are symmetric)")
-    if p.motor.saturation_torque > 0.0:
-        return ("motor.saturation_torque", p.motor.saturation_torque,
-                "0 (the plain-Python equations have a linear drive)")
-    for k, a in enumerate(p.friction.position_map):
-        if a != 0.0:
-            return (f"friction.position_map_{k}", a, "0 (the plain-Python equations have no friction map)")
-    if p.nut.backlash > 0.0:
-        return ("nut.backlash", p.nut.backlash, "0 (the plain-Python equations have no lost motion)")
-    if p.friction.time_drift != 0.0:
-        return ("friction.time_drift", p.friction.time_drift, "0 (the plain-Python equations have no friction drift)")
-    if p.table.mode_mass_share > 0.0:
-        return ("table.mode_mass_share", p.table.mode_mass_share,
-                "0 (the plain-Python equations have a rigid table)")
+    for path, value, what in two_mass_effects(p):  # the lead error and the cogging: the disturbances' below
+        if not path.startswith("disturbance."):
+            return (path, value, f"0 (the plain-Python equations lack {what})")
     d = p.disturbance
     if d.has_lead_error or d.has_cogging or d.force_ripple > 0 or d.load_ripple > 0:
         return ("disturbance", "switched on", "all amplitudes 0 (the plain-Python equations have no disturbances)")

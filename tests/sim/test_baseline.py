@@ -38,12 +38,14 @@ def test_the_plain_python_equations_refuse_asymmetric_friction(short_paper):
     assert unsupported(asym) == ("friction.viscous_asymmetry", 0.2, "0 (the plain-Python equations are symmetric)")
     mapped = with_value(short_paper, "friction.position_map_2", -0.1)  # a friction map: the Drake systems' alone
     assert unsupported(mapped) == ("friction.position_map_2", -0.1,
-                                   "0 (the plain-Python equations have no friction map)")
+                                   "0 (the plain-Python equations lack the friction map)")
     weak = with_value(short_paper, "motor.saturation_torque", 0.5)  # a saturating drive: the Drake systems' alone
-    assert unsupported(weak) == ("motor.saturation_torque", 0.5, "0 (the plain-Python equations have a linear drive)")
+    assert unsupported(weak) == ("motor.saturation_torque", 0.5,
+                                 "0 (the plain-Python equations lack the drive's saturation)")
     loose = with_value(short_paper, "nut.backlash", 8e-6)  # a lost motion: the Drake systems' alone
-    assert unsupported(loose) == ("nut.backlash", 8e-6, "0 (the plain-Python equations have no lost motion)")
+    assert unsupported(loose) == ("nut.backlash", 8e-6, "0 (the plain-Python equations lack the nut's lost motion)")
     modal = with_value(short_paper, "table.mode_mass_share", 0.2)  # a structural mode: the Drake systems' alone
-    assert unsupported(modal) == ("table.mode_mass_share", 0.2, "0 (the plain-Python equations have a rigid table)")
+    assert unsupported(modal) == ("table.mode_mass_share", 0.2,
+                                  "0 (the plain-Python equations lack the structural mode on the table)")
     warm = with_value(short_paper, "friction.time_drift", -0.1)  # a friction drift: the Drake systems' alone
-    assert unsupported(warm) == ("friction.time_drift", -0.1, "0 (the plain-Python equations have no friction drift)")
+    assert unsupported(warm) == ("friction.time_drift", -0.1, "0 (the plain-Python equations lack the friction drift)")
