@@ -47,7 +47,7 @@ def test_diagnose_with_the_projects_controller_runs_to_the_end(own_csv, tmp_path
     path, _ = own_csv
     out = tmp_path / "diag"
     code = cli.main(["-q", "diagnose", str(path), "--train", "r0,r1", "--test", "r2,r3",
-                     "--uncertain", "table.seal_force", "--effects", "lead_error,stribeck",
+                     "--uncertain", "table.seal_force", "--effects", "lead_error,law_coulomb",
                      "--out", str(out), "--json", "--score", str(path)])
     assert code == 0
     result = json.loads(capsys.readouterr().out)
