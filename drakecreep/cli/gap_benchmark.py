@@ -2,9 +2,8 @@
 the product diagnosis of each controller kind (``diagnose_drake`` for p_p_cascade, ``diagnose_drive`` on a
 declared params file for drakecreep), scored on audit runs it never sees."""
 
-import sys
-
 import json
+import sys
 
 from drakecreep.cli._common import integer_in, names, print_json
 
@@ -69,8 +68,6 @@ ROWS = "rows.json"
 def _earlier_rows(out, settings):
     """The rows a run with the same ``settings`` left in ``out`` (none without a rows file); a folder holding a run
     of other settings, or a rows file that cannot be read, is refused naming ``--out``."""
-    import json
-
     from drakecreep.errors import InputError
     from drakecreep.files import read_input_text
 
