@@ -1,8 +1,8 @@
 """The ``drakecreep`` kind's candidates fitted only when named (``drive_fit.ON_REQUEST``) that change the model
 beyond a force: a friction map along the travel, a saturating drive, the nut's backlash, a structural mode on the
 table, a friction drift over each run. Each withheld from the params file of the quick rig's runs is found, fitted and
-claimed; on runs without any of them, all named at once, nothing is claimed (one diagnosis for the five nulls: until
-session 93 each case had its own, the same runs without the effect, a minute of the suite's CPU).
+claimed; on runs without any of them, all named at once, nothing is claimed (one diagnosis for the five nulls, each
+candidate beside the others; until session 93 each case had its own).
 
 Kept apart from ``test_drive_fit.py`` so that the two files, each minutes of diagnoses, run on different workers
 (``pytest -n auto --dist loadfile``)."""
