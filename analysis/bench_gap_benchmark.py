@@ -15,6 +15,10 @@ Run (about 2-4 min per dataset on one core)::
         --n-ool 3 --json heldout.json > heldout.txt 2> heldout.err &
     PYTHONPATH=. python analysis/bench_gap_benchmark.py --score heldout.json
     PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --resume heldout.json --json heldout2.json  # go on
+    # a drakecreep run that keeps each diagnosis's finished steps: killed in a dataset, it resumes inside it
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py --kinds drakecreep ... --checkpoints ckpt --json a.json
+    PYTHONPATH=. python analysis/bench_gap_benchmark.py --kinds drakecreep ... --checkpoints ckpt --resume a.json \
+        --json a2.json
     # two processes (or machines) sharing one run, scored together
     PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --shard 0/2 --json a.json &
     PYTHONPATH=. python analysis/bench_gap_benchmark.py ... --shard 1/2 --json b.json &
@@ -26,7 +30,7 @@ import json
 import time
 
 from drakecreep.cli._common import names
-from drakecreep.files import write_text
+from drakecreep.files import check_output_dir, write_text
 from drakecreep.errors import InputError
 from drakecreep.gap.benchmark import (BENCHMARK_KINDS, DEFAULT_KINDS, DEV_SEEDS, HELDOUT_SEEDS, benchmark_specs,
                                       check_effects, check_mass_spread, check_uncertain, run_benchmark, score_rows)
@@ -116,6 +120,10 @@ def main():
                          "0.15 (a workpiece left out or guessed; each row carries its mass_factor); default 0, exact")
     ap.add_argument("--resume", help="a JSON file of an interrupted run with the same settings: its datasets are "
                                      "not diagnosed again")
+    ap.add_argument("--checkpoints", metavar="DIR",
+                    help="a folder where each drakecreep dataset's diagnosis keeps its finished steps (nominal fit and "
+                         "null, each candidate) until its row is written: with --resume and the same folder, a "
+                         "dataset the run was killed in goes on where it was (same code only)")
     ap.add_argument("--skip-seeds", metavar="SEEDS", type=seed_list, default=(),
                     help="--seeds dev alone: datasets not to draw, comma-separated seeds or ranges (e.g. "
                          "114000-114003,104000): those an earlier study looked at; the next datasets take their place")
@@ -149,6 +157,8 @@ def main():
         check_uncertain(args.kinds, uncertain)
         check_effects(args.kinds, effects)
         check_mass_spread(args.mass_spread, args.kinds, "--mass-spread")
+        if args.checkpoints is not None:
+            check_output_dir(args.checkpoints, "--checkpoints")
     except InputError as err:
         ap.error(str(err))
     done = []
@@ -169,7 +179,8 @@ def main():
 
     res = run_benchmark(seed=seed, kinds=args.kinds, n_per_effect=args.n_per_effect, n_null=args.n_null, n_ool=args.n_ool,
                         progress=True, tries=args.tries, on_row=write, done=done, shard=shard, library=args.library,
-                        uncertain=uncertain, effects=effects, skip=args.skip_seeds, mass_spread=args.mass_spread)
+                        uncertain=uncertain, effects=effects, skip=args.skip_seeds, mass_spread=args.mass_spread,
+                        checkpoints=args.checkpoints)
     s = res["scores"]
     print(f"{s['n_datasets']} datasets diagnosed, {args.seeds} seeds from {seed}, {', '.join(args.kinds)}, "
           f"{time.perf_counter() - t0:.0f} s; candidates skipped for SNR < 3: {res['low_snr_skipped']}; "

@@ -134,6 +134,8 @@ def test_gap_benchmark_rows_files_are_checked_and_a_resumed_shard_is_scored_once
     ("bench_gap_benchmark.py", ("--mass-spread", "0.15"), "--mass-spread: got 0.15; allowed: 0 unless kinds"),
     ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--mass-spread", "0.7"), "--mass-spread: got 0.7"),
     ("bench_gap_benchmark.py", ("--seeds", "dev", "--skip-seeds", "114003-114000"), "'114003-114000': seeds >= 0"),
+    ("bench_gap_benchmark.py", ("--kinds", "drakecreep", "--checkpoints", "/dev/null/steps"),
+     "--checkpoints: got '/dev/null/steps'; allowed: a folder"),
 ])
 def test_diagnosis_benches_refuse_bad_options_before_any_work(tmp_path, monkeypatch, capsys, script, args, field):
     code, out, err = _in_process(script, args, monkeypatch, capsys, tmp_path)

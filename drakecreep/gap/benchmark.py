@@ -55,11 +55,13 @@ import dataclasses
 import math
 import sys
 import time
+from pathlib import Path
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from drakecreep.errors import InputError
+from drakecreep.files import check_output_dir
 from drakecreep.gap import truth as T
 from drakecreep.gap.drake_replay import rms_force_error
 from drakecreep.gap.screen import NOT_SCREENED, SLOW_SHARE
@@ -646,11 +648,12 @@ def _audit_fields(a, claimed):
                           and a["claimed"]["energy"] > a["nominal"]["energy"])}
 
 
-def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None):
+def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None, checkpoint=None):
     """One benchmark row of a ``drakecreep`` dataset: ``diagnose_drive`` on the declared params file, its default
     uncertain fields (or ``uncertain``), then the audit runs replayed with the fitted params file (nominal), the
     augmented one, and the nominal with the truth's own values of its effect (:func:`true_drive_values`; not
-    fitted, unlike the ``p_p_cascade`` kind's true effect; not where the held-out runs oscillate)."""
+    fitted, unlike the ``p_p_cascade`` kind's true effect; not where the held-out runs oscillate). ``checkpoint``:
+    ``diagnose_drive``'s, a file where the diagnosis keeps its finished steps."""
     from drakecreep.gap.drake_replay import drake_replay_errors, replay_drakecreep
     from drakecreep.gap.drive_fit import DEFAULT_UNCERTAIN, _with, diagnose_drive
     from drakecreep.gap.residuals import oscillation_log_errors
@@ -659,7 +662,7 @@ def _evaluate_drive(ds, effects=None, progress=None, audit=True, uncertain=None)
     kw = {} if effects is None else {"effects": tuple(effects)}
     if uncertain is not None:
         kw["uncertain"] = tuple(uncertain)
-    res = diagnose_drive(ds.train, ds.test, progress=progress or False, **kw)
+    res = diagnose_drive(ds.train, ds.test, progress=progress or False, checkpoint=checkpoint, **kw)
     claimed = list(res.claimed)
     labels = list(res.nominal_test_errors)
     # each held-out run's force error [%] beside the nominal's (the same run order) and the run-to-run null, with
@@ -760,15 +763,18 @@ def _own_moves(ds, ranked):
     return None if moves is None else [[float(v) for v in m] for m in moves]
 
 
-def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto", uncertain=None):
+def evaluate(ds, effects=None, progress=None, audit=True, max_nfev=6, friction="auto", uncertain=None,
+             checkpoint=None):
     """Diagnose ``ds`` with its kind's product path and score the answer against the truth: one benchmark row.
 
     ``p_p_cascade``: ``diagnose_drake`` (``max_nfev``, ``friction`` are its settings); ``drakecreep``:
-    ``diagnose_drive`` with its defaults, or the fields ``uncertain`` (:func:`_evaluate_drive`).
+    ``diagnose_drive`` with its defaults, or the fields ``uncertain`` (:func:`_evaluate_drive`), keeping its
+    finished steps in the file ``checkpoint`` if given (a ``p_p_cascade`` diagnosis, minutes long, keeps none).
     """
     _check_kind(ds.kind)
     if ds.kind == "drakecreep":
-        return _evaluate_drive(ds, effects=effects, progress=progress, audit=audit, uncertain=uncertain)
+        return _evaluate_drive(ds, effects=effects, progress=progress, audit=audit, uncertain=uncertain,
+                               checkpoint=checkpoint)
     if uncertain is not None:
         raise InputError("uncertain", uncertain, "only for drakecreep-kind datasets (p_p_cascade fits its own axis)")
     t0 = time.perf_counter()
@@ -963,7 +969,7 @@ def check_uncertain(kinds, uncertain):
 
 def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_null=10, n_ool=6, n_no_candidate=None,
                   audit=True, progress=False, tries=4.0, n_samples=N_SAMPLES, chunk=24, effects=None, on_row=None,
-                  done=(), shard=(0, 1), library=None, uncertain=None, skip=(), mass_spread=0.0):
+                  done=(), shard=(0, 1), library=None, uncertain=None, skip=(), mass_spread=0.0, checkpoints=None):
     """Generate the datasets of :func:`benchmark_specs`, select them, diagnose each blind, score.
 
     Library effects: of the candidates (in seed order), the first ``n_per_effect`` with SNR >= 3 are
@@ -995,6 +1001,11 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     mass_spread : float
         The log-normal spread of the ``drakecreep`` kind's declared ``table.mass`` (:func:`generate_datasets`;
         default 0: the truth's mass); each row carries its ``mass_factor``.
+    checkpoints : str or Path, optional
+        A folder where each ``drakecreep`` dataset's diagnosis keeps its finished steps (``<seed>.pkl``,
+        ``diagnose_drive``'s ``checkpoint``) until its row is handed to ``on_row``: a run killed in a dataset and
+        resumed (``done``) with the same folder and code goes on from the last step that dataset finished, with
+        the row an uninterrupted run gives. A ``drakecreep`` dataset took up to 3 h on one core (docs 3ct).
 
     Returns
     -------
@@ -1010,6 +1021,8 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
     if (not isinstance(shard, tuple) or len(shard) != 2 or not all(isinstance(x, int) for x in shard)
             or not 0 <= shard[0] < shard[1]):
         raise InputError("shard", shard, "(i, n) with integers 0 <= i < n")
+    if checkpoints is not None:
+        checkpoints = check_output_dir(checkpoints, "checkpoints")
     say = (lambda line: print(f"[gap-benchmark] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None)
     skip = {int(x) for x in skip}
     # a skipped null or dataset outside the library is replaced by the next one of its kind (drawn beyond n_null,
@@ -1065,8 +1078,9 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
             continue
         t_ds = time.perf_counter()
         inner = (lambda line, t=t_ds: say(f"    {time.perf_counter() - t:5.0f} s  {line}")) if progress else None
+        steps = None if checkpoints is None else Path(checkpoints) / f"{ds.seed}.pkl"
         try:
-            row = evaluate(ds, effects=effects, audit=audit, progress=inner, uncertain=uncertain)
+            row = evaluate(ds, effects=effects, audit=audit, progress=inner, uncertain=uncertain, checkpoint=steps)
         except Exception as err:  # noqa: BLE001 - one failing dataset is reported, the benchmark goes on
             failed.append({"seed": ds.seed, "withheld": list(ds.withheld), "error": f"{type(err).__name__}: {err}"})
             say(f"{n}/{len(order)} seed {ds.seed}: FAILED {type(err).__name__}: {err}")
@@ -1078,6 +1092,8 @@ def run_benchmark(seed=HELDOUT_SEEDS, kinds=DEFAULT_KINDS, n_per_effect=10, n_nu
                if audit else "") + f" ({row['seconds']:.0f} s)")
         if on_row is not None:
             on_row(row, rows)
+        if steps is not None:  # the row is the caller's now (written by on_row)
+            steps.unlink(missing_ok=True)
     short = {f"{k}/{e}": len(kept.get((k, (e,)), [])) for k in kinds for e in T.LIBRARY_EFFECTS
              if category_of(k, (e,)) == "library" and len(kept.get((k, (e,)), [])) < n_per_effect}
     return {"scores": score_rows(rows), "datasets": rows, "failed": failed, "low_snr_skipped": skipped, "short": short}

@@ -14,7 +14,7 @@ compiled fast path) and the params file itself is identified and augmented, so t
 Signature (what the ``diagnose`` CLI calls for ``kind: drakecreep`` runs)::
 
     diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0,
-                   max_nfev=20, progress=False, workers=1) -> DriveDiagnosis
+                   max_nfev=20, progress=False, workers=1, on_stage=None, checkpoint=None) -> DriveDiagnosis
 
 Steps:
 
@@ -1852,7 +1852,7 @@ def _held_out_on_scale(name, values, train_gain, current_errors, errs, null, tra
 
 
 def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, load_case=0, max_nfev=20,
-                   progress=False, workers=1, on_stage=None):
+                   progress=False, workers=1, on_stage=None, checkpoint=None):
     """Identify and augment the run's params file on ``kind: drakecreep`` runs (see the module docstring).
 
     Parameters
@@ -1882,6 +1882,13 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         null (``params`` is the fitted params file, no candidate yet), ``"candidate"`` after each candidate's
         held-out replay, ``"claims"`` once the claims are decided, before the refit with them (``params``
         then holds the claimed effects on the nominal fit's values; its ``where`` is empty until the end).
+    checkpoint : str or Path, optional
+        A file that keeps the finished steps (the nominal fit with its run-to-run null, each candidate, the
+        result) as they end (:class:`drakecreep.gap.checkpoint.Checkpoint`): a call with the same runs, params,
+        fields, effects, ``load_case`` and ``max_nfev`` on the same package code resumes from them, so a diagnosis
+        stopped or killed loses only the step it was in. The result is the one an uninterrupted call returns
+        (``seconds`` adds the earlier calls' time up to their last kept step). A file of other inputs or code is
+        not read, and is overwritten.
 
     Returns
     -------
@@ -1905,22 +1912,55 @@ def diagnose_drive(train, test, *, uncertain=DEFAULT_UNCERTAIN, effects=None, lo
         (lambda line: print(f"[diagnose] {line}", file=sys.stderr, flush=True)) if progress else (lambda line: None))
     if on_stage is not None and not callable(on_stage):
         raise InputError("on_stage", on_stage, "a callable or None")
+    if checkpoint is not None:
+        from drakecreep.gap.checkpoint import Checkpoint
+
+        checkpoint = Checkpoint(checkpoint, (train, test, prior, uncertain, names, load_case, max_nfev))
+        if "result" in checkpoint:
+            say(f"resumed from {checkpoint.path}: the whole diagnosis")
+            return checkpoint.get("result")
+        if checkpoint.resumed:
+            say(f"resumed from {checkpoint.path}: " + ", ".join(
+                step if isinstance(step, str) else step[1] for step in checkpoint.resumed))
     if workers == 1:
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, _Replayer(load_case),
-                               say, t0, on_stage)
+                               say, t0, on_stage, checkpoint)
     from drakecreep.processes import process_pool
 
     with process_pool(workers) as pool:  # a Ctrl-C or an error ends the workers at once
         return _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev,
-                               _Replayer(load_case, pool), say, t0, on_stage)
+                               _Replayer(load_case, pool), say, t0, on_stage, checkpoint)
 
 
-def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0, on_stage=None):
+def _nominal_step(train, test, prior, uncertain, max_nfev, replay, run_null):
+    """The nominal fit, its run-to-run null and its training replays: the diagnosis's first step, kept whole by a
+    checkpoint."""
     prior_errors = replay.errors(test, prior)
     params, fitted, warnings, sse0, fit = fit_drive(train, prior, uncertain, replay, max_nfev=max_nfev, details=True)
     nominal_sims = replay(test, params)
     nominal_errors = _errors_of(test, nominal_sims)
-    say(f"fitted {', '.join(uncertain) or 'nothing'} ({replay.count} replays)")
+    fit_replays = replay.count
+    null = _replay_null(train, test, fit, replay, nominal_errors) if run_null else (None, None, None, None)
+    return dict(prior_errors=prior_errors, params=params, fitted=fitted, warnings=warnings, sse0=sse0, fit=fit,
+                nominal_sims=nominal_sims, null=null, fit_replays=fit_replays,
+                base_sims=replay(train, params))
+
+
+def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, replay, say, t0, on_stage=None,
+                    checkpoint=None):
+    kept = {} if checkpoint is None else checkpoint.steps
+    if "nominal" in kept:  # replays and time up to it as if this call had made them
+        step, count, seconds = kept["nominal"]
+        replay._add(count)
+        t0 -= seconds
+    else:
+        step = _nominal_step(train, test, prior, uncertain, max_nfev, replay, bool(names))
+        if checkpoint is not None:
+            checkpoint.put("nominal", (step, replay.count, _time.perf_counter() - t0))
+    prior_errors, params, fitted, warnings, sse0, fit, nominal_sims = (
+        step[k] for k in ("prior_errors", "params", "fitted", "warnings", "sse0", "fit", "nominal_sims"))
+    nominal_errors = _errors_of(test, nominal_sims)
+    say(f"fitted {', '.join(uncertain) or 'nothing'} ({step['fit_replays']} replays)")
     shares = {r.label: saturated_share(r, prior) for r in (*train, *test)}
     saturated = {k: v for k, v in shares.items() if v >= SATURATED_SHARE}
     notes = () if not saturated else (
@@ -1934,8 +1974,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
         say("warning: " + mass)
         notes += (mass,)  # kept past the refit with the claimed effects, as the saturation's note is
     warnings = tuple(warnings) + notes
-    null, null_runs, transmission_null, null_runs_lowpass = (
-        _replay_null(train, test, fit, replay, nominal_errors) if names else (None, None, None, None))
+    null, null_runs, transmission_null, null_runs_lowpass = step["null"]
     kinematic = _on_scale(train) and _on_scale(test)
     if names:
         say("run-to-run null of the held-out replay: " + ("unavailable" if null is None else f"{100 * null:.2f} %")
@@ -1955,7 +1994,7 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                                           seconds=_time.perf_counter() - t0))
 
     stage("nominal")
-    base_sims = replay(train, params)
+    base_sims = step["base_sims"]
     oscillation = sustained_oscillation([r.force for r in train], [s.force for s in base_sims], train[0].dt)
     if oscillation is not None:
         say(f"the measured runs oscillate at {oscillation['freq_Hz']:.0f} Hz ({oscillation['runs']} of "
@@ -1984,6 +2023,8 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
     def finished(name, result, why, used):  # in this thread, as each candidate ends: say it, keep what is known
         nonlocal warnings
         done[name] = (result, why)
+        if checkpoint is not None and ("candidate", name) not in kept:
+            checkpoint.put(("candidate", name), (result, why, used))
         if why is not None:
             warnings = tuple(warnings) + (_failure_warning(name, why),)
             say(f"{name}: failed ({why})")
@@ -1998,7 +2039,11 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
                             max_nfev=max_nfev, oscillation=oscillation, uncertain=uncertain,
                             nominal_errors=nominal_errors, null=null, withheld=withheld,
                             transmission_null=transmission_null, kinematic=kinematic, prior=prior)
-    _fit_candidates(fit_now, replay, fit, finished)
+    for name in [n for n in fit_now if ("candidate", n) in kept]:  # a checkpoint's: as if fitted here
+        result, why, used = kept["candidate", name]
+        replay._add(used)
+        finished(name, result, why, used)
+    _fit_candidates([n for n in fit_now if n not in done], replay, fit, finished)
     # in the order asked for, whatever order they ended in (ties of the gain keep it; so do the failures' warnings)
     failures = [_failure_warning(name, done[name][1]) for name in names
                 if name in done and done[name][1] is not None]
@@ -2046,11 +2091,14 @@ def _diagnose_drive(train, test, prior, uncertain, names, load_case, max_nfev, r
             f"{replay.count} in all)")
     else:  # the final model's held-out replays: the nominal's, or those of the claims without a refit
         final_sims = nominal_sims if current is params else replay(test, current)
-    return DriveDiagnosis(**known, params=current, fitted=fitted, warnings=warnings, candidates=tuple(candidates),
-                          claimed=tuple(claimed), test_errors=current_errors, simulations=replay.count,
-                          seconds=_time.perf_counter() - t0, oscillation=oscillation,
-                          where=locate(test, final_sims, lead=prior.screw.lead),
-                          residuals=_residual_traces(test[0], nominal_sims[0], final_sims[0]))
+    result = DriveDiagnosis(**known, params=current, fitted=fitted, warnings=warnings, candidates=tuple(candidates),
+                            claimed=tuple(claimed), test_errors=current_errors, simulations=replay.count,
+                            seconds=_time.perf_counter() - t0, oscillation=oscillation,
+                            where=locate(test, final_sims, lead=prior.screw.lead),
+                            residuals=_residual_traces(test[0], nominal_sims[0], final_sims[0]))
+    if checkpoint is not None:
+        checkpoint.put("result", result)
+    return result
 
 
 #: the reason of a candidate that found nothing to fit (listed, neither said nor staged on its own)

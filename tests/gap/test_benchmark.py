@@ -391,6 +391,48 @@ def test_a_resumed_run_keeps_the_earlier_rows_and_diagnoses_only_the_rest(monkey
     assert again["datasets"][0]["marker"] == "earlier"
 
 
+def test_each_drakecreep_diagnosis_keeps_its_steps_in_the_checkpoint_folder_until_its_row_is_written(
+        monkeypatch, tmp_path):
+    """``checkpoints``: each dataset's diagnosis gets ``<folder>/<seed>.pkl`` (``diagnose_drive``'s checkpoint,
+    tests/gap/test_checkpoint.py), removed once ``on_row`` has the row; a file in the folder's place is refused
+    before any dataset is generated."""
+    from types import SimpleNamespace
+
+    from drakecreep.gap import benchmark, drive_fit
+
+    folder, given, present = tmp_path / "ckpt", [], []
+
+    def fake_evaluate(ds, **kw):
+        given.append(kw["checkpoint"])
+        kw["checkpoint"].write_bytes(b"steps")
+        return {"seed": ds.seed, "withheld": [], "claimed": [], "seconds": 0.0}
+
+    monkeypatch.setattr(benchmark, "evaluate", fake_evaluate)
+    monkeypatch.setattr(benchmark, "score_rows", lambda rows: {"n_datasets": len(rows)})
+    kw = dict(seed=DEV_SEEDS, kinds=("drakecreep",), n_per_effect=0, n_null=2, n_ool=0, n_no_candidate=0,
+              audit=False, n_samples=300)
+    rows = run_benchmark(checkpoints=folder, on_row=lambda row, rows: present.append(
+        (folder / f"{row['seed']}.pkl").exists()), **kw)["datasets"]
+    assert given == [folder / f"{r['seed']}.pkl" for r in rows] and present == [True, True]
+    assert list(folder.iterdir()) == []
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="checkpoints"):
+        run_benchmark(checkpoints=tmp_path / "file", **kw)
+    monkeypatch.undo()
+
+    class Stop(Exception):
+        pass
+
+    def fake(train, test, **kwargs):
+        given.append(kwargs["checkpoint"])
+        raise Stop
+
+    monkeypatch.setattr(drive_fit, "diagnose_drive", fake)
+    with pytest.raises(Stop):
+        benchmark.evaluate(SimpleNamespace(kind="drakecreep", train=[], test=[]), checkpoint=folder / "1.pkl")
+    assert given[-1] == folder / "1.pkl"
+
+
 def test_skipped_seeds_are_neither_generated_nor_diagnosed(monkeypatch):
     """A development study's fresh datasets: the seeds an earlier study looked at are left out, a library
     effect's next dataset with SNR >= 3 takes a skipped one's place, and the next null a skipped null's."""
