@@ -631,3 +631,31 @@ def test_delay_signature_counts_the_runs_that_agree_and_are_helped(tmp_path, mon
     assert code == 0 and len(out.splitlines()) == 2
     _refused_in_one_line("delay_signature.py", (([str(tmp_path / "no.json")], "ROWS.json"),), monkeypatch, capsys,
                          tmp_path)
+
+
+def test_single_run_oscillation_study_refuses_bad_datasets_and_reads_the_on_off_pattern(tmp_path, monkeypatch, capsys):
+    """``analysis/single_run_oscillation.py`` (docs 3db): a malformed dataset, a held-out seed, an unwritable rows
+    file and a checkpoint folder that is a file exit 2 in one line before any dataset is generated; its pattern reads
+    which runs oscillate, and its rule asks for the exact on/off pattern with a held-out run oscillating."""
+    (tmp_path / "file").write_text("")
+    cases = ((["o.json", "9073:nothing:flexible"], "nothing"),
+             (["o.json", f"{HELD_OUT}:control_delay:flexible"], str(HELD_OUT)),
+             (["/proc/o.json", "9073:control_delay:flexible"], "OUT.json"),
+             (["o.json", "9073:control_delay:flexible", "--checkpoints", str(tmp_path / "file")], "--checkpoints"))
+    _refused_in_one_line("single_run_oscillation.py", cases, monkeypatch, capsys, tmp_path)
+    study = _script_module("single_run_oscillation.py")
+    dt, t = 1e-3, np.arange(1000) * 1e-3
+    rng = np.random.default_rng(0)
+    quiet = rng.normal(0.0, 1.0, t.size)
+    at = lambda f: 30.0 * np.sin(2 * np.pi * f * t) + quiet  # noqa: E731
+    got = study.pattern([at(200.0), quiet, at(200.0)], [at(205.0), at(200.0), at(300.0)], dt, fallback_hz=200.0)
+    assert [g["measured"] for g in got] == [True, False, True]
+    # within 15 % of the measured 200 Hz; on a quiet run at the fallback frequency; 300 Hz is not 200 Hz
+    assert [g["model"] for g in got] == [True, True, False]
+    assert abs(got[0]["measured_hz"] - 200.0) < 5.0 and abs(got[2]["model_hz"] - 300.0) < 5.0
+    held = [{"measured": m, "model": s} for m, s in ((True, True), (False, False), (False, False))]
+    assert study.rule([True, False], [True, False], held) == (True, "the on/off pattern of every run matches")
+    assert not study.rule([True, False], [True, True], held)[0]
+    assert not study.rule([True, False], [True, False], [dict(h, model=True) for h in held])[0]
+    assert study.rule([True, False], [True, False], [dict(h, measured=False, model=False) for h in held]) == \
+        (False, "no held-out run oscillates")
