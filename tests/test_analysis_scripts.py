@@ -635,13 +635,15 @@ def test_delay_signature_counts_the_runs_that_agree_and_are_helped(tmp_path, mon
 
 def test_single_run_oscillation_study_refuses_bad_datasets_and_reads_the_on_off_pattern(tmp_path, monkeypatch, capsys):
     """``analysis/single_run_oscillation.py`` (docs 3db): a malformed dataset, a held-out seed, an unwritable rows
-    file and a checkpoint folder that is a file exit 2 in one line before any dataset is generated; its pattern reads
-    which runs oscillate, and its rule asks for the exact on/off pattern with a held-out run oscillating."""
+    file, a checkpoint folder that is a file and a --max-nfev out of range exit 2 in one line before any dataset is
+    generated; its pattern reads which runs oscillate, and its rule asks for the exact on/off pattern with a held-out
+    run oscillating."""
     (tmp_path / "file").write_text("")
     cases = ((["o.json", "9073:nothing:flexible"], "nothing"),
              (["o.json", f"{HELD_OUT}:control_delay:flexible"], str(HELD_OUT)),
              (["/proc/o.json", "9073:control_delay:flexible"], "OUT.json"),
-             (["o.json", "9073:control_delay:flexible", "--checkpoints", str(tmp_path / "file")], "--checkpoints"))
+             (["o.json", "9073:control_delay:flexible", "--checkpoints", str(tmp_path / "file")], "--checkpoints"),
+             (["o.json", "9073:control_delay:flexible", "--max-nfev", "0"], "--max-nfev"))
     _refused_in_one_line("single_run_oscillation.py", cases, monkeypatch, capsys, tmp_path)
     study = _script_module("single_run_oscillation.py")
     dt, t = 1e-3, np.arange(1000) * 1e-3
