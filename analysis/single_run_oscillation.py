@@ -47,7 +47,7 @@ from drakecreep.files import check_output_file, write_text
 from drakecreep.gap import benchmark as B
 from study_cli import dev_spec
 
-__all__ = ["pattern", "study_dataset", "main"]
+__all__ = ["pattern", "rule", "study_dataset", "summary", "main"]
 
 
 def pattern(measured, model, dt, fallback_hz):
@@ -143,6 +143,8 @@ def summary(row):
 
 
 def main(argv=None):
+    """Parse ``argv``, study each dataset and print its line; the exit status (2 on a bad argument, 1 when a dataset
+    failed)."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out", metavar="OUT.json", help="rows file, rewritten after each dataset")
     ap.add_argument("datasets", nargs="+", type=dev_spec, metavar="SEED:WITHHELD:AXIS",
