@@ -40,8 +40,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from drakecreep.errors import InputError
 from drakecreep.files import check_output_file, write_text
 from drakecreep.gap import benchmark as B
@@ -172,12 +170,8 @@ def main(argv=None):
         else:
             rows.append(row)
             print(summary(row) + f" ({row['seconds']:.0f} s)", flush=True)
-        write_text(a.out, json.dumps({"datasets": rows, "failed": failed}, indent=1, default=_plain))
+        write_text(a.out, json.dumps({"datasets": rows, "failed": failed}, indent=1, default=str))
     return 1 if failed else 0
-
-
-def _plain(x):
-    return x.tolist() if isinstance(x, np.ndarray) else float(x) if isinstance(x, np.generic) else str(x)
 
 
 if __name__ == "__main__":
